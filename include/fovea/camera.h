@@ -1,0 +1,70 @@
+/* fovea — pinhole camera, stereo pairs and keyframed camera paths.
+ *
+ * Screen convention used everywhere in fovea: pixel (0,0) is the top-left corner, x grows right,
+ * y grows down; normalised screen coordinates are (x + 0.5)/width, (y + 0.5)/height in [0,1].
+ */
+#ifndef FOVEA_CAMERA_H
+#define FOVEA_CAMERA_H
+
+#include "fovea/math.h"
+#include "fovea/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct fv_camera {
+    fv_vec3 pos;    /* eye position */
+    fv_vec3 look;   /* a point the camera looks at */
+    fv_vec3 up;     /* up hint, need not be orthogonal to the view direction */
+    float fov_y;    /* vertical field of view in degrees, (0, 180) */
+    int width, height;
+} fv_camera;
+
+/* Derived, per-frame constant data for generating rays and projecting points. */
+typedef struct fv_camera_basis {
+    fv_vec3 pos, right, up, forward; /* orthonormal; right-handed with forward = -z in view space */
+    float tan_half_y, tan_half_x;
+    int width, height;
+} fv_camera_basis;
+
+/* Checks fields (finite vectors, look != pos, up not parallel to view, fov in (0,180), sizes > 0)
+ * and builds the basis. */
+fv_status fv_camera_basis_make(const fv_camera *cam, fv_camera_basis *out, fv_error *err);
+
+/* Direction (unit) of the ray through film position (px, py) in pixels, e.g. (x + 0.5, y + 0.5). */
+static inline fv_vec3 fv_camera_dir(const fv_camera_basis *b, float px, float py)
+{
+    float sx = (2.0f * px / (float)b->width - 1.0f) * b->tan_half_x;
+    float sy = (1.0f - 2.0f * py / (float)b->height) * b->tan_half_y;
+    return fv_normalize(fv_add(b->forward, fv_add(fv_scale(b->right, sx), fv_scale(b->up, sy))));
+}
+
+/* Projects a world point to film coordinates in pixels; false when behind the camera.
+ * Inverse of fv_camera_dir: used by reprojection between two cameras. */
+bool fv_camera_project(const fv_camera_basis *b, fv_vec3 p, float *px, float *py);
+
+/* Left and right eye cameras of a stereo pair: each offset by half of eye_sep along the camera's
+ * right vector, looking in parallel (look point offset by the same amount). */
+void fv_camera_stereo(const fv_camera *center, float eye_sep, fv_camera *left, fv_camera *right);
+
+/* A keyframed camera path: position, look-at point and fov interpolated linearly in time;
+ * times strictly increasing. Before the first / after the last key the end key holds. */
+typedef struct fv_camera_key {
+    double time;
+    fv_vec3 pos, look, up;
+    float fov_y;
+} fv_camera_key;
+
+typedef struct fv_camera_path {
+    fv_camera_key *keys; /* owned by whoever filled the struct */
+    int count;
+} fv_camera_path;
+
+/* Camera at time t along path (count >= 1); width/height are taken from base. */
+void fv_camera_path_eval(const fv_camera_path *path, double t, const fv_camera *base, fv_camera *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,83 @@
+/* fovea — the film: linear float RGB plus auxiliary buffers shared by all techniques, and image
+ * files (PNG tone-mapped sRGB, PFM linear, EXR linear with auxiliary channels).
+ *
+ * A film is created with the auxiliary buffers asked for; the colour buffer always exists.
+ * Buffers are row-major from the top-left pixel. Writes go to a temporary file in the target's
+ * directory and are renamed into place, so a failed or interrupted write leaves nothing behind.
+ */
+#ifndef FOVEA_FILM_H
+#define FOVEA_FILM_H
+
+#include <stdint.h>
+#include "fovea/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Largest accepted width or height, and pixel count: sizes are refused before allocating. */
+#define FV_FILM_MAX_DIM 16384
+#define FV_FILM_MAX_PIXELS (8192LL * 8192LL)
+
+typedef enum fv_film_aux {
+    FV_AUX_DEPTH = 1 << 0,    /* 1 float: distance along the primary ray, +inf for no hit */
+    FV_AUX_NORMAL = 1 << 1,   /* 3 floats: world shading normal at the first hit */
+    FV_AUX_ALBEDO = 1 << 2,   /* 3 floats: first-hit reflectance */
+    FV_AUX_ID = 1 << 3,       /* 1 uint32: object id + 1 at the first hit, 0 for none */
+    FV_AUX_POSITION = 1 << 4, /* 3 floats: world position at the first hit */
+    FV_AUX_ALL = 0x1f
+} fv_film_aux;
+
+typedef struct fv_film fv_film;
+
+/* Checks the size (1..FV_FILM_MAX_DIM each, at most FV_FILM_MAX_PIXELS) before allocating. */
+fv_status fv_film_check_size(int width, int height, fv_error *err);
+fv_status fv_film_create(int width, int height, unsigned aux, fv_film **out, fv_error *err);
+void fv_film_destroy(fv_film *film);
+/* Zeroes colour, sets depth to +inf, ids to 0. */
+void fv_film_clear(fv_film *film);
+
+int fv_film_width(const fv_film *film);
+int fv_film_height(const fv_film *film);
+unsigned fv_film_aux_flags(const fv_film *film);
+float *fv_film_color(fv_film *film);          /* 3 floats per pixel */
+const float *fv_film_color_const(const fv_film *film);
+float *fv_film_depth(fv_film *film);          /* NULL when not requested */
+float *fv_film_normal(fv_film *film);
+float *fv_film_albedo(fv_film *film);
+float *fv_film_position(fv_film *film);
+uint32_t *fv_film_id(fv_film *film);
+
+/* ---- image files ---- */
+
+typedef enum fv_image_format { FV_IMG_UNKNOWN = 0, FV_IMG_PNG, FV_IMG_PFM, FV_IMG_EXR } fv_image_format;
+
+/* Format from the path's extension (case-insensitive); FV_IMG_UNKNOWN when not recognised. */
+fv_image_format fv_image_format_from_path(const char *path);
+
+/* Writes linear RGB (3 floats per pixel). PNG: multiplied by `exposure`, clamped to [0,1],
+ * sRGB-encoded, 8 bits. PFM: exact floats. EXR: half-free 32-bit float R,G,B. */
+fv_status fv_image_write(const char *path, const float *rgb, int width, int height, float exposure,
+                         fv_error *err);
+/* Writes the film: PNG/PFM get the colour; EXR gets colour plus every auxiliary buffer as named
+ * channels (depth Z, normal N.x/N.y/N.z, albedo albedo.R/G/B, position P.x/P.y/P.z, id). */
+fv_status fv_film_write(const fv_film *film, const char *path, float exposure, fv_error *err);
+
+/* A loaded image: linear RGB floats (PNG is decoded from sRGB). Free with fv_image_free. */
+typedef struct fv_image {
+    int width, height;
+    float *rgb;
+} fv_image;
+
+/* Reads PNG, PFM or EXR (RGB channels). Errors name the file and what is wrong with it. */
+fv_status fv_image_read(const char *path, fv_image *out, fv_error *err);
+void fv_image_free(fv_image *img);
+
+/* The sRGB transfer function and its inverse, on one channel. */
+float fv_srgb_encode(float linear);
+float fv_srgb_decode(float encoded);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,18 @@
+/* fovea — umbrella header of libfovea. */
+#ifndef FOVEA_H
+#define FOVEA_H
+
+#define FOVEA_VERSION_MAJOR 0
+#define FOVEA_VERSION_MINOR 1
+#define FOVEA_VERSION_PATCH 0
+#define FOVEA_VERSION_STRING "0.1.0"
+
+#include "fovea/status.h"
+#include "fovea/math.h"
+#include "fovea/camera.h"
+#include "fovea/gaze.h"
+#include "fovea/scene.h"
+#include "fovea/film.h"
+#include "fovea/technique.h"
+
+#endif

@@ -1,0 +1,152 @@
+/* fovea — the scene: triangle meshes (static or rigidly animated), materials, lights, and the
+ * camera/view data a scene file may carry.
+ *
+ * Ownership: fv_scene_create returns a scene the caller destroys with fv_scene_destroy. Every
+ * fv_scene_add_* call copies what it is given. After fv_scene_commit the geometry is frozen; only
+ * the time (fv_scene_set_time, which moves dynamic objects) changes. Area lights are emissive
+ * triangles: any triangle whose material has non-zero emission.
+ */
+#ifndef FOVEA_SCENE_H
+#define FOVEA_SCENE_H
+
+#include <stdint.h>
+#include "fovea/camera.h"
+#include "fovea/gaze.h"
+#include "fovea/math.h"
+#include "fovea/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct fv_scene fv_scene;
+
+typedef enum fv_material_type {
+    FV_MAT_DIFFUSE = 0, /* Lambert: albedo */
+    FV_MAT_MIRROR,      /* perfect specular reflection tinted by `specular` */
+    FV_MAT_GLOSSY,      /* Lambert `albedo` + GGX microfacet lobe (`specular` = F0, `roughness` = alpha) */
+    FV_MAT_DIELECTRIC   /* smooth glass: Fresnel reflection + refraction with index `ior`, tint `specular` */
+} fv_material_type;
+
+#define FV_NAME_MAX 64
+
+typedef struct fv_material {
+    char name[FV_NAME_MAX];
+    fv_material_type type;
+    fv_vec3 albedo;    /* diffuse reflectance, each channel in [0,1] */
+    fv_vec3 specular;  /* specular reflectance / transmission tint, each channel in [0,1] */
+    float roughness;   /* GGX alpha in [0.001, 1] (GLOSSY only) */
+    float ior;         /* index of refraction > 1 inside the object (DIELECTRIC only) */
+    fv_vec3 emission;  /* emitted radiance (W/m^2/sr), on the side the triangle's normal faces */
+    bool two_sided_emission;
+} fv_material;
+
+/* A default material of the given type (grey diffuse, white mirror, ...), to be adjusted. */
+fv_material fv_material_default(fv_material_type type);
+/* Checks ranges and finiteness; the message names the material and field. */
+fv_status fv_material_validate(const fv_material *m, fv_error *err);
+/* "diffuse" | "mirror" | "glossy" | "dielectric" <-> type; false when unknown. */
+bool fv_material_type_from_name(const char *name, fv_material_type *out);
+const char *fv_material_type_name(fv_material_type type);
+
+typedef enum fv_light_type { FV_LIGHT_POINT = 0, FV_LIGHT_SPOT } fv_light_type;
+
+/* Delta lights. Area lights are emissive triangles (see fv_material.emission). */
+typedef struct fv_light_desc {
+    fv_light_type type;
+    fv_vec3 pos;
+    fv_vec3 dir;         /* SPOT: axis the light points along */
+    fv_vec3 intensity;   /* radiant intensity, W/sr */
+    float inner_deg;     /* SPOT: full intensity inside this half-angle */
+    float outer_deg;     /* SPOT: zero outside this half-angle, smooth in between */
+} fv_light_desc;
+
+typedef struct fv_mesh_desc {
+    const char *name;
+    const fv_vec3 *positions;
+    int vertex_count;
+    const fv_vec3 *normals;      /* optional per-vertex shading normals (NULL: flat shading) */
+    const uint32_t *indices;     /* 3 per triangle */
+    int triangle_count;
+    const int *materials;        /* optional per-triangle material ids (NULL: all `material`) */
+    int material;
+} fv_mesh_desc;
+
+/* One key of a rigid animation: scale first, then rotation, then translation. */
+typedef struct fv_anim_key {
+    double time;
+    fv_vec3 translate;
+    fv_quat rotate;
+    fv_vec3 scale;
+} fv_anim_key;
+
+fv_status fv_scene_create(fv_scene **out, fv_error *err);
+void fv_scene_destroy(fv_scene *scene);
+
+/* Returns the new material's id in *id. */
+fv_status fv_scene_add_material(fv_scene *scene, const fv_material *m, int *id, fv_error *err);
+/* Looks a material up by name; -1 when absent. */
+int fv_scene_find_material(const fv_scene *scene, const char *name);
+
+/* Adds a triangle mesh as one object (static until fv_scene_animate_object makes it dynamic).
+ * Triangles with a non-finite vertex, an index out of range or zero area are dropped, with one
+ * warning per mesh through log; a mesh left empty is refused. *object_id may be NULL. */
+fv_status fv_scene_add_mesh(fv_scene *scene, const fv_mesh_desc *mesh, const fv_log *log,
+                            int *object_id, fv_error *err);
+
+/* Makes an object dynamic, moved rigidly along keys (times strictly increasing; translation lerp,
+ * rotation slerp, scale lerp). A dynamic object may not be emissive. */
+fv_status fv_scene_animate_object(fv_scene *scene, int object_id, const fv_anim_key *keys, int count,
+                                  fv_error *err);
+
+fv_status fv_scene_add_light(fv_scene *scene, const fv_light_desc *light, fv_error *err);
+
+/* Optional data a scene file carries for the view. */
+void fv_scene_set_camera(fv_scene *scene, const fv_camera *camera);
+/* Copies path (count >= 1). */
+fv_status fv_scene_set_camera_path(fv_scene *scene, const fv_camera_key *keys, int count, fv_error *err);
+
+/* Validates the scene and builds the acceleration structures. A scene without any triangle is
+ * refused; a scene without any light gets a default point light (a warning says so); a scene
+ * without camera gets one framing its bounds. */
+fv_status fv_scene_commit(fv_scene *scene, const fv_log *log, fv_error *err);
+
+/* Moves dynamic objects to time t (seconds) and refits only what moved. */
+fv_status fv_scene_set_time(fv_scene *scene, double t, fv_error *err);
+double fv_scene_time(const fv_scene *scene);
+
+/* Queries. */
+void fv_scene_bounds(const fv_scene *scene, fv_vec3 *lo, fv_vec3 *hi);
+int fv_scene_triangle_count(const fv_scene *scene);
+int fv_scene_object_count(const fv_scene *scene);
+int fv_scene_dynamic_object_count(const fv_scene *scene);
+int fv_scene_light_count(const fv_scene *scene);       /* delta lights + emissive triangles */
+int fv_scene_material_count(const fv_scene *scene);
+const fv_material *fv_scene_material(const fv_scene *scene, int id);
+/* The scene's camera (set, or framed at commit) with the given size. At time t along the
+ * camera path when the scene has one. */
+void fv_scene_camera(const fv_scene *scene, double t, int width, int height, fv_camera *out);
+bool fv_scene_has_camera_path(const fv_scene *scene);
+
+/* ---- loading ---- */
+
+/* Loads SCENE, a built-in name (see fv_builtin_*) or a file path: .json (fovea scene format,
+ * docs/scene-format.md) or any mesh file assimp reads (.obj, .gltf, .glb, .ply, ...). The scene
+ * is committed. Errors name the file (and line or field) at fault. */
+fv_status fv_scene_load(const char *name_or_path, const fv_log *log, fv_scene **out, fv_error *err);
+
+/* Like fv_scene_load but leaves the scene uncommitted, so the caller can still add lights,
+ * materials or meshes (the CLI's --point-light) before fv_scene_commit. */
+fv_status fv_scene_open(const char *name_or_path, const fv_log *log, fv_scene **out, fv_error *err);
+
+/* Built-in scenes: they need no file. */
+int fv_builtin_count(void);
+const char *fv_builtin_name(int i);
+const char *fv_builtin_summary(int i);
+/* Builds (uncommitted) built-in scene `name` into an empty scene; FV_ERR_INVALID if unknown. */
+fv_status fv_builtin_build(const char *name, fv_scene *scene, const fv_log *log, fv_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,49 @@
+/* fovea — tile loop and parallel-for over OpenMP (see parallel.h). */
+#include <omp.h>
+#include "core/parallel.h"
+
+int fv_thread_count(int requested)
+{
+    int n = requested > 0 ? requested : omp_get_max_threads();
+    if (n < 1) n = 1;
+    if (n > FV_MAX_THREADS) n = FV_MAX_THREADS;
+    return n;
+}
+
+void fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *ctx,
+                       fv_progress_fn progress, void *progress_user)
+{
+    const int tx = (width + FV_TILE_SIZE - 1) / FV_TILE_SIZE;
+    const int ty = (height + FV_TILE_SIZE - 1) / FV_TILE_SIZE;
+    const int ntiles = tx * ty;
+    const int nthreads = fv_thread_count(threads);
+    int done = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+    for (int i = 0; i < ntiles; i++) {
+        fv_tile t;
+        t.x0 = (i % tx) * FV_TILE_SIZE;
+        t.y0 = (i / tx) * FV_TILE_SIZE;
+        t.x1 = t.x0 + FV_TILE_SIZE < width ? t.x0 + FV_TILE_SIZE : width;
+        t.y1 = t.y0 + FV_TILE_SIZE < height ? t.y0 + FV_TILE_SIZE : height;
+        t.thread = omp_get_thread_num();
+        fn(ctx, &t);
+        int d;
+#pragma omp atomic capture
+        d = ++done;
+        /* Only thread 0 reports, so the callback never runs concurrently with itself. */
+        if (progress && t.thread == 0) progress(progress_user, (double)d / ntiles);
+    }
+    if (progress) progress(progress_user, 1.0);
+}
+
+void fv_parallel_for(int64_t n, int64_t chunk, int threads, fv_range_fn fn, void *ctx)
+{
+    if (chunk < 1) chunk = 1;
+    const int64_t nchunks = (n + chunk - 1) / chunk;
+    const int nthreads = fv_thread_count(threads);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+    for (int64_t c = 0; c < nchunks; c++) {
+        int64_t b = c * chunk, e = b + chunk < n ? b + chunk : n;
+        fn(ctx, b, e, omp_get_thread_num());
+    }
+}

@@ -1,0 +1,52 @@
+/* fovea — counter-based random numbers.
+ *
+ * A stream is a 64-bit key hashed from (seed, pixel, sample, frame) plus a dimension counter;
+ * each draw hashes (key, dimension). No state is shared between pixels, so an image does not
+ * depend on the thread count or tile order, and any single sample can be replayed alone.
+ */
+#ifndef FV_CORE_RNG_H
+#define FV_CORE_RNG_H
+
+#include <stdint.h>
+
+typedef struct fv_rng {
+    uint64_t key;
+    uint32_t dim;
+} fv_rng;
+
+/* A strong 64-bit finaliser (the splitmix64 / murmur3 style xor-shift-multiply cascade). */
+static inline uint64_t fv_hash64(uint64_t x)
+{
+    x ^= x >> 30;
+    x *= 0xbf58476d1ce4e5b9ULL;
+    x ^= x >> 27;
+    x *= 0x94d049bb133111ebULL;
+    x ^= x >> 31;
+    return x;
+}
+
+static inline uint64_t fv_hash_combine(uint64_t h, uint64_t v)
+{
+    return fv_hash64(h ^ (v + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2)));
+}
+
+static inline fv_rng fv_rng_make(uint64_t seed, uint64_t pixel, uint64_t sample, uint64_t frame)
+{
+    fv_rng r;
+    r.key = fv_hash_combine(fv_hash_combine(fv_hash_combine(fv_hash64(seed), pixel), sample), frame);
+    r.dim = 0;
+    return r;
+}
+
+static inline uint32_t fv_rng_u32(fv_rng *r)
+{
+    return (uint32_t)(fv_hash64(r->key + 0x632be59bd9b4e019ULL * (uint64_t)(++r->dim)) >> 32);
+}
+
+/* Uniform float in [0, 1): 24 random mantissa bits. */
+static inline float fv_rng_next(fv_rng *r)
+{
+    return (float)(fv_rng_u32(r) >> 8) * (1.0f / 16777216.0f);
+}
+
+#endif

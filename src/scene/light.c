@@ -1,0 +1,141 @@
+/* fovea — light sampling (see light.h). Spot lights fall off smoothly (smoothstep in cos) between
+ * the inner and outer cone; point lights are isotropic. */
+#include "scene/light.h"
+#include "scene/bsdf.h"
+
+static int pick_light(const fv_scene *s, float u, float *pmf)
+{
+    int lo = 0, hi = s->nlights - 1;
+    while (lo < hi) { /* first i with cdf[i+1] > u */
+        int mid = (lo + hi) / 2;
+        if (s->light_cdf[mid + 1] <= u) lo = mid + 1;
+        else hi = mid;
+    }
+    *pmf = s->light_cdf[lo + 1] - s->light_cdf[lo];
+    return lo;
+}
+
+static float spot_falloff(const fv_light_desc *d, fv_vec3 w_out)
+{
+    float c = fv_dot(w_out, d->dir);
+    float ci = cosf(fv_radians(d->inner_deg)), co = cosf(fv_radians(d->outer_deg));
+    if (c >= ci) return 1.0f;
+    if (c <= co) return 0.0f;
+    float t = (c - co) / (ci - co);
+    return t * t * (3.0f - 2.0f * t);
+}
+
+static fv_vec3 sample_triangle(const fv_scene *s, const fv_light *l, float u0, float u1)
+{
+    fv_vec3 a, b, c;
+    fv_scene_triangle(s, l->obj, l->prim, &a, &b, &c);
+    float su = sqrtf(u0);
+    float ba = 1.0f - su, bb = u1 * su;
+    return fv_add(fv_add(fv_scale(a, ba), fv_scale(b, bb)), fv_scale(c, 1.0f - ba - bb));
+}
+
+fv_vec3 fv_light_emitted(const fv_scene *s, const fv_material *m, fv_vec3 ng, fv_vec3 w)
+{
+    (void)s;
+    float c = fv_dot(ng, w);
+    if (c > 0.0f || (m->two_sided_emission && c < 0.0f)) return m->emission;
+    return fv_v3s(0.0f);
+}
+
+bool fv_light_sample_li(const fv_scene *s, fv_vec3 p, float u0, float u1, float u2, fv_light_sample *out)
+{
+    if (s->nlights == 0) return false;
+    float pmf;
+    const fv_light *l = &s->lights[pick_light(s, u0, &pmf)];
+    if (!(pmf > 0.0f)) return false;
+    if (l->kind == 0) {
+        fv_vec3 d = fv_sub(l->desc.pos, p);
+        float d2 = fv_dot(d, d);
+        if (!(d2 > 0.0f)) return false;
+        out->dist = sqrtf(d2);
+        out->wi = fv_scale(d, 1.0f / out->dist);
+        float fall = l->desc.type == FV_LIGHT_SPOT ? spot_falloff(&l->desc, fv_neg(out->wi)) : 1.0f;
+        if (fall <= 0.0f) return false;
+        out->li = fv_scale(l->desc.intensity, fall / d2);
+        out->pdf = pmf;
+        out->delta = true;
+        return true;
+    }
+    fv_vec3 q = sample_triangle(s, l, u1, u2);
+    fv_vec3 d = fv_sub(q, p);
+    float d2 = fv_dot(d, d);
+    if (!(d2 > 0.0f)) return false;
+    out->dist = sqrtf(d2);
+    out->wi = fv_scale(d, 1.0f / out->dist);
+    float cos_l = fv_dot(l->n, out->wi); /* emitter faces p when negative */
+    if (!(cos_l < 0.0f || (l->two_sided && cos_l > 0.0f))) return false;
+    out->li = l->emission;
+    out->pdf = pmf * d2 / (fabsf(cos_l) * l->area);
+    out->delta = false;
+    return true;
+}
+
+float fv_light_pdf_li(const fv_scene *s, int obj, int prim, fv_vec3 p, fv_vec3 hit_p, fv_vec3 hit_ng, fv_vec3 w)
+{
+    if (!s->tri_light || !s->tri_light[obj]) return 0.0f;
+    int li = s->tri_light[obj][prim];
+    if (li < 0) return 0.0f;
+    const fv_light *l = &s->lights[li];
+    float pmf = s->light_cdf[li + 1] - s->light_cdf[li];
+    fv_vec3 d = fv_sub(hit_p, p);
+    float cos_l = fabsf(fv_dot(hit_ng, w));
+    if (!(cos_l > 0.0f)) return 0.0f;
+    return pmf * fv_dot(d, d) / (cos_l * l->area);
+}
+
+bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *origin, fv_vec3 *dir, fv_vec3 *power,
+                              fv_vec3 *normal)
+{
+    if (s->nlights == 0) return false;
+    float pmf;
+    const fv_light *l = &s->lights[pick_light(s, u[0], &pmf)];
+    if (!(pmf > 0.0f)) return false;
+    if (l->kind == 0) {
+        *origin = l->desc.pos;
+        *normal = fv_v3s(0.0f);
+        /* Uniform sphere direction: pdf 1/(4 pi), so power = I * 4 pi * falloff / pmf. */
+        float z = 1.0f - 2.0f * u[1], r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * FV_PI * u[2];
+        *dir = fv_v3(r * cosf(phi), r * sinf(phi), z);
+        float fall = l->desc.type == FV_LIGHT_SPOT ? spot_falloff(&l->desc, *dir) : 1.0f;
+        *power = fv_scale(l->desc.intensity, 4.0f * FV_PI * fall / pmf);
+        return fall > 0.0f;
+    }
+    *origin = sample_triangle(s, l, u[1], u[2]);
+    fv_vec3 n = l->n, t, b;
+    float side = 1.0f;
+    float uu = u[3];
+    if (l->two_sided) { /* pick a side, reuse the number */
+        side = uu < 0.5f ? 1.0f : -1.0f;
+        uu = uu < 0.5f ? 2.0f * uu : 2.0f * uu - 1.0f;
+    }
+    n = fv_scale(n, side);
+    fv_basis(n, &t, &b);
+    fv_vec3 w = fv_sample_cosine_hemisphere(uu, u[4]);
+    *dir = fv_from_local(w, t, b, n);
+    *normal = n;
+    /* L cos / (pmf * (1/A) * cos/pi * side prob) = L pi A / (pmf * side prob) */
+    *power = fv_scale(l->emission, FV_PI * l->area * (l->two_sided ? 2.0f : 1.0f) / pmf);
+    return true;
+}
+
+fv_vec3 fv_light_total_power(const fv_scene *s)
+{
+    fv_vec3 p = fv_v3s(0.0f);
+    for (int i = 0; i < s->nlights; i++) {
+        const fv_light *l = &s->lights[i];
+        if (l->kind == 1) {
+            p = fv_add(p, fv_scale(l->emission, FV_PI * l->area * (l->two_sided ? 2.0f : 1.0f)));
+        } else if (l->desc.type == FV_LIGHT_POINT) {
+            p = fv_add(p, fv_scale(l->desc.intensity, 4.0f * FV_PI));
+        } else {
+            float ci = cosf(fv_radians(l->desc.inner_deg)), co = cosf(fv_radians(l->desc.outer_deg));
+            p = fv_add(p, fv_scale(l->desc.intensity, 2.0f * FV_PI * (1.0f - 0.5f * (ci + co))));
+        }
+    }
+    return p;
+}

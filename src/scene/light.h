@@ -1,0 +1,40 @@
+/* fovea — light sampling shared by every technique: next-event estimation from a shading point,
+ * the density of hitting an emitter by chance (for MIS), and emission of photons/VPLs.
+ *
+ * A light is picked with probability proportional to its emitted power (table built at commit).
+ * Area lights are sampled uniformly by area on the chosen triangle.
+ */
+#ifndef FV_SCENE_LIGHT_H
+#define FV_SCENE_LIGHT_H
+
+#include "scene/scene_impl.h"
+
+typedef struct fv_light_sample {
+    fv_vec3 wi;      /* unit direction from the shading point to the light */
+    float dist;      /* distance to the sampled point */
+    fv_vec3 li;      /* incident radiance (area) or intensity / dist^2 (delta) */
+    float pdf;       /* solid-angle density including the light pick (area); pick probability (delta) */
+    bool delta;
+} fv_light_sample;
+
+/* Samples incident light at p with three uniform numbers; false when nothing was sampled
+ * (no light, or the point is behind a one-sided emitter). Visibility is NOT tested. */
+bool fv_light_sample_li(const fv_scene *s, fv_vec3 p, float u0, float u1, float u2, fv_light_sample *out);
+
+/* Radiance emitted by triangle (obj, prim) toward direction w (unit, pointing away from the
+ * surface), given its geometric normal ng. */
+fv_vec3 fv_light_emitted(const fv_scene *s, const fv_material *m, fv_vec3 ng, fv_vec3 w);
+
+/* Solid-angle density with which fv_light_sample_li would pick the point `hit_p` on emissive
+ * triangle (obj, prim) seen from p along direction w (unit). */
+float fv_light_pdf_li(const fv_scene *s, int obj, int prim, fv_vec3 p, fv_vec3 hit_p, fv_vec3 hit_ng, fv_vec3 w);
+
+/* Photon emission: origin, unit direction and the power the photon carries (already divided
+ * by the pick and sampling densities; divide by the number of photons emitted). u[5]. */
+bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *origin, fv_vec3 *dir, fv_vec3 *power,
+                              fv_vec3 *normal);
+
+/* Total emitted power of all lights (W): the scale of a photon map. */
+fv_vec3 fv_light_total_power(const fv_scene *s);
+
+#endif

@@ -1,0 +1,642 @@
+/* fovea — scene model and its Embree acceleration structures (see scene_impl.h for the layout).
+ *
+ * Limits: triangles only; rigid animation only; emissive objects must be static (area lights are
+ * sampled from a table built once at commit).
+ */
+#include <float.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "scene/scene_impl.h"
+
+static void embree_error(void *user, enum RTCError code, const char *str)
+{
+    fv_scene *s = user;
+    snprintf(s->embree_msg, sizeof s->embree_msg, "Embree error %d: %s", (int)code, str ? str : "");
+}
+
+fv_status fv_scene_create(fv_scene **out, fv_error *err)
+{
+    fv_scene *s = calloc(1, sizeof *s);
+    if (!s) return fv_error_set(err, FV_ERR_NOMEM, "out of memory creating a scene");
+    s->dev = rtcNewDevice(NULL);
+    if (!s->dev) {
+        free(s);
+        return fv_error_set(err, FV_ERR_INTERNAL, "cannot create an Embree device (error %d)", (int)rtcGetDeviceError(NULL));
+    }
+    rtcSetDeviceErrorFunction(s->dev, embree_error, s);
+    *out = s;
+    return FV_OK;
+}
+
+void fv_scene_destroy(fv_scene *s)
+{
+    if (!s) return;
+    for (int i = 0; i < s->nobj; i++) {
+        fv_object *o = &s->objs[i];
+        free(o->pos);
+        free(o->nrm);
+        free(o->idx);
+        free(o->mat);
+        free(o->keys);
+        if (o->rtc_child) rtcReleaseScene(o->rtc_child);
+        if (s->tri_light) free(s->tri_light[i]);
+    }
+    if (s->rtc_all) rtcReleaseScene(s->rtc_all);
+    if (s->rtc_dynamic) rtcReleaseScene(s->rtc_dynamic);
+    if (s->rtc_static) rtcReleaseScene(s->rtc_static);
+    if (s->dev) rtcReleaseDevice(s->dev);
+    free(s->tri_light);
+    free(s->objs);
+    free(s->mats);
+    free(s->delta);
+    free(s->lights);
+    free(s->light_cdf);
+    free(s->cam_keys);
+    free(s);
+}
+
+static fv_status check_open(const fv_scene *s, fv_error *err)
+{
+    return s->committed ? fv_error_set(err, FV_ERR_INTERNAL, "scene already committed: it cannot be changed") : FV_OK;
+}
+
+fv_status fv_scene_add_material(fv_scene *s, const fv_material *m, int *id, fv_error *err)
+{
+    fv_status st = check_open(s, err);
+    if (st != FV_OK || (st = fv_material_validate(m, err)) != FV_OK) return st;
+    if (fv_grow((void **)&s->mats, &s->capmat, s->nmat + 1, sizeof *s->mats))
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory adding material '%s'", m->name);
+    s->mats[s->nmat] = *m;
+    s->mats[s->nmat].name[FV_NAME_MAX - 1] = '\0';
+    if (id) *id = s->nmat;
+    s->nmat++;
+    return FV_OK;
+}
+
+int fv_scene_find_material(const fv_scene *s, const char *name)
+{
+    for (int i = 0; i < s->nmat; i++)
+        if (strcmp(s->mats[i].name, name) == 0) return i;
+    return -1;
+}
+
+/* A triangle is kept when its vertices are finite and it has a non-zero area relative to its
+ * edge lengths (collinear vertices give zero area and a NaN normal). */
+static bool triangle_ok(fv_vec3 a, fv_vec3 b, fv_vec3 c)
+{
+    if (!fv_is_finite3(a) || !fv_is_finite3(b) || !fv_is_finite3(c)) return false;
+    fv_vec3 e1 = fv_sub(b, a), e2 = fv_sub(c, a);
+    float cr = fv_length(fv_cross(e1, e2));
+    return isfinite(cr) && cr > 1e-7f * fv_length(e1) * fv_length(e2);
+}
+
+fv_status fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, const fv_log *log, int *object_id, fv_error *err)
+{
+    fv_status st = check_open(s, err);
+    if (st != FV_OK) return st;
+    const char *name = m->name ? m->name : "mesh";
+    if (m->vertex_count < 0 || m->triangle_count < 0 || (m->triangle_count > 0 && (!m->positions || !m->indices)))
+        return fv_error_set(err, FV_ERR_INVALID, "mesh '%s': bad vertex/triangle arrays", name);
+    if (!m->materials && (m->material < 0 || m->material >= s->nmat))
+        return fv_error_set(err, FV_ERR_INVALID, "mesh '%s': material id %d does not exist", name, m->material);
+
+    fv_object o;
+    memset(&o, 0, sizeof o);
+    snprintf(o.name, sizeof o.name, "%s", name);
+    o.xf = o.inv = fv_xform_identity();
+    o.idx = fv_alloc_array((size_t)m->triangle_count, 3 * sizeof(uint32_t));
+    o.mat = fv_alloc_array((size_t)m->triangle_count, sizeof(int));
+    int *remap = fv_alloc_array((size_t)m->vertex_count, sizeof(int));
+    if (!o.idx || !o.mat || !remap) goto nomem;
+    for (int i = 0; i < m->vertex_count; i++) remap[i] = -1;
+
+    int dropped = 0;
+    for (int t = 0; t < m->triangle_count; t++) {
+        const uint32_t *ix = &m->indices[3 * t];
+        if (ix[0] >= (uint32_t)m->vertex_count || ix[1] >= (uint32_t)m->vertex_count || ix[2] >= (uint32_t)m->vertex_count ||
+            !triangle_ok(m->positions[ix[0]], m->positions[ix[1]], m->positions[ix[2]])) {
+            dropped++;
+            continue;
+        }
+        int mat = m->materials ? m->materials[t] : m->material;
+        if (mat < 0 || mat >= s->nmat) {
+            free(remap);
+            free(o.idx);
+            free(o.mat);
+            return fv_error_set(err, FV_ERR_INVALID, "mesh '%s': triangle %d uses material id %d, which does not exist", name, t, mat);
+        }
+        for (int k = 0; k < 3; k++) {
+            if (remap[ix[k]] < 0) remap[ix[k]] = o.nv++;
+            o.idx[3 * o.nt + k] = (uint32_t)remap[ix[k]];
+        }
+        o.mat[o.nt++] = mat;
+    }
+    if (o.nt == 0) {
+        free(remap);
+        free(o.idx);
+        free(o.mat);
+        return fv_error_set(err, FV_ERR_INVALID, "mesh '%s': no valid triangles (%d dropped as degenerate or non-finite)", name, dropped);
+    }
+    if (dropped) fv_log_warn(log, "mesh '%s': dropped %d of %d triangles (degenerate, non-finite or bad index)", name, dropped, m->triangle_count);
+
+    /* +1 element: Embree reads vertex buffers with 16-byte loads. */
+    o.pos = fv_alloc_array((size_t)o.nv + 1, sizeof(fv_vec3));
+    if (!o.pos) goto nomem;
+    if (m->normals && !(o.nrm = fv_alloc_array((size_t)o.nv + 1, sizeof(fv_vec3)))) goto nomem;
+    o.lo = fv_v3s(FLT_MAX);
+    o.hi = fv_v3s(-FLT_MAX);
+    for (int i = 0; i < m->vertex_count; i++) {
+        if (remap[i] < 0) continue;
+        o.pos[remap[i]] = m->positions[i];
+        o.lo = fv_vmin(o.lo, m->positions[i]);
+        o.hi = fv_vmax(o.hi, m->positions[i]);
+        if (o.nrm) {
+            fv_vec3 n = m->normals[i];
+            o.nrm[remap[i]] = fv_is_finite3(n) && fv_length(n) > 0.0f ? fv_normalize(n) : fv_v3(0, 0, 0);
+        }
+    }
+    o.pos[o.nv] = fv_v3(0, 0, 0);
+    if (o.nrm) o.nrm[o.nv] = fv_v3(0, 0, 0);
+    free(remap);
+    remap = NULL;
+    if (fv_grow((void **)&s->objs, &s->capobj, s->nobj + 1, sizeof *s->objs)) goto nomem;
+    s->objs[s->nobj] = o;
+    if (object_id) *object_id = s->nobj;
+    s->nobj++;
+    return FV_OK;
+nomem:
+    free(remap);
+    free(o.idx);
+    free(o.mat);
+    free(o.pos);
+    free(o.nrm);
+    return fv_error_set(err, FV_ERR_NOMEM, "out of memory adding mesh '%s' (%d triangles)", name, m->triangle_count);
+}
+
+static bool object_emissive(const fv_scene *s, const fv_object *o)
+{
+    for (int t = 0; t < o->nt; t++)
+        if (fv_max3(s->mats[o->mat[t]].emission) > 0.0f) return true;
+    return false;
+}
+
+fv_status fv_scene_animate_object(fv_scene *s, int id, const fv_anim_key *keys, int count, fv_error *err)
+{
+    fv_status st = check_open(s, err);
+    if (st != FV_OK) return st;
+    if (id < 0 || id >= s->nobj) return fv_error_set(err, FV_ERR_INVALID, "animation: object %d does not exist", id);
+    fv_object *o = &s->objs[id];
+    if (count < 1) return fv_error_set(err, FV_ERR_INVALID, "animation of '%s': no keys", o->name);
+    for (int i = 0; i < count; i++) {
+        const fv_anim_key *k = &keys[i];
+        float ql = sqrtf(k->rotate.x * k->rotate.x + k->rotate.y * k->rotate.y + k->rotate.z * k->rotate.z + k->rotate.w * k->rotate.w);
+        if (!isfinite(k->time) || !fv_is_finite3(k->translate) || !fv_is_finite3(k->scale) || !(ql > 1e-6f) || !isfinite(ql))
+            return fv_error_set(err, FV_ERR_INVALID, "animation of '%s': key %d has non-finite values or a zero rotation", o->name, i);
+        if (fv_min3(k->scale) <= 0.0f)
+            return fv_error_set(err, FV_ERR_INVALID, "animation of '%s': key %d has a scale <= 0", o->name, i);
+        if (i > 0 && !(k->time > keys[i - 1].time))
+            return fv_error_set(err, FV_ERR_INVALID, "animation of '%s': key times must increase (key %d)", o->name, i);
+    }
+    if (object_emissive(s, o))
+        return fv_error_set(err, FV_ERR_INVALID, "animation of '%s': emissive objects cannot be dynamic", o->name);
+    fv_anim_key *copy = fv_alloc_array((size_t)count, sizeof *copy);
+    if (!copy) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    memcpy(copy, keys, (size_t)count * sizeof *copy);
+    for (int i = 0; i < count; i++) {
+        fv_quat q = copy[i].rotate;
+        float l = sqrtf(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+        copy[i].rotate = (fv_quat){q.x / l, q.y / l, q.z / l, q.w / l};
+    }
+    free(o->keys);
+    o->keys = copy;
+    o->nkeys = count;
+    o->dynamic = true;
+    return FV_OK;
+}
+
+fv_status fv_scene_add_light(fv_scene *s, const fv_light_desc *l, fv_error *err)
+{
+    fv_status st = check_open(s, err);
+    if (st != FV_OK) return st;
+    if (l->type != FV_LIGHT_POINT && l->type != FV_LIGHT_SPOT)
+        return fv_error_set(err, FV_ERR_INVALID, "light: unknown type %d", (int)l->type);
+    if (!fv_is_finite3(l->pos) || !fv_is_finite3(l->intensity) || fv_min3(l->intensity) < 0.0f)
+        return fv_error_set(err, FV_ERR_INVALID, "light: position and intensity must be finite, intensity >= 0");
+    fv_light_desc c = *l;
+    if (l->type == FV_LIGHT_SPOT) {
+        if (!fv_is_finite3(l->dir) || fv_length(l->dir) <= 0.0f)
+            return fv_error_set(err, FV_ERR_INVALID, "spot light: direction must be finite and non-zero");
+        if (!(l->outer_deg > 0.0f && l->outer_deg < 90.0f && l->inner_deg >= 0.0f && l->inner_deg <= l->outer_deg))
+            return fv_error_set(err, FV_ERR_INVALID, "spot light: need 0 <= inner (%g) <= outer (%g) < 90 degrees", l->inner_deg, l->outer_deg);
+        c.dir = fv_normalize(l->dir);
+    }
+    if (fv_grow((void **)&s->delta, &s->capdelta, s->ndelta + 1, sizeof *s->delta))
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    s->delta[s->ndelta++] = c;
+    return FV_OK;
+}
+
+void fv_scene_set_camera(fv_scene *s, const fv_camera *c)
+{
+    s->camera = *c;
+    s->has_camera = true;
+}
+
+fv_status fv_scene_set_camera_path(fv_scene *s, const fv_camera_key *keys, int count, fv_error *err)
+{
+    if (count < 1) return fv_error_set(err, FV_ERR_INVALID, "camera path: no keys");
+    for (int i = 0; i < count; i++) {
+        if (!isfinite(keys[i].time) || !fv_is_finite3(keys[i].pos) || !fv_is_finite3(keys[i].look) || !fv_is_finite3(keys[i].up) ||
+            !(keys[i].fov_y > 0.0f && keys[i].fov_y < 180.0f))
+            return fv_error_set(err, FV_ERR_INVALID, "camera path: key %d has non-finite values or a fov outside (0,180)", i);
+        if (i > 0 && !(keys[i].time > keys[i - 1].time))
+            return fv_error_set(err, FV_ERR_INVALID, "camera path: key times must increase (key %d)", i);
+    }
+    fv_camera_key *copy = fv_alloc_array((size_t)count, sizeof *copy);
+    if (!copy) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    memcpy(copy, keys, (size_t)count * sizeof *copy);
+    free(s->cam_keys);
+    s->cam_keys = copy;
+    s->ncam_keys = count;
+    return FV_OK;
+}
+
+/* ---- animation ---- */
+
+static fv_xform anim_eval(const fv_object *o, double t)
+{
+    const fv_anim_key *k = o->keys;
+    int n = o->nkeys;
+    if (n == 1 || t <= k[0].time) return fv_xform_trs(k[0].translate, k[0].rotate, k[0].scale);
+    if (t >= k[n - 1].time) return fv_xform_trs(k[n - 1].translate, k[n - 1].rotate, k[n - 1].scale);
+    int i = 0;
+    while (i + 1 < n && k[i + 1].time <= t) i++;
+    float a = (float)((t - k[i].time) / (k[i + 1].time - k[i].time));
+    return fv_xform_trs(fv_lerp3(k[i].translate, k[i + 1].translate, a), fv_quat_slerp(k[i].rotate, k[i + 1].rotate, a),
+                        fv_lerp3(k[i].scale, k[i + 1].scale, a));
+}
+
+static void bounds_add_box(fv_vec3 *lo, fv_vec3 *hi, const fv_xform *x, fv_vec3 a, fv_vec3 b)
+{
+    for (int c = 0; c < 8; c++) {
+        fv_vec3 p = fv_v3(c & 1 ? b.x : a.x, c & 2 ? b.y : a.y, c & 4 ? b.z : a.z);
+        p = fv_xform_point(x, p);
+        *lo = fv_vmin(*lo, p);
+        *hi = fv_vmax(*hi, p);
+    }
+}
+
+/* ---- commit ---- */
+
+static fv_status embree_status(fv_scene *s, const char *what, fv_error *err)
+{
+    enum RTCError e = rtcGetDeviceError(s->dev);
+    if (e == RTC_ERROR_NONE) return FV_OK;
+    if (e == RTC_ERROR_OUT_OF_MEMORY) return fv_error_set(err, FV_ERR_NOMEM, "out of memory while %s (%s)", what, s->embree_msg);
+    return fv_error_set(err, FV_ERR_INTERNAL, "%s failed: %s", what, s->embree_msg[0] ? s->embree_msg : "Embree error");
+}
+
+static RTCGeometry make_triangles(fv_scene *s, fv_object *o)
+{
+    RTCGeometry g = rtcNewGeometry(s->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, o->pos, 0, sizeof(fv_vec3), (size_t)o->nv);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, o->idx, 0, 3 * sizeof(uint32_t), (size_t)o->nt);
+    rtcCommitGeometry(g);
+    return g;
+}
+
+static void attach_instance(fv_scene *s, RTCScene parent, RTCScene child, unsigned id, const fv_xform *x)
+{
+    RTCGeometry g = rtcNewGeometry(s->dev, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(g, child);
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &x->m[0][0]);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(parent, g, id);
+    rtcReleaseGeometry(g);
+}
+
+static float tri_area(const fv_object *o, int t)
+{
+    fv_vec3 a = o->pos[o->idx[3 * t]], b = o->pos[o->idx[3 * t + 1]], c = o->pos[o->idx[3 * t + 2]];
+    return 0.5f * fv_length(fv_cross(fv_sub(b, a), fv_sub(c, a)));
+}
+
+static fv_status build_lights(fv_scene *s, fv_error *err)
+{
+    int n = s->ndelta;
+    for (int i = 0; i < s->nobj; i++)
+        for (int t = 0; t < s->objs[i].nt; t++)
+            if (fv_max3(s->mats[s->objs[i].mat[t]].emission) > 0.0f) n++;
+    s->lights = fv_calloc_array((size_t)n, sizeof *s->lights);
+    s->light_cdf = fv_calloc_array((size_t)n + 1, sizeof(float));
+    s->tri_light = fv_calloc_array((size_t)s->nobj, sizeof(int *));
+    if (!s->lights || !s->light_cdf || !s->tri_light) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building lights");
+    int k = 0;
+    for (int i = 0; i < s->ndelta; i++) {
+        fv_light *l = &s->lights[k];
+        l->kind = 0;
+        l->desc = s->delta[i];
+        float lum = fv_luminance(l->desc.intensity);
+        if (l->desc.type == FV_LIGHT_POINT) {
+            l->power = 4.0f * FV_PI * lum;
+        } else {
+            float ci = cosf(fv_radians(l->desc.inner_deg)), co = cosf(fv_radians(l->desc.outer_deg));
+            l->power = 2.0f * FV_PI * (1.0f - 0.5f * (ci + co)) * lum;
+        }
+        if (l->power > 0.0f) k++;
+    }
+    for (int i = 0; i < s->nobj; i++) {
+        fv_object *o = &s->objs[i];
+        if (!object_emissive(s, o)) continue;
+        if (!(s->tri_light[i] = fv_alloc_array((size_t)o->nt, sizeof(int)))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        for (int t = 0; t < o->nt; t++) {
+            const fv_material *m = &s->mats[o->mat[t]];
+            s->tri_light[i][t] = -1;
+            float area = tri_area(o, t);
+            if (!(fv_max3(m->emission) > 0.0f) || !(area > 0.0f)) continue;
+            fv_light *l = &s->lights[k];
+            l->kind = 1;
+            l->obj = i;
+            l->prim = t;
+            l->area = area;
+            fv_vec3 a = o->pos[o->idx[3 * t]], b = o->pos[o->idx[3 * t + 1]], c = o->pos[o->idx[3 * t + 2]];
+            l->n = fv_normalize(fv_cross(fv_sub(b, a), fv_sub(c, a)));
+            l->emission = m->emission;
+            l->two_sided = m->two_sided_emission;
+            l->power = FV_PI * fv_luminance(m->emission) * area * (l->two_sided ? 2.0f : 1.0f);
+            if (l->power > 0.0f) s->tri_light[i][t] = k++;
+        }
+    }
+    s->nlights = k;
+    double total = 0.0;
+    for (int i = 0; i < k; i++) total += s->lights[i].power;
+    double acc = 0.0;
+    for (int i = 0; i < k; i++) {
+        s->light_cdf[i] = (float)(acc / total);
+        acc += s->lights[i].power;
+    }
+    s->light_cdf[k] = 1.0f;
+    return FV_OK;
+}
+
+fv_status fv_scene_commit(fv_scene *s, const fv_log *log, fv_error *err)
+{
+    fv_status st = check_open(s, err);
+    if (st != FV_OK) return st;
+    if (s->nobj == 0) return fv_error_set(err, FV_ERR_INVALID, "scene is empty: it has no triangles");
+    for (int i = 0; i < s->nobj; i++)
+        if (s->objs[i].dynamic) s->ndynamic++;
+
+    /* World bounds: static objects as they are, dynamic ones at every key. */
+    s->lo = fv_v3s(FLT_MAX);
+    s->hi = fv_v3s(-FLT_MAX);
+    for (int i = 0; i < s->nobj; i++) {
+        fv_object *o = &s->objs[i];
+        if (!o->dynamic) {
+            bounds_add_box(&s->lo, &s->hi, &o->xf, o->lo, o->hi);
+            continue;
+        }
+        for (int k = 0; k < o->nkeys; k++) {
+            fv_xform x = anim_eval(o, o->keys[k].time);
+            bounds_add_box(&s->lo, &s->hi, &x, o->lo, o->hi);
+        }
+    }
+    fv_vec3 ext = fv_sub(s->hi, s->lo);
+    float diag = fv_length(ext);
+    if (!(diag > 0.0f) || !isfinite(diag)) return fv_error_set(err, FV_ERR_INVALID, "scene has zero or non-finite extent");
+    s->eps = 1e-4f * diag;
+
+    if ((st = build_lights(s, err)) != FV_OK) return st;
+    if (s->nlights == 0) {
+        fv_vec3 c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
+        fv_light_desc l = {FV_LIGHT_POINT, fv_v3(c.x, s->lo.y + 0.9f * ext.y, c.z), fv_v3(0, -1, 0),
+                           fv_v3s(0.25f * diag * diag), 0, 0};
+        fv_log_warn(log, "scene has no lights: added a point light at (%g, %g, %g) with intensity %g", l.pos.x, l.pos.y, l.pos.z,
+                    l.intensity.x);
+        if ((st = fv_scene_add_light(s, &l, err)) != FV_OK) return st;
+        free(s->lights);
+        free(s->light_cdf);
+        for (int i = 0; i < s->nobj; i++) free(s->tri_light[i]);
+        free(s->tri_light);
+        s->lights = NULL;
+        s->light_cdf = NULL;
+        s->tri_light = NULL;
+        if ((st = build_lights(s, err)) != FV_OK) return st;
+    }
+    if (!s->has_camera) {
+        /* Frame the bounding sphere from the +z side with a 45 degree view. */
+        fv_vec3 c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
+        float r = 0.5f * diag, fov = 45.0f;
+        float dist = 1.05f * r / sinf(fv_radians(fov) * 0.5f);
+        fv_camera cam = {fv_add(c, fv_v3(0, 0, dist)), c, fv_v3(0, 1, 0), fov, 512, 512};
+        s->camera = cam;
+        s->has_camera = true;
+    }
+
+    s->rtc_static = rtcNewScene(s->dev);
+    rtcSetSceneBuildQuality(s->rtc_static, RTC_BUILD_QUALITY_HIGH);
+    for (int i = 0; i < s->nobj; i++) {
+        fv_object *o = &s->objs[i];
+        RTCGeometry g = make_triangles(s, o);
+        if (o->dynamic) {
+            o->rtc_child = rtcNewScene(s->dev);
+            rtcAttachGeometryByID(o->rtc_child, g, 0);
+            rtcCommitScene(o->rtc_child);
+        } else {
+            rtcAttachGeometryByID(s->rtc_static, g, (unsigned)i);
+        }
+        rtcReleaseGeometry(g);
+    }
+    rtcCommitScene(s->rtc_static);
+    if ((st = embree_status(s, "building the static BVH", err)) != FV_OK) return st;
+
+    s->static_inst_id = RTC_INVALID_GEOMETRY_ID;
+    if (s->ndynamic == 0) {
+        s->rtc_all = s->rtc_static;
+        rtcRetainScene(s->rtc_all);
+    } else {
+        s->rtc_all = rtcNewScene(s->dev);
+        s->rtc_dynamic = rtcNewScene(s->dev);
+        rtcSetSceneFlags(s->rtc_all, RTC_SCENE_FLAG_DYNAMIC);
+        rtcSetSceneFlags(s->rtc_dynamic, RTC_SCENE_FLAG_DYNAMIC);
+        rtcSetSceneBuildQuality(s->rtc_all, RTC_BUILD_QUALITY_LOW);
+        rtcSetSceneBuildQuality(s->rtc_dynamic, RTC_BUILD_QUALITY_LOW);
+        s->static_inst_id = (unsigned)s->nobj;
+        fv_xform id = fv_xform_identity();
+        attach_instance(s, s->rtc_all, s->rtc_static, s->static_inst_id, &id);
+        for (int i = 0; i < s->nobj; i++) {
+            if (!s->objs[i].dynamic) continue;
+            attach_instance(s, s->rtc_all, s->objs[i].rtc_child, (unsigned)i, &id);
+            attach_instance(s, s->rtc_dynamic, s->objs[i].rtc_child, (unsigned)i, &id);
+        }
+    }
+    s->committed = true;
+    s->time = -1.0;
+    return fv_scene_set_time(s, 0.0, err);
+}
+
+fv_status fv_scene_set_time(fv_scene *s, double t, fv_error *err)
+{
+    if (!s->committed) return fv_error_set(err, FV_ERR_INTERNAL, "scene not committed");
+    if (!isfinite(t)) return fv_error_set(err, FV_ERR_INVALID, "scene time must be finite");
+    if (t == s->time) return FV_OK;
+    s->time = t;
+    if (s->ndynamic == 0) return FV_OK;
+    for (int i = 0; i < s->nobj; i++) {
+        fv_object *o = &s->objs[i];
+        if (!o->dynamic) continue;
+        o->xf = anim_eval(o, t);
+        if (!fv_xform_inverse(&o->xf, &o->inv)) o->inv = fv_xform_identity();
+        RTCScene parents[2] = {s->rtc_all, s->rtc_dynamic};
+        for (int p = 0; p < 2; p++) {
+            RTCGeometry g = rtcGetGeometry(parents[p], (unsigned)i);
+            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &o->xf.m[0][0]);
+            rtcCommitGeometry(g);
+        }
+    }
+    rtcCommitScene(s->rtc_all);
+    rtcCommitScene(s->rtc_dynamic);
+    return embree_status(s, "updating dynamic objects", err);
+}
+
+double fv_scene_time(const fv_scene *s) { return s->time; }
+
+/* ---- ray queries ---- */
+
+static RTCScene pick(const fv_scene *s, fv_trace_set set)
+{
+    switch (set) {
+    case FV_TRACE_STATIC: return s->rtc_static;
+    case FV_TRACE_DYNAMIC: return s->rtc_dynamic;
+    default: return s->rtc_all;
+    }
+}
+
+bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax, fv_hit *hit)
+{
+    RTCScene scn = pick(s, set);
+    if (!scn) return false;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    rh.ray.org_x = o.x;
+    rh.ray.org_y = o.y;
+    rh.ray.org_z = o.z;
+    rh.ray.dir_x = d.x;
+    rh.ray.dir_y = d.y;
+    rh.ray.dir_z = d.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = tmax;
+    rh.ray.time = 0.0f;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scn, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+
+    unsigned inst = rh.hit.instID[0];
+    /* Static triangles are found directly or through the static instance; dynamic ones through
+     * their own instance, whose id is the object index. */
+    int obj = (inst == RTC_INVALID_GEOMETRY_ID || inst == s->static_inst_id) ? (int)rh.hit.geomID : (int)inst;
+    const fv_object *ob = &s->objs[obj];
+    int prim = (int)rh.hit.primID;
+    const uint32_t *ix = &ob->idx[3 * prim];
+    fv_vec3 a = ob->pos[ix[0]], b = ob->pos[ix[1]], c = ob->pos[ix[2]];
+    fv_vec3 ng = fv_cross(fv_sub(b, a), fv_sub(c, a));
+    float u = rh.hit.u, v = rh.hit.v;
+    fv_vec3 ns = ng;
+    if (ob->nrm) {
+        fv_vec3 n = fv_add(fv_add(fv_scale(ob->nrm[ix[0]], 1.0f - u - v), fv_scale(ob->nrm[ix[1]], u)), fv_scale(ob->nrm[ix[2]], v));
+        if (fv_length(n) > 1e-6f) ns = n;
+    }
+    if (ob->dynamic) {
+        ng = fv_xform_normal(&ob->inv, ng);
+        ns = fv_xform_normal(&ob->inv, ns);
+    }
+    hit->t = rh.ray.tfar;
+    hit->p = fv_madd(o, d, rh.ray.tfar);
+    hit->ng = fv_normalize(ng);
+    hit->ns = fv_normalize(ns);
+    if (fv_dot(hit->ns, hit->ng) < 0.0f) hit->ns = fv_neg(hit->ns);
+    hit->obj = obj;
+    hit->prim = prim;
+    hit->mat = ob->mat[prim];
+    hit->u = u;
+    hit->v = v;
+    return true;
+}
+
+bool fv_scene_occluded(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax)
+{
+    RTCScene scn = pick(s, set);
+    if (!scn) return false;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRay r;
+    r.org_x = o.x;
+    r.org_y = o.y;
+    r.org_z = o.z;
+    r.dir_x = d.x;
+    r.dir_y = d.y;
+    r.dir_z = d.z;
+    r.tnear = 0.0f;
+    r.tfar = tmax;
+    r.time = 0.0f;
+    r.mask = 0xffffffffu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(scn, &ctx, &r);
+    return r.tfar < 0.0f;
+}
+
+void fv_scene_triangle(const fv_scene *s, int obj, int prim, fv_vec3 *a, fv_vec3 *b, fv_vec3 *c)
+{
+    const fv_object *o = &s->objs[obj];
+    const uint32_t *ix = &o->idx[3 * prim];
+    *a = fv_xform_point(&o->xf, o->pos[ix[0]]);
+    *b = fv_xform_point(&o->xf, o->pos[ix[1]]);
+    *c = fv_xform_point(&o->xf, o->pos[ix[2]]);
+}
+
+/* ---- queries ---- */
+
+void fv_scene_bounds(const fv_scene *s, fv_vec3 *lo, fv_vec3 *hi)
+{
+    *lo = s->lo;
+    *hi = s->hi;
+}
+
+int fv_scene_triangle_count(const fv_scene *s)
+{
+    int n = 0;
+    for (int i = 0; i < s->nobj; i++) n += s->objs[i].nt;
+    return n;
+}
+int fv_scene_object_count(const fv_scene *s) { return s->nobj; }
+int fv_scene_dynamic_object_count(const fv_scene *s)
+{
+    int n = 0;
+    for (int i = 0; i < s->nobj; i++) n += s->objs[i].dynamic;
+    return n;
+}
+int fv_scene_light_count(const fv_scene *s) { return s->committed ? s->nlights : s->ndelta; }
+int fv_scene_material_count(const fv_scene *s) { return s->nmat; }
+const fv_material *fv_scene_material(const fv_scene *s, int id) { return id >= 0 && id < s->nmat ? &s->mats[id] : NULL; }
+bool fv_scene_has_camera_path(const fv_scene *s) { return s->ncam_keys > 0; }
+
+void fv_scene_camera(const fv_scene *s, double t, int width, int height, fv_camera *out)
+{
+    fv_camera base = s->camera;
+    base.width = width;
+    base.height = height;
+    if (s->ncam_keys > 0) {
+        fv_camera_path p = {s->cam_keys, s->ncam_keys};
+        fv_camera_path_eval(&p, t, &base, out);
+    } else {
+        *out = base;
+    }
+}

@@ -1,0 +1,263 @@
+/* fovea — `pt`, the reference unidirectional path tracer: the ground truth every technique is
+ * measured against.
+ *
+ * Next-event estimation at every non-delta vertex, combined with BSDF sampling by multiple
+ * importance sampling (balance heuristic, Veach 1997 ch. 9) for area lights; delta lights are
+ * sampled only by NEE, delta lobes only by the BSDF. Russian roulette from `rr_depth` on, with
+ * survival probability max(throughput) capped at 0.95. `max_depth` counts path segments after
+ * the camera: 1 = direct light only (Embree's `--max-path-length` convention). No environment
+ * light: rays leaving the scene carry nothing.
+ */
+#include <stdlib.h>
+#include <string.h>
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "fovea/technique.h"
+#include "scene/bsdf.h"
+#include "scene/light.h"
+#include "technique/pt/pt.h"
+
+typedef struct pt_state {
+    const fv_scene *scene;
+    fv_pt_options opt;
+} pt_state;
+
+static float mis_weight(float a, float b) { return a / (a + b); }
+
+fv_vec3 fv_pt_trace(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_vec3 d, fv_rng *rng,
+                    fv_pt_first_hit *first, uint64_t *rays)
+{
+    fv_vec3 L = fv_v3s(0.0f), beta = fv_v3s(1.0f);
+    bool delta_prev = true;
+    float pdf_prev = 1.0f;
+    fv_vec3 p_prev = o;
+    uint64_t nrays = 0;
+    for (int depth = 1; depth <= opt->max_depth; depth++) {
+        fv_hit h;
+        nrays++;
+        if (!fv_scene_intersect(s, FV_TRACE_ALL, o, d, INFINITY, &h)) break;
+        const fv_material *m = &s->mats[h.mat];
+        fv_vec3 wo = fv_neg(d);
+        if (depth == 1 && first) {
+            first->hit = true;
+            first->t = h.t;
+            first->p = h.p;
+            first->n = h.ns;
+            first->obj = h.obj;
+            first->albedo = m->type == FV_MAT_DIFFUSE || m->type == FV_MAT_GLOSSY ? m->albedo : m->specular;
+        }
+        if (fv_max3(m->emission) > 0.0f) {
+            fv_vec3 le = fv_light_emitted(s, m, h.ng, wo);
+            float w = 1.0f;
+            if (!delta_prev) w = mis_weight(pdf_prev, fv_light_pdf_li(s, h.obj, h.prim, p_prev, h.p, h.ng, d));
+            L = fv_add(L, fv_mul(beta, fv_scale(le, w)));
+        }
+        if (depth == opt->max_depth) break;
+
+        /* Shading frame: two-sided surfaces face the incoming ray; glass keeps its orientation
+         * so the BSDF can tell entering from leaving. */
+        fv_vec3 ng = h.ng, ns = h.ns;
+        if (m->type != FV_MAT_DIELECTRIC && fv_dot(wo, ng) < 0.0f) {
+            ng = fv_neg(ng);
+            ns = fv_neg(ns);
+        }
+        fv_vec3 t, b;
+        fv_basis(ns, &t, &b);
+        fv_vec3 wo_l = fv_to_local(wo, t, b, ns);
+        if (m->type != FV_MAT_DIELECTRIC && wo_l.z <= 0.0f) wo_l.z = 1e-4f; /* shading normal past the view: clamp */
+
+        if (fv_bsdf_is_smooth(m)) {
+            fv_light_sample ls;
+            float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), u2 = fv_rng_next(rng);
+            if (fv_light_sample_li(s, h.p, u0, u1, u2, &ls) && fv_dot(ls.wi, ng) > 0.0f) {
+                float pdf_b;
+                fv_vec3 f = fv_bsdf_eval(m, wo_l, fv_to_local(ls.wi, t, b, ns), &pdf_b);
+                float cosv = fabsf(fv_dot(ls.wi, ns));
+                if (fv_max3(f) > 0.0f) {
+                    fv_vec3 po = fv_offset_point(s, h.p, ng, ls.wi);
+                    nrays++;
+                    if (!fv_scene_occluded(s, FV_TRACE_ALL, po, ls.wi, ls.dist * (1.0f - 1e-4f) - s->eps)) {
+                        float w = ls.delta ? 1.0f : mis_weight(ls.pdf, pdf_b);
+                        L = fv_add(L, fv_mul(beta, fv_scale(fv_mul(f, ls.li), cosv * w / ls.pdf)));
+                    }
+                }
+            }
+        } else {
+            /* keep the random stream aligned across material types */
+            rng->dim += 3;
+        }
+
+        fv_bsdf_sample bs;
+        float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), u2 = fv_rng_next(rng);
+        if (!fv_bsdf_sample_dir(m, wo_l, FV_TRANSPORT_RADIANCE, u0, u1, u2, &bs)) break;
+        fv_vec3 wi = fv_from_local(bs.wi, t, b, ns);
+        /* Reflection must leave on the geometric side it arrived on (and refraction cross it);
+         * shading normals can disagree, which would leak light through surfaces. */
+        bool reflect = bs.wi.z * wo_l.z > 0.0f;
+        if ((fv_dot(wi, h.ng) * fv_dot(wo, h.ng) > 0.0f) != reflect) break;
+        beta = fv_mul(beta, bs.weight);
+        delta_prev = bs.delta;
+        pdf_prev = bs.pdf;
+        p_prev = h.p;
+        o = fv_offset_point(s, h.p, h.ng, wi);
+        d = wi;
+        if (depth >= opt->rr_depth) {
+            float q = fminf(0.95f, fv_max3(beta));
+            if (!(fv_rng_next(rng) < q)) break;
+            beta = fv_scale(beta, 1.0f / q);
+        } else {
+            rng->dim++;
+        }
+    }
+    if (rays) *rays += nrays;
+    return L;
+}
+
+fv_status fv_pt_read_options(fv_params *p, fv_pt_options *opt, fv_error *err)
+{
+    fv_status s;
+    if ((s = fv_params_int(p, "spp", 16, 1, 1 << 20, &opt->spp, err)) != FV_OK) return s;
+    if ((s = fv_params_int(p, "max_depth", 8, 1, 1024, &opt->max_depth, err)) != FV_OK) return s;
+    if ((s = fv_params_int(p, "rr_depth", 3, 1, 1024, &opt->rr_depth, err)) != FV_OK) return s;
+    return FV_OK;
+}
+
+static fv_status pt_create(const fv_scene *scene, fv_params *params, const fv_log *log, void **state, fv_error *err)
+{
+    pt_state *st = calloc(1, sizeof *st);
+    if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    st->scene = scene;
+    fv_status s = fv_pt_read_options(params, &st->opt, err);
+    if (s == FV_OK) s = fv_params_check_used(params, "pt", err);
+    if (s != FV_OK) {
+        free(st);
+        return s;
+    }
+    *state = st;
+    return FV_OK;
+}
+
+typedef struct pt_job {
+    const pt_state *st;
+    const fv_frame *frame;
+    fv_camera_basis cam;
+    fv_film *film;
+    float *color, *depth, *normal, *albedo, *position;
+    uint32_t *id;
+    int eye;
+    struct {
+        uint64_t rays, bad;
+        char pad[48]; /* one cache line per thread */
+    } counters[FV_MAX_THREADS];
+} pt_job;
+
+static void pt_tile(void *ctx, const fv_tile *tile)
+{
+    pt_job *j = ctx;
+    const fv_pt_options *opt = &j->st->opt;
+    const int w = j->cam.width;
+    uint64_t rays = 0, bad = 0;
+    for (int y = tile->y0; y < tile->y1; y++) {
+        for (int x = tile->x0; x < tile->x1; x++) {
+            size_t pix = (size_t)y * (size_t)w + (size_t)x;
+            fv_vec3 sum = fv_v3s(0.0f);
+            fv_pt_first_hit first = {0};
+            for (int sidx = 0; sidx < opt->spp; sidx++) {
+                /* The eye is folded into the pixel index so both eyes get independent noise. */
+                fv_rng rng = fv_rng_make(j->frame->seed, pix * 2 + (size_t)j->eye, (uint64_t)sidx, (uint64_t)j->frame->index);
+                float jx = fv_rng_next(&rng), jy = fv_rng_next(&rng);
+                fv_vec3 dir = fv_camera_dir(&j->cam, (float)x + jx, (float)y + jy);
+                fv_vec3 L = fv_pt_trace(j->st->scene, opt, j->cam.pos, dir, &rng, sidx == 0 ? &first : NULL, &rays);
+                if (!fv_is_finite3(L)) { /* the NaN/Inf guard: count it, keep it off the film */
+                    bad++;
+                    continue;
+                }
+                sum = fv_add(sum, L);
+            }
+            sum = fv_scale(sum, 1.0f / (float)opt->spp);
+            j->color[3 * pix] = sum.x;
+            j->color[3 * pix + 1] = sum.y;
+            j->color[3 * pix + 2] = sum.z;
+            if (j->depth) j->depth[pix] = first.hit ? first.t : INFINITY;
+            if (j->normal) memcpy(&j->normal[3 * pix], first.hit ? &first.n : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
+            if (j->albedo) memcpy(&j->albedo[3 * pix], first.hit ? &first.albedo : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
+            if (j->position) memcpy(&j->position[3 * pix], first.hit ? &first.p : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
+            if (j->id) j->id[pix] = first.hit ? (uint32_t)first.obj + 1u : 0u;
+        }
+    }
+    j->counters[tile->thread].rays += rays;
+    j->counters[tile->thread].bad += bad;
+}
+
+typedef struct pt_progress {
+    const fv_frame *frame;
+    double base, span;
+} pt_progress;
+
+static void pt_report(void *user, double f)
+{
+    pt_progress *p = user;
+    p->frame->progress(p->frame->progress_user, p->base + p->span * f);
+}
+
+static fv_status render_eye(const pt_state *st, const fv_frame *frame, const fv_camera *cam, fv_film *film, int eye,
+                            int neyes, fv_stats *stats, fv_error *err)
+{
+    pt_job *j = calloc(1, sizeof *j);
+    if (!j) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    fv_status s = fv_camera_basis_make(cam, &j->cam, err);
+    if (s == FV_OK && (cam->width != fv_film_width(film) || cam->height != fv_film_height(film)))
+        s = fv_error_set(err, FV_ERR_INVALID, "camera size %dx%d differs from the film's %dx%d", cam->width, cam->height,
+                         fv_film_width(film), fv_film_height(film));
+    if (s != FV_OK) {
+        free(j);
+        return s;
+    }
+    j->st = st;
+    j->frame = frame;
+    j->film = film;
+    j->eye = eye;
+    j->color = fv_film_color(film);
+    j->depth = fv_film_depth(film);
+    j->normal = fv_film_normal(film);
+    j->albedo = fv_film_albedo(film);
+    j->position = fv_film_position(film);
+    j->id = fv_film_id(film);
+    pt_progress prog = {frame, (double)eye / neyes, 1.0 / neyes};
+    double t0 = fv_time_ms();
+    fv_parallel_tiles(cam->width, cam->height, frame->threads, pt_tile, j, frame->progress ? pt_report : NULL, &prog);
+    fv_stats_add_ms(stats, "trace", fv_time_ms() - t0);
+    uint64_t rays = 0, bad = 0;
+    for (int i = 0; i < FV_MAX_THREADS; i++) {
+        rays += j->counters[i].rays;
+        bad += j->counters[i].bad;
+    }
+    fv_stats_add_count(stats, "rays", (double)rays);
+    fv_stats_add_count(stats, "samples", (double)cam->width * cam->height * st->opt.spp);
+    fv_stats_add_count(stats, "nan_samples", (double)bad);
+    free(j);
+    return FV_OK;
+}
+
+static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv_film *film_right, fv_stats *stats,
+                           fv_error *err)
+{
+    const pt_state *st = state;
+    int neyes = frame->camera_right ? 2 : 1;
+    fv_status s = render_eye(st, frame, frame->camera, film, 0, neyes, stats, err);
+    if (s == FV_OK && frame->camera_right) s = render_eye(st, frame, frame->camera_right, film_right, 1, neyes, stats, err);
+    return s;
+}
+
+static void pt_destroy(void *state) { free(state); }
+
+const fv_technique_class fv_technique_pt = {
+    "pt",
+    "reference path tracer: NEE + MIS, Russian roulette (ground truth)",
+    "spp=int (16): samples per pixel\n"
+    "max_depth=int (8): path segments after the camera, 1 = direct light only\n"
+    "rr_depth=int (3): depth from which Russian roulette may end paths\n",
+    pt_create,
+    pt_render,
+    pt_destroy,
+};

@@ -1,0 +1,133 @@
+/* fovea CLI — shared helpers (see cli.h). */
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "cli.h"
+
+int fv_cli_exit_code(fv_status s)
+{
+    switch (s) {
+    case FV_OK: return FV_EXIT_OK;
+    case FV_ERR_INVALID:
+    case FV_ERR_IO: return FV_EXIT_USAGE;
+    default: return FV_EXIT_INTERNAL;
+    }
+}
+
+int fv_cli_fail(const char *cmd, fv_status s, const char *msg)
+{
+    fprintf(stderr, "fovea %s: %s\n", cmd, msg && *msg ? msg : fv_status_name(s));
+    return fv_cli_exit_code(s);
+}
+
+int fv_cli_usage_error(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "fovea %s: ", cmd);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    return FV_EXIT_USAGE;
+}
+
+bool fv_cli_parse_int(const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || end == s || *end || v < lo || v > hi) return false;
+    *out = v;
+    return true;
+}
+
+bool fv_cli_parse_float(const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(v)) return false;
+    *out = v;
+    return true;
+}
+
+bool fv_cli_parse_floats(const char *s, int n, float *out)
+{
+    const char *p = s;
+    for (int i = 0; i < n; i++) {
+        char *end;
+        errno = 0;
+        double v = strtod(p, &end);
+        if (errno || end == p || !isfinite(v)) return false;
+        out[i] = (float)v;
+        p = end;
+        if (i < n - 1) {
+            if (*p != ',') return false;
+            p++;
+        }
+    }
+    return *p == '\0';
+}
+
+bool fv_cli_parse_size(const char *s, int *w, int *h)
+{
+    char *end;
+    errno = 0;
+    long a = strtol(s, &end, 10);
+    if (errno || end == s || (*end != 'x' && *end != 'X')) return false;
+    const char *q = end + 1;
+    long b = strtol(q, &end, 10);
+    if (errno || end == q || *end) return false;
+    /* Range is checked by fv_film_check_size so the message is the same everywhere. */
+    if (a < -1000000000L || a > 1000000000L || b < -1000000000L || b > 1000000000L) return false;
+    *w = (int)a;
+    *h = (int)b;
+    return true;
+}
+
+static void warn_sink(void *user, const char *msg)
+{
+    const bool *quiet = user;
+    if (!quiet || !*quiet) fprintf(stderr, "fovea: warning: %s\n", msg);
+}
+
+fv_log fv_cli_log(bool *quiet)
+{
+    fv_log l = {warn_sink, quiet};
+    return l;
+}
+
+void fv_cli_progress_init(fv_cli_progress *p, bool quiet, int frames)
+{
+    memset(p, 0, sizeof *p);
+    p->enabled = !quiet && isatty(STDERR_FILENO);
+    p->t0 = fv_time_ms();
+    p->frames = frames > 0 ? frames : 1;
+    p->last_percent = -1;
+}
+
+void fv_cli_progress_frame(void *user, double fraction)
+{
+    fv_cli_progress *p = user;
+    if (!p->enabled) return;
+    double total = (p->frame + fraction) / p->frames;
+    int percent = (int)(total * 100.0);
+    if (percent == p->last_percent) return;
+    p->last_percent = percent;
+    double el = (fv_time_ms() - p->t0) / 1000.0;
+    double eta = total > 0.001 ? el * (1.0 - total) / total : 0.0;
+    char bar[31];
+    int filled = (int)(total * 30.0);
+    for (int i = 0; i < 30; i++) bar[i] = i < filled ? '#' : '.';
+    bar[30] = '\0';
+    fprintf(stderr, "\r[%s] %3d%%  frame %d/%d  %.0fs elapsed, ETA %.0fs ", bar, percent, p->frame + 1, p->frames, el, eta);
+    fflush(stderr);
+}
+
+void fv_cli_progress_done(fv_cli_progress *p)
+{
+    if (p->enabled) fprintf(stderr, "\r%*s\r", 78, "");
+}

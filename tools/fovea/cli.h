@@ -1,0 +1,47 @@
+/* fovea CLI — helpers shared by the subcommands: argument parsing, exit codes, the warning sink
+ * and the progress bar. The library never exits or prints; this is where that happens. */
+#ifndef FV_CLI_H
+#define FV_CLI_H
+
+#include <stdbool.h>
+#include <stdio.h>
+#include "fovea/fovea.h"
+
+/* Exit statuses of every subcommand. */
+enum { FV_EXIT_OK = 0, FV_EXIT_INTERNAL = 1, FV_EXIT_USAGE = 2 };
+
+/* Status -> exit code: bad input and file problems are the user's (2), the rest ours (1). */
+int fv_cli_exit_code(fv_status s);
+/* Prints "fovea <cmd>: <msg>" on stderr and returns the exit code for s. */
+int fv_cli_fail(const char *cmd, fv_status s, const char *msg);
+/* Prints "fovea <cmd>: <printf...>" on stderr and returns FV_EXIT_USAGE. */
+int fv_cli_usage_error(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Parsers for option values; false with a message in err when malformed. */
+bool fv_cli_parse_int(const char *s, long lo, long hi, long *out);
+bool fv_cli_parse_float(const char *s, double *out);
+bool fv_cli_parse_floats(const char *s, int n, float *out); /* "x,y,z" with exactly n numbers */
+bool fv_cli_parse_size(const char *s, int *w, int *h);      /* "WxH" */
+
+/* Warning sink printing "fovea: warning: ..." on stderr (silenced when quiet). */
+fv_log fv_cli_log(bool *quiet);
+
+/* A progress bar with ETA on stderr, drawn only when stderr is a terminal and not quiet. */
+typedef struct fv_cli_progress {
+    bool enabled;
+    double t0;
+    int frame, frames;
+    int last_percent;
+} fv_cli_progress;
+void fv_cli_progress_init(fv_cli_progress *p, bool quiet, int frames);
+void fv_cli_progress_frame(void *user, double fraction); /* fv_progress_fn */
+void fv_cli_progress_done(fv_cli_progress *p);
+
+/* Subcommands. */
+int fv_cmd_render(int argc, char **argv);
+int fv_cmd_methods(int argc, char **argv);
+int fv_cmd_scenes(int argc, char **argv);
+int fv_cmd_compare(int argc, char **argv);
+int fv_cmd_bench(int argc, char **argv);
+
+#endif

@@ -1,0 +1,45 @@
+/* fovea — command-line entry point: dispatches to one subcommand per file (cmd_*.c). */
+#include <stdio.h>
+#include <string.h>
+#include "cli.h"
+
+typedef struct fv_command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} fv_command;
+
+static const fv_command k_commands[] = {
+    {"render", fv_cmd_render, "render a scene with a method to image files"},
+    {"methods", fv_cmd_methods, "list the rendering methods and their parameters"},
+    {"scenes", fv_cmd_scenes, "list the built-in scenes"},
+};
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: fovea <command> [options]   (fovea <command> --help for details)\n\ncommands:\n");
+    for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
+        fprintf(f, "  %-9s %s\n", k_commands[i].name, k_commands[i].summary);
+    fprintf(f, "\nfovea renders global illumination where the effort follows the viewer's gaze.\n"
+               "Exit status: 0 success, 1 internal error, 2 bad input (the message names it).\n");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return FV_EXIT_USAGE;
+    }
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+        usage(stdout);
+        return FV_EXIT_OK;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        printf("fovea %s\n", FOVEA_VERSION_STRING);
+        return FV_EXIT_OK;
+    }
+    for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
+        if (!strcmp(argv[1], k_commands[i].name)) return k_commands[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "fovea: unknown command '%s' (try fovea --help)\n", argv[1]);
+    return FV_EXIT_USAGE;
+}
