@@ -8,6 +8,7 @@
 #ifndef FOVEA_FILM_H
 #define FOVEA_FILM_H
 
+#include <stdbool.h>
 #include <stdint.h>
 #include "fovea/status.h"
 
@@ -47,6 +48,9 @@ float *fv_film_normal(fv_film *film);
 float *fv_film_albedo(fv_film *film);
 float *fv_film_position(fv_film *film);
 uint32_t *fv_film_id(fv_film *film);
+/* Read-only views: depth/normal/albedo/position by flag (NULL when absent), and the ids. */
+const float *fv_film_aux_const(const fv_film *film, fv_film_aux which);
+const uint32_t *fv_film_id_const(const fv_film *film);
 
 /* ---- image files ---- */
 
