@@ -1,11 +1,20 @@
-/* fovea — where the viewer looks.
+/* fovea — where the viewer looks, and how acuity falls off around it.
  *
- * This header holds the gaze point every technique receives with a frame. The display/eye model,
- * eccentricity, regions and acuity models build on it (see docs/architecture.md, src/gaze/).
+ * The display/eye model turns a pixel's distance from the gaze point into an eccentricity angle
+ * and splits the image into the three regions all the papers use: fovea (radius r_f), transition
+ * (r_f..r_t) and periphery. The acuity models are the ones the papers use to spend effort:
+ *   - Foveated Photon Mapping, Eq. 6 (transition blend) and Eq. 7 (r_f = tan(e_f) * b * PPI);
+ *   - Foveated Instant Radiosity, Sec. 5: foveal radius as a fraction (25%) of the image width;
+ *   - Visual-Polar path tracing, Eq. 1 (acuity V(e)), Eq. 2 (its cumulative distribution) and
+ *     Eq. 3 (the fitted inverse);
+ *   - Inverted-pyramid sphere tracing, Eq. 1: p(w) = 0.90964 e^(-w/2.9661) + 0.00792 (the sign of
+ *     the exponent is negative: the printed positive sign is a typo, acuity falls with w).
+ * Gaze over time is fixed, keyframed, or a recorded trace (docs/gaze.md gives the CSV format).
  */
 #ifndef FOVEA_GAZE_H
 #define FOVEA_GAZE_H
 
+#include <stdint.h>
 #include "fovea/math.h"
 #include "fovea/status.h"
 
@@ -17,6 +26,95 @@ extern "C" {
 typedef struct fv_gaze {
     float x, y;
 } fv_gaze;
+
+/* How the foveal and transition radii are given. */
+typedef enum fv_fovea_mode {
+    FV_FOVEA_ANGLE = 0,  /* angular radii e_f, e_t in degrees -> pixels through the viewing distance */
+    FV_FOVEA_WIDTH       /* radii as fractions of the image width (Foveated Instant Radiosity) */
+} fv_fovea_mode;
+
+/* Display and eye. The viewing distance in pixels D links pixels and angles: a pixel at distance
+ * d pixels from the gaze point has eccentricity atan(d / D), the inverse of Eq. 7 of Foveated
+ * Photon Mapping. D comes from the pixel density and the pupil-to-lens distance (D = b * PPI, the
+ * HMD case) or, when fov_x_deg > 0, from the horizontal field of view (D = (w/2) / tan(fov/2)). */
+typedef struct fv_eye_model {
+    int width, height;      /* pixels per eye */
+    float ppi;              /* pixel density, pixels per inch (HTC Vive: 615) */
+    float eye_dist_mm;      /* pupil-to-lens distance b in mm (HTC Vive: 18) */
+    float fov_x_deg;        /* > 0: horizontal field of view, overrides ppi/eye_dist */
+    fv_fovea_mode mode;
+    float fovea_deg;        /* e_f (default 9.78, Foveated Photon Mapping Sec. 4.1) */
+    float transition_deg;   /* e_t, outer edge of the transition (default 2 e_f: the paper gives none) */
+    float fovea_frac;       /* FV_FOVEA_WIDTH: r_f / width (default 0.25) */
+    float transition_frac;  /* FV_FOVEA_WIDTH: r_t / width (default 0.375) */
+} fv_eye_model;
+
+/* The defaults above for a display of the given size. */
+void fv_eye_model_default(int width, int height, fv_eye_model *out);
+/* Checks every field (positive sizes and densities, 0 < e_f <= e_t < 90, 0 < frac_f <= frac_t). */
+fv_status fv_eye_model_validate(const fv_eye_model *m, fv_error *err);
+
+/* Viewing distance D in pixels. */
+double fv_eye_view_dist_px(const fv_eye_model *m);
+/* Foveal and transition radii r_f <= r_t in pixels (Eq. 7 in angle mode). */
+double fv_eye_fovea_radius_px(const fv_eye_model *m);
+double fv_eye_transition_radius_px(const fv_eye_model *m);
+/* Eccentricity in degrees of pixel centre (x + 0.5, y + 0.5) for a gaze point. */
+double fv_eye_eccentricity_deg(const fv_eye_model *m, fv_gaze g, double px, double py);
+/* Distance of film position (px, py) from the gaze point, in pixels. */
+double fv_eye_gaze_dist_px(const fv_eye_model *m, fv_gaze g, double px, double py);
+
+typedef enum fv_region {
+    FV_REGION_FOVEA = 0,
+    FV_REGION_TRANSITION,
+    FV_REGION_PERIPHERY,
+    FV_REGION_ALL,         /* for reports: the whole image */
+    FV_REGION_COUNT
+} fv_region;
+const char *fv_region_name(fv_region r); /* "fovea", "transition", "periphery", "all" */
+
+/* Region of the pixel (x, y) (its centre) for a gaze. */
+fv_region fv_eye_region(const fv_eye_model *m, fv_gaze g, int x, int y);
+/* Fills labels[y * width + x] with the fv_region of every pixel. */
+void fv_eye_region_labels(const fv_eye_model *m, fv_gaze g, uint8_t *labels);
+/* Transition blend weight b(x) of Foveated Photon Mapping Eq. 6, clamped to [0,1]: 0 in the
+ * fovea, 1 in the periphery, linear in the pixel distance in between. */
+double fv_eye_blend(const fv_eye_model *m, fv_gaze g, double px, double py);
+
+/* ---- acuity models ---- */
+
+/* Visual acuity in cycles per degree at eccentricity e (Visual-Polar, Eq. 1). */
+double fv_acuity_v(double e_deg);
+/* The cumulative distribution of Visual-Polar Eq. 2 at distance d (degrees) from the gaze. */
+double fv_acuity_cdf(double d_deg);
+/* Eq. 3: the fitted polynomial inverse of the cumulative distribution, for p in [0,1]. */
+double fv_acuity_cdf_inv_fit(double p);
+/* Sphere-tracing probability (Inverted pyramid, Eq. 1, exponent negative) with its three zones:
+ * 1 inside fovea_deg, 0 beyond outer_deg (<= 0: no outer zone), the fitted fall-off between. */
+double fv_acuity_hyperbolic(double w_deg, double fovea_deg, double outer_deg);
+/* Linear fall-off: 1 up to e0, min_value from e1 on, linear between (Visual-Polar's baseline). */
+double fv_acuity_linear(double e_deg, double e0, double e1, double min_value);
+
+/* ---- gaze over time ---- */
+
+typedef struct fv_gaze_key {
+    double time;
+    fv_gaze left, right;   /* right == left for a monocular trace */
+} fv_gaze_key;
+
+typedef struct fv_gaze_path fv_gaze_path;
+
+/* A fixed gaze (both eyes). Coordinates must be in [0,1]. */
+fv_status fv_gaze_path_create_fixed(fv_gaze g, fv_gaze_path **out, fv_error *err);
+/* Keys with strictly increasing times, linear interpolation, end keys held. */
+fv_status fv_gaze_path_create_keys(const fv_gaze_key *keys, int count, fv_gaze_path **out, fv_error *err);
+/* A recorded trace: CSV lines "time,x,y" or "time,xl,yl,xr,yr" (docs/gaze.md); '#' comments
+ * and a header line are allowed. Errors name the file and line. */
+fv_status fv_gaze_path_load_csv(const char *path, fv_gaze_path **out, fv_error *err);
+void fv_gaze_path_destroy(fv_gaze_path *p);
+/* Gaze of each eye at time t. */
+void fv_gaze_path_eval(const fv_gaze_path *p, double t, fv_gaze *left, fv_gaze *right);
+int fv_gaze_path_key_count(const fv_gaze_path *p);
 
 #ifdef __cplusplus
 }

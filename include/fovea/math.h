@@ -14,6 +14,7 @@ extern "C" {
 #endif
 
 #define FV_PI 3.14159265358979323846f
+#define FV_PI_D 3.14159265358979323846
 #define FV_INV_PI 0.31830988618379067154f
 
 typedef struct fv_vec3 { float x, y, z; } fv_vec3;

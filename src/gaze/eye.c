@@ -1,0 +1,115 @@
+/* fovea — display/eye model: eccentricity of a pixel and the fovea / transition / periphery split.
+ *
+ * Foveated Photon Mapping, Eq. 7 gives the foveal radius in pixels as tan(e_f) * b * PPI with b the
+ * pupil-to-lens distance; we read b * PPI as a viewing distance D in pixels and use the same
+ * relation both ways (eccentricity = atan(d / D) for a pixel d pixels from the gaze point), so
+ * radii given in degrees and eccentricities measured in degrees always agree. Eq. 6 gives the
+ * transition blend weight. Foveated Instant Radiosity (Sec. 5) gives the radius as 25% of the
+ * image width instead; FV_FOVEA_WIDTH covers it.
+ */
+#include <math.h>
+#include "fovea/gaze.h"
+
+#define MM_PER_INCH 25.4
+
+void fv_eye_model_default(int width, int height, fv_eye_model *m)
+{
+    m->width = width;
+    m->height = height;
+    m->ppi = 615.0f;        /* HTC Vive (Foveated Photon Mapping, Sec. 4.1) */
+    m->eye_dist_mm = 18.0f; /* HTC Vive pupil-to-lens distance, same section */
+    m->fov_x_deg = 0.0f;
+    m->mode = FV_FOVEA_ANGLE;
+    m->fovea_deg = 9.78f;
+    m->transition_deg = 2.0f * 9.78f;
+    m->fovea_frac = 0.25f;  /* Foveated Instant Radiosity, Sec. 5 */
+    m->transition_frac = 0.375f;
+}
+
+fv_status fv_eye_model_validate(const fv_eye_model *m, fv_error *err)
+{
+    if (m->width < 1 || m->height < 1)
+        return fv_error_set(err, FV_ERR_INVALID, "eye model: display size %dx%d must be positive", m->width, m->height);
+    if (!(m->fov_x_deg >= 0.0f && m->fov_x_deg < 180.0f))
+        return fv_error_set(err, FV_ERR_INVALID, "eye model: field of view %g must be in (0,180) degrees (0: use ppi)", m->fov_x_deg);
+    if (m->fov_x_deg == 0.0f && !(m->ppi > 0.0f && isfinite(m->ppi) && m->eye_dist_mm > 0.0f && isfinite(m->eye_dist_mm)))
+        return fv_error_set(err, FV_ERR_INVALID, "eye model: ppi (%g) and eye distance (%g mm) must be positive", m->ppi, m->eye_dist_mm);
+    if (m->mode == FV_FOVEA_ANGLE) {
+        if (!(m->fovea_deg > 0.0f && m->fovea_deg <= m->transition_deg && m->transition_deg < 90.0f))
+            return fv_error_set(err, FV_ERR_INVALID, "eye model: need 0 < fovea (%g) <= transition (%g) < 90 degrees", m->fovea_deg,
+                                m->transition_deg);
+    } else if (m->mode == FV_FOVEA_WIDTH) {
+        if (!(m->fovea_frac > 0.0f && m->fovea_frac <= m->transition_frac && m->transition_frac <= 4.0f))
+            return fv_error_set(err, FV_ERR_INVALID, "eye model: need 0 < fovea fraction (%g) <= transition fraction (%g) <= 4",
+                                m->fovea_frac, m->transition_frac);
+    } else {
+        return fv_error_set(err, FV_ERR_INVALID, "eye model: unknown fovea mode %d", (int)m->mode);
+    }
+    return FV_OK;
+}
+
+double fv_eye_view_dist_px(const fv_eye_model *m)
+{
+    if (m->fov_x_deg > 0.0f) return 0.5 * m->width / tan(0.5 * m->fov_x_deg * FV_PI_D / 180.0);
+    return (double)m->eye_dist_mm / MM_PER_INCH * m->ppi;
+}
+
+double fv_eye_fovea_radius_px(const fv_eye_model *m)
+{
+    if (m->mode == FV_FOVEA_WIDTH) return (double)m->fovea_frac * m->width;
+    return tan(m->fovea_deg * FV_PI_D / 180.0) * fv_eye_view_dist_px(m);
+}
+
+double fv_eye_transition_radius_px(const fv_eye_model *m)
+{
+    if (m->mode == FV_FOVEA_WIDTH) return (double)m->transition_frac * m->width;
+    return tan(m->transition_deg * FV_PI_D / 180.0) * fv_eye_view_dist_px(m);
+}
+
+double fv_eye_gaze_dist_px(const fv_eye_model *m, fv_gaze g, double px, double py)
+{
+    return hypot(px - (double)g.x * m->width, py - (double)g.y * m->height);
+}
+
+double fv_eye_eccentricity_deg(const fv_eye_model *m, fv_gaze g, double px, double py)
+{
+    return atan(fv_eye_gaze_dist_px(m, g, px, py) / fv_eye_view_dist_px(m)) * 180.0 / FV_PI_D;
+}
+
+const char *fv_region_name(fv_region r)
+{
+    switch (r) {
+    case FV_REGION_FOVEA: return "fovea";
+    case FV_REGION_TRANSITION: return "transition";
+    case FV_REGION_PERIPHERY: return "periphery";
+    case FV_REGION_ALL: return "all";
+    default: return "?";
+    }
+}
+
+static fv_region classify(double d, double rf, double rt)
+{
+    return d <= rf ? FV_REGION_FOVEA : d <= rt ? FV_REGION_TRANSITION : FV_REGION_PERIPHERY;
+}
+
+fv_region fv_eye_region(const fv_eye_model *m, fv_gaze g, int x, int y)
+{
+    return classify(fv_eye_gaze_dist_px(m, g, x + 0.5, y + 0.5), fv_eye_fovea_radius_px(m), fv_eye_transition_radius_px(m));
+}
+
+void fv_eye_region_labels(const fv_eye_model *m, fv_gaze g, uint8_t *labels)
+{
+    double rf = fv_eye_fovea_radius_px(m), rt = fv_eye_transition_radius_px(m);
+    for (int y = 0; y < m->height; y++)
+        for (int x = 0; x < m->width; x++)
+            labels[(size_t)y * m->width + x] = (uint8_t)classify(fv_eye_gaze_dist_px(m, g, x + 0.5, y + 0.5), rf, rt);
+}
+
+double fv_eye_blend(const fv_eye_model *m, fv_gaze g, double px, double py)
+{
+    double d = fv_eye_gaze_dist_px(m, g, px, py);
+    double rf = fv_eye_fovea_radius_px(m), rt = fv_eye_transition_radius_px(m);
+    if (d <= rf) return 0.0;
+    if (d >= rt || rt <= rf) return 1.0;
+    return (d - rf) / (rt - rf);
+}
