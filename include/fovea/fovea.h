@@ -14,5 +14,7 @@
 #include "fovea/scene.h"
 #include "fovea/film.h"
 #include "fovea/technique.h"
+#include "fovea/metrics.h"
+#include "fovea/bench.h"
 
 #endif

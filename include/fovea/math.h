@@ -107,6 +107,23 @@ static inline fv_quat fv_quat_axis_angle(fv_vec3 axis, float angle)
     return q;
 }
 
+/* Hamilton product: rotating by b, then by a. */
+static inline fv_quat fv_quat_mul(fv_quat a, fv_quat b)
+{
+    fv_quat r = {a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y, a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+                 a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w, a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z};
+    return r;
+}
+
+/* Rotation about x, then y, then z (fixed axes), angles in degrees. */
+static inline fv_quat fv_quat_euler_deg(fv_vec3 deg)
+{
+    fv_quat qx = fv_quat_axis_angle(fv_v3(1, 0, 0), fv_radians(deg.x));
+    fv_quat qy = fv_quat_axis_angle(fv_v3(0, 1, 0), fv_radians(deg.y));
+    fv_quat qz = fv_quat_axis_angle(fv_v3(0, 0, 1), fv_radians(deg.z));
+    return fv_quat_mul(qz, fv_quat_mul(qy, qx));
+}
+
 /* Spherical linear interpolation along the shorter arc. */
 static inline fv_quat fv_quat_slerp(fv_quat a, fv_quat b, float t)
 {

@@ -128,6 +128,14 @@ const fv_material *fv_scene_material(const fv_scene *scene, int id);
 void fv_scene_camera(const fv_scene *scene, double t, int width, int height, fv_camera *out);
 bool fv_scene_has_camera_path(const fv_scene *scene);
 
+/* The display/eye model and the gaze path a scene file may carry ("display" and "gaze" blocks).
+ * fv_scene_eye returns false (and leaves *out alone) when the scene has none. The scene takes
+ * ownership of the gaze path. */
+void fv_scene_set_eye(fv_scene *scene, const fv_eye_model *eye);
+bool fv_scene_eye(const fv_scene *scene, fv_eye_model *out);
+void fv_scene_set_gaze_path(fv_scene *scene, fv_gaze_path *path);
+const fv_gaze_path *fv_scene_gaze_path(const fv_scene *scene);
+
 /* ---- loading ---- */
 
 /* Loads SCENE, a built-in name (see fv_builtin_*) or a file path: .json (fovea scene format,

@@ -87,6 +87,8 @@ typedef struct fv_frame {
     const fv_camera *prev_camera_right;
     fv_gaze gaze;                     /* gaze of the (left) eye */
     fv_gaze gaze_right;
+    const fv_eye_model *eye;          /* display/eye model for the regions; NULL: fv_eye_model_default
+                                         for the film's size */
     fv_progress_fn progress;          /* optional, called with the fraction of the frame done */
     void *progress_user;
 } fv_frame;

@@ -8,7 +8,6 @@
  * Limits: PNG read is 8 bits per channel (16-bit files are reduced); EXR read takes the first
  * part, scanline or tiled images decoded by scanline chunks only (tiled files are refused).
  */
-#define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>

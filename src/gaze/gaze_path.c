@@ -4,7 +4,6 @@
  * the tracker's rate can drive frames at any rate. Limits: no saccade detection or filtering; a
  * trace is read whole into memory.
  */
-#define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>

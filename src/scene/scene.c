@@ -54,6 +54,7 @@ void fv_scene_destroy(fv_scene *s)
     free(s->lights);
     free(s->light_cdf);
     free(s->cam_keys);
+    fv_gaze_path_destroy(s->gaze);
     free(s);
 }
 
@@ -243,6 +244,26 @@ void fv_scene_set_camera(fv_scene *s, const fv_camera *c)
     s->camera = *c;
     s->has_camera = true;
 }
+
+void fv_scene_set_eye(fv_scene *s, const fv_eye_model *eye)
+{
+    s->eye = *eye;
+    s->has_eye = true;
+}
+
+bool fv_scene_eye(const fv_scene *s, fv_eye_model *out)
+{
+    if (s->has_eye) *out = s->eye;
+    return s->has_eye;
+}
+
+void fv_scene_set_gaze_path(fv_scene *s, fv_gaze_path *path)
+{
+    fv_gaze_path_destroy(s->gaze);
+    s->gaze = path;
+}
+
+const fv_gaze_path *fv_scene_gaze_path(const fv_scene *s) { return s->gaze; }
 
 fv_status fv_scene_set_camera_path(fv_scene *s, const fv_camera_key *keys, int count, fv_error *err)
 {
@@ -591,6 +612,15 @@ bool fv_scene_occluded(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d
     r.flags = 0;
     rtcOccluded1(scn, &ctx, &r);
     return r.tfar < 0.0f;
+}
+
+bool fv_scene_visible(const fv_scene *s, fv_trace_set set, fv_vec3 p, fv_vec3 ng, fv_vec3 q)
+{
+    fv_vec3 o = fv_offset_point(s, p, ng, fv_sub(q, p));
+    fv_vec3 d = fv_sub(q, o);
+    float len = fv_length(d);
+    if (!(len > 2.0f * s->eps)) return true;
+    return !fv_scene_occluded(s, set, o, fv_scale(d, 1.0f / len), len - s->eps);
 }
 
 void fv_scene_triangle(const fv_scene *s, int obj, int prim, fv_vec3 *a, fv_vec3 *b, fv_vec3 *c)

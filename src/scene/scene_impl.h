@@ -68,6 +68,10 @@ struct fv_scene {
     fv_camera camera;
     fv_camera_key *cam_keys;
     int ncam_keys;
+
+    bool has_eye;
+    fv_eye_model eye;
+    fv_gaze_path *gaze;        /* owned */
 };
 
 /* ---- ray queries (scene.c) ---- */
@@ -91,6 +95,11 @@ typedef struct fv_hit {
 bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax, fv_hit *hit);
 /* Any hit in (eps, tmax). */
 bool fv_scene_occluded(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax);
+/* True when nothing blocks the segment from surface point p (geometric normal ng, either side)
+ * to point q, q excluded: the shadow ray of next-event estimation and of every light connection.
+ * The ray starts off the surface and stops eps short of q, so q may lie on a light's surface. */
+bool fv_scene_visible(const fv_scene *s, fv_trace_set set, fv_vec3 p, fv_vec3 ng, fv_vec3 q);
+
 /* A point just off the surface on the side of direction d, to start the next ray from. */
 static inline fv_vec3 fv_offset_point(const fv_scene *s, fv_vec3 p, fv_vec3 ng, fv_vec3 d)
 {

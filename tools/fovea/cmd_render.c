@@ -83,7 +83,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
     opterr = 0;
     optind = 1;
     int c;
-    while ((c = getopt_long(argc, argv, "+h", longs, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "h", longs, NULL)) != -1) {
         switch (c) {
         case O_METHOD: o->method = optarg; break;
         case O_SPP:

@@ -13,6 +13,8 @@ static const fv_command k_commands[] = {
     {"render", fv_cmd_render, "render a scene with a method to image files"},
     {"methods", fv_cmd_methods, "list the rendering methods and their parameters"},
     {"scenes", fv_cmd_scenes, "list the built-in scenes"},
+    {"compare", fv_cmd_compare, "error metrics per region between two images"},
+    {"bench", fv_cmd_bench, "run a benchmark scenario: timings and errors side by side"},
 };
 
 static void usage(FILE *f)

@@ -4,8 +4,9 @@
  * Next-event estimation at every non-delta vertex, combined with BSDF sampling by multiple
  * importance sampling (balance heuristic, Veach 1997 ch. 9) for area lights; delta lights are
  * sampled only by NEE, delta lobes only by the BSDF. Russian roulette from `rr_depth` on, with
- * survival probability max(throughput) capped at 0.95. `max_depth` counts path segments after
- * the camera: 1 = direct light only (Embree's `--max-path-length` convention). No environment
+ * survival probability max(throughput) capped at 0.95. `max_depth` is the number of path vertices
+ * that gather light: 1 = direct light only (emission seen directly plus one light connection),
+ * which is the convention of Embree's `--max-path-length`. No environment
  * light: rays leaving the scene carry nothing.
  */
 #include <stdlib.h>
@@ -52,8 +53,6 @@ fv_vec3 fv_pt_trace(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_v
             if (!delta_prev) w = mis_weight(pdf_prev, fv_light_pdf_li(s, h.obj, h.prim, p_prev, h.p, h.ng, d));
             L = fv_add(L, fv_mul(beta, fv_scale(le, w)));
         }
-        if (depth == opt->max_depth) break;
-
         /* Shading frame: two-sided surfaces face the incoming ray; glass keeps its orientation
          * so the BSDF can tell entering from leaving. */
         fv_vec3 ng = h.ng, ns = h.ns;
@@ -74,10 +73,11 @@ fv_vec3 fv_pt_trace(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_v
                 fv_vec3 f = fv_bsdf_eval(m, wo_l, fv_to_local(ls.wi, t, b, ns), &pdf_b);
                 float cosv = fabsf(fv_dot(ls.wi, ns));
                 if (fv_max3(f) > 0.0f) {
-                    fv_vec3 po = fv_offset_point(s, h.p, ng, ls.wi);
                     nrays++;
-                    if (!fv_scene_occluded(s, FV_TRACE_ALL, po, ls.wi, ls.dist * (1.0f - 1e-4f) - s->eps)) {
-                        float w = ls.delta ? 1.0f : mis_weight(ls.pdf, pdf_b);
+                    if (fv_scene_visible(s, FV_TRACE_ALL, h.p, ng, fv_madd(h.p, ls.wi, ls.dist))) {
+                        /* At the last vertex BSDF sampling does not continue, so light sampling
+                         * is the only strategy for these paths and takes the full weight. */
+                        float w = ls.delta || depth == opt->max_depth ? 1.0f : mis_weight(ls.pdf, pdf_b);
                         L = fv_add(L, fv_mul(beta, fv_scale(fv_mul(f, ls.li), cosv * w / ls.pdf)));
                     }
                 }
@@ -86,6 +86,7 @@ fv_vec3 fv_pt_trace(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_v
             /* keep the random stream aligned across material types */
             rng->dim += 3;
         }
+        if (depth == opt->max_depth) break;
 
         fv_bsdf_sample bs;
         float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), u2 = fv_rng_next(rng);

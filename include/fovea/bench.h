@@ -1,0 +1,45 @@
+/* fovea — the benchmark harness: renders a scenario's methods side by side in one run, times them
+ * (median of repeats), measures their error per region against a cached reference, and writes a
+ * JSON report, a Markdown table, images and, for parameter sweeps, a CSV and a plot.
+ *
+ * The scenario file format is documented in docs/bench.md; scenarios live in bench/.
+ */
+#ifndef FOVEA_BENCH_H
+#define FOVEA_BENCH_H
+
+#include "fovea/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum fv_bench_mode {
+    FV_BENCH_DEFAULT = 0, /* a few minutes on a 2-core machine */
+    FV_BENCH_QUICK,       /* under a minute: used by the tests */
+    FV_BENCH_FULL         /* the papers' sizes */
+} fv_bench_mode;
+
+typedef struct fv_bench_options {
+    const char *out_dir;    /* where reports and images go (created if missing) */
+    const char *cache_dir;  /* reference cache; NULL: <out_dir>/cache */
+    fv_bench_mode mode;
+    int threads;            /* 0: all */
+    int repeats;            /* > 0 overrides the scenario's */
+    const fv_log *log;      /* warnings */
+    /* Progress lines ("[2/6] pt-4: repeat 1/3, frame 2/5"); may be NULL. */
+    void (*status)(void *user, const char *line);
+    void *status_user;
+} fv_bench_options;
+
+/* Runs the scenario file at `path`. Bad scenario -> FV_ERR_INVALID naming file and field. Writes
+ * <out_dir>/<name>.json, <name>.md, <name>/ images and, with a sweep, <name>-sweep.csv and .png.
+ * Every file is written whole or not at all. */
+fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *err);
+
+/* Only parses and validates the scenario (for `fovea bench --check`). */
+fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,36 @@
+/* fovea — benchmark harness internals shared by the runner (run.c) and the reports (report.c). */
+#ifndef FV_BENCH_IMPL_H
+#define FV_BENCH_IMPL_H
+
+#include "bench/scenario.h"
+#include "fovea/metrics.h"
+
+/* What one method measured over all frames and repeats. */
+typedef struct fv_bench_result {
+    const fv_bench_method *m;
+    double *ms;                 /* per repeat: mean ms per frame */
+    double ms_median, ms_min, ms_max;
+    double speedup;             /* baseline median / this median */
+    fv_stats stages;            /* per stage: median over repeats of the mean per frame */
+    fv_stats counters;          /* mean per frame, last repeat */
+    fv_metric_report error;     /* mean over frames, per region */
+    bool has_temporal;
+    double temporal_mse[FV_REGION_COUNT], temporal_e[FV_REGION_COUNT];
+    char img[4096], heat[4096], crop[4096]; /* paths relative to the output folder */
+} fv_bench_result;
+
+typedef struct fv_bench_run_info {
+    const fv_scenario *sc;
+    const fv_bench_options *opt;
+    int threads;
+    const char *out_dir;
+    double ref_ms;              /* reference render time per frame (0 when cached) */
+    int ref_cached;             /* how many reference frames came from the cache */
+    char ref_img[4096];
+    fv_gaze last_gaze;          /* gaze at the last frame (the images show it) */
+} fv_bench_run_info;
+
+/* report.c */
+fv_status fv_bench_write_reports(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err);
+
+#endif

@@ -1,0 +1,268 @@
+/* fovea — benchmark reports: <name>.json (every figure, machine-readable), <name>.md (a table like
+ * the papers' plus the images), and for a sweep <name>-sweep.csv and <name>-sweep.png (plotted
+ * with gnuplot when it is installed; the CSV is written regardless).
+ */
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "bench/bench_impl.h"
+#include "core/fileio.h"
+#include "fovea/fovea.h"
+
+/* A growable text buffer for the Markdown and CSV files. */
+typedef struct text {
+    char *s;
+    size_t len, cap;
+    bool oom;
+} text;
+
+static void tprintf(text *t, const char *fmt, ...)
+{
+    if (t->oom) return;
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        int w = vsnprintf(t->s ? t->s + t->len : NULL, t->s ? t->cap - t->len : 0, fmt, ap);
+        va_end(ap);
+        if (w < 0) {
+            t->oom = true;
+            return;
+        }
+        if (t->s && t->len + (size_t)w < t->cap) {
+            t->len += (size_t)w;
+            return;
+        }
+        size_t nc = (t->cap ? t->cap * 2 : 4096) + (size_t)w;
+        char *ns = realloc(t->s, nc);
+        if (!ns) {
+            t->oom = true;
+            return;
+        }
+        t->s = ns;
+        t->cap = nc;
+    }
+}
+
+static fv_status text_write(text *t, const char *path, fv_error *err)
+{
+    fv_status st = t->oom ? fv_error_set(err, FV_ERR_NOMEM, "out of memory writing '%s'", path)
+                          : fv_file_write_atomic(path, t->s ? t->s : "", t->len, err);
+    free(t->s);
+    memset(t, 0, sizeof *t);
+    return st;
+}
+
+/* JSON numbers cannot be inf or NaN: those become null. */
+static cJSON *num(double v) { return isfinite(v) ? cJSON_CreateNumber(v) : cJSON_CreateNull(); }
+
+static cJSON *params_json(const fv_params *p)
+{
+    cJSON *o = cJSON_CreateObject();
+    for (int i = 0; i < fv_params_count(p); i++) cJSON_AddStringToObject(o, fv_params_key(p, i), fv_params_value(p, i));
+    return o;
+}
+
+static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *r)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "method", r->m->label);
+    cJSON_AddStringToObject(o, "technique", r->m->method);
+    cJSON_AddItemToObject(o, "params", params_json(r->m->params));
+    if (r->m->from_sweep) cJSON_AddItemToObject(o, "sweep_value", num(r->m->sweep_value));
+    cJSON *ms = cJSON_AddObjectToObject(o, "ms_per_frame");
+    cJSON_AddItemToObject(ms, "median", num(r->ms_median));
+    cJSON_AddItemToObject(ms, "min", num(r->ms_min));
+    cJSON_AddItemToObject(ms, "max", num(r->ms_max));
+    int reps = info->opt->repeats > 0 ? info->opt->repeats : info->sc->repeats;
+    cJSON *all = cJSON_AddArrayToObject(ms, "repeats");
+    for (int i = 0; i < reps; i++) cJSON_AddItemToArray(all, num(r->ms[i]));
+    cJSON *st = cJSON_AddObjectToObject(o, "stages_ms");
+    for (int i = 0; i < r->stages.n_stages; i++) cJSON_AddItemToObject(st, r->stages.stage[i].name, num(r->stages.stage[i].value));
+    cJSON_AddItemToObject(o, "speedup", num(r->speedup));
+    cJSON *er = cJSON_AddObjectToObject(o, "error");
+    for (int g = 0; g < FV_REGION_COUNT; g++) {
+        const fv_metric_values *v = &r->error.region[g];
+        cJSON *e = cJSON_AddObjectToObject(er, fv_region_name((fv_region)g));
+        cJSON_AddNumberToObject(e, "pixels", (double)v->pixels);
+        cJSON_AddItemToObject(e, "mse", num(v->mse));
+        cJSON_AddItemToObject(e, "psnr", num(v->psnr));
+        cJSON_AddItemToObject(e, "e", num(v->e));
+        cJSON_AddItemToObject(e, "ssim", num(v->ssim));
+        cJSON_AddItemToObject(e, "flip", num(v->flip));
+    }
+    cJSON *te = cJSON_AddObjectToObject(o, "temporal");
+    for (int g = 0; g < FV_REGION_COUNT; g++) {
+        cJSON *e = cJSON_AddObjectToObject(te, fv_region_name((fv_region)g));
+        cJSON_AddItemToObject(e, "mse", r->has_temporal ? num(r->temporal_mse[g]) : cJSON_CreateNull());
+        cJSON_AddItemToObject(e, "e", r->has_temporal ? num(r->temporal_e[g]) : cJSON_CreateNull());
+    }
+    cJSON *co = cJSON_AddObjectToObject(o, "counters");
+    for (int i = 0; i < r->counters.n_counters; i++)
+        cJSON_AddItemToObject(co, r->counters.counter[i].name, num(r->counters.counter[i].value));
+    cJSON *im = cJSON_AddObjectToObject(o, "images");
+    cJSON_AddStringToObject(im, "frame", r->img);
+    cJSON_AddStringToObject(im, "flip", r->heat);
+    cJSON_AddStringToObject(im, "fovea", r->crop);
+    return o;
+}
+
+static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
+{
+    const fv_scenario *sc = info->sc;
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "scenario", sc->name);
+    if (sc->description) cJSON_AddStringToObject(root, "description", sc->description);
+    cJSON_AddStringToObject(root, "fovea_version", FOVEA_VERSION_STRING);
+    cJSON_AddStringToObject(root, "scene", sc->scene);
+    cJSON *size = cJSON_AddArrayToObject(root, "size");
+    cJSON_AddItemToArray(size, cJSON_CreateNumber(sc->width));
+    cJSON_AddItemToArray(size, cJSON_CreateNumber(sc->height));
+    cJSON_AddNumberToObject(root, "frames", sc->frames);
+    cJSON_AddNumberToObject(root, "fps", sc->fps);
+    cJSON_AddNumberToObject(root, "repeats", info->opt->repeats > 0 ? info->opt->repeats : sc->repeats);
+    cJSON_AddNumberToObject(root, "threads", info->threads);
+    cJSON_AddStringToObject(root, "mode", info->opt->mode == FV_BENCH_QUICK ? "quick" : info->opt->mode == FV_BENCH_FULL ? "full" : "default");
+    cJSON *eye = cJSON_AddObjectToObject(root, "eye");
+    cJSON_AddItemToObject(eye, "fovea_radius_px", num(fv_eye_fovea_radius_px(&sc->eye)));
+    cJSON_AddItemToObject(eye, "transition_radius_px", num(fv_eye_transition_radius_px(&sc->eye)));
+    cJSON *ref = cJSON_AddObjectToObject(root, "reference");
+    cJSON_AddStringToObject(ref, "method", sc->reference.method);
+    cJSON_AddItemToObject(ref, "params", params_json(sc->reference.params));
+    cJSON_AddNumberToObject(ref, "cached_frames", info->ref_cached);
+    cJSON_AddItemToObject(ref, "ms_per_frame", info->ref_ms > 0 ? num(info->ref_ms) : cJSON_CreateNull());
+    cJSON_AddStringToObject(ref, "image", info->ref_img);
+    cJSON_AddStringToObject(root, "baseline", sc->baseline);
+    cJSON *rows = cJSON_AddArrayToObject(root, "results");
+    for (int i = 0; i < n; i++) cJSON_AddItemToArray(rows, result_json(info, &res[i]));
+    char *textj = cJSON_Print(root);
+    cJSON_Delete(root);
+    if (!textj) return fv_error_set(err, FV_ERR_NOMEM, "out of memory writing the JSON report");
+    char path[4096 + 128];
+    snprintf(path, sizeof path, "%s/%s.json", info->out_dir, sc->name);
+    fv_status st = fv_file_write_atomic(path, textj, strlen(textj), err);
+    free(textj);
+    return st;
+}
+
+static const char *sci(char *buf, double v)
+{
+    if (!isfinite(v)) return strcpy(buf, "–");
+    snprintf(buf, 32, "%.3g", v);
+    return buf;
+}
+
+static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
+{
+    const fv_scenario *sc = info->sc;
+    text t = {0};
+    char a[32], b[32], c[32], d[32], e[32], f[32], g[32], h[32];
+    tprintf(&t, "# Benchmark `%s`\n\n", sc->name);
+    if (sc->description) tprintf(&t, "%s\n\n", sc->description);
+    tprintf(&t, "Scene `%s`, %dx%d, %d frame(s) at %g fps, gaze (%.2f, %.2f) at the last frame, fovea radius %.0f px, "
+                "transition %.0f px. Reference: `%s`",
+            sc->scene, sc->width, sc->height, sc->frames, sc->fps, info->last_gaze.x, info->last_gaze.y, fv_eye_fovea_radius_px(&sc->eye),
+            fv_eye_transition_radius_px(&sc->eye), sc->reference.method);
+    for (int i = 0; i < fv_params_count(sc->reference.params); i++)
+        tprintf(&t, " %s=%s", fv_params_key(sc->reference.params, i), fv_params_value(sc->reference.params, i));
+    int reps = info->opt->repeats > 0 ? info->opt->repeats : sc->repeats;
+    tprintf(&t, ". Times are medians of %d repeat(s) (ms per frame, render call only); speed-up is relative to `%s`. "
+                "Errors are means over frames on display values (exposure %g, sRGB); MSE' is the temporal error "
+                "(Foveated Photon Mapping Eq. 9).\n\n",
+            reps, sc->baseline, sc->exposure);
+    tprintf(&t, "| method | params | ms/frame | speed-up | MSE fovea | MSE transition | MSE periphery | SSIM fovea | FLIP fovea | "
+                "FLIP all | MSE' fovea | MSE' periphery |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (int i = 0; i < n; i++) {
+        const fv_bench_result *r = &res[i];
+        tprintf(&t, "| %s | ", r->m->label);
+        for (int k = 0; k < fv_params_count(r->m->params); k++)
+            tprintf(&t, "%s%s=%s", k ? " " : "", fv_params_key(r->m->params, k), fv_params_value(r->m->params, k));
+        const fv_metric_values *v = r->error.region;
+        tprintf(&t, " | %.1f | %.2f | %s | %s | %s | %s | %s | %s | %s | %s |\n", r->ms_median, r->speedup,
+                sci(a, v[FV_REGION_FOVEA].mse), sci(b, v[FV_REGION_TRANSITION].mse), sci(c, v[FV_REGION_PERIPHERY].mse),
+                sci(d, v[FV_REGION_FOVEA].ssim), sci(e, v[FV_REGION_FOVEA].flip), sci(f, v[FV_REGION_ALL].flip),
+                sci(g, r->has_temporal ? r->temporal_mse[FV_REGION_FOVEA] : NAN),
+                sci(h, r->has_temporal ? r->temporal_mse[FV_REGION_PERIPHERY] : NAN));
+    }
+    tprintf(&t, "\n| method | last frame | FLIP error (rings: fovea, transition) | around the gaze |\n|---|---|---|---|\n");
+    tprintf(&t, "| reference | ![](%s) | | |\n", info->ref_img);
+    for (int i = 0; i < n; i++)
+        tprintf(&t, "| %s | ![](%s) | ![](%s) | ![](%s) |\n", res[i].m->label, res[i].img, res[i].heat, res[i].crop);
+    if (sc->has_sweep) tprintf(&t, "\nSweep of `%s` over `%s`: ![](%s-sweep.png) (data: %s-sweep.csv)\n", sc->sweep_method, sc->sweep_param, sc->name, sc->name);
+    char path[4096 + 128];
+    snprintf(path, sizeof path, "%s/%s.md", info->out_dir, sc->name);
+    return text_write(&t, path, err);
+}
+
+/* Runs gnuplot on a script; false when gnuplot is missing or fails (the CSV still stands). */
+static bool run_gnuplot(const char *script_path)
+{
+    pid_t pid = fork();
+    if (pid < 0) return false;
+    if (pid == 0) {
+        if (!freopen("/dev/null", "w", stdout)) _exit(127);
+        execlp("gnuplot", "gnuplot", script_path, (char *)NULL);
+        _exit(127);
+    }
+    int status = 0;
+    if (waitpid(pid, &status, 0) < 0) return false;
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
+{
+    const fv_scenario *sc = info->sc;
+    text t = {0};
+    tprintf(&t, "%s,ms_per_frame,speedup,mse_fovea,mse_transition,mse_periphery,mse_all,ssim_fovea,ssim_all,flip_fovea,flip_"
+                "transition,flip_periphery,flip_all\n",
+            sc->sweep_param);
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i < n; i++) {
+        const fv_bench_result *r = &res[i];
+        if (!r->m->from_sweep) continue;
+        const fv_metric_values *v = r->error.region;
+        lo = fmin(lo, r->m->sweep_value);
+        hi = fmax(hi, r->m->sweep_value);
+        tprintf(&t, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", r->m->sweep_value, r->ms_median, r->speedup,
+                v[0].mse, v[1].mse, v[2].mse, v[3].mse, v[0].ssim, v[3].ssim, v[0].flip, v[1].flip, v[2].flip, v[3].flip);
+    }
+    char csv[4096 + 128], png[4096 + 128], gp[4096 + 128];
+    snprintf(csv, sizeof csv, "%s/%s-sweep.csv", info->out_dir, sc->name);
+    snprintf(png, sizeof png, "%s/%s-sweep.png", info->out_dir, sc->name);
+    snprintf(gp, sizeof gp, "%s/%s-sweep.gp", info->out_dir, sc->name);
+    fv_status st = text_write(&t, csv, err);
+    if (st != FV_OK) return st;
+    /* MSE per region against the swept value; log axes when the values span a decade. */
+    bool logx = lo > 0 && hi / lo >= 10.0;
+    char tmp_png[4096 + 160];
+    snprintf(tmp_png, sizeof tmp_png, "%s.tmp.png", png);
+    tprintf(&t,
+            "set terminal png size 800,500\nset output '%s'\nset datafile separator ','\nset key top right\n"
+            "set title \"%s: error per region vs %s\" noenhanced\nset xlabel '%s' noenhanced\nset ylabel 'MSE'\n"
+            "set logscale y\n%s\nset grid\n"
+            "plot '%s' every ::1 using 1:4 with linespoints lw 2 title 'fovea', "
+            "'' every ::1 using 1:5 with linespoints lw 2 title 'transition', "
+            "'' every ::1 using 1:6 with linespoints lw 2 title 'periphery'\n",
+            tmp_png, sc->name, sc->sweep_param, sc->sweep_param, logx ? "set logscale x 2" : "", csv);
+    if ((st = text_write(&t, gp, err)) != FV_OK) return st;
+    if (run_gnuplot(gp) && rename(tmp_png, png) == 0) {
+        unlink(gp);
+        return FV_OK;
+    }
+    unlink(tmp_png);
+    unlink(gp);
+    fv_log_warn(info->opt->log, "could not plot %s with gnuplot (is gnuplot installed?); the CSV %s is complete", png, csv);
+    return FV_OK;
+}
+
+fv_status fv_bench_write_reports(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
+{
+    fv_status st = write_json(info, res, n, err);
+    if (st == FV_OK) st = write_markdown(info, res, n, err);
+    if (st == FV_OK && info->sc->has_sweep) st = write_sweep(info, res, n, err);
+    return st;
+}

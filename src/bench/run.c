@@ -1,0 +1,445 @@
+/* fovea — the benchmark runner: every method of a scenario renders the same frames (same scene
+ * times, cameras, gaze and seeds) in one process, so the ratios between them are fair on a shared,
+ * noisy machine. Timing covers the technique's render call only, repeated with a fresh technique
+ * state each repeat (temporal methods replay their whole sequence) and summarised by the median.
+ * Errors are measured on the last repeat against a reference rendered once and cached on disk
+ * under a hash of everything that determines it.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include "bench/bench_impl.h"
+#include "core/alloc.h"
+#include "core/fileio.h"
+#include "fovea/fovea.h"
+
+typedef struct frame_setup {
+    double time;
+    fv_camera cam;
+    fv_gaze gaze;
+    uint8_t *labels;
+    float *ref;
+} frame_setup;
+
+static void say(const fv_bench_options *opt, const char *fmt, ...)
+{
+    if (!opt->status) return;
+    char line[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    opt->status(opt->status_user, line);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(const double *v, int n)
+{
+    double *c = malloc((size_t)n * sizeof *c);
+    if (!c) return v[0];
+    memcpy(c, v, (size_t)n * sizeof *c);
+    qsort(c, (size_t)n, sizeof *c, cmp_double);
+    double m = n % 2 ? c[n / 2] : 0.5 * (c[n / 2 - 1] + c[n / 2]);
+    free(c);
+    return m;
+}
+
+/* FNV-1a, 64 bits: a stable name for a reference frame in the cache. */
+static uint64_t fnv1a(const char *s)
+{
+    uint64_t h = 1469598103934665603ULL;
+    for (; *s; s++) {
+        h ^= (unsigned char)*s;
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+/* Everything a reference frame depends on, as text: its hash names the cache file. A scene file's
+ * size and modification time stand in for its contents. */
+static void reference_key(const fv_scenario *sc, const frame_setup *f, int index, char *buf, size_t n)
+{
+    size_t len = 0;
+#define KEY(...)                                                                      \
+    do {                                                                              \
+        int w_ = snprintf(buf + len, n - len, __VA_ARGS__);                           \
+        if (w_ > 0) len = (size_t)w_ < n - len ? len + (size_t)w_ : n - 1;            \
+    } while (0)
+    KEY("fovea %s|scene=%s", FOVEA_VERSION_STRING, sc->scene);
+    struct stat sb;
+    if (stat(sc->scene, &sb) == 0) KEY("|bytes=%lld|mtime=%lld", (long long)sb.st_size, (long long)sb.st_mtime);
+    KEY("|%dx%d|frame=%d|t=%.9g|seed=%llu|method=%s", sc->width, sc->height, index, f->time, sc->seed, sc->reference.method);
+    for (int i = 0; i < fv_params_count(sc->reference.params); i++)
+        KEY("|%s=%s", fv_params_key(sc->reference.params, i), fv_params_value(sc->reference.params, i));
+    const fv_camera *c = &f->cam;
+    KEY("|cam=%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", c->pos.x, c->pos.y, c->pos.z, c->look.x, c->look.y, c->look.z,
+        c->up.x, c->up.y, c->up.z, c->fov_y);
+    KEY("|gaze=%.9g,%.9g", f->gaze.x, f->gaze.y);
+#undef KEY
+}
+
+/* Renders frames [0, nframes) of one method with a fresh technique; calls back per frame. */
+typedef struct render_job {
+    const fv_scenario *sc;
+    fv_scene *scene;
+    frame_setup *frames;
+    int threads;
+    const fv_bench_method *m;
+    const fv_log *log;
+} render_job;
+
+typedef fv_status (*frame_fn)(void *user, int index, fv_film *film, double ms, const fv_stats *stats, fv_error *err);
+
+static fv_status render_sequence(const render_job *j, frame_fn on_frame, void *user, fv_error *err)
+{
+    fv_params *params = NULL;
+    fv_technique *t = NULL;
+    fv_film *film = NULL;
+    fv_status st = fv_params_clone(j->m->params, &params, err);
+    if (st == FV_OK && (st = fv_technique_create(j->m->method, j->scene, params, j->log, &t, err)) != FV_OK)
+        fv_error_prefix(err, "%s: ", j->m->label);
+    if (st == FV_OK) st = fv_film_create(j->sc->width, j->sc->height, 0, &film, err);
+    for (int i = 0; i < j->sc->frames && st == FV_OK; i++) {
+        const frame_setup *f = &j->frames[i];
+        if ((st = fv_scene_set_time(j->scene, f->time, err)) != FV_OK) break;
+        fv_frame fr;
+        memset(&fr, 0, sizeof fr);
+        fr.time = f->time;
+        fr.index = i;
+        fr.seed = j->sc->seed;
+        fr.threads = j->threads;
+        fr.camera = &f->cam;
+        fr.prev_camera = i > 0 ? &j->frames[i - 1].cam : NULL;
+        fr.gaze = fr.gaze_right = f->gaze;
+        fr.eye = &j->sc->eye;
+        fv_stats stats;
+        fv_stats_clear(&stats);
+        fv_film_clear(film);
+        double t0 = fv_time_ms();
+        st = fv_technique_render(t, &fr, film, NULL, &stats, err);
+        double ms = fv_time_ms() - t0;
+        if (st != FV_OK) {
+            fv_error_prefix(err, "%s, frame %d: ", j->m->label, i);
+            break;
+        }
+        st = on_frame(user, i, film, ms, &stats, err);
+    }
+    fv_film_destroy(film);
+    fv_technique_destroy(t);
+    fv_params_destroy(params);
+    return st;
+}
+
+/* ---- the reference ---- */
+
+typedef struct ref_ctx {
+    frame_setup *frames;
+    const char *const *paths;
+    double ms;
+} ref_ctx;
+
+static fv_status on_reference_frame(void *user, int i, fv_film *film, double ms, const fv_stats *stats, fv_error *err)
+{
+    (void)stats;
+    ref_ctx *c = user;
+    c->ms += ms;
+    size_t n = (size_t)fv_film_width(film) * fv_film_height(film) * 3;
+    memcpy(c->frames[i].ref, fv_film_color(film), n * sizeof(float));
+    if (!c->paths[i]) return FV_OK;
+    return fv_image_write(c->paths[i], c->frames[i].ref, fv_film_width(film), fv_film_height(film), 1.0f, err);
+}
+
+static fv_status load_references(fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, const char *cache_dir,
+                                 fv_error *err)
+{
+    const fv_scenario *sc = info->sc;
+    int n = sc->frames;
+    char **paths = calloc((size_t)n, sizeof *paths);
+    if (!paths) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    fv_status st = FV_OK;
+    int missing = 0;
+    for (int i = 0; i < n && st == FV_OK; i++) {
+        char key[2048];
+        reference_key(sc, &frames[i], i, key, sizeof key);
+        char path[4096 + 64];
+        snprintf(path, sizeof path, "%s/ref-%016llx.pfm", cache_dir, (unsigned long long)fnv1a(key));
+        fv_image img;
+        fv_error e2;
+        if (fv_file_exists(path) && fv_image_read(path, &img, &e2) == FV_OK) {
+            if (img.width == sc->width && img.height == sc->height) {
+                memcpy(frames[i].ref, img.rgb, (size_t)sc->width * sc->height * 3 * sizeof(float));
+                info->ref_cached++;
+                fv_image_free(&img);
+                continue;
+            }
+            fv_image_free(&img);
+        }
+        if (!(paths[i] = strdup(path))) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        missing++;
+    }
+    if (st == FV_OK && missing > 0) {
+        /* Render the whole sequence (a temporal reference needs its history); frames already cached
+         * are simply not written again. */
+        say(info->opt, "reference: rendering %d frame(s) with %s (%d cached)", n, sc->reference.method, info->ref_cached);
+        render_job j = {sc, scene, frames, info->threads, &sc->reference, info->opt->log};
+        ref_ctx c = {frames, (const char *const *)paths, 0.0};
+        st = render_sequence(&j, on_reference_frame, &c, err);
+        info->ref_ms = c.ms / n;
+        if (st != FV_OK) fv_error_prefix(err, "reference: ");
+    } else if (st == FV_OK) {
+        say(info->opt, "reference: %d frame(s) from the cache", n);
+    }
+    for (int i = 0; i < n; i++) free(paths[i]);
+    free(paths);
+    return st;
+}
+
+/* ---- the methods ---- */
+
+typedef struct method_ctx {
+    const fv_bench_run_info *info;
+    frame_setup *frames;
+    fv_bench_result *res;
+    bool measure;              /* last repeat: compute errors and keep images */
+    double ms_sum;
+    fv_stats stage_sum, counter_sum;
+    fv_temporal *temporal;
+    fv_metric_opts mopts;
+    float *flip_map;
+    float *last;               /* the last frame, for the images */
+} method_ctx;
+
+static void stats_accumulate(fv_stats *sum, const fv_stats *s)
+{
+    for (int k = 0; k < s->n_stages; k++) fv_stats_add_ms(sum, s->stage[k].name, s->stage[k].value);
+    for (int k = 0; k < s->n_counters; k++) fv_stats_add_count(sum, s->counter[k].name, s->counter[k].value);
+}
+
+static fv_status on_method_frame(void *user, int i, fv_film *film, double ms, const fv_stats *stats, fv_error *err)
+{
+    method_ctx *c = user;
+    const fv_scenario *sc = c->info->sc;
+    c->ms_sum += ms;
+    stats_accumulate(&c->stage_sum, stats);
+    stats_accumulate(&c->counter_sum, stats);
+    if (!c->measure) return FV_OK;
+    const float *rgb = fv_film_color(film);
+    fv_metric_report rep;
+    fv_status st = fv_metrics_compare(c->frames[i].ref, rgb, sc->width, sc->height, c->frames[i].labels, &c->mopts, &rep,
+                                      i == sc->frames - 1 ? c->flip_map : NULL, err);
+    if (st != FV_OK) return st;
+    for (int r = 0; r < FV_REGION_COUNT; r++) {
+        fv_metric_values *d = &c->res->error.region[r];
+        const fv_metric_values *v = &rep.region[r];
+        d->pixels = v->pixels;
+        d->mse += v->mse / sc->frames;
+        d->e += v->e / sc->frames;
+        d->ssim += v->ssim / sc->frames;
+        d->flip += v->flip / sc->frames;
+    }
+    if (c->temporal && (st = fv_temporal_push(c->temporal, rgb, c->frames[i].labels, err)) != FV_OK) return st;
+    if (i == sc->frames - 1) memcpy(c->last, rgb, (size_t)sc->width * sc->height * 3 * sizeof(float));
+    return FV_OK;
+}
+
+/* A square crop around the gaze point of side 2 r_t (at least 32 px), clamped to the image. */
+static fv_status write_crop(const fv_scenario *sc, const float *rgb, fv_gaze g, const char *path, fv_error *err)
+{
+    int side = (int)ceil(2.0 * fv_eye_transition_radius_px(&sc->eye));
+    if (side < 32) side = 32;
+    if (side > sc->width) side = sc->width;
+    if (side > sc->height) side = sc->height;
+    int x0 = (int)lround(g.x * sc->width - 0.5 * side), y0 = (int)lround(g.y * sc->height - 0.5 * side);
+    x0 = x0 < 0 ? 0 : x0 + side > sc->width ? sc->width - side : x0;
+    y0 = y0 < 0 ? 0 : y0 + side > sc->height ? sc->height - side : y0;
+    float *crop = fv_alloc_array((size_t)side * side, 3 * sizeof(float));
+    if (!crop) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    for (int y = 0; y < side; y++)
+        memcpy(crop + (size_t)y * side * 3, rgb + ((size_t)(y0 + y) * sc->width + x0) * 3, (size_t)side * 3 * sizeof(float));
+    fv_status st = fv_image_write(path, crop, side, side, sc->exposure, err);
+    free(crop);
+    return st;
+}
+
+static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, int index, int total,
+                            fv_bench_result *res, fv_error *err)
+{
+    const fv_scenario *sc = info->sc;
+    const fv_bench_method *m = res->m;
+    int reps = info->opt->repeats > 0 ? info->opt->repeats : sc->repeats;
+    size_t npix = (size_t)sc->width * sc->height;
+    method_ctx c;
+    memset(&c, 0, sizeof c);
+    c.info = info;
+    c.frames = frames;
+    c.res = res;
+    fv_metric_opts_default(&c.mopts);
+    c.mopts.exposure = sc->exposure;
+    res->ms = calloc((size_t)reps, sizeof(double));
+    double *stage_per_rep = calloc((size_t)reps * FV_STATS_MAX, sizeof(double));
+    c.flip_map = fv_alloc_array(npix, sizeof(float));
+    c.last = fv_alloc_array(npix, 3 * sizeof(float));
+    fv_status st = FV_OK;
+    if (!res->ms || !stage_per_rep || !c.flip_map || !c.last) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    fv_stats stage_names;
+    fv_stats_clear(&stage_names);
+    render_job j = {sc, scene, frames, info->threads, m, info->opt->log};
+    for (int r = 0; r < reps && st == FV_OK; r++) {
+        say(info->opt, "[%d/%d] %s: repeat %d/%d, %d frame(s)", index + 1, total, m->label, r + 1, reps, sc->frames);
+        c.measure = r == reps - 1;
+        c.ms_sum = 0.0;
+        fv_stats_clear(&c.stage_sum);
+        fv_stats_clear(&c.counter_sum);
+        if (c.measure) {
+            memset(&res->error, 0, sizeof res->error);
+            if (sc->frames > 1 && (st = fv_temporal_create(sc->width, sc->height, &c.mopts, &c.temporal, err)) != FV_OK) break;
+        }
+        if ((st = render_sequence(&j, on_method_frame, &c, err)) != FV_OK) break;
+        res->ms[r] = c.ms_sum / sc->frames;
+        for (int k = 0; k < c.stage_sum.n_stages; k++) {
+            fv_stats_add_ms(&stage_names, c.stage_sum.stage[k].name, 0.0);
+            for (int q = 0; q < stage_names.n_stages; q++)
+                if (strcmp(stage_names.stage[q].name, c.stage_sum.stage[k].name) == 0)
+                    stage_per_rep[(size_t)q * reps + r] = c.stage_sum.stage[k].value / sc->frames;
+        }
+    }
+    if (st == FV_OK) {
+        res->ms_median = median(res->ms, reps);
+        res->ms_min = res->ms_max = res->ms[0];
+        for (int r = 1; r < reps; r++) {
+            res->ms_min = fmin(res->ms_min, res->ms[r]);
+            res->ms_max = fmax(res->ms_max, res->ms[r]);
+        }
+        fv_stats_clear(&res->stages);
+        for (int q = 0; q < stage_names.n_stages; q++)
+            fv_stats_add_ms(&res->stages, stage_names.stage[q].name, median(stage_per_rep + (size_t)q * reps, reps));
+        fv_stats_clear(&res->counters);
+        for (int k = 0; k < c.counter_sum.n_counters; k++)
+            fv_stats_add_count(&res->counters, c.counter_sum.counter[k].name, c.counter_sum.counter[k].value / sc->frames);
+        for (int r = 0; r < FV_REGION_COUNT; r++) {
+            fv_metric_values *v = &res->error.region[r];
+            v->psnr = v->mse > 0.0 ? 10.0 * log10(1.0 / v->mse) : INFINITY;
+        }
+        if (c.temporal) {
+            res->has_temporal = true;
+            for (int r = 0; r < FV_REGION_COUNT; r++)
+                fv_temporal_result(c.temporal, (fv_region)r, &res->temporal_mse[r], &res->temporal_e[r]);
+        }
+        /* Images of the last frame: the frame, its FLIP heat map with the region rings, the fovea. */
+        char path[4096 + 128];
+        const frame_setup *lf = &frames[sc->frames - 1];
+        snprintf(res->img, sizeof res->img, "%s/%s.png", sc->name, m->label);
+        snprintf(res->heat, sizeof res->heat, "%s/%s-flip.png", sc->name, m->label);
+        snprintf(res->crop, sizeof res->crop, "%s/%s-fovea.png", sc->name, m->label);
+        snprintf(path, sizeof path, "%s/%s", info->out_dir, res->img);
+        st = fv_image_write(path, c.last, sc->width, sc->height, sc->exposure, err);
+        snprintf(path, sizeof path, "%s/%s", info->out_dir, res->heat);
+        if (st == FV_OK) st = fv_heatmap_write(path, c.flip_map, sc->width, sc->height, 1.0f, &sc->eye, lf->gaze, err);
+        snprintf(path, sizeof path, "%s/%s", info->out_dir, res->crop);
+        if (st == FV_OK) st = write_crop(sc, c.last, lf->gaze, path, err);
+    }
+    fv_temporal_destroy(c.temporal);
+    free(stage_per_rep);
+    free(c.flip_map);
+    free(c.last);
+    return st;
+}
+
+/* ---- entry points ---- */
+
+fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err)
+{
+    fv_scenario *sc;
+    fv_status st = fv_scenario_load(path, mode, &sc, err);
+    fv_scenario_destroy(st == FV_OK ? sc : NULL);
+    return st;
+}
+
+fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *err)
+{
+    fv_scenario *sc = NULL;
+    fv_scene *scene = NULL;
+    frame_setup *frames = NULL;
+    fv_bench_result *res = NULL;
+    fv_bench_run_info info;
+    memset(&info, 0, sizeof info);
+    fv_status st = fv_scenario_load(path, opt->mode, &sc, err);
+    if (st != FV_OK) return st;
+    info.sc = sc;
+    info.opt = opt;
+    info.threads = opt->threads;
+    info.out_dir = opt->out_dir ? opt->out_dir : "bench-out";
+    char cache_dir[4096], img_dir[4096 + 128];
+    snprintf(cache_dir, sizeof cache_dir, "%s", opt->cache_dir ? opt->cache_dir : "");
+    if (!opt->cache_dir) snprintf(cache_dir, sizeof cache_dir, "%s/cache", info.out_dir);
+    snprintf(img_dir, sizeof img_dir, "%s/%s", info.out_dir, sc->name);
+    if ((st = fv_mkdirs(info.out_dir, err)) || (st = fv_mkdirs(cache_dir, err)) || (st = fv_mkdirs(img_dir, err))) goto done;
+
+    say(opt, "scenario %s: scene %s, %dx%d, %d frame(s), %d method(s)", sc->name, sc->scene, sc->width, sc->height, sc->frames,
+        sc->nmethods);
+    if ((st = fv_scene_load(sc->scene, opt->log, &scene, err)) != FV_OK) goto done;
+    size_t npix = (size_t)sc->width * sc->height;
+    if (!(frames = fv_calloc_array((size_t)sc->frames, sizeof *frames))) {
+        st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    fv_camera_path cpath = {sc->cam_keys, sc->ncam_keys};
+    for (int i = 0; i < sc->frames; i++) {
+        frame_setup *f = &frames[i];
+        f->time = sc->start_time + i / sc->fps;
+        fv_scene_camera(scene, f->time, sc->width, sc->height, &f->cam);
+        if (sc->ncam_keys) fv_camera_path_eval(&cpath, f->time, &f->cam, &f->cam);
+        fv_gaze_path_eval(sc->gaze, f->time, &f->gaze, NULL);
+        f->labels = fv_alloc_array(npix, 1);
+        f->ref = fv_alloc_array(npix, 3 * sizeof(float));
+        if (!f->labels || !f->ref) {
+            st = fv_error_set(err, FV_ERR_NOMEM, "out of memory for %d frames of %dx%d", sc->frames, sc->width, sc->height);
+            goto done;
+        }
+        fv_eye_region_labels(&sc->eye, f->gaze, f->labels);
+    }
+    if ((st = load_references(&info, scene, frames, cache_dir, err)) != FV_OK) goto done;
+    snprintf(info.ref_img, sizeof info.ref_img, "%s/reference.png", sc->name);
+    info.last_gaze = frames[sc->frames - 1].gaze;
+    {
+        char p[4096 + 160];
+        snprintf(p, sizeof p, "%s/%s", info.out_dir, info.ref_img);
+        if ((st = fv_image_write(p, frames[sc->frames - 1].ref, sc->width, sc->height, sc->exposure, err)) != FV_OK) goto done;
+    }
+
+    if (!(res = fv_calloc_array((size_t)sc->nmethods, sizeof *res))) {
+        st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (int i = 0; i < sc->nmethods && st == FV_OK; i++) {
+        res[i].m = &sc->methods[i];
+        st = run_method(&info, scene, frames, i, sc->nmethods, &res[i], err);
+    }
+    if (st != FV_OK) goto done;
+    double base = 0.0;
+    for (int i = 0; i < sc->nmethods; i++)
+        if (strcmp(sc->methods[i].label, sc->baseline) == 0) base = res[i].ms_median;
+    for (int i = 0; i < sc->nmethods; i++) res[i].speedup = res[i].ms_median > 0.0 ? base / res[i].ms_median : 0.0;
+    st = fv_bench_write_reports(&info, res, sc->nmethods, err);
+done:
+    if (frames)
+        for (int i = 0; i < sc->frames; i++) {
+            free(frames[i].labels);
+            free(frames[i].ref);
+        }
+    free(frames);
+    if (res)
+        for (int i = 0; i < sc->nmethods; i++) free(res[i].ms);
+    free(res);
+    fv_scene_destroy(scene);
+    fv_scenario_destroy(sc);
+    return st;
+}

@@ -1,0 +1,47 @@
+/* fovea — a benchmark scenario in memory (parsed from bench/<name>.json, see docs/bench.md). */
+#ifndef FV_BENCH_SCENARIO_H
+#define FV_BENCH_SCENARIO_H
+
+#include "fovea/bench.h"
+#include "fovea/camera.h"
+#include "fovea/gaze.h"
+#include "fovea/technique.h"
+
+#define FV_BENCH_LABEL_MAX 64
+
+typedef struct fv_bench_method {
+    char label[FV_BENCH_LABEL_MAX];
+    char method[FV_BENCH_LABEL_MAX];
+    fv_params *params;
+    bool from_sweep;
+    double sweep_value;
+} fv_bench_method;
+
+typedef struct fv_scenario {
+    char name[FV_BENCH_LABEL_MAX];
+    char *description;
+    char *scene;             /* built-in name or a path resolved against the scenario's folder */
+    int width, height;
+    int frames;
+    double fps, start_time;
+    int repeats;
+    float exposure;
+    unsigned long long seed;
+    fv_eye_model eye;
+    fv_gaze_path *gaze;
+    fv_camera_key *cam_keys; /* optional camera path overriding the scene's */
+    int ncam_keys;
+    fv_bench_method reference;
+    char baseline[FV_BENCH_LABEL_MAX]; /* label of the method speed-ups are relative to */
+    fv_bench_method *methods;          /* listed methods, then the sweep's */
+    int nmethods;
+    bool has_sweep;
+    char sweep_param[FV_BENCH_LABEL_MAX];
+    char sweep_method[FV_BENCH_LABEL_MAX];
+    int sweep_first;                   /* index of the first sweep method in methods[] */
+} fv_scenario;
+
+fv_status fv_scenario_load(const char *path, fv_bench_mode mode, fv_scenario **out, fv_error *err);
+void fv_scenario_destroy(fv_scenario *s);
+
+#endif

@@ -1,0 +1,78 @@
+/* fovea — opening a scene by name: a built-in scene, a fovea JSON scene file, or any mesh file
+ * assimp imports. On failure nothing is returned: the partly built scene is destroyed. */
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include "scene/load_impl.h"
+
+static bool is_builtin(const char *name)
+{
+    for (int i = 0; i < fv_builtin_count(); i++)
+        if (strcmp(name, fv_builtin_name(i)) == 0) return true;
+    return false;
+}
+
+static bool has_ext(const char *path, const char *ext)
+{
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    return dot && (!slash || dot > slash) && strcasecmp(dot, ext) == 0;
+}
+
+fv_status fv_scene_open(const char *name, const fv_log *log, fv_scene **out, fv_error *err)
+{
+    if (!name || !name[0]) return fv_error_set(err, FV_ERR_INVALID, "no scene given");
+    fv_scene *s;
+    fv_status st;
+    if (is_builtin(name)) {
+        if ((st = fv_scene_create(&s, err)) != FV_OK) return st;
+        st = fv_builtin_build(name, s, log, err);
+    } else {
+        struct stat sb;
+        if (stat(name, &sb) != 0) {
+            bool looks_like_file = strchr(name, '/') || strchr(name, '.');
+            if (!looks_like_file) {
+                char known[256] = "";
+                size_t len = 0;
+                for (int i = 0; i < fv_builtin_count(); i++) {
+                    int w = snprintf(known + len, sizeof known - len, "%s%s", i ? ", " : "", fv_builtin_name(i));
+                    if (w > 0 && (size_t)w < sizeof known - len) len += (size_t)w;
+                }
+                return fv_error_set(err, FV_ERR_INVALID, "unknown scene '%s': not a built-in (%s) nor an existing file", name, known);
+            }
+            return fv_error_set(err, FV_ERR_IO, "cannot open scene '%s': %s", name, strerror(errno));
+        }
+        if (S_ISDIR(sb.st_mode)) return fv_error_set(err, FV_ERR_IO, "cannot open scene '%s': it is a directory", name);
+        if (!has_ext(name, ".json") && !fv_load_assimp_supports(name))
+            return fv_error_set(err, FV_ERR_INVALID,
+                                "scene '%s': unknown file type (use .json, or a mesh format assimp reads: .obj, .gltf, .glb, .ply, ...)", name);
+        if ((st = fv_scene_create(&s, err)) != FV_OK) return st;
+        if (has_ext(name, ".json")) {
+            st = fv_load_json(name, s, log, err);
+        } else {
+            fv_import_opts o = {-1, NULL, true, true, ""};
+            st = fv_load_assimp(name, s, &o, log, NULL, NULL, err);
+        }
+    }
+    if (st != FV_OK) {
+        fv_scene_destroy(s);
+        return st;
+    }
+    *out = s;
+    return FV_OK;
+}
+
+fv_status fv_scene_load(const char *name, const fv_log *log, fv_scene **out, fv_error *err)
+{
+    fv_scene *s;
+    fv_status st = fv_scene_open(name, log, &s, err);
+    if (st != FV_OK) return st;
+    if ((st = fv_scene_commit(s, log, err)) != FV_OK) {
+        if (err && strncmp(err->msg, name, strlen(name)) != 0) fv_error_prefix(err, "%s: ", name);
+        fv_scene_destroy(s);
+        return st;
+    }
+    *out = s;
+    return FV_OK;
+}

@@ -1,0 +1,379 @@
+/* fovea — the fovea JSON scene format (docs/scene-format.md): materials, objects (mesh files or
+ * inline quads, boxes, spheres), rigid animation of objects, lights, camera, camera path, display
+ * (eye model) and gaze path. Strict: unknown fields, wrong types, non-finite or out-of-range
+ * numbers and unknown material names are errors naming the file and the field.
+ */
+#include <libgen.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "fovea/film.h"
+#include "core/json_util.h"
+#include "gaze/gaze_json.h"
+#include "scene/load_impl.h"
+#include "scene/mesh_gen.h"
+
+#define BIG 1e30
+
+typedef struct json_ctx {
+    const char *file;
+    char dir[4096];
+    fv_scene *scene;
+    const fv_log *log;
+} json_ctx;
+
+static fv_status vec3(const cJSON *o, const char *key, double lo, double hi, const json_ctx *c, const char *where, fv_vec3 *out,
+                      fv_error *err)
+{
+    double v[3] = {out->x, out->y, out->z};
+    fv_status st = fv_json_numbers(o, key, 3, lo, hi, c->file, where, v, err);
+    if (st == FV_OK) *out = fv_v3((float)v[0], (float)v[1], (float)v[2]);
+    return st;
+}
+
+static fv_status parse_material(const cJSON *o, const json_ctx *c, fv_error *err)
+{
+    static const char *const keys[] = {"type", "albedo", "specular", "roughness", "ior", "emission", "two_sided", NULL};
+    char where[FV_NAME_MAX + 16];
+    snprintf(where, sizeof where, "materials.%s", o->string);
+    if (strlen(o->string) >= FV_NAME_MAX)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s: material name longer than %d characters", c->file, where, FV_NAME_MAX - 1);
+    if (fv_scene_find_material(c->scene, o->string) >= 0)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s: defined twice", c->file, where);
+    fv_status st = fv_json_check_keys(o, keys, c->file, where, err);
+    const char *type = "diffuse";
+    if (st || (st = fv_json_string(o, "type", c->file, where, &type, err))) return st;
+    fv_material_type t;
+    if (!fv_material_type_from_name(type, &t))
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.type: unknown material type '%s' (diffuse, mirror, glossy, dielectric)", c->file,
+                            where, type);
+    fv_material m = fv_material_default(t);
+    snprintf(m.name, sizeof m.name, "%s", o->string);
+    double rough = m.roughness, ior = m.ior;
+    if ((st = vec3(o, "albedo", 0, 1, c, where, &m.albedo, err)) || (st = vec3(o, "specular", 0, 1, c, where, &m.specular, err)) ||
+        (st = vec3(o, "emission", 0, BIG, c, where, &m.emission, err)) ||
+        (st = fv_json_number(o, "roughness", 0.001, 1, c->file, where, &rough, err)) ||
+        (st = fv_json_number(o, "ior", 1.0001, 10, c->file, where, &ior, err)) ||
+        (st = fv_json_bool(o, "two_sided", c->file, where, &m.two_sided_emission, err)))
+        return st;
+    m.roughness = (float)rough;
+    m.ior = (float)ior;
+    if ((st = fv_scene_add_material(c->scene, &m, NULL, err)) != FV_OK) fv_error_prefix(err, "%s: ", c->file);
+    return st;
+}
+
+static fv_status find_material(const cJSON *o, const json_ctx *c, const char *where, int *id, fv_error *err)
+{
+    const char *name = NULL;
+    fv_status st = fv_json_string(o, "material", c->file, where, &name, err);
+    if (st != FV_OK || !name) return st;
+    if ((*id = fv_scene_find_material(c->scene, name)) < 0)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.material: unknown material '%s'", c->file, where, name);
+    return FV_OK;
+}
+
+/* "transform" or one animation key: translate, rotate_deg (about x, then y, then z), scale
+ * (a number or three). */
+static fv_status parse_trs(const cJSON *o, const json_ctx *c, const char *where, const char *const *keys, fv_vec3 *t, fv_quat *q,
+                           fv_vec3 *s, fv_error *err)
+{
+    fv_status st = fv_json_check_keys(o, keys, c->file, where, err);
+    fv_vec3 rot = fv_v3s(0.0f);
+    *t = fv_v3s(0.0f);
+    *s = fv_v3s(1.0f);
+    if (st || (st = vec3(o, "translate", -BIG, BIG, c, where, t, err)) || (st = vec3(o, "rotate_deg", -1e6, 1e6, c, where, &rot, err)))
+        return st;
+    const cJSON *sc = cJSON_GetObjectItemCaseSensitive(o, "scale");
+    if (cJSON_IsNumber(sc)) {
+        double v = 1.0;
+        if ((st = fv_json_number(o, "scale", 1e-9, BIG, c->file, where, &v, err))) return st;
+        *s = fv_v3s((float)v);
+    } else if ((st = vec3(o, "scale", 1e-9, BIG, c, where, s, err))) {
+        return st;
+    }
+    *q = fv_quat_euler_deg(rot);
+    return FV_OK;
+}
+
+static fv_status parse_shape(const cJSON *o, const json_ctx *c, const char *where, int mat, fv_meshbuf *mb, fv_error *err)
+{
+    char w2[128];
+    fv_status st;
+    const cJSON *it;
+    if ((it = cJSON_GetObjectItemCaseSensitive(o, "quad"))) {
+        snprintf(w2, sizeof w2, "%s.quad", where);
+        if (!cJSON_IsArray(it) || cJSON_GetArraySize(it) != 4)
+            return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected 4 corners [[x,y,z], ...]", c->file, w2);
+        fv_vec3 p[4];
+        int i = 0;
+        for (const cJSON *e = it->child; e; e = e->next, i++) {
+            double v[3];
+            cJSON *wrap = cJSON_CreateObject();
+            cJSON_AddItemReferenceToObject(wrap, "corner", (cJSON *)e);
+            st = fv_json_numbers(wrap, "corner", 3, -BIG, BIG, c->file, w2, v, err);
+            cJSON_Delete(wrap);
+            if (st) return st;
+            p[i] = fv_v3((float)v[0], (float)v[1], (float)v[2]);
+        }
+        fv_mesh_quad(mb, p[0], p[1], p[2], p[3], mat);
+        return FV_OK;
+    }
+    if ((it = cJSON_GetObjectItemCaseSensitive(o, "box"))) {
+        static const char *const keys[] = {"center", "half", "yaw_deg", NULL};
+        snprintf(w2, sizeof w2, "%s.box", where);
+        fv_vec3 ce = fv_v3s(0), h = fv_v3s(0.5f);
+        double yaw = 0;
+        if ((st = fv_json_check_keys(it, keys, c->file, w2, err)) || (st = fv_json_require(it, "half", c->file, w2, err)) ||
+            (st = vec3(it, "center", -BIG, BIG, c, w2, &ce, err)) || (st = vec3(it, "half", 1e-9, BIG, c, w2, &h, err)) ||
+            (st = fv_json_number(it, "yaw_deg", -1e6, 1e6, c->file, w2, &yaw, err)))
+            return st;
+        fv_mesh_box(mb, ce, h, (float)yaw, mat);
+        return FV_OK;
+    }
+    it = cJSON_GetObjectItemCaseSensitive(o, "sphere");
+    static const char *const keys[] = {"center", "radius", "segments", NULL};
+    snprintf(w2, sizeof w2, "%s.sphere", where);
+    fv_vec3 ce = fv_v3s(0);
+    double r = 1, seg[2] = {64, 32};
+    if ((st = fv_json_check_keys(it, keys, c->file, w2, err)) || (st = fv_json_require(it, "radius", c->file, w2, err)) ||
+        (st = vec3(it, "center", -BIG, BIG, c, w2, &ce, err)) || (st = fv_json_number(it, "radius", 1e-9, BIG, c->file, w2, &r, err)) ||
+        (st = fv_json_numbers(it, "segments", 2, 3, 2048, c->file, w2, seg, err)))
+        return st;
+    fv_mesh_sphere(mb, ce, (float)r, (int)seg[0], (int)seg[1], false, mat);
+    return FV_OK;
+}
+
+static fv_status parse_animation(const cJSON *arr, const json_ctx *c, const char *where, int first, int count, fv_error *err)
+{
+    static const char *const keys[] = {"time", "translate", "rotate_deg", "scale", NULL};
+    int n = cJSON_GetArraySize(arr);
+    if (!cJSON_IsArray(arr) || n < 1 || n > 100000)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.animation: expected an array of keys", c->file, where);
+    fv_anim_key *k = fv_alloc_array((size_t)n, sizeof *k);
+    if (!k) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    fv_status st = FV_OK;
+    int i = 0;
+    for (const cJSON *e = arr->child; e && st == FV_OK; e = e->next, i++) {
+        char w2[128];
+        snprintf(w2, sizeof w2, "%s.animation[%d]", where, i);
+        double t = 0;
+        if ((st = parse_trs(e, c, w2, keys, &k[i].translate, &k[i].rotate, &k[i].scale, err)) ||
+            (st = fv_json_require(e, "time", c->file, w2, err)) || (st = fv_json_number(e, "time", -1e9, 1e9, c->file, w2, &t, err)))
+            break;
+        k[i].time = t;
+    }
+    for (int o = 0; o < count && st == FV_OK; o++)
+        if ((st = fv_scene_animate_object(c->scene, first + o, k, n, err)) != FV_OK) fv_error_prefix(err, "%s: %s: ", c->file, where);
+    free(k);
+    return st;
+}
+
+static fv_status parse_object(const cJSON *o, const json_ctx *c, int index, fv_error *err)
+{
+    static const char *const keys[] = {"name", "mesh", "quad", "box", "sphere", "material", "transform", "animation", NULL};
+    static const char *const tkeys[] = {"translate", "rotate_deg", "scale", NULL};
+    char where[64];
+    snprintf(where, sizeof where, "objects[%d]", index);
+    fv_status st = fv_json_check_keys(o, keys, c->file, where, err);
+    if (st != FV_OK) return st;
+    int kinds = !!cJSON_GetObjectItemCaseSensitive(o, "mesh") + !!cJSON_GetObjectItemCaseSensitive(o, "quad") +
+                !!cJSON_GetObjectItemCaseSensitive(o, "box") + !!cJSON_GetObjectItemCaseSensitive(o, "sphere");
+    if (kinds != 1) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: give exactly one of mesh, quad, box, sphere", c->file, where);
+    const char *name = NULL, *mesh = NULL;
+    int mat = -1;
+    if ((st = fv_json_string(o, "name", c->file, where, &name, err)) || (st = fv_json_string(o, "mesh", c->file, where, &mesh, err)) ||
+        (st = find_material(o, c, where, &mat, err)))
+        return st;
+    char oname[FV_NAME_MAX];
+    snprintf(oname, sizeof oname, "%s", name ? name : where);
+    fv_xform x = fv_xform_identity();
+    const cJSON *tr = cJSON_GetObjectItemCaseSensitive(o, "transform");
+    if (tr) {
+        fv_vec3 t, s;
+        fv_quat q;
+        char w2[80];
+        snprintf(w2, sizeof w2, "%s.transform", where);
+        if ((st = parse_trs(tr, c, w2, tkeys, &t, &q, &s, err))) return st;
+        x = fv_xform_trs(t, q, s);
+    }
+    int first = -1, count = 0;
+    if (mesh) {
+        char path[8192];
+        snprintf(path, sizeof path, "%s%s%s", mesh[0] == '/' ? "" : c->dir, mesh[0] == '/' ? "" : "/", mesh);
+        FILE *f = fopen(path, "rb");
+        if (!f) return fv_error_set(err, FV_ERR_IO, "%s: %s.mesh: cannot open '%s'", c->file, where, path);
+        fclose(f);
+        char prefix[FV_NAME_MAX];
+        snprintf(prefix, sizeof prefix, "%.30s/", oname);
+        fv_import_opts io = {mat, &x, false, false, prefix};
+        if ((st = fv_load_assimp(path, c->scene, &io, c->log, &first, &count, err)) != FV_OK) {
+            fv_error_prefix(err, "%s: %s: ", c->file, where);
+            return st;
+        }
+    } else {
+        if (mat < 0) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: an inline shape needs a 'material'", c->file, where);
+        fv_meshbuf mb;
+        fv_meshbuf_init(&mb);
+        st = parse_shape(o, c, where, mat, &mb, err);
+        if (st == FV_OK && tr) {
+            fv_xform inv = fv_xform_identity();
+            bool has_inv = fv_xform_inverse(&x, &inv);
+            for (int i = 0; i < mb.nv; i++) {
+                mb.pos[i] = fv_xform_point(&x, mb.pos[i]);
+                if (has_inv) mb.nrm[i] = fv_normalize(fv_xform_normal(&inv, mb.nrm[i]));
+            }
+        }
+        if (st == FV_OK && (st = fv_meshbuf_add(&mb, c->scene, oname, c->log, &first, err)) != FV_OK)
+            fv_error_prefix(err, "%s: %s: ", c->file, where);
+        fv_meshbuf_free(&mb);
+        if (st != FV_OK) return st;
+        count = 1;
+    }
+    const cJSON *an = cJSON_GetObjectItemCaseSensitive(o, "animation");
+    return an ? parse_animation(an, c, where, first, count, err) : FV_OK;
+}
+
+static fv_status parse_light(const cJSON *o, const json_ctx *c, int index, fv_error *err)
+{
+    static const char *const keys[] = {"type", "pos", "dir", "intensity", "inner_deg", "outer_deg", NULL};
+    char where[64];
+    snprintf(where, sizeof where, "lights[%d]", index);
+    fv_status st = fv_json_check_keys(o, keys, c->file, where, err);
+    const char *type = "point";
+    fv_light_desc d;
+    memset(&d, 0, sizeof d);
+    d.dir = fv_v3(0, -1, 0);
+    d.intensity = fv_v3s(1.0f);
+    double inner = 20, outer = 30;
+    if (st || (st = fv_json_string(o, "type", c->file, where, &type, err)) || (st = fv_json_require(o, "pos", c->file, where, err)) ||
+        (st = vec3(o, "pos", -BIG, BIG, c, where, &d.pos, err)) || (st = vec3(o, "dir", -BIG, BIG, c, where, &d.dir, err)) ||
+        (st = vec3(o, "intensity", 0, BIG, c, where, &d.intensity, err)) ||
+        (st = fv_json_number(o, "inner_deg", 0, 89.9, c->file, where, &inner, err)) ||
+        (st = fv_json_number(o, "outer_deg", 0.01, 89.9, c->file, where, &outer, err)))
+        return st;
+    if (strcmp(type, "point") == 0) d.type = FV_LIGHT_POINT;
+    else if (strcmp(type, "spot") == 0) d.type = FV_LIGHT_SPOT;
+    else return fv_error_set(err, FV_ERR_INVALID, "%s: %s.type: unknown light type '%s' (point, spot; area lights are emissive materials)", c->file, where, type);
+    d.inner_deg = (float)inner;
+    d.outer_deg = (float)outer;
+    if ((st = fv_scene_add_light(c->scene, &d, err)) != FV_OK) fv_error_prefix(err, "%s: %s: ", c->file, where);
+    return st;
+}
+
+static fv_status parse_camera_key(const cJSON *o, const json_ctx *c, const char *where, bool timed, fv_camera_key *k, fv_error *err)
+{
+    static const char *const keys[] = {"time", "pos", "look", "up", "fov", NULL};
+    static const char *const ckeys[] = {"pos", "look", "up", "fov", NULL};
+    fv_status st = fv_json_check_keys(o, timed ? keys : ckeys, c->file, where, err);
+    double t = 0, fov = 40;
+    k->up = fv_v3(0, 1, 0);
+    if (st || (st = fv_json_require(o, "pos", c->file, where, err)) || (st = fv_json_require(o, "look", c->file, where, err)) ||
+        (timed && (st = fv_json_require(o, "time", c->file, where, err))) || (st = vec3(o, "pos", -BIG, BIG, c, where, &k->pos, err)) ||
+        (st = vec3(o, "look", -BIG, BIG, c, where, &k->look, err)) || (st = vec3(o, "up", -BIG, BIG, c, where, &k->up, err)) ||
+        (st = fv_json_number(o, "fov", 0.01, 179.9, c->file, where, &fov, err)) ||
+        (st = fv_json_number(o, "time", -1e9, 1e9, c->file, where, &t, err)))
+        return st;
+    k->time = t;
+    k->fov_y = (float)fov;
+    fv_camera cam = {k->pos, k->look, k->up, k->fov_y, 1, 1};
+    fv_camera_basis b;
+    if ((st = fv_camera_basis_make(&cam, &b, err)) != FV_OK) fv_error_prefix(err, "%s: %s: ", c->file, where);
+    return st;
+}
+
+fv_status fv_load_json(const char *path, fv_scene *scene, const fv_log *log, fv_error *err)
+{
+    static const char *const keys[] = {"materials", "objects", "lights", "camera", "camera_path", "display", "gaze", "description", NULL};
+    cJSON *root = NULL;
+    fv_status st = fv_json_parse_file(path, &root, err);
+    if (st != FV_OK) return st;
+    json_ctx c;
+    c.file = path;
+    c.scene = scene;
+    c.log = log;
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s", path);
+    snprintf(c.dir, sizeof c.dir, "%s", dirname(tmp));
+    if ((st = fv_json_check_keys(root, keys, path, "", err)) != FV_OK) goto done;
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(root, "materials");
+    if (it && !cJSON_IsObject(it)) {
+        st = fv_error_set(err, FV_ERR_INVALID, "%s: materials: expected an object of name: material", path);
+        goto done;
+    }
+    for (const cJSON *m = it ? it->child : NULL; m && st == FV_OK; m = m->next) st = parse_material(m, &c, err);
+    if (st != FV_OK) goto done;
+    it = cJSON_GetObjectItemCaseSensitive(root, "objects");
+    if (!cJSON_IsArray(it) || cJSON_GetArraySize(it) == 0) {
+        st = fv_error_set(err, FV_ERR_INVALID, "%s: objects: expected a non-empty array", path);
+        goto done;
+    }
+    int i = 0;
+    for (const cJSON *o = it->child; o && st == FV_OK; o = o->next, i++) st = parse_object(o, &c, i, err);
+    if (st != FV_OK) goto done;
+    it = cJSON_GetObjectItemCaseSensitive(root, "lights");
+    if (it && !cJSON_IsArray(it)) {
+        st = fv_error_set(err, FV_ERR_INVALID, "%s: lights: expected an array", path);
+        goto done;
+    }
+    i = 0;
+    for (const cJSON *l = it ? it->child : NULL; l && st == FV_OK; l = l->next, i++) st = parse_light(l, &c, i, err);
+    if (st != FV_OK) goto done;
+    if ((it = cJSON_GetObjectItemCaseSensitive(root, "camera"))) {
+        fv_camera_key k;
+        if ((st = parse_camera_key(it, &c, "camera", false, &k, err)) != FV_OK) goto done;
+        fv_camera cam = {k.pos, k.look, k.up, k.fov_y, 512, 512};
+        fv_scene_set_camera(scene, &cam);
+    }
+    if ((it = cJSON_GetObjectItemCaseSensitive(root, "camera_path"))) {
+        int n = cJSON_GetArraySize(it);
+        if (!cJSON_IsArray(it) || n < 1) {
+            st = fv_error_set(err, FV_ERR_INVALID, "%s: camera_path: expected a non-empty array", path);
+            goto done;
+        }
+        fv_camera_key *k = fv_alloc_array((size_t)n, sizeof *k);
+        if (!k) {
+            st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+        i = 0;
+        for (const cJSON *e = it->child; e && st == FV_OK; e = e->next, i++) {
+            char w[48];
+            snprintf(w, sizeof w, "camera_path[%d]", i);
+            st = parse_camera_key(e, &c, w, true, &k[i], err);
+        }
+        if (st == FV_OK && (st = fv_scene_set_camera_path(scene, k, n, err)) != FV_OK) fv_error_prefix(err, "%s: ", path);
+        free(k);
+        if (st != FV_OK) goto done;
+    }
+    if ((it = cJSON_GetObjectItemCaseSensitive(root, "display"))) {
+        fv_eye_model eye;
+        fv_eye_model_default(1, 1, &eye);
+        double size[2] = {0, 0};
+        /* "size" is the display's pixels per eye; the rest is the eye model of docs/gaze.md. */
+        cJSON *copy = cJSON_Duplicate(it, 1);
+        if (!copy) {
+            st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+        st = fv_json_numbers(copy, "size", 2, 1, FV_FILM_MAX_DIM, path, "display", size, err);
+        cJSON_DeleteItemFromObjectCaseSensitive(copy, "size");
+        if (st == FV_OK) {
+            eye.width = size[0] > 0 ? (int)size[0] : 1;
+            eye.height = size[1] > 0 ? (int)size[1] : 1;
+            st = fv_gaze_json_eye(copy, path, "display", &eye, err);
+        }
+        cJSON_Delete(copy);
+        if (st != FV_OK) goto done;
+        fv_scene_set_eye(scene, &eye);
+    }
+    if ((it = cJSON_GetObjectItemCaseSensitive(root, "gaze"))) {
+        fv_gaze_path *g;
+        if ((st = fv_gaze_json_path(it, path, "gaze", c.dir, &g, err)) != FV_OK) goto done;
+        fv_scene_set_gaze_path(scene, g);
+    }
+done:
+    cJSON_Delete(root);
+    return st;
+}

@@ -1,0 +1,210 @@
+/* fovea CLI — `fovea compare REF TEST`: every metric per gaze region between two images, as a
+ * table or JSON, and optionally a heat map of the per-pixel error. */
+#include <getopt.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "cli.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: fovea compare REF TEST [options]\n"
+               "Compares TEST against REF (PNG, PFM or EXR) over the whole image and per region around the gaze.\n\n"
+               "  --gaze X,Y              gaze point in [0,1] screen coordinates [0.5,0.5]\n"
+               "  --json                  print JSON instead of a table\n"
+               "  --heatmap FILE          write a PNG heat map of the per-pixel error\n"
+               "  --heatmap-metric M      flip | mse | e [flip]\n"
+               "  --exposure E            scale linear values before display encoding [1]\n"
+               "  --linear                compare linear values (FLIP still uses display values)\n"
+               "  --ppd N                 pixels per degree for FLIP [67]\n"
+               "  --fovea-deg D           foveal radius in degrees [9.78]; --transition-deg D [2 x fovea]\n"
+               "  --fovea-frac F          foveal radius as a fraction of the width (instead of degrees)\n"
+               "  --transition-frac F     transition radius as a fraction of the width [1.5 x fovea]\n"
+               "  --ppi N --eye-dist MM   display density and pupil-to-lens distance [615, 18]\n"
+               "  --fov-x DEG             horizontal field of view (instead of ppi and eye distance)\n"
+               "Regions and their defaults: docs/gaze.md. Metrics: docs/metrics.md.\n");
+}
+
+static fv_status load(const char *path, fv_image *img, fv_error *err)
+{
+    fv_status s = fv_image_read(path, img, err);
+    /* Reading an image that is not there is the user's input problem, as a malformed one is. */
+    return s;
+}
+
+static void print_value(double v)
+{
+    if (isinf(v)) printf(" %10s", "inf");
+    else printf(" %10.4g", v);
+}
+
+int fv_cmd_compare(int argc, char **argv)
+{
+    enum { O_GAZE = 256, O_JSON, O_HEAT, O_HEATM, O_EXPOSURE, O_LINEAR, O_PPD, O_FDEG, O_TDEG, O_FFRAC, O_TFRAC, O_PPI, O_EYED, O_FOVX, O_HELP };
+    static const struct option longs[] = {
+        {"gaze", 1, 0, O_GAZE}, {"json", 0, 0, O_JSON}, {"heatmap", 1, 0, O_HEAT}, {"heatmap-metric", 1, 0, O_HEATM},
+        {"exposure", 1, 0, O_EXPOSURE}, {"linear", 0, 0, O_LINEAR}, {"ppd", 1, 0, O_PPD}, {"fovea-deg", 1, 0, O_FDEG},
+        {"transition-deg", 1, 0, O_TDEG}, {"fovea-frac", 1, 0, O_FFRAC}, {"transition-frac", 1, 0, O_TFRAC},
+        {"ppi", 1, 0, O_PPI}, {"eye-dist", 1, 0, O_EYED}, {"fov-x", 1, 0, O_FOVX}, {"help", 0, 0, O_HELP}, {0, 0, 0, 0}};
+    const char *cmd = "compare";
+    float gaze[2] = {0.5f, 0.5f};
+    bool json = false;
+    const char *heat = NULL, *heat_metric = "flip";
+    fv_metric_opts mo;
+    fv_metric_opts_default(&mo);
+    double fdeg = 0, tdeg = 0, ffrac = 0, tfrac = 0, ppi = 0, eyed = 0, fovx = 0, d;
+    opterr = 0;
+    optind = 1;
+    int c;
+    while ((c = getopt_long(argc, argv, "h", longs, NULL)) != -1) {
+        double *target = NULL;
+        const char *name = NULL;
+        switch (c) {
+        case O_GAZE:
+            if (!fv_cli_parse_floats(optarg, 2, gaze) || !(gaze[0] >= 0 && gaze[0] <= 1 && gaze[1] >= 0 && gaze[1] <= 1))
+                return fv_cli_usage_error(cmd, "--gaze %s: expected X,Y with both in [0,1]", optarg);
+            break;
+        case O_JSON: json = true; break;
+        case O_HEAT: heat = optarg; break;
+        case O_HEATM:
+            if (strcmp(optarg, "flip") && strcmp(optarg, "mse") && strcmp(optarg, "e"))
+                return fv_cli_usage_error(cmd, "--heatmap-metric %s: expected flip, mse or e", optarg);
+            heat_metric = optarg;
+            break;
+        case O_EXPOSURE:
+            if (!fv_cli_parse_float(optarg, &d) || !(d > 0)) return fv_cli_usage_error(cmd, "--exposure %s: expected a positive number", optarg);
+            mo.exposure = (float)d;
+            break;
+        case O_LINEAR: mo.linear = true; break;
+        case O_PPD: target = &d, name = "--ppd"; break;
+        case O_FDEG: target = &fdeg, name = "--fovea-deg"; break;
+        case O_TDEG: target = &tdeg, name = "--transition-deg"; break;
+        case O_FFRAC: target = &ffrac, name = "--fovea-frac"; break;
+        case O_TFRAC: target = &tfrac, name = "--transition-frac"; break;
+        case O_PPI: target = &ppi, name = "--ppi"; break;
+        case O_EYED: target = &eyed, name = "--eye-dist"; break;
+        case O_FOVX: target = &fovx, name = "--fov-x"; break;
+        case 'h':
+        case O_HELP: usage(stdout); return FV_EXIT_OK;
+        default: return fv_cli_usage_error(cmd, "unknown option '%s' (try fovea compare --help)", argv[optind - 1]);
+        }
+        if (target) {
+            if (!fv_cli_parse_float(optarg, target) || !(*target > 0) || !isfinite(*target))
+                return fv_cli_usage_error(cmd, "%s %s: expected a positive number", name, optarg);
+            if (c == O_PPD) mo.ppd = (float)d;
+        }
+    }
+    if (argc - optind != 2) return fv_cli_usage_error(cmd, "expected two images: REF TEST (try fovea compare --help)");
+    const char *ref_path = argv[optind], *test_path = argv[optind + 1];
+    if (heat && fv_image_format_from_path(heat) != FV_IMG_PNG) return fv_cli_usage_error(cmd, "--heatmap %s: the heat map is a .png file", heat);
+    fv_error err;
+    fv_image ref, test;
+    fv_status s = load(ref_path, &ref, &err);
+    if (s != FV_OK) return fv_cli_fail(cmd, s == FV_ERR_IO || s == FV_ERR_INVALID ? FV_ERR_INVALID : s, err.msg);
+    if ((s = load(test_path, &test, &err)) != FV_OK) {
+        fv_image_free(&ref);
+        return fv_cli_fail(cmd, s == FV_ERR_IO || s == FV_ERR_INVALID ? FV_ERR_INVALID : s, err.msg);
+    }
+    int rc = FV_EXIT_OK;
+    uint8_t *labels = NULL;
+    float *map = NULL;
+    if (ref.width != test.width || ref.height != test.height) {
+        rc = fv_cli_usage_error(cmd, "size mismatch: %s is %dx%d, %s is %dx%d", ref_path, ref.width, ref.height, test_path, test.width,
+                                test.height);
+        goto done;
+    }
+    int w = ref.width, h = ref.height;
+    fv_eye_model eye;
+    fv_eye_model_default(w, h, &eye);
+    if (ffrac > 0 || tfrac > 0) {
+        eye.mode = FV_FOVEA_WIDTH;
+        if (ffrac > 0) eye.fovea_frac = (float)ffrac;
+        eye.transition_frac = tfrac > 0 ? (float)tfrac : 1.5f * eye.fovea_frac;
+    }
+    if (fdeg > 0) eye.fovea_deg = (float)fdeg;
+    eye.transition_deg = tdeg > 0 ? (float)tdeg : 2.0f * eye.fovea_deg;
+    if (ppi > 0) eye.ppi = (float)ppi;
+    if (eyed > 0) eye.eye_dist_mm = (float)eyed;
+    if (fovx > 0) eye.fov_x_deg = (float)fovx;
+    if ((s = fv_eye_model_validate(&eye, &err)) != FV_OK) {
+        rc = fv_cli_fail(cmd, s, err.msg);
+        goto done;
+    }
+    fv_gaze g = {gaze[0], gaze[1]};
+    size_t n = (size_t)w * h;
+    labels = malloc(n);
+    map = malloc(n * sizeof *map);
+    if (!labels || !map) {
+        rc = fv_cli_fail(cmd, FV_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    fv_eye_region_labels(&eye, g, labels);
+    fv_metric_report rep;
+    if ((s = fv_metrics_compare(ref.rgb, test.rgb, w, h, labels, &mo, &rep, map, &err)) != FV_OK) {
+        rc = fv_cli_fail(cmd, s, err.msg);
+        goto done;
+    }
+    if (heat) {
+        float vmax = 1.0f;
+        if (strcmp(heat_metric, "flip") != 0) {
+            /* Per-pixel squared or absolute error of the compared values. */
+            float *a = malloc(n * 3 * sizeof *a), *b = malloc(n * 3 * sizeof *b);
+            if (!a || !b) {
+                free(a);
+                free(b);
+                rc = fv_cli_fail(cmd, FV_ERR_NOMEM, "out of memory");
+                goto done;
+            }
+            fv_metrics_prepare(ref.rgb, n, &mo, a);
+            fv_metrics_prepare(test.rgb, n, &mo, b);
+            bool sq = strcmp(heat_metric, "mse") == 0;
+            for (size_t i = 0; i < n; i++) {
+                float acc = 0.0f;
+                for (int k = 0; k < 3; k++) {
+                    float dd = a[3 * i + k] - b[3 * i + k];
+                    acc += sq ? dd * dd : fabsf(dd);
+                }
+                map[i] = acc / 3.0f;
+            }
+            free(a);
+            free(b);
+            vmax = 0.0f; /* scale to the largest error */
+        }
+        if ((s = fv_heatmap_write(heat, map, w, h, vmax, &eye, g, &err)) != FV_OK) {
+            rc = fv_cli_fail(cmd, s, err.msg);
+            goto done;
+        }
+    }
+    if (json) {
+        printf("{\n  \"ref\": \"%s\",\n  \"test\": \"%s\",\n  \"size\": [%d, %d],\n  \"gaze\": [%g, %g],\n", ref_path, test_path, w, h,
+               g.x, g.y);
+        printf("  \"fovea_radius_px\": %.6g,\n  \"transition_radius_px\": %.6g,\n  \"regions\": {\n", fv_eye_fovea_radius_px(&eye),
+               fv_eye_transition_radius_px(&eye));
+        for (int r = 0; r < FV_REGION_COUNT; r++) {
+            const fv_metric_values *v = &rep.region[r];
+            printf("    \"%s\": {\"pixels\": %lld, \"mse\": %.9g, \"psnr\": ", fv_region_name((fv_region)r), v->pixels, v->mse);
+            if (isfinite(v->psnr)) printf("%.9g", v->psnr);
+            else printf("null");
+            printf(", \"e\": %.9g, \"ssim\": %.9g, \"flip\": %.9g}%s\n", v->e, v->ssim, v->flip, r + 1 < FV_REGION_COUNT ? "," : "");
+        }
+        printf("  }\n}\n");
+    } else {
+        printf("%-11s %10s %10s %10s %10s %10s %10s\n", "region", "pixels", "MSE", "PSNR", "E", "SSIM", "FLIP");
+        for (int r = 0; r < FV_REGION_COUNT; r++) {
+            const fv_metric_values *v = &rep.region[r];
+            printf("%-11s %10lld", fv_region_name((fv_region)r), v->pixels);
+            print_value(v->mse);
+            print_value(v->psnr);
+            print_value(v->e);
+            print_value(v->ssim);
+            print_value(v->flip);
+            printf("\n");
+        }
+    }
+done:
+    free(labels);
+    free(map);
+    fv_image_free(&ref);
+    fv_image_free(&test);
+    return rc;
+}
