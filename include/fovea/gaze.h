@@ -39,7 +39,7 @@ typedef enum fv_fovea_mode {
  * HMD case) or, when fov_x_deg > 0, from the horizontal field of view (D = (w/2) / tan(fov/2)). */
 typedef struct fv_eye_model {
     int width, height;      /* pixels per eye */
-    float ppi;              /* pixel density, pixels per inch (HTC Vive: 615) */
+    float ppi;              /* pixel density, pixels per inch (HTC Vive: 615 at 1080 px wide) */
     float eye_dist_mm;      /* pupil-to-lens distance b in mm (HTC Vive: 18) */
     float fov_x_deg;        /* > 0: horizontal field of view, overrides ppi/eye_dist */
     fv_fovea_mode mode;
@@ -49,7 +49,8 @@ typedef struct fv_eye_model {
     float transition_frac;  /* FV_FOVEA_WIDTH: r_t / width (default 0.375) */
 } fv_eye_model;
 
-/* The defaults above for a display of the given size. */
+/* The defaults above for a display of the given size: the Vive's panel, its ppi scaled by
+ * width / 1080 so that the regions cover the same part of the view at any resolution. */
 void fv_eye_model_default(int width, int height, fv_eye_model *out);
 /* Checks every field (positive sizes and densities, 0 < e_f <= e_t < 90, 0 < frac_f <= frac_t). */
 fv_status fv_eye_model_validate(const fv_eye_model *m, fv_error *err);

@@ -29,7 +29,7 @@ void fv_metric_opts_default(fv_metric_opts *o);
 
 typedef struct fv_metric_values {
     double mse, psnr, e, ssim, flip;  /* psnr is +inf when mse is 0 */
-    long long pixels;                 /* pixels in the region; the other fields are 0 when none */
+    long long pixels;                 /* pixels in the region; the other fields are NaN when none */
 } fv_metric_values;
 
 typedef struct fv_metric_report {

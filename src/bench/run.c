@@ -98,7 +98,7 @@ typedef struct render_job {
 
 typedef fv_status (*frame_fn)(void *user, int index, fv_film *film, double ms, const fv_stats *stats, fv_error *err);
 
-static fv_status render_sequence(const render_job *j, frame_fn on_frame, void *user, fv_error *err)
+static fv_status render_sequence(const render_job *j, int nframes, frame_fn on_frame, void *user, fv_error *err)
 {
     fv_params *params = NULL;
     fv_technique *t = NULL;
@@ -107,7 +107,7 @@ static fv_status render_sequence(const render_job *j, frame_fn on_frame, void *u
     if (st == FV_OK && (st = fv_technique_create(j->m->method, j->scene, params, j->log, &t, err)) != FV_OK)
         fv_error_prefix(err, "%s: ", j->m->label);
     if (st == FV_OK) st = fv_film_create(j->sc->width, j->sc->height, 0, &film, err);
-    for (int i = 0; i < j->sc->frames && st == FV_OK; i++) {
+    for (int i = 0; i < nframes && st == FV_OK; i++) {
         const frame_setup *f = &j->frames[i];
         if ((st = fv_scene_set_time(j->scene, f->time, err)) != FV_OK) break;
         fv_frame fr;
@@ -191,7 +191,7 @@ static fv_status load_references(fv_bench_run_info *info, fv_scene *scene, frame
         say(info->opt, "reference: rendering %d frame(s) with %s (%d cached)", n, sc->reference.method, info->ref_cached);
         render_job j = {sc, scene, frames, info->threads, &sc->reference, info->opt->log};
         ref_ctx c = {frames, (const char *const *)paths, 0.0};
-        st = render_sequence(&j, on_reference_frame, &c, err);
+        st = render_sequence(&j, n, on_reference_frame, &c, err);
         info->ref_ms = c.ms / n;
         if (st != FV_OK) fv_error_prefix(err, "reference: ");
     } else if (st == FV_OK) {
@@ -250,6 +250,12 @@ static fv_status on_method_frame(void *user, int i, fv_film *film, double ms, co
     return FV_OK;
 }
 
+static fv_status on_warmup_frame(void *user, int i, fv_film *film, double ms, const fv_stats *stats, fv_error *err)
+{
+    (void)user, (void)i, (void)film, (void)ms, (void)stats, (void)err;
+    return FV_OK;
+}
+
 /* A square crop around the gaze point of side 2 r_t (at least 32 px), clamped to the image. */
 static fv_status write_crop(const fv_scenario *sc, const float *rgb, fv_gaze g, const char *path, fv_error *err)
 {
@@ -292,6 +298,9 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
     fv_stats stage_names;
     fv_stats_clear(&stage_names);
     render_job j = {sc, scene, frames, info->threads, m, info->opt->log};
+    /* One untimed frame first: thread start-up and cold caches would otherwise land in the
+     * first repeat of whichever method runs first. */
+    if (st == FV_OK) st = render_sequence(&j, 1, on_warmup_frame, NULL, err);
     for (int r = 0; r < reps && st == FV_OK; r++) {
         say(info->opt, "[%d/%d] %s: repeat %d/%d, %d frame(s)", index + 1, total, m->label, r + 1, reps, sc->frames);
         c.measure = r == reps - 1;
@@ -302,7 +311,7 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
             memset(&res->error, 0, sizeof res->error);
             if (sc->frames > 1 && (st = fv_temporal_create(sc->width, sc->height, &c.mopts, &c.temporal, err)) != FV_OK) break;
         }
-        if ((st = render_sequence(&j, on_method_frame, &c, err)) != FV_OK) break;
+        if ((st = render_sequence(&j, sc->frames, on_method_frame, &c, err)) != FV_OK) break;
         res->ms[r] = c.ms_sum / sc->frames;
         for (int k = 0; k < c.stage_sum.n_stages; k++) {
             fv_stats_add_ms(&stage_names, c.stage_sum.stage[k].name, 0.0);
@@ -326,7 +335,7 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
             fv_stats_add_count(&res->counters, c.counter_sum.counter[k].name, c.counter_sum.counter[k].value / sc->frames);
         for (int r = 0; r < FV_REGION_COUNT; r++) {
             fv_metric_values *v = &res->error.region[r];
-            v->psnr = v->mse > 0.0 ? 10.0 * log10(1.0 / v->mse) : INFINITY;
+            v->psnr = v->mse > 0.0 ? 10.0 * log10(1.0 / v->mse) : v->mse == 0.0 ? INFINITY : NAN;
         }
         if (c.temporal) {
             res->has_temporal = true;

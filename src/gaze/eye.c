@@ -16,7 +16,10 @@ void fv_eye_model_default(int width, int height, fv_eye_model *m)
 {
     m->width = width;
     m->height = height;
-    m->ppi = 615.0f;        /* HTC Vive (Foveated Photon Mapping, Sec. 4.1) */
+    /* The HTC Vive's panel (Foveated Photon Mapping, Sec. 4.1): 1080 px per eye at 615 ppi. A
+     * render of another width shows the same view on the same panel, so the density scales with
+     * the width and the regions cover the same part of the view at any resolution. */
+    m->ppi = 615.0f * (float)width / 1080.0f;
     m->eye_dist_mm = 18.0f; /* HTC Vive pupil-to-lens distance, same section */
     m->fov_x_deg = 0.0f;
     m->mode = FV_FOVEA_ANGLE;

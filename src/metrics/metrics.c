@@ -170,8 +170,10 @@ fv_status fv_metrics_compare(const float *ref, const float *test, int w, int h, 
             v->e = s[2] / s[0];
             v->ssim = s[3] / s[0];
             v->flip = s[4] / s[0];
+            v->psnr = v->mse > 0.0 ? 10.0 * log10(1.0 / v->mse) : INFINITY;
+        } else { /* an empty region has no error, not a zero error */
+            v->mse = v->e = v->ssim = v->flip = v->psnr = NAN;
         }
-        v->psnr = v->mse > 0.0 ? 10.0 * log10(1.0 / v->mse) : INFINITY;
     }
 done:
     free(a);

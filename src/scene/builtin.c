@@ -18,7 +18,7 @@ static const builtin k_builtins[] = {
      fv_builtin_cornell_glossy},
     {"cornell-fpm", "Foveated Photon Mapping Fig. 2: glass sphere (caustic), moving mirror cube, camera path, 0-4 s",
      fv_builtin_cornell_fpm},
-    {"city", "performance scene: ~190k triangles of towers and spheres, mixed materials, sun + lamps",
+    {"city", "performance scene: 180,906 triangles of towers and spheres, mixed materials, sun + lamps",
      fv_builtin_city},
     {"furnace", "white furnace test: inside a sphere of albedo 0.5 emitting 0.5, radiance is exactly 1",
      fv_builtin_furnace},

@@ -2,8 +2,8 @@
  * tessellated ground, each block either a tower (a stack of two or three shrinking boxes, turned
  * a little) or a finely tessellated sphere, in diffuse, glossy (three roughnesses), mirror and
  * glass materials. Lit by a warm, distant sun-like spot light, three street-level point lights
- * and emissive panels on some roofs. About 190k triangles, most of them in the spheres, so the
- * BVH, not the shading, dominates ray cost.
+ * and emissive panels on some roofs (38 panels, 76 emissive triangles). 180,906 triangles in
+ * four objects: ground 28,800, towers 12,190, 92 spheres 139,840, panels 76.
  *
  * Deterministic: every choice comes from an integer hash of the block's grid coordinates (no
  * rand()), so the scene is the same on every machine and run. Limits: no instancing; the towers

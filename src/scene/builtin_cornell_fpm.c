@@ -46,14 +46,14 @@ fv_status fv_builtin_cornell_fpm(fv_scene *s, const fv_log *log, fv_error *err)
     if (st != FV_OK) return st;
 
     /* The cube rests on the floor (centre at y = 75) on the right, slides towards the middle and
-     * back while swinging between 30 and 60 degrees about +y. Near 45 degrees the two faces the
+     * back while swinging between 30 and 50 degrees about +y. Near 45 degrees the two faces the
      * camera sees mirror the red and green walls; turned square to the camera a face would only
      * mirror the black void behind it (the box is open at z = 0). Its half diagonal is 106, so
      * it keeps clear of the walls and, by at least 129, of the sphere. */
     const fv_vec3 up = P(0, 1, 0), one = fv_v3s(1.0f);
     const fv_anim_key keys[3] = {
         {0.0, P(150, CUBE_HALF, 170), fv_quat_axis_angle(up, fv_radians(30.0f)), one},
-        {2.0, P(270, CUBE_HALF, 150), fv_quat_axis_angle(up, fv_radians(60.0f)), one},
+        {2.0, P(270, CUBE_HALF, 150), fv_quat_axis_angle(up, fv_radians(50.0f)), one},
         {4.0, P(150, CUBE_HALF, 170), fv_quat_axis_angle(up, fv_radians(30.0f)), one},
     };
     if ((st = fv_scene_animate_object(s, cube, keys, 3, err)) != FV_OK) return st;

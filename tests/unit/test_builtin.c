@@ -246,9 +246,9 @@ static void test_fpm(void **st)
     assert_int_equal(h.mat, mirror);
     assert_float_equal(h.t, 0.90336, 1e-4);
     assert_float_equal(h.p.z, 76.26, 0.05);
-    /* At t = 2 it sits at (270, 75, 150), turned 60 degrees: its footprint's low-x edge runs
-     * from (242.6, 47.6) to (167.6, 177.4) in x, z, where the ray is at x = 166.2 and 149.0, so
-     * the ray passes on that side (higher corners lie further away) and ends on the floor. */
+    /* At t = 2 it sits at (270, 75, 150), turned 50 degrees: its footprint's low-x edge runs
+     * from (260.8, 44.3) to (164.3, 159.2) in x, z, where the ray is at x = 166.6 and 151.4, so
+     * the ray passes on that side (the other corners lie further away) and ends on the floor. */
     assert_int_equal(fv_scene_set_time(s, 2.0, &err), FV_OK);
     assert_true(fv_scene_intersect(s, FV_TRACE_ALL, eye, d, 1e30f, &h));
     assert_int_not_equal(h.mat, mirror);

@@ -24,6 +24,9 @@ static void test_eq7_radii(void **st)
     assert_float_equal(fv_eye_view_dist_px(&m), 435.827, 1e-3);
     assert_float_equal(fv_eye_fovea_radius_px(&m), 75.124, 1e-3);
     assert_float_equal(fv_eye_transition_radius_px(&m), 154.848, 1e-3);
+    /* The same panel rendered 270 px wide: ppi 615/4, every radius a quarter. */
+    fv_eye_model_default(270, 300, &m);
+    assert_float_equal(fv_eye_fovea_radius_px(&m), 75.124 / 4, 1e-3);
 }
 
 /* Eccentricity is the inverse of Eq. 7: a pixel D pixels from the gaze is at atan(1) = 45 deg; a
