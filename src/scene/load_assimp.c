@@ -270,7 +270,7 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, const fv_import_opts
     /* Points and lines would only be dropped later; ask assimp not to produce them. */
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const struct aiScene *ai = aiImportFileExWithProperties(
-        path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType | aiProcess_FindInvalidData, NULL, props);
+        path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType, NULL, props);
     aiReleasePropertyStore(props);
     if (!ai) {
         const char *why = aiGetErrorString();

@@ -337,6 +337,18 @@ static void test_city(void **st)
     /* 4 delta lights plus two triangles per roof panel. */
     int lights = fv_scene_light_count(a);
     assert_true(lights > 4 && (lights - 4) % 2 == 0);
+    /* The point lights hang over street crossings, not inside a tower: straight down from each
+     * is the open ground, 6 below. */
+    int ground = fv_scene_find_material(a, "ground"), points = 0;
+    for (int i = 0; i < a->ndelta; i++) {
+        if (a->delta[i].type != FV_LIGHT_POINT) continue;
+        points++;
+        fv_hit g;
+        assert_true(fv_scene_intersect(a, FV_TRACE_ALL, a->delta[i].pos, fv_v3(0, -1, 0), 1e30f, &g));
+        assert_int_equal(g.mat, ground);
+        assert_float_equal(g.t, 6.0, 1e-3);
+    }
+    assert_int_equal(points, 3);
     /* The camera's centre ray hits the city. */
     fv_camera cam;
     fv_camera_basis bs;
