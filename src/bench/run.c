@@ -395,6 +395,17 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
     say(opt, "scenario %s: scene %s, %dx%d, %d frame(s), %d method(s)", sc->name, sc->scene, sc->width, sc->height, sc->frames,
         sc->nmethods);
     if ((st = fv_scene_load(sc->scene, opt->log, &scene, err)) != FV_OK) goto done;
+    /* Every method's parameters are checked before anything is rendered. */
+    for (int i = -1; i < sc->nmethods && st == FV_OK; i++) {
+        const fv_bench_method *m = i < 0 ? &sc->reference : &sc->methods[i];
+        fv_params *p = NULL;
+        fv_technique *t = NULL;
+        if ((st = fv_params_clone(m->params, &p, err)) == FV_OK && (st = fv_technique_create(m->method, scene, p, opt->log, &t, err)) != FV_OK)
+            fv_error_prefix(err, "%s: %s: ", path, m->label);
+        fv_technique_destroy(t);
+        fv_params_destroy(p);
+    }
+    if (st != FV_OK) goto done;
     size_t npix = (size_t)sc->width * sc->height;
     if (!(frames = fv_calloc_array((size_t)sc->frames, sizeof *frames))) {
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");

@@ -30,7 +30,8 @@ static void help(void)
            "  --camera-pos x,y,z    camera position      --camera-look x,y,z  point looked at\n"
            "  --camera-up x,y,z     camera up vector     --fov DEG            vertical field of view\n"
            "  --point-light x,y,z,r,g,b  add a point light (intensity W/sr), repeatable\n"
-           "  --gaze X,Y            gaze point in normalised screen coordinates [0.5,0.5]\n"
+           "  --gaze X,Y            gaze point in normalised screen coordinates [the scene's gaze, or 0.5,0.5]\n"
+           "  --gaze-trace FILE     gaze over time from a CSV trace (docs/gaze.md)\n"
            "  --stereo SEP          render a stereo pair with eye separation SEP: OUT_left.ext, OUT_right.ext\n"
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
            "  --quiet               no progress bar, warnings or per-frame lines\n"
@@ -59,7 +60,8 @@ typedef struct render_opts {
     int width, height, frames, threads, spp;
     double fps, time0, exposure, stereo;
     unsigned long long seed;
-    bool quiet, has_pos, has_look, has_up, has_fov;
+    bool quiet, has_pos, has_look, has_up, has_fov, has_gaze;
+    const char *gaze_trace;
     float pos[3], look[3], up[3], fov, gaze[2];
     int nlights;
     float lights[MAX_LIGHTS][6];
@@ -68,12 +70,12 @@ typedef struct render_opts {
 static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
     enum { O_METHOD = 256, O_SPP, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
-           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_STEREO, O_PARAM, O_QUIET, O_HELP };
+           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_STEREO, O_PARAM, O_QUIET, O_HELP };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
         {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
-        {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE},
+        {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE},
         {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"help", 0, 0, O_HELP},
         {0, 0, 0, 0}};
     const char *cmd = "render";
@@ -146,7 +148,9 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
         case O_GAZE:
             if (!fv_cli_parse_floats(optarg, 2, o->gaze) || o->gaze[0] < 0 || o->gaze[0] > 1 || o->gaze[1] < 0 || o->gaze[1] > 1)
                 return fv_cli_usage_error(cmd, "--gaze %s: expected X,Y with both in [0,1]", optarg);
+            o->has_gaze = true;
             break;
+        case O_TRACE: o->gaze_trace = optarg; break;
         case O_STEREO:
             if (!fv_cli_parse_float(optarg, &d) || d <= 0) return fv_cli_usage_error(cmd, "--stereo %s: expected a positive eye separation", optarg);
             o->stereo = d;
@@ -186,6 +190,7 @@ int fv_cmd_render(int argc, char **argv)
     fv_scene *scene = NULL;
     fv_technique *tech = NULL;
     fv_film *film[2] = {NULL, NULL};
+    fv_gaze_path *trace = NULL;
     int rc = FV_EXIT_OK;
     fv_status s;
 
@@ -243,6 +248,24 @@ int fv_cmd_render(int argc, char **argv)
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
     }
+    /* Gaze: --gaze, else --gaze-trace, else the scene's gaze path, else the centre. The eye model
+     * is the scene's display (its density rescaled to this image width) or the default. */
+    if (o.has_gaze && o.gaze_trace) {
+        rc = fv_cli_usage_error(cmd, "--gaze and --gaze-trace exclude each other");
+        goto done;
+    }
+    if (o.gaze_trace && (s = fv_gaze_path_load_csv(o.gaze_trace, &trace, &err)) != FV_OK) {
+        rc = fv_cli_fail(cmd, s, err.msg);
+        goto done;
+    }
+    const fv_gaze_path *gpath = trace ? trace : o.has_gaze ? NULL : fv_scene_gaze_path(scene);
+    fv_eye_model eye;
+    fv_eye_model_default(o.width, o.height, &eye);
+    if (fv_scene_eye(scene, &eye)) {
+        eye.ppi *= (float)o.width / (float)eye.width;
+        eye.width = o.width;
+        eye.height = o.height;
+    }
     unsigned aux = fmt == FV_IMG_EXR ? FV_AUX_ALL : 0;
     int neyes = o.stereo > 0 ? 2 : 1;
     for (int e = 0; e < neyes; e++)
@@ -277,6 +300,8 @@ int fv_cmd_render(int argc, char **argv)
         fr.prev_camera_right = neyes == 2 && f > 0 ? &prev[1] : NULL;
         fr.gaze.x = fr.gaze_right.x = o.gaze[0];
         fr.gaze.y = fr.gaze_right.y = o.gaze[1];
+        if (gpath) fv_gaze_path_eval(gpath, t, &fr.gaze, &fr.gaze_right);
+        fr.eye = &eye;
         fr.progress = fv_cli_progress_frame;
         fr.progress_user = &prog;
         prog.frame = f;
@@ -316,6 +341,7 @@ int fv_cmd_render(int argc, char **argv)
     fv_cli_progress_done(&prog);
     if (s != FV_OK) rc = fv_cli_fail(cmd, s, err.msg);
 done:
+    fv_gaze_path_destroy(trace);
     fv_film_destroy(film[0]);
     fv_film_destroy(film[1]);
     fv_technique_destroy(tech);

@@ -1,0 +1,49 @@
+# `fovea bench`: the pt-cornell scenario in quick mode writes a complete JSON report whose errors
+# fall with spp in every region; the reference is cached; bad scenarios exit 2.
+. "$(dirname "$0")/lib.sh"
+B="$FOVEA bench"
+OUT=$TMP/bench
+expect 0 "" -- $B pt-cornell --quick --out "$OUT" --quiet
+python3 - "$OUT/pt-cornell.json" <<'PY' || fail "pt-cornell.json is incomplete or wrong"
+import json, sys
+d = json.load(open(sys.argv[1]))
+rows = d["results"]
+assert len(rows) == 3, rows
+for r in rows:
+    for k in ("method", "params", "ms_per_frame", "stages_ms", "speedup", "error", "temporal", "counters", "images"):
+        assert k in r, k
+    assert r["ms_per_frame"]["min"] <= r["ms_per_frame"]["median"] <= r["ms_per_frame"]["max"]
+    for g in ("fovea", "transition", "periphery", "all"):
+        for m in ("mse", "ssim", "flip"):
+            assert r["error"][g][m] is not None, (g, m)
+    assert r["counters"]["rays"] > 0
+spp = [int(r["params"]["spp"]) for r in rows]
+assert spp == [1, 4, 16], spp
+for g in ("fovea", "transition", "periphery", "all"):
+    e = [r["error"][g]["mse"] for r in rows]
+    assert e[0] > e[1] > e[2], (g, e)
+base = [r for r in rows if r["method"] == d["baseline"]][0]
+assert abs(base["speedup"] - 1.0) < 1e-9
+PY
+for f in pt-cornell.md pt-cornell-sweep.csv pt-cornell/reference.png pt-cornell/pt-spp=4.png pt-cornell/pt-spp=4-flip.png pt-cornell/pt-spp=4-fovea.png; do
+  [ -s "$OUT/$f" ] || fail "missing $f"
+done
+ls "$OUT"/cache/ref-*.pfm >/dev/null 2>&1 || fail "no cached reference"
+expect 0 "" -- $B pt-cornell --quick --out "$OUT" --repeats 1
+grep -q "from the cache" "$TMP/err" || fail "second run did not use the cached reference"
+
+expect 2 "unknown scenario 'nope'" -- $B nope
+printf '{\n  "scene": "cornell",\n  "reference": {"method": "pt"}\n  "methods": []\n}\n' > "$TMP/bad1.json"
+expect 2 "bad1.json:4:" -- $B "$TMP/bad1.json" --out "$OUT"
+printf '{"scene": "cornell", "reference": {"method": "pt"}, "methods": [{"method": "pt"}], "sizes": [8, 8]}' > "$TMP/bad2.json"
+expect 2 "unknown field 'sizes'" -- $B "$TMP/bad2.json" --out "$OUT"
+printf '{"scene": "cornell", "reference": {"method": "pt"}, "methods": [{"method": "pt"}], "gaze": {"fixed": [1.2, 0.5]}}' > "$TMP/bad3.json"
+expect 2 "gaze" -- $B "$TMP/bad3.json" --out "$OUT"
+printf '{"scene": "cornell", "reference": {"method": "pt"}, "methods": [{"method": "warp"}]}' > "$TMP/bad4.json"
+expect 2 "unknown method 'warp'" -- $B "$TMP/bad4.json" --out "$OUT"
+printf '{"scene": "cornell", "reference": {"method": "pt"}, "methods": [{"method": "pt", "params": {"sp": 4}}], "size": [8, 8]}' > "$TMP/bad5.json"
+expect 2 "unknown parameter 'sp'" -- $B "$TMP/bad5.json" --out "$OUT" --quiet
+printf '{"scene": "cornell", "reference": {"method": "pt"}, "methods": [{"method": "pt"}], "size": [100000, 8]}' > "$TMP/bad6.json"
+expect 2 "size" -- $B "$TMP/bad6.json" --out "$OUT"
+expect 0 "" -- $B pt-cornell --check
+finish

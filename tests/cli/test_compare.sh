@@ -1,0 +1,31 @@
+# `fovea compare`: identical images give zero error, a noisier render gives more error than a
+# less noisy one, JSON output parses, a heat map is written; bad input exits 2.
+. "$(dirname "$0")/lib.sh"
+C="$FOVEA compare"
+$FOVEA render cornell --size 48x48 --spp 64 --out "$TMP/ref.pfm" --quiet || fail "render ref"
+$FOVEA render cornell --size 48x48 --spp 1 --seed 7 --out "$TMP/a.pfm" --quiet || fail "render a"
+$FOVEA render cornell --size 48x48 --spp 8 --seed 7 --out "$TMP/b.png" --quiet || fail "render b"
+$FOVEA render cornell --size 32x32 --spp 1 --out "$TMP/small.pfm" --quiet || fail "render small"
+
+expect 0 "" -- $C "$TMP/ref.pfm" "$TMP/ref.pfm"
+awk '$1 == "all" && $3 != 0 { bad = 1 } END { exit bad }' "$TMP/out" || fail "identical images: non-zero MSE: $(cat "$TMP/out")"
+grep -q '^fovea ' "$TMP/out" || fail "no fovea row: $(cat "$TMP/out")"
+
+expect 0 "" -- $C "$TMP/ref.pfm" "$TMP/a.pfm" --json --gaze 0.3,0.6 --heatmap "$TMP/heat.png"
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); r=d["regions"]; assert set(r)=={"fovea","transition","periphery","all"}; assert r["all"]["mse"]>0 and 0<r["all"]["flip"]<1; assert d["gaze"]==[0.3,0.6]' "$TMP/out" \
+  || fail "bad JSON from compare: $(cat "$TMP/out")"
+cp "$TMP/out" "$TMP/a.json"
+[ -s "$TMP/heat.png" ] || fail "no heat map written"
+expect 0 "" -- $C "$TMP/ref.pfm" "$TMP/b.png" --json --gaze 0.3,0.6
+python3 -c 'import json,sys; a=json.load(open(sys.argv[1]))["regions"]["all"]; b=json.load(open(sys.argv[2]))["regions"]["all"]; assert b["mse"]<a["mse"] and b["flip"]<a["flip"] and b["ssim"]>a["ssim"], (a,b)' "$TMP/a.json" "$TMP/out" \
+  || fail "8 spp is not closer to the reference than 1 spp"
+expect 0 "" -- $C "$TMP/ref.pfm" "$TMP/a.pfm" --fovea-frac 0.25 --heatmap "$TMP/heat-mse.png" --heatmap-metric mse
+
+expect 2 "size mismatch" -- $C "$TMP/ref.pfm" "$TMP/small.pfm"
+expect 2 "missing.png" -- $C "$TMP/ref.pfm" "$TMP/missing.png"
+expect 2 "--gaze" -- $C "$TMP/ref.pfm" "$TMP/a.pfm" --gaze 0.5,-0.1
+expect 2 "expected two images" -- $C "$TMP/ref.pfm"
+printf 'not an image' > "$TMP/junk.png"
+expect 2 "junk.png" -- $C "$TMP/ref.pfm" "$TMP/junk.png"
+expect 2 "--heatmap" -- $C "$TMP/ref.pfm" "$TMP/a.pfm" --heatmap "$TMP/heat.jpg"
+finish

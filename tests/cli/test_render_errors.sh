@@ -1,0 +1,48 @@
+# `fovea render` on bad input: every case exits 2 with one line naming the problem and leaves no
+# output file; good input renders a valid image.
+. "$(dirname "$0")/lib.sh"
+D=$SRC/tests/data
+OUT=$TMP/out.png
+R="$FOVEA render"
+
+expect 2 "no/such/scene.obj" -- $R "$TMP/no/such/scene.obj" --size 8x8 --out "$OUT"
+expect 2 "unknown scene 'cornel'" -- $R cornel --size 8x8 --out "$OUT"
+expect 2 "unknown method" -- $R cornell --method nope --size 8x8 --out "$OUT"
+expect 2 "unknown parameter 'bogus'" -- $R cornell --param bogus=1 --size 8x8 --out "$OUT"
+expect 2 "max_depth" -- $R cornell --param max_depth=-3 --size 8x8 --out "$OUT"
+expect 2 "0x10" -- $R cornell --size 0x10 --out "$OUT"
+expect 2 "-5x5" -- $R cornell --size -5x5 --out "$OUT"
+expect 2 "100000x100000" -- $R cornell --size 100000x100000 --out "$OUT"
+expect 2 "--size" -- $R cornell --size abc --out "$OUT"
+expect 2 "--spp" -- $R cornell --spp 0 --out "$OUT"
+expect 2 "--gaze" -- $R cornell --gaze 1.5,0.5 --size 8x8 --out "$OUT"
+expect 2 "nope.csv" -- $R cornell --gaze-trace "$TMP/nope.csv" --size 8x8 --out "$OUT"
+expect 2 "unknown image format" -- $R cornell --size 8x8 --out "$TMP/x.jpg"
+expect 2 "cannot write" -- $R cornell --size 8x8 --out "$TMP/missing/dir/x.png"
+expect 2 "empty.obj" -- $R "$D/empty.obj" --size 8x8 --out "$OUT"
+expect 2 "bad_syntax.json:4:" -- $R "$D/bad_syntax.json" --size 8x8 --out "$OUT"
+expect 2 "unknown field 'albdo'" -- $R "$D/bad_field.json" --size 8x8 --out "$OUT"
+expect 2 "unknown material 'whte'" -- $R "$D/bad_material.json" --size 8x8 --out "$OUT"
+expect 2 "materials.white.emission" -- $R "$D/bad_inf.json" --size 8x8 --out "$OUT"
+expect 2 "unknown or incomplete option" -- $R cornell --frobnicate
+expect 2 "unknown command" -- $FOVEA frobnicate
+[ -e "$OUT" ] && fail "a failed render left $OUT behind"
+ls "$TMP" | grep -q 'tmp\.' && fail "temporary files left in $TMP"
+
+# A mesh with NaN and degenerate triangles renders, with a warning.
+expect 0 "" -- $R "$D/nan.obj" --size 8x8 --spp 1 --out "$OUT"
+grep -q "dropped 2 of 3 triangles" "$TMP/err" || fail "no warning about the dropped triangles: $(cat "$TMP/err")"
+[ -s "$OUT" ] || fail "no image written for nan.obj"
+
+# Good renders: PNG, PFM, EXR; a sequence gets numbered files.
+expect 0 "" -- $R cornell --size 16x12 --spp 2 --out "$TMP/c.png" --quiet
+head -c 8 "$TMP/c.png" | od -An -c | grep -q 'P   N   G' || fail "c.png is not a PNG"
+expect 0 "" -- $R cornell --size 16x12 --spp 1 --out "$TMP/c.pfm" --quiet
+head -c 2 "$TMP/c.pfm" | grep -q PF || fail "c.pfm is not a PFM"
+expect 0 "" -- $R cornell-fpm --size 16x12 --spp 1 --frames 2 --out "$TMP/seq.exr" --quiet
+[ -s "$TMP/seq_0000.exr" ] && [ -s "$TMP/seq_0001.exr" ] || fail "sequence frames missing: $(ls "$TMP")"
+expect 0 "" -- $FOVEA scenes
+grep -q "cornell-fpm" "$TMP/out" || fail "fovea scenes does not list cornell-fpm"
+expect 0 "" -- $FOVEA methods
+grep -q "^pt " "$TMP/out" || fail "fovea methods does not list pt"
+finish
