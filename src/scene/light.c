@@ -123,6 +123,12 @@ bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *orig
     return true;
 }
 
+fv_vec3 fv_light_delta_intensity(const fv_light *l, fv_vec3 w)
+{
+    float fall = l->desc.type == FV_LIGHT_SPOT ? spot_falloff(&l->desc, w) : 1.0f;
+    return fv_scale(l->desc.intensity, fall);
+}
+
 fv_vec3 fv_light_total_power(const fv_scene *s)
 {
     fv_vec3 p = fv_v3s(0.0f);

@@ -34,6 +34,9 @@ float fv_light_pdf_li(const fv_scene *s, int obj, int prim, fv_vec3 p, fv_vec3 h
 bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *origin, fv_vec3 *dir, fv_vec3 *power,
                               fv_vec3 *normal);
 
+/* Radiant intensity of delta light l towards unit direction w (spot fall-off applied). */
+fv_vec3 fv_light_delta_intensity(const fv_light *l, fv_vec3 w);
+
 /* Total emitted power of all lights (W): the scale of a photon map. */
 fv_vec3 fv_light_total_power(const fv_scene *s);
 

@@ -9,9 +9,12 @@
 #include "fovea/technique.h"
 
 extern const fv_technique_class fv_technique_pt;
+extern const fv_technique_class fv_technique_pm;
+extern const fv_technique_class fv_technique_pm_t;
+extern const fv_technique_class fv_technique_fpm;
 
 static const fv_technique_class *const k_classes[] = {
-    &fv_technique_pt,
+    &fv_technique_pt, &fv_technique_pm, &fv_technique_pm_t, &fv_technique_fpm,
 };
 
 #define N_CLASSES ((int)(sizeof k_classes / sizeof k_classes[0]))

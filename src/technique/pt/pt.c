@@ -256,7 +256,7 @@ const fv_technique_class fv_technique_pt = {
     "pt",
     "reference path tracer: NEE + MIS, Russian roulette (ground truth)",
     "spp=int (16): samples per pixel\n"
-    "max_depth=int (8): path segments after the camera, 1 = direct light only\n"
+    "max_depth=int (8): path vertices that gather light, 1 = direct light only\n"
     "rr_depth=int (3): depth from which Russian roulette may end paths\n",
     pt_create,
     pt_render,

@@ -1,0 +1,57 @@
+/* fovea — photons and photon maps stored in a sorted uniform grid.
+ *
+ * Foveated Photon Mapping (Sec. 3) keeps four maps (light/foveated x static/dynamic); a photon
+ * has a direction, a signed RGB flux and a position (and the map remembers the surface normal to
+ * keep photons from leaking through thin walls). The paper stores maps in sorted uniform grids
+ * rather than kd-trees because they rebuild in linear time; so do we: cells are hashed into a
+ * table of 2^k buckets (memory independent of the scene's extent), photons are counting-sorted by
+ * bucket, and a query visits the neighbouring cells.
+ */
+#ifndef FV_PHOTON_MAP_H
+#define FV_PHOTON_MAP_H
+
+#include <stdint.h>
+#include "fovea/math.h"
+#include "fovea/status.h"
+
+typedef struct fv_photon {
+    fv_vec3 pos;
+    fv_vec3 dir;   /* unit direction of travel when the photon arrived */
+    fv_vec3 flux;  /* signed RGB flux (negative photons cancel light a dynamic object blocks) */
+    fv_vec3 n;     /* unit geometric normal, on the side the photon arrived from */
+} fv_photon;
+
+typedef struct fv_photon_map {
+    fv_photon *p;          /* after fv_photon_map_build: sorted by grid bucket */
+    int n, cap;
+    /* grid */
+    float cell, inv_cell;
+    uint32_t mask;         /* buckets - 1 */
+    uint32_t *start;       /* buckets + 1 offsets into p */
+    uint32_t nbuckets;
+    fv_photon *scratch;
+    int scratch_cap;
+} fv_photon_map;
+
+void fv_photon_map_init(fv_photon_map *m);
+void fv_photon_map_free(fv_photon_map *m);
+void fv_photon_map_clear(fv_photon_map *m);
+/* Appends (not thread-safe; see fv_photon_map_append_many). */
+fv_status fv_photon_map_push(fv_photon_map *m, const fv_photon *ph, fv_error *err);
+fv_status fv_photon_map_append(fv_photon_map *m, const fv_photon *ph, int count, fv_error *err);
+/* Sorts the photons into the grid of cell size `cell` (queries may reach up to 3 cells; about the
+ * gather radius is best). O(n). */
+fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err);
+
+/* Calls fn for every photon within radius r (r <= 3 cell) of x. */
+typedef void (*fv_photon_fn)(void *ctx, const fv_photon *ph, float d2);
+void fv_photon_map_query(const fv_photon_map *m, fv_vec3 x, float r, fv_photon_fn fn, void *ctx);
+/* Index of the nearest photon within r (r <= 3 cell) of x whose normal agrees with n
+ * (dot > 0.5); -1 when none. *d2 gets its squared distance. */
+int fv_photon_map_nearest(const fv_photon_map *m, fv_vec3 x, fv_vec3 n, float r, float *d2);
+
+/* The gather radius of Foveated Photon Mapping Eq. 8: the mean extent of the scene's bounding
+ * box over the mean image side, times 20. */
+float fv_photon_radius_eq8(fv_vec3 lo, fv_vec3 hi, int width, int height);
+
+#endif

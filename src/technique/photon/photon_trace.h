@@ -1,0 +1,55 @@
+/* fovea — light photon tracing shared by pm, pm-t and fpm (Foveated Photon Mapping, Sec. 3).
+ *
+ * PT_s / full tracing: photons leave the lights in proportion to power, bounce with the shared
+ * BSDFs (importance transport), Russian roulette keeps the flux per photon near constant, and a
+ * photon is stored at every hit on a diffuse or glossy surface (mirrors and glass only redirect,
+ * so caustics form), up to `max_depth` bounces (8 in the paper, Sec. 4.1).
+ *
+ * PT_d: photons for the dynamic objects. The paper renders a cube map of the dynamic objects from
+ * the light and samples directions from its covered pixels. Our CPU equivalent samples, from each
+ * photon's origin on the light, a direction in the cone of a dynamic object's bounding sphere
+ * (fv_dyn_dirs): exact densities and no pixel-sized gaps at silhouettes, which the negative photons
+ * need to cancel the static light exactly. A photon sent that way whose first hit is
+ * a dynamic object spawns a positive photon path (reflected, refracted or absorbed by the object's
+ * material, stored everywhere it lands) and a negative one that pierces the object and carries
+ * the negated flux through the static scene, cancelling the light the object now blocks. Paths
+ * whose first hit is static are dropped: the static map already holds them. Limits: light reaching
+ * a dynamic object only after bouncing elsewhere is not re-traced (as in the paper).
+ *
+ * Results do not depend on the thread count: photon i always uses random stream i, and the
+ * per-block outputs are concatenated in block order.
+ */
+#ifndef FV_PHOTON_TRACE_H
+#define FV_PHOTON_TRACE_H
+
+#include "scene/scene_impl.h"
+#include "technique/photon/photon_map.h"
+
+/* Where the dynamic objects are: their bounding spheres at the scene's current time. */
+typedef struct fv_dyn_dirs fv_dyn_dirs;
+fv_status fv_dyn_dirs_create(fv_dyn_dirs **out, fv_error *err);
+void fv_dyn_dirs_destroy(fv_dyn_dirs *d);
+fv_status fv_dyn_dirs_build(fv_dyn_dirs *d, const fv_scene *s, fv_error *err);
+int fv_dyn_dirs_count(const fv_dyn_dirs *d);
+
+typedef struct fv_photon_job {
+    const fv_scene *scene;
+    int64_t count;         /* photons emitted */
+    uint64_t seed;
+    int frame;             /* decorrelates frames; use 0 for maps traced once */
+    int max_depth;
+    int threads;
+    uint64_t stream;       /* distinguishes several maps traced in one frame */
+} fv_photon_job;
+
+/* Traces job->count photons from the lights through `set` (FV_TRACE_ALL for plain photon mapping,
+ * FV_TRACE_STATIC for M_ls), appending the stored photons to out. Each carries 1/count of the
+ * emitted power it represents. *rays receives the number of rays cast. */
+fv_status fv_photon_trace_lights(const fv_photon_job *job, fv_trace_set set, fv_photon_map *out, uint64_t *rays, fv_error *err);
+
+/* Traces job->count photons towards the dynamic objects (PT_d) with the maps in dirs; appends the
+ * positive and negative photons to out. */
+fv_status fv_photon_trace_dynamic(const fv_photon_job *job, const fv_dyn_dirs *dirs, fv_photon_map *out, uint64_t *rays,
+                                  fv_error *err);
+
+#endif

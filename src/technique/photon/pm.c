@@ -1,0 +1,481 @@
+/* fovea — photon mapping techniques of Foveated Photon Mapping (Shi et al., TVCG):
+ *   pm   — photon mapping, all photons retraced every frame (the paper's PM_3M);
+ *   pm-t — photon mapping with the temporal strategy of its ref. [43]: static light photons (M_ls)
+ *          traced once, photons for the dynamic objects (M_ld, positive and negative) every frame,
+ *          radiance by Eq. 5 with the static/dynamic blend of Eq. 4 (PM^t);
+ *   fpm  — foveated photon mapping (Alg. 1): pm-t's light photons plus foveated photons (M_fs,
+ *          M_fd) traced from the eye through the focus region, kept across frames by temporal
+ *          photon management (Alg. 2), energy-normalised by eta (Eq. 1); fovea by Eq. 3, periphery
+ *          by Eq. 5, transition blended by b(x) (Eq. 6).
+ * All three share the photon tracer, the grids, the eye paths, the gather and the filter; they
+ * differ only where the paper's methods differ.
+ *
+ * Our reading of Eq. 3-5: the printed k * sum(M_d) + (1 - k) * sum(M_s) would drop the static
+ * photons exactly where dynamic ones matter (W -> 1) and turn a shadow negative; we blend the
+ * static-only estimate with the static-plus-dynamic one, sum(M_s) + k * sum(M_d), which is the
+ * irradiance-cache blending the paper cites. Eq. 4's W uses sum(M_ld) + sum(M_fd) / eta in the
+ * numerator (the seed's README notes the printed duplicate).
+ *
+ * Stereo (Sec. 3.3): the left eye is shaded fully; each right-eye pixel whose first surface
+ * reprojects onto the same surface in the left image copies that colour, the others are shaded.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+/*ATROUS*/
+#include "fovea/technique.h"
+#include "technique/photon/foveated.h"
+#include "technique/photon/gather.h"
+#include "technique/photon/photon_trace.h"
+
+typedef enum pm_mode { MODE_PM = 0, MODE_PMT, MODE_FPM } pm_mode;
+
+typedef struct pm_opts {
+    int photons;          /* total photons per frame (fpm: light + foveated) */
+    double fov_fraction;  /* fpm: share of foveated photons (Sec. 4: 40%) */
+    double dyn_fraction;  /* pm-t, fpm: share of the light photons sent to dynamic objects */
+    double radius;        /* gather radius gamma; 0: Eq. 8 */
+    int max_depth;        /* photon bounces (Sec. 4.1: 8) */
+    int eye_depth;        /* mirror/glass bounces of eye paths */
+    int paths;            /* fpm: N paths per focus pixel; 0: from the budget */
+    int passes;           /* pm: independent passes averaged (references) */
+    bool filter, tpm;
+} pm_opts;
+
+typedef struct pm_state {
+    pm_mode mode;
+    const fv_scene *scene;
+    pm_opts o;
+    fv_photon_map ls, ld, all;
+    bool ls_done;
+    fv_dyn_dirs *dirs;
+    fv_foveated *fov;
+    int fov_w, fov_h;
+    /* first-hit buffers of the left eye: normal, position, object id (filter, stereo) */
+    float *nbuf, *pbuf;
+    int32_t *obuf;
+    size_t bufn;
+} pm_state;
+
+static const char *const k_mode_names[] = {"pm", "pm-t", "fpm"};
+
+static fv_status read_opts(pm_mode mode, fv_params *p, pm_opts *o, fv_error *err)
+{
+    fv_status s;
+    memset(o, 0, sizeof *o);
+    if ((s = fv_params_int(p, "photons", 300000, 1, 500000000, &o->photons, err)) ||
+        (s = fv_params_float(p, "radius", 0.0, 0.0, 1e30, &o->radius, err)) ||
+        (s = fv_params_int(p, "max_depth", 8, 1, FV_FOV_MAX_DEPTH, &o->max_depth, err)) ||
+        (s = fv_params_int(p, "eye_depth", 8, 1, 64, &o->eye_depth, err)) || (s = fv_params_bool(p, "filter", true, &o->filter, err)))
+        return s;
+    if (fv_params_count(p) > 0) {
+        /* radius = 0 means "Eq. 8"; an explicit negative or zero radius is a mistake. */
+        for (int i = 0; i < fv_params_count(p); i++)
+            if (strcmp(fv_params_key(p, i), "radius") == 0 && !(o->radius > 0.0))
+                return fv_error_set(err, FV_ERR_INVALID, "parameter radius=%s: the gather radius must be > 0 (leave it out for Eq. 8)",
+                                    fv_params_value(p, i));
+    }
+    if (mode == MODE_PM && (s = fv_params_int(p, "passes", 1, 1, 100000, &o->passes, err))) return s;
+    if (mode != MODE_PM) {
+        if ((s = fv_params_float(p, "dyn_fraction", 0.2, 0.0, 0.95, &o->dyn_fraction, err))) return s;
+    }
+    if (mode == MODE_FPM) {
+        if ((s = fv_params_float(p, "fov_fraction", 0.4, 0.0, 1.0, &o->fov_fraction, err)) ||
+            (s = fv_params_int(p, "paths_per_pixel", 0, 0, 64, &o->paths, err)) || (s = fv_params_bool(p, "tpm", true, &o->tpm, err)))
+            return s;
+        if (o->fov_fraction >= 1.0)
+            return fv_error_set(err, FV_ERR_INVALID, "parameter fov_fraction=%g: some light photons are needed (use < 1)", o->fov_fraction);
+    }
+    return fv_params_check_used(p, k_mode_names[mode], err);
+}
+
+static fv_status pm_create_mode(pm_mode mode, const fv_scene *scene, fv_params *params, void **state, fv_error *err)
+{
+    pm_state *st = calloc(1, sizeof *st);
+    if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    st->mode = mode;
+    st->scene = scene;
+    fv_photon_map_init(&st->ls);
+    fv_photon_map_init(&st->ld);
+    fv_photon_map_init(&st->all);
+    fv_status s = read_opts(mode, params, &st->o, err);
+    if (s == FV_OK && mode != MODE_PM) s = fv_dyn_dirs_create(&st->dirs, err);
+    if (s != FV_OK) {
+        fv_dyn_dirs_destroy(st->dirs);
+        free(st);
+        return s;
+    }
+    *state = st;
+    return FV_OK;
+}
+
+static void pm_destroy(void *state)
+{
+    pm_state *st = state;
+    if (!st) return;
+    fv_photon_map_free(&st->ls);
+    fv_photon_map_free(&st->ld);
+    fv_photon_map_free(&st->all);
+    fv_dyn_dirs_destroy(st->dirs);
+    fv_foveated_destroy(st->fov);
+    free(st->nbuf);
+    free(st->pbuf);
+    free(st->obuf);
+    free(st);
+}
+
+/* ---- per-pixel radiance ---- */
+
+typedef struct render_ctx {
+    const pm_state *st;
+    const fv_frame *frame;
+    fv_camera_basis cam;
+    const fv_eye_model *eye;
+    fv_gaze gaze;
+    float gamma, norm;       /* gather radius and 1 / (pi gamma^2) */
+    double eta;
+    int pass;
+    float *color;            /* accumulates (passes) */
+    float *depth, *normal, *albedo, *position;
+    uint32_t *id;
+    float *nbuf, *pbuf;
+    int32_t *obuf;
+    bool right;              /* shading the right eye: reproject from the left first */
+    const float *left_color;
+    const fv_camera_basis *left_cam;
+    uint64_t counters[FV_MAX_THREADS][4]; /* rays, reprojected, shaded */
+} render_ctx;
+
+static float blend_k(double num, double den)
+{
+    double w = den > 0.0 ? fmin(num / den, 1.0) : (num > 0.0 ? 1.0 : 0.0);
+    return (float)(3.0 * w * w - 2.0 * w * w * w);
+}
+
+/* Eq. 5 (light photons only), or plain photon mapping for pm. */
+static fv_vec3 estimate_light(const render_ctx *c, const fv_pm_hit *x)
+{
+    const pm_state *st = c->st;
+    if (st->mode == MODE_PM) return fv_scale(fv_pm_gather(st->scene, &st->all, x, c->gamma, NULL), c->norm);
+    double u_ls = 0.0, u_ld = 0.0;
+    fv_vec3 s_ls = fv_pm_gather(st->scene, &st->ls, x, c->gamma, &u_ls);
+    fv_vec3 s_ld = fv_pm_gather(st->scene, &st->ld, x, c->gamma, &u_ld);
+    float k = blend_k(u_ld, u_ls);
+    return fv_scale(fv_madd(s_ls, s_ld, k), c->norm);
+}
+
+/* Eq. 3: all four maps, normalised by eta, with Eq. 4's k. */
+static fv_vec3 estimate_foveal(const render_ctx *c, const fv_pm_hit *x)
+{
+    const pm_state *st = c->st;
+    double u_ls = 0, u_ld = 0, u_fs = 0, u_fd = 0;
+    fv_vec3 s_ls = fv_pm_gather(st->scene, &st->ls, x, c->gamma, &u_ls);
+    fv_vec3 s_ld = fv_pm_gather(st->scene, &st->ld, x, c->gamma, &u_ld);
+    fv_vec3 s_fs = fv_pm_gather(st->scene, fv_foveated_static_map(st->fov), x, c->gamma, &u_fs);
+    fv_vec3 s_fd = fv_pm_gather(st->scene, fv_foveated_dynamic_map(st->fov), x, c->gamma, &u_fd);
+    float k = blend_k(u_ld + u_fd / c->eta, u_ls + u_fs);
+    return fv_scale(fv_madd(fv_add(s_ls, s_fs), fv_add(s_ld, s_fd), k), (float)c->eta * c->norm);
+}
+
+static fv_vec3 shade(const render_ctx *c, const fv_pm_hit *x, float px, float py)
+{
+    fv_vec3 L = x->emitted;
+    if (!x->hit) return L;
+    fv_vec3 g;
+    if (c->st->mode != MODE_FPM) {
+        g = estimate_light(c, x);
+    } else {
+        double b = fv_eye_blend(c->eye, c->gaze, px, py); /* Eq. 6: 0 in the fovea, 1 in the periphery */
+        if (b >= 1.0) g = estimate_light(c, x);
+        else if (b <= 0.0) g = estimate_foveal(c, x);
+        else g = fv_add(fv_scale(estimate_foveal(c, x), (float)(1.0 - b)), fv_scale(estimate_light(c, x), (float)b));
+    }
+    return fv_add(L, fv_mul(x->weight, g));
+}
+
+static void render_tile(void *ctx, const fv_tile *tile)
+{
+    render_ctx *c = ctx;
+    const int w = c->cam.width;
+    uint64_t rays = 0, reproj = 0, shaded = 0;
+    for (int y = tile->y0; y < tile->y1; y++)
+        for (int x = tile->x0; x < tile->x1; x++) {
+            size_t pix = (size_t)y * w + x;
+            fv_rng rng = fv_rng_make(c->frame->seed, pix * 2 + (c->right ? 1 : 0), (uint64_t)c->pass, (uint64_t)c->frame->index);
+            fv_vec3 d = fv_camera_dir(&c->cam, x + 0.5f, y + 0.5f);
+            fv_pm_hit h;
+            fv_pm_eye_path(c->st->scene, c->cam.pos, d, c->st->o.eye_depth, &rng, &h);
+            rays++;
+            fv_vec3 L;
+            bool copied = false;
+            if (c->right && h.first_obj >= 0) {
+                /* Sec. 3.3: reuse the left eye's colour when its pixel shows the same surface. */
+                float lx, ly;
+                if (fv_camera_project(c->left_cam, h.first_p, &lx, &ly) && lx >= 0 && ly >= 0 && lx < w && ly < c->cam.height) {
+                    size_t lp = (size_t)(int)ly * w + (int)lx;
+                    fv_vec3 q = fv_v3(c->pbuf[3 * lp], c->pbuf[3 * lp + 1], c->pbuf[3 * lp + 2]);
+                    if (c->obuf[lp] == h.first_obj && fv_length(fv_sub(q, h.first_p)) < 0.01f * h.first_t) {
+                        L = fv_v3(c->left_color[3 * lp], c->left_color[3 * lp + 1], c->left_color[3 * lp + 2]);
+                        copied = true;
+                        reproj++;
+                    }
+                }
+            }
+            if (!copied) {
+                L = shade(c, &h, x + 0.5f, y + 0.5f);
+                shaded++;
+            }
+            if (!fv_is_finite3(L)) L = fv_v3s(0.0f);
+            float *col = &c->color[3 * pix];
+            float wgt = 1.0f / (float)(c->pass + 1); /* running mean over passes */
+            col[0] += (L.x - col[0]) * wgt;
+            col[1] += (L.y - col[1]) * wgt;
+            col[2] += (L.z - col[2]) * wgt;
+            if (c->pass > 0) continue;
+            bool any = h.first_obj >= 0;
+            fv_vec3 zero = fv_v3s(0.0f), n = any ? h.first_n : zero, p = any ? h.first_p : zero;
+            if (c->depth) c->depth[pix] = h.first_t;
+            if (c->normal) memcpy(&c->normal[3 * pix], &n, sizeof n);
+            if (c->albedo) memcpy(&c->albedo[3 * pix], any ? &h.albedo : &zero, sizeof zero);
+            if (c->position) memcpy(&c->position[3 * pix], &p, sizeof p);
+            if (c->id) c->id[pix] = any ? (uint32_t)h.first_obj + 1u : 0u;
+            if (!c->right) {
+                memcpy(&c->nbuf[3 * pix], &n, sizeof n);
+                memcpy(&c->pbuf[3 * pix], &p, sizeof p);
+                c->obuf[pix] = h.first_obj;
+            }
+        }
+    c->counters[tile->thread][0] += rays;
+    c->counters[tile->thread][1] += reproj;
+    c->counters[tile->thread][2] += shaded;
+}
+
+/* ---- one frame ---- */
+
+static fv_status ensure_buffers(pm_state *st, int w, int h, fv_error *err)
+{
+    size_t n = (size_t)w * h;
+    if (st->bufn == n) return FV_OK;
+    free(st->nbuf);
+    free(st->pbuf);
+    free(st->obuf);
+    st->nbuf = fv_alloc_array(n, 3 * sizeof(float));
+    st->pbuf = fv_alloc_array(n, 3 * sizeof(float));
+    st->obuf = fv_alloc_array(n, sizeof(int32_t));
+    st->bufn = st->nbuf && st->pbuf && st->obuf ? n : 0;
+    return st->bufn ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory for %dx%d photon mapping buffers", w, h);
+}
+
+/* Light photons of this frame (pm: the whole map; pm-t / fpm: M_ls once, M_ld every frame). */
+static fv_status light_tracing(pm_state *st, const fv_frame *frame, float cell, int pass, double n_light, fv_stats *stats, fv_error *err)
+{
+    const fv_scene *s = st->scene;
+    uint64_t rays = 0;
+    fv_status rc = FV_OK;
+    fv_photon_job job = {s, 0, frame->seed, frame->index, st->o.max_depth, frame->threads, 0};
+    if (st->mode == MODE_PM) {
+        fv_photon_map_clear(&st->all);
+        job.count = (int64_t)n_light;
+        job.stream = 100 + (uint64_t)pass;
+        if ((rc = fv_photon_trace_lights(&job, FV_TRACE_ALL, &st->all, &rays, err)) == FV_OK) rc = fv_photon_map_build(&st->all, cell, err);
+        fv_stats_add_count(stats, "light_photons", st->all.n);
+    } else {
+        bool dyn = s->ndynamic > 0;
+        double n_ls = dyn ? n_light * (1.0 - st->o.dyn_fraction) : n_light, n_ld = dyn ? n_light - n_ls : 0.0;
+        if (!st->ls_done) {
+            job.count = (int64_t)n_ls;
+            job.frame = 0; /* traced once, valid for every frame */
+            job.stream = 1;
+            rc = fv_photon_trace_lights(&job, FV_TRACE_STATIC, &st->ls, &rays, err);
+            st->ls_done = rc == FV_OK;
+            job.frame = frame->index;
+        }
+        if (rc == FV_OK && st->ls.cell != cell) rc = fv_photon_map_build(&st->ls, cell, err);
+        fv_photon_map_clear(&st->ld);
+        if (rc == FV_OK && n_ld >= 1.0) {
+            if ((rc = fv_dyn_dirs_build(st->dirs, s, err)) == FV_OK) {
+                job.count = (int64_t)n_ld;
+                job.stream = 2;
+                rc = fv_photon_trace_dynamic(&job, st->dirs, &st->ld, &rays, err);
+            }
+        }
+        if (rc == FV_OK) rc = fv_photon_map_build(&st->ld, cell, err);
+        fv_stats_add_count(stats, "light_photons", st->ls.n + st->ld.n);
+        fv_stats_add_count(stats, "dynamic_photons", st->ld.n);
+    }
+    fv_stats_add_count(stats, "rays", (double)rays);
+    return rc;
+}
+
+/* N of Alg. 1 from the foveated photon budget: paths per focus pixel, assuming about 2.5 photons
+ * per path (the first frame's paths keep that guess honest enough; N stays fixed afterwards). */
+static int paths_per_pixel(const pm_state *st, const fv_eye_model *eye, fv_gaze g, int w, int h)
+{
+    if (st->o.paths > 0) return st->o.paths;
+    double rt = fv_eye_transition_radius_px(eye);
+    long focus = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) focus += fv_eye_gaze_dist_px(eye, g, x + 0.5, y + 0.5) <= rt;
+    double n = st->o.photons * st->o.fov_fraction / (2.5 * (focus > 0 ? focus : 1));
+    return n < 1.0 ? 1 : n > 64.0 ? 64 : (int)lround(n);
+}
+
+static fv_status render_eye_pass(pm_state *st, render_ctx *c, fv_film *film, const fv_camera *cam, fv_gaze gaze, bool right,
+                                 fv_stats *stats, fv_error *err)
+{
+    fv_status rc = fv_camera_basis_make(cam, &c->cam, err);
+    if (rc != FV_OK) return rc;
+    if (cam->width != fv_film_width(film) || cam->height != fv_film_height(film))
+        return fv_error_set(err, FV_ERR_INVALID, "camera size %dx%d differs from the film's %dx%d", cam->width, cam->height, fv_film_width(film),
+                            fv_film_height(film));
+    c->gaze = gaze;
+    c->right = right;
+    c->color = fv_film_color(film);
+    c->depth = fv_film_depth(film);
+    c->normal = fv_film_normal(film);
+    c->albedo = fv_film_albedo(film);
+    c->position = fv_film_position(film);
+    c->id = fv_film_id(film);
+    memset(c->counters, 0, sizeof c->counters);
+    double t0 = fv_time_ms();
+    fv_parallel_tiles(cam->width, cam->height, c->frame->threads, render_tile, c, NULL, NULL);
+    fv_stats_add_ms(stats, "render", fv_time_ms() - t0);
+    uint64_t rays = 0, reproj = 0;
+    for (int i = 0; i < FV_MAX_THREADS; i++) rays += c->counters[i][0], reproj += c->counters[i][1];
+    fv_stats_add_count(stats, "rays", (double)rays);
+    if (right) fv_stats_add_count(stats, "reprojected_fraction", (double)reproj / ((double)cam->width * cam->height));
+    (void)st;
+    return FV_OK;
+}
+
+static fv_status filter_film(pm_state *st, fv_film *film, float gamma, fv_stats *stats, fv_error *err)
+{
+    if (!st->o.filter) return FV_OK;
+    (void)film, (void)gamma, (void)stats, (void)err; /*ATROUS-CALL*/
+    return FV_OK;
+}
+
+static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv_film *film_right, fv_stats *stats, fv_error *err)
+{
+    pm_state *st = state;
+    const fv_scene *s = st->scene;
+    int w = fv_film_width(film), h = fv_film_height(film);
+    fv_eye_model def;
+    const fv_eye_model *eye = frame->eye;
+    if (!eye) {
+        fv_eye_model_default(w, h, &def);
+        eye = &def;
+    }
+    render_ctx *c = calloc(1, sizeof *c);
+    if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    fv_status rc = ensure_buffers(st, w, h, err);
+    c->st = st;
+    c->frame = frame;
+    c->eye = eye;
+    c->nbuf = st->nbuf;
+    c->pbuf = st->pbuf;
+    c->obuf = st->obuf;
+    c->gamma = st->o.radius > 0.0 ? (float)st->o.radius : fv_photon_radius_eq8(s->lo, s->hi, w, h);
+    c->norm = 1.0f / (FV_PI * c->gamma * c->gamma);
+    c->eta = 1.0;
+    float cell = c->gamma;
+    double n_light = st->mode == MODE_FPM ? st->o.photons * (1.0 - st->o.fov_fraction) : st->o.photons;
+    int passes = st->mode == MODE_PM ? st->o.passes : 1;
+    if (rc == FV_OK) memset(fv_film_color(film), 0, (size_t)w * h * 3 * sizeof(float));
+    for (int pass = 0; pass < passes && rc == FV_OK; pass++) {
+        double t0 = fv_time_ms();
+        rc = light_tracing(st, frame, cell, pass, n_light, stats, err);
+        fv_stats_add_ms(stats, "light_tracing", fv_time_ms() - t0);
+        if (rc == FV_OK && st->mode == MODE_FPM) {
+            /* Alg. 1 lines 7-10. */
+            if (st->fov && (st->fov_w != w || st->fov_h != h)) {
+                fv_foveated_destroy(st->fov);
+                st->fov = NULL;
+            }
+            if (!st->fov) {
+                rc = fv_foveated_create(w, h, paths_per_pixel(st, eye, frame->gaze, w, h), st->o.max_depth, &st->fov, err);
+                st->fov_w = w;
+                st->fov_h = h;
+            }
+            fv_fov_stats fs;
+            memset(&fs, 0, sizeof fs);
+            t0 = fv_time_ms();
+            const fv_camera *prev = st->o.tpm ? frame->prev_camera : NULL;
+            if (rc == FV_OK) rc = fv_foveated_manage(st->fov, s, frame->camera, prev, eye, frame->gaze, frame->threads, &fs, err);
+            fv_stats_add_ms(stats, "tpm", fv_time_ms() - t0);
+            t0 = fv_time_ms();
+            if (rc == FV_OK)
+                rc = fv_foveated_trace(st->fov, s, frame->camera, &st->ls, &st->ld, c->gamma, cell, frame->seed, frame->index, frame->threads,
+                                       &fs, err);
+            if (rc == FV_OK) c->eta = fv_foveated_eta(st->fov, frame->camera, eye, frame->gaze, &st->ls, &st->ld);
+            fv_stats_add_ms(stats, "foveated_tracing", fv_time_ms() - t0);
+            fv_stats_add_count(stats, "foveated_photons", fs.photons_static + fs.photons_dynamic);
+            fv_stats_add_count(stats, "paths_traced", (double)fs.paths_traced);
+            fv_stats_add_count(stats, "paths_reused", (double)fs.paths_reused);
+            fv_stats_add_count(stats, "paths_deleted", (double)fs.paths_deleted);
+            long denom = fs.paths_reused + fs.paths_traced;
+            fv_stats_add_count(stats, "reuse_rate", denom > 0 ? (double)fs.paths_reused / (double)denom : 0.0);
+            fv_stats_add_count(stats, "eta", c->eta);
+        }
+        c->pass = pass;
+        if (rc == FV_OK) rc = render_eye_pass(st, c, film, frame->camera, frame->gaze, false, stats, err);
+    }
+    if (rc == FV_OK) rc = filter_film(st, film, c->gamma, stats, err);
+    if (rc == FV_OK && frame->camera_right && film_right) {
+        fv_camera_basis left;
+        rc = fv_camera_basis_make(frame->camera, &left, err);
+        c->left_cam = &left;
+        c->left_color = fv_film_color_const(film);
+        c->pass = 0;
+        memset(fv_film_color(film_right), 0, (size_t)w * h * 3 * sizeof(float));
+        if (rc == FV_OK) rc = render_eye_pass(st, c, film_right, frame->camera_right, frame->gaze_right, true, stats, err);
+    }
+    free(c);
+    return rc;
+}
+
+static fv_status pm_create(const fv_scene *s, fv_params *p, const fv_log *log, void **state, fv_error *err)
+{
+    (void)log;
+    return pm_create_mode(MODE_PM, s, p, state, err);
+}
+static fv_status pmt_create(const fv_scene *s, fv_params *p, const fv_log *log, void **state, fv_error *err)
+{
+    (void)log;
+    return pm_create_mode(MODE_PMT, s, p, state, err);
+}
+static fv_status fpm_create(const fv_scene *s, fv_params *p, const fv_log *log, void **state, fv_error *err)
+{
+    (void)log;
+    return pm_create_mode(MODE_FPM, s, p, state, err);
+}
+
+#define COMMON_HELP                                                                                 \
+    "photons=int (300000): photons per frame\n"                                                     \
+    "radius=float (Eq. 8): gather radius gamma in scene units\n"                                    \
+    "max_depth=int (8): photon bounces\n"                                                           \
+    "eye_depth=int (8): mirror/glass bounces of eye rays\n"                                         \
+    "filter=bool (true): edge-avoiding A-Trous filter afterwards\n"
+
+const fv_technique_class fv_technique_pm = {
+    "pm", "photon mapping, all photons retraced every frame (the paper's PM baseline)",
+    COMMON_HELP "passes=int (1): independent passes averaged (for references)\n", pm_create, pm_render, pm_destroy,
+};
+
+const fv_technique_class fv_technique_pm_t = {
+    "pm-t", "photon mapping with the temporal strategy: static photons once, dynamic ones every frame (PM^t)",
+    COMMON_HELP "dyn_fraction=float (0.2): share of photons sent towards dynamic objects each frame\n",
+    pmt_create, pm_render, pm_destroy,
+};
+
+const fv_technique_class fv_technique_fpm = {
+    "fpm", "foveated photon mapping: foveated photons in the focus region, temporal photon management",
+    COMMON_HELP "dyn_fraction=float (0.2): share of light photons sent towards dynamic objects each frame\n"
+                "fov_fraction=float (0.4): share of foveated photons in the total\n"
+                "paths_per_pixel=int (from the budget): N foveated paths per focus pixel\n"
+                "tpm=bool (true): temporal photon management (false: retrace all foveated paths)\n",
+    fpm_create, pm_render, pm_destroy,
+};
