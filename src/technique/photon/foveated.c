@@ -74,6 +74,12 @@ const fv_photon_map *fv_foveated_static_map(const fv_foveated *f) { return &f->f
 const fv_photon_map *fv_foveated_dynamic_map(const fv_foveated *f) { return &f->fd; }
 const uint8_t *fv_foveated_focus(const fv_foveated *f) { return f->focus; }
 
+void fv_foveated_pool(const fv_foveated *f, int *live, int *capacity)
+{
+    *live = f->live;
+    *capacity = f->cap;
+}
+
 static void free_path(fv_foveated *f, int32_t id)
 {
     if (id < 0 || id >= f->cap || f->len[id] == 0) return;
@@ -416,7 +422,7 @@ fv_status fv_foveated_trace(fv_foveated *f, const fv_scene *s, const fv_camera *
     return rc;
 }
 
-static double focus_flux(const fv_photon_map *m, const fv_camera_basis *cb, const uint8_t *focus, int w, int h)
+double fv_photon_focus_flux(const fv_photon_map *m, const fv_camera_basis *cb, const uint8_t *focus, int w, int h)
 {
     double sum = 0.0;
     for (int i = 0; i < m->n; i++) {
@@ -436,7 +442,7 @@ double fv_foveated_eta(const fv_foveated *f, const fv_camera *cam, const fv_eye_
     fv_camera_basis cb;
     fv_error err;
     if (fv_camera_basis_make(cam, &cb, &err) != FV_OK) return 1.0;
-    double light = focus_flux(m_ls, &cb, f->focus, f->w, f->h) + focus_flux(m_ld, &cb, f->focus, f->w, f->h);
-    double fov = focus_flux(&f->fs, &cb, f->focus, f->w, f->h) + focus_flux(&f->fd, &cb, f->focus, f->w, f->h);
+    double light = fv_photon_focus_flux(m_ls, &cb, f->focus, f->w, f->h) + fv_photon_focus_flux(m_ld, &cb, f->focus, f->w, f->h);
+    double fov = fv_photon_focus_flux(&f->fs, &cb, f->focus, f->w, f->h) + fv_photon_focus_flux(&f->fd, &cb, f->focus, f->w, f->h);
     return light + fov > 0.0 && fov > 0.0 ? light / (light + fov) : 1.0;
 }

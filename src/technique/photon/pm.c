@@ -416,6 +416,11 @@ static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv
             fv_stats_add_count(stats, "paths_traced", (double)fs.paths_traced);
             fv_stats_add_count(stats, "paths_reused", (double)fs.paths_reused);
             fv_stats_add_count(stats, "paths_deleted", (double)fs.paths_deleted);
+            fv_stats_add_count(stats, "paths_stored", (double)fs.paths_stored_static);
+            int live = 0, cap = 0;
+            if (st->fov) fv_foveated_pool(st->fov, &live, &cap);
+            fv_stats_add_count(stats, "paths_live", live);
+            fv_stats_add_count(stats, "path_capacity", cap);
             long denom = fs.paths_reused + fs.paths_traced;
             fv_stats_add_count(stats, "reuse_rate", denom > 0 ? (double)fs.paths_reused / (double)denom : 0.0);
             fv_stats_add_count(stats, "eta", c->eta);

@@ -1,0 +1,289 @@
+/* Photon mapping (Foveated Photon Mapping, Sec. 3): Eq. 1 on a hand-built photon set, Eq. 8,
+ * negative photons cancelling the light a dynamic occluder blocks, temporal photon management
+ * (full reuse for a still view, deletion and retracing when the gaze moves), bounded memory over
+ * a long moving sequence, and parameter checking. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+#include "fovea/fovea.h"
+#include "technique/photon/foveated.h"
+#include "technique/photon/photon_trace.h"
+
+/* Eq. 8 for the Cornell box (0..556, 0..548.8, 0..559.2) at 1080x1200: mean extent
+ * (556 + 548.8 + 559.2) / 3 = 554.667, over (1080 + 1200) / 2 = 1140, times 20 = 9.73099. */
+static void test_eq8(void **st)
+{
+    (void)st;
+    assert_float_equal(fv_photon_radius_eq8(fv_v3(0, 0, 0), fv_v3(556.0f, 548.8f, 559.2f), 1080, 1200), 9.73099, 1e-4);
+}
+
+/* Eq. 1 by hand: a 10x10 image whose left half is the focus region, camera at the origin looking
+ * down -z with a 90 degree field of view. Light photons: luminance 2 (left, counted), 5 (right,
+ * not counted), -1 (left, negative: not counted). Foveated: 3 (left), 4 (right). eta = 2 / (2 + 3)
+ * = 0.4. */
+static void test_eta(void **st)
+{
+    (void)st;
+    fv_camera cam = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 90.0f, 10, 10};
+    fv_camera_basis cb;
+    fv_error err;
+    assert_int_equal(fv_camera_basis_make(&cam, &cb, &err), FV_OK);
+    uint8_t focus[100];
+    for (int i = 0; i < 100; i++) focus[i] = (i % 10) < 5;
+    fv_photon_map light, fov;
+    fv_photon_map_init(&light);
+    fv_photon_map_init(&fov);
+    const fv_vec3 left = {-0.5f, 0, -1}, right = {0.5f, 0, -1}, n = {0, 0, 1}, d = {0, 0, -1};
+    fv_photon p[3] = {{left, d, {2, 2, 2}, n}, {right, d, {5, 5, 5}, n}, {left, d, {-1, -1, -1}, n}};
+    assert_int_equal(fv_photon_map_append(&light, p, 3, &err), FV_OK);
+    fv_photon q[2] = {{left, d, {3, 3, 3}, n}, {right, d, {4, 4, 4}, n}};
+    assert_int_equal(fv_photon_map_append(&fov, q, 2, &err), FV_OK);
+    double l = fv_photon_focus_flux(&light, &cb, focus, 10, 10), f = fv_photon_focus_flux(&fov, &cb, focus, 10, 10);
+    assert_float_equal(l, 2.0, 1e-5);
+    assert_float_equal(f, 3.0, 1e-5);
+    assert_float_equal(l / (l + f), 0.4, 1e-6);
+    fv_photon_map_free(&light);
+    fv_photon_map_free(&fov);
+}
+
+/* A floor (albedo 0.5) under a 20x20 area light at height 100, and a dynamic 20x20x20 box at
+ * height 40..60 between them. One bounce only, so all light on the floor is direct and the static
+ * map plus the dynamic map (negative photons behind the box) must match a full retrace. */
+static fv_scene *occluder_scene(void)
+{
+    fv_scene *s;
+    fv_error err;
+    assert_int_equal(fv_scene_create(&s, &err), FV_OK);
+    fv_material m = fv_material_default(FV_MAT_DIFFUSE), e = fv_material_default(FV_MAT_DIFFUSE);
+    m.albedo = fv_v3s(0.5f);
+    e.albedo = fv_v3s(0.0f);
+    e.emission = fv_v3s(10.0f);
+    int mm, em;
+    assert_int_equal(fv_scene_add_material(s, &m, &mm, &err), FV_OK);
+    assert_int_equal(fv_scene_add_material(s, &e, &em, &err), FV_OK);
+    const uint32_t quad[6] = {0, 1, 2, 0, 2, 3};
+    const fv_vec3 fl[4] = {{-100, 0, -100}, {-100, 0, 100}, {100, 0, 100}, {100, 0, -100}};
+    fv_mesh_desc floor = {"floor", fl, 4, NULL, quad, 2, NULL, mm};
+    assert_int_equal(fv_scene_add_mesh(s, &floor, NULL, NULL, &err), FV_OK);
+    const fv_vec3 lv[4] = {{-10, 100, -10}, {10, 100, -10}, {10, 100, 10}, {-10, 100, 10}};
+    fv_mesh_desc light = {"light", lv, 4, NULL, quad, 2, NULL, em};
+    assert_int_equal(fv_scene_add_mesh(s, &light, NULL, NULL, &err), FV_OK);
+    fv_vec3 bv[8];
+    for (int k = 0; k < 8; k++) bv[k] = fv_v3(k & 1 ? 10.0f : -10.0f, k & 2 ? 10.0f : -10.0f, k & 4 ? 10.0f : -10.0f);
+    const uint32_t bi[36] = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
+    fv_mesh_desc box = {"box", bv, 8, NULL, bi, 12, NULL, mm};
+    int obj;
+    assert_int_equal(fv_scene_add_mesh(s, &box, NULL, &obj, &err), FV_OK);
+    fv_anim_key keys[2] = {{0.0, {0, 50, 0}, {0, 0, 0, 1}, {1, 1, 1}}, {1.0, {0, 50, 0}, {0, 0, 0, 1}, {1, 1, 1}}};
+    assert_int_equal(fv_scene_animate_object(s, obj, keys, 2, &err), FV_OK);
+    fv_camera cam = {{0, 150, 150}, {0, 0, 0}, {0, 1, 0}, 60.0f, 32, 32};
+    fv_scene_set_camera(s, &cam);
+    assert_int_equal(fv_scene_commit(s, NULL, &err), FV_OK);
+    assert_int_equal(fv_scene_set_time(s, 0.0, &err), FV_OK);
+    return s;
+}
+
+static void add_flux(void *ctx, const fv_photon *ph, float d2)
+{
+    (void)d2;
+    *(double *)ctx += ph->flux.y;
+}
+
+static double irradiance(const fv_photon_map *m, fv_vec3 x, float r)
+{
+    double sum = 0.0;
+    fv_photon_map_query(m, x, r, add_flux, &sum);
+    return sum / (FV_PI * r * r);
+}
+
+static void test_negative_photons(void **st)
+{
+    (void)st;
+    fv_scene *s = occluder_scene();
+    fv_error err;
+    fv_photon_map all, ls, ld;
+    fv_photon_map_init(&all);
+    fv_photon_map_init(&ls);
+    fv_photon_map_init(&ld);
+    fv_photon_job job = {s, 400000, 7, 0, 1, 0, 0};
+    assert_int_equal(fv_photon_trace_lights(&job, FV_TRACE_ALL, &all, NULL, &err), FV_OK);
+    job.stream = 1;
+    assert_int_equal(fv_photon_trace_lights(&job, FV_TRACE_STATIC, &ls, NULL, &err), FV_OK);
+    fv_dyn_dirs *dirs;
+    assert_int_equal(fv_dyn_dirs_create(&dirs, &err), FV_OK);
+    assert_int_equal(fv_dyn_dirs_build(dirs, s, &err), FV_OK);
+    assert_int_equal(fv_dyn_dirs_count(dirs), 1);
+    job.stream = 2;
+    job.count = 100000;
+    assert_int_equal(fv_photon_trace_dynamic(&job, dirs, &ld, NULL, &err), FV_OK);
+    const float r = 8.0f; /* ~2500 photons in the disc under the light: 2% noise */
+    assert_int_equal(fv_photon_map_build(&all, r, &err), FV_OK);
+    assert_int_equal(fv_photon_map_build(&ls, r, &err), FV_OK);
+    assert_int_equal(fv_photon_map_build(&ld, r, &err), FV_OK);
+    /* Irradiance on the floor from the light, worked out as E = Le * F * pi with the point-to-
+     * parallel-square form factor (side 20 at height 100, X = 0.1): F = 4 * (1/2pi) * 2 * c atan(c),
+     * c = 0.1 / sqrt(1.01) = 0.0995037, atan(c) = 0.0991773 -> F = 0.0125634; E = 10 * pi * F
+     * = 0.394690 at the point under the light when nothing blocks it. */
+    double lit_static = irradiance(&ls, fv_v3(0, 0, 0), r);
+    assert_float_equal(lit_static, 0.394690, 0.06 * 0.394690);
+    /* Under the box (full umbra): the full retrace is dark, the static map is lit, the negative
+     * photons cancel it. */
+    double full = irradiance(&all, fv_v3(0, 0, 0), r), dyn = irradiance(&ld, fv_v3(0, 0, 0), r);
+    assert_true(fabs(full) < 0.01);
+    assert_true(dyn < -0.8 * lit_static);
+    assert_float_equal(lit_static + dyn, full, 0.08 * lit_static);
+    /* Well away from the shadow the dynamic photons change nothing. */
+    double far_full = irradiance(&all, fv_v3(60, 0, 0), r), far_sum = irradiance(&ls, fv_v3(60, 0, 0), r) + irradiance(&ld, fv_v3(60, 0, 0), r);
+    assert_float_equal(far_sum, far_full, 0.08 * far_full);
+    fv_dyn_dirs_destroy(dirs);
+    fv_photon_map_free(&all);
+    fv_photon_map_free(&ls);
+    fv_photon_map_free(&ld);
+    fv_scene_destroy(s);
+}
+
+static fv_technique *make(const fv_scene *s, const char *method, const char *const *kv)
+{
+    fv_error err;
+    fv_params *p;
+    assert_int_equal(fv_params_create(&p, &err), FV_OK);
+    for (int i = 0; kv && kv[i]; i++) assert_int_equal(fv_params_parse(p, kv[i], &err), FV_OK);
+    fv_technique *t = NULL;
+    fv_status rc = fv_technique_create(method, s, p, NULL, &t, &err);
+    if (rc != FV_OK) fail_msg("%s", err.msg);
+    fv_params_destroy(p);
+    return t;
+}
+
+static void frame_stats(fv_technique *t, fv_scene *s, fv_film *f, const fv_camera *cam, const fv_camera *prev, fv_gaze g, int index,
+                        fv_stats *stats)
+{
+    fv_error err;
+    fv_frame fr;
+    memset(&fr, 0, sizeof fr);
+    fr.camera = cam;
+    fr.prev_camera = prev;
+    fr.index = index;
+    fr.seed = 3;
+    fr.gaze = fr.gaze_right = g;
+    fr.time = fv_scene_time(s);
+    fv_stats_clear(stats);
+    fv_status rc = fv_technique_render(t, &fr, f, NULL, stats, &err);
+    if (rc != FV_OK) fail_msg("%s", err.msg);
+}
+
+/* Alg. 2: with the camera and gaze still, every stored path is reused and none is deleted; when
+ * the gaze jumps to the other side, the paths of the old focus region are deleted and new ones
+ * traced. */
+static void test_tpm_reuse(void **st)
+{
+    (void)st;
+    fv_scene *s;
+    fv_error err;
+    assert_int_equal(fv_scene_load("cornell", NULL, &s, &err), FV_OK);
+    const char *kv[] = {"photons=40000", "filter=false", "paths_per_pixel=2", NULL};
+    fv_technique *t = make(s, "fpm", kv);
+    fv_camera cam;
+    fv_scene_camera(s, 0.0, 48, 48, &cam);
+    fv_film *f;
+    assert_int_equal(fv_film_create(48, 48, 0, &f, &err), FV_OK);
+    fv_stats a, b, c;
+    fv_gaze g = {0.3f, 0.5f};
+    frame_stats(t, s, f, &cam, NULL, g, 0, &a);
+    double stored = fv_stats_get_count(&a, "paths_stored");
+    assert_true(stored > 100);
+    frame_stats(t, s, f, &cam, &cam, g, 1, &b);
+    assert_float_equal(fv_stats_get_count(&b, "paths_reused"), stored, 0.0);
+    assert_float_equal(fv_stats_get_count(&b, "paths_deleted"), 0.0, 0.0);
+    assert_true(fv_stats_get_count(&b, "reuse_rate") > 0.5);
+    fv_gaze g2 = {0.8f, 0.5f};
+    frame_stats(t, s, f, &cam, &cam, g2, 2, &c);
+    assert_true(fv_stats_get_count(&c, "paths_deleted") > 0);
+    assert_true(fv_stats_get_count(&c, "paths_traced") > 0);
+    assert_true(fv_stats_get_count(&c, "paths_reused") < stored);
+    /* Without temporal photon management nothing is reused. */
+    const char *kv2[] = {"photons=40000", "filter=false", "paths_per_pixel=2", "tpm=false", NULL};
+    fv_technique *t2 = make(s, "fpm", kv2);
+    frame_stats(t2, s, f, &cam, NULL, g, 0, &a);
+    frame_stats(t2, s, f, &cam, &cam, g, 1, &b);
+    assert_float_equal(fv_stats_get_count(&b, "paths_reused"), 0.0, 0.0);
+    fv_technique_destroy(t);
+    fv_technique_destroy(t2);
+    fv_film_destroy(f);
+    fv_scene_destroy(s);
+}
+
+/* 500 frames along cornell-fpm's camera path with a wandering gaze: the live paths and the pool
+ * stop growing once the focus region has been filled. */
+static void test_memory_flat(void **st)
+{
+    (void)st;
+    fv_scene *s;
+    fv_error err;
+    assert_int_equal(fv_scene_load("cornell-fpm", NULL, &s, &err), FV_OK);
+    const char *kv[] = {"photons=6000", "filter=false", "paths_per_pixel=2", NULL};
+    fv_technique *t = make(s, "fpm", kv);
+    fv_film *f;
+    assert_int_equal(fv_film_create(24, 24, 0, &f, &err), FV_OK);
+    fv_camera cam, prev;
+    fv_stats stats;
+    double cap_early = 0, cap_late = 0, live_max = 0;
+    const int frames = 500;
+    for (int i = 0; i < frames; i++) {
+        double time = 4.0 * i / frames;
+        assert_int_equal(fv_scene_set_time(s, time, &err), FV_OK);
+        fv_scene_camera(s, time, 24, 24, &cam);
+        fv_gaze g = {0.5f + 0.3f * sinf(0.05f * i), 0.5f + 0.2f * cosf(0.03f * i)};
+        frame_stats(t, s, f, &cam, i ? &prev : NULL, g, i, &stats);
+        prev = cam;
+        if (i == 50) cap_early = fv_stats_get_count(&stats, "path_capacity");
+        cap_late = fv_stats_get_count(&stats, "path_capacity");
+        live_max = fmax(live_max, fv_stats_get_count(&stats, "paths_live"));
+    }
+    /* At most N paths per pixel are ever alive; the pool never needs more than twice that. */
+    assert_true(live_max <= 2 * 24 * 24);
+    assert_true(cap_late <= 2 * cap_early || cap_late <= 4 * 24 * 24);
+    fv_technique_destroy(t);
+    fv_film_destroy(f);
+    fv_scene_destroy(s);
+}
+
+static void test_bad_params(void **st)
+{
+    (void)st;
+    fv_scene *s;
+    fv_error err;
+    assert_int_equal(fv_scene_load("cornell", NULL, &s, &err), FV_OK);
+    const char *cases[][2] = {{"fpm", "photons=-5"},       {"fpm", "fov_fraction=1.5"}, {"fpm", "fov_fraction=-0.1"},
+                              {"pm", "radius=0"},           {"pm-t", "radius=-2"},       {"fpm", "paths_per_pixel=100"},
+                              {"pm", "max_depth=0"},        {"pm-t", "dyn_fraction=2"},  {"pm", "fov_fraction=0.4"},
+                              {"fpm", "tpm=maybe"}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        fv_params *p;
+        assert_int_equal(fv_params_create(&p, &err), FV_OK);
+        assert_int_equal(fv_params_parse(p, cases[i][1], &err), FV_OK);
+        fv_technique *t = NULL;
+        fv_status rc = fv_technique_create(cases[i][0], s, p, NULL, &t, &err);
+        if (rc != FV_ERR_INVALID) fail_msg("%s %s: status %d", cases[i][0], cases[i][1], rc);
+        char key[32];
+        snprintf(key, sizeof key, "%.*s", (int)strcspn(cases[i][1], "="), cases[i][1]);
+        if (!strstr(err.msg, key)) fail_msg("%s %s: message '%s' does not name %s", cases[i][0], cases[i][1], err.msg, key);
+        assert_null(t);
+        fv_params_destroy(p);
+    }
+    fv_scene_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_eq8),       cmocka_unit_test(test_eta),         cmocka_unit_test(test_negative_photons),
+        cmocka_unit_test(test_tpm_reuse), cmocka_unit_test(test_memory_flat), cmocka_unit_test(test_bad_params),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
