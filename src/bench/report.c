@@ -74,6 +74,15 @@ static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *
     cJSON_AddStringToObject(o, "technique", r->m->method);
     cJSON_AddItemToObject(o, "params", params_json(r->m->params));
     if (r->m->from_sweep) cJSON_AddItemToObject(o, "sweep_value", num(r->m->sweep_value));
+    if (r->m->match > 0) {
+        const fv_bench_match *mt = &info->sc->matches[r->m->match - 1];
+        cJSON *mo = cJSON_AddObjectToObject(o, "match");
+        cJSON_AddStringToObject(mo, "target", mt->target);
+        cJSON_AddStringToObject(mo, "metric", mt->metric);
+        cJSON_AddStringToObject(mo, "region", fv_region_name(mt->region));
+        cJSON_AddStringToObject(mo, "param", mt->param);
+        cJSON_AddBoolToObject(mo, "reached", r->m->match_reached);
+    }
     cJSON *ms = cJSON_AddObjectToObject(o, "ms_per_frame");
     cJSON_AddItemToObject(ms, "median", num(r->ms_median));
     cJSON_AddItemToObject(ms, "min", num(r->ms_min));
@@ -178,7 +187,7 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
                 "FLIP all | MSE' fovea | MSE' periphery |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int i = 0; i < n; i++) {
         const fv_bench_result *r = &res[i];
-        tprintf(&t, "| %s | ", r->m->label);
+        tprintf(&t, "| %s%s | ", r->m->label, r->m->match > 0 && !r->m->match_reached ? " (target not reached)" : "");
         for (int k = 0; k < fv_params_count(r->m->params); k++)
             tprintf(&t, "%s%s=%s", k ? " " : "", fv_params_key(r->m->params, k), fv_params_value(r->m->params, k));
         const fv_metric_values *v = r->error.region;

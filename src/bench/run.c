@@ -362,6 +362,46 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
     return st;
 }
 
+/* ---- "match": the smallest parameter value that reaches a target's error ---- */
+
+static double metric_of(const fv_metric_values *v, const char *metric)
+{
+    return !strcmp(metric, "flip") ? v->flip : !strcmp(metric, "e") ? v->e : v->mse;
+}
+
+static fv_status run_match(const fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, const fv_bench_result *res, int k,
+                           fv_bench_method *m, fv_bench_result *out, fv_error *err)
+{
+    const fv_scenario *sc = info->sc;
+    const fv_bench_match *mt = &sc->matches[k];
+    double target = NAN;
+    for (int i = 0; i < sc->nmethods; i++)
+        if (!strcmp(sc->methods[i].label, mt->target)) target = metric_of(&res[i].error.region[mt->region], mt->metric);
+    fv_status st = FV_OK;
+    for (int v = 0; v < mt->nvalues && st == FV_OK; v++) {
+        char text[64];
+        snprintf(text, sizeof text, "%.17g", mt->values[v]);
+        fv_params_destroy(m->params);
+        m->params = NULL;
+        *m = mt->base;
+        m->params = NULL;
+        m->match = k + 1;
+        if ((st = fv_params_clone(mt->base.params, &m->params, err)) != FV_OK || (st = fv_params_set(m->params, mt->param, text, err)) != FV_OK)
+            break;
+        free(out->ms);
+        memset(out, 0, sizeof *out);
+        out->m = m;
+        say(info->opt, "match %s: %s=%s against %s's %s %s %.4g", m->label, mt->param, text, mt->target, fv_region_name(mt->region), mt->metric,
+            target);
+        if ((st = run_method(info, scene, frames, sc->nmethods + k, sc->nmethods + sc->nmatches, out, err)) != FV_OK) break;
+        if (metric_of(&out->error.region[mt->region], mt->metric) <= target) {
+            m->match_reached = true;
+            break;
+        }
+    }
+    return st;
+}
+
 /* ---- entry points ---- */
 
 fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err)
@@ -378,6 +418,8 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
     fv_scene *scene = NULL;
     frame_setup *frames = NULL;
     fv_bench_result *res = NULL;
+    fv_bench_method *match_methods = NULL;
+    int nrows = 0;
     fv_bench_run_info info;
     memset(&info, 0, sizeof info);
     fv_status st = fv_scenario_load(path, opt->mode, &sc, err);
@@ -435,20 +477,23 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
         if ((st = fv_image_write(p, frames[sc->frames - 1].ref, sc->width, sc->height, sc->exposure, err)) != FV_OK) goto done;
     }
 
-    if (!(res = fv_calloc_array((size_t)sc->nmethods, sizeof *res))) {
+    nrows = sc->nmethods + sc->nmatches;
+    if (!(res = fv_calloc_array((size_t)nrows, sizeof *res)) || !(match_methods = fv_calloc_array((size_t)sc->nmatches + 1, sizeof *match_methods))) {
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
         goto done;
     }
     for (int i = 0; i < sc->nmethods && st == FV_OK; i++) {
         res[i].m = &sc->methods[i];
-        st = run_method(&info, scene, frames, i, sc->nmethods, &res[i], err);
+        st = run_method(&info, scene, frames, i, nrows, &res[i], err);
     }
+    for (int k = 0; k < sc->nmatches && st == FV_OK; k++)
+        st = run_match(&info, scene, frames, res, k, &match_methods[k], &res[sc->nmethods + k], err);
     if (st != FV_OK) goto done;
     double base = 0.0;
     for (int i = 0; i < sc->nmethods; i++)
         if (strcmp(sc->methods[i].label, sc->baseline) == 0) base = res[i].ms_median;
-    for (int i = 0; i < sc->nmethods; i++) res[i].speedup = res[i].ms_median > 0.0 ? base / res[i].ms_median : 0.0;
-    st = fv_bench_write_reports(&info, res, sc->nmethods, err);
+    for (int i = 0; i < nrows; i++) res[i].speedup = res[i].ms_median > 0.0 ? base / res[i].ms_median : 0.0;
+    st = fv_bench_write_reports(&info, res, nrows, err);
 done:
     if (frames)
         for (int i = 0; i < sc->frames; i++) {
@@ -457,8 +502,11 @@ done:
         }
     free(frames);
     if (res)
-        for (int i = 0; i < sc->nmethods; i++) free(res[i].ms);
+        for (int i = 0; i < nrows; i++) free(res[i].ms);
     free(res);
+    if (match_methods)
+        for (int k = 0; k < sc->nmatches; k++) fv_params_destroy(match_methods[k].params);
+    free(match_methods);
     fv_scene_destroy(scene);
     fv_scenario_destroy(sc);
     return st;

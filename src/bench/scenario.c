@@ -192,11 +192,61 @@ static fv_status parse_sweep(const cJSON *o, const char *file, fv_scenario *s, i
     return st;
 }
 
+static fv_status parse_match(const cJSON *o, const char *file, int index, fv_scenario *s, fv_error *err)
+{
+    static const char *const keys[] = {"label", "method", "params", "param", "values", "target", "metric", "region", NULL};
+    char where[32];
+    snprintf(where, sizeof where, "match[%d]", index);
+    fv_status st;
+    const char *param = NULL, *target = NULL, *metric = "mse", *region = "fovea";
+    if ((st = fv_json_check_keys(o, keys, file, where, err)) || (st = fv_json_require(o, "param", file, where, err)) ||
+        (st = fv_json_require(o, "values", file, where, err)) || (st = fv_json_require(o, "target", file, where, err)) ||
+        (st = fv_json_string(o, "param", file, where, &param, err)) || (st = fv_json_string(o, "target", file, where, &target, err)) ||
+        (st = fv_json_string(o, "metric", file, where, &metric, err)) || (st = fv_json_string(o, "region", file, where, &region, err)))
+        return st;
+    fv_bench_match *m = &s->matches[index];
+    memset(m, 0, sizeof *m);
+    cJSON *mo = cJSON_CreateObject();
+    if (!mo) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    for (const cJSON *it = o->child; it; it = it->next)
+        if (!strcmp(it->string, "label") || !strcmp(it->string, "method") || !strcmp(it->string, "params"))
+            cJSON_AddItemToObject(mo, it->string, cJSON_Duplicate(it, 1));
+    st = parse_method(mo, file, where, true, &m->base, err);
+    cJSON_Delete(mo);
+    if (st != FV_OK) return st;
+    snprintf(m->param, sizeof m->param, "%s", param);
+    snprintf(m->target, sizeof m->target, "%s", target);
+    if (strcmp(metric, "mse") && strcmp(metric, "flip") && strcmp(metric, "e"))
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.metric: '%s' is not mse, flip or e", file, where, metric);
+    snprintf(m->metric, sizeof m->metric, "%s", metric);
+    int r;
+    for (r = 0; r < FV_REGION_COUNT; r++)
+        if (!strcmp(region, fv_region_name((fv_region)r))) break;
+    if (r == FV_REGION_COUNT)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.region: '%s' is not fovea, transition, periphery or all", file, where, region);
+    m->region = (fv_region)r;
+    const cJSON *vals = cJSON_GetObjectItemCaseSensitive(o, "values");
+    int n = cJSON_GetArraySize(vals);
+    if (!cJSON_IsArray(vals) || n < 1 || n > 64)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.values: expected 1 to 64 increasing numbers", file, where);
+    int i = 0;
+    for (const cJSON *v = vals->child; v; v = v->next, i++) {
+        if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || (i > 0 && !(v->valuedouble > m->values[i - 1])))
+            return fv_error_set(err, FV_ERR_INVALID, "%s: %s.values[%d]: expected increasing finite numbers", file, where, i);
+        m->values[i] = v->valuedouble;
+    }
+    m->nvalues = n;
+    bool found = false;
+    for (int k = 0; k < s->nmethods && !found; k++) found = !strcmp(s->methods[k].label, target);
+    if (!found) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.target: no method is labelled '%s'", file, where, target);
+    return FV_OK;
+}
+
 static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_scenario *s, fv_error *err)
 {
     static const char *const keys[] = {"name", "description", "scene", "size", "frames", "fps", "start_time", "repeats",
                                        "exposure", "seed", "eye", "gaze", "camera_path", "reference", "baseline", "methods",
-                                       "sweep", "quick", "full", NULL};
+                                       "sweep", "match", "quick", "full", NULL};
     fv_status st = fv_json_check_keys(root, keys, file, "", err);
     if (st != FV_OK) return st;
     const char *name = NULL, *desc = NULL, *scene = NULL, *baseline = NULL;
@@ -264,6 +314,16 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
     }
     if ((o = cJSON_GetObjectItemCaseSensitive(root, "sweep")) && (st = parse_sweep(o, file, s, &cap, err))) return st;
     if (s->nmethods == 0) return fv_error_set(err, FV_ERR_INVALID, "%s: no methods to compare (give 'methods' or 'sweep')", file);
+    const cJSON *ma = cJSON_GetObjectItemCaseSensitive(root, "match");
+    if (ma) {
+        int n = cJSON_GetArraySize(ma);
+        if (!cJSON_IsArray(ma) || n < 1 || n > 16) return fv_error_set(err, FV_ERR_INVALID, "%s: match: expected an array of 1 to 16 searches", file);
+        if (!(s->matches = fv_calloc_array((size_t)n, sizeof *s->matches))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        s->nmatches = n;
+        int k = 0;
+        for (const cJSON *m = ma->child; m; m = m->next, k++)
+            if ((st = parse_match(m, file, k, s, err)) != FV_OK) return st;
+    }
     if (baseline) {
         bool found = false;
         for (int k = 0; k < s->nmethods && !found; k++) found = strcmp(s->methods[k].label, baseline) == 0;
@@ -327,6 +387,8 @@ void fv_scenario_destroy(fv_scenario *s)
 {
     if (!s) return;
     for (int i = 0; i < s->nmethods; i++) fv_params_destroy(s->methods[i].params);
+    for (int i = 0; i < s->nmatches; i++) fv_params_destroy(s->matches[i].base.params);
+    free(s->matches);
     fv_params_destroy(s->reference.params);
     fv_gaze_path_destroy(s->gaze);
     free(s->methods);

@@ -15,7 +15,22 @@ typedef struct fv_bench_method {
     fv_params *params;
     bool from_sweep;
     double sweep_value;
+    int match;               /* 0: an ordinary row; k > 0: the row "match" search k - 1 chose */
+    bool match_reached;
 } fv_bench_method;
+
+/* "match": the smallest value of `param` for which `method` reaches the `target` method's
+ * error (`metric` in `region`), e.g. the paper's PM_eq: photon mapping with the photon count
+ * that matches foveated photon mapping's error in the fovea. */
+typedef struct fv_bench_match {
+    fv_bench_method base;
+    char param[FV_BENCH_LABEL_MAX];
+    double values[64];
+    int nvalues;
+    char target[FV_BENCH_LABEL_MAX];
+    char metric[16];   /* "mse", "flip", "e" (lower is better) */
+    fv_region region;
+} fv_bench_match;
 
 typedef struct fv_scenario {
     char name[FV_BENCH_LABEL_MAX];
@@ -39,6 +54,8 @@ typedef struct fv_scenario {
     char sweep_param[FV_BENCH_LABEL_MAX];
     char sweep_method[FV_BENCH_LABEL_MAX];
     int sweep_first;                   /* index of the first sweep method in methods[] */
+    fv_bench_match *matches;
+    int nmatches;
 } fv_scenario;
 
 fv_status fv_scenario_load(const char *path, fv_bench_mode mode, fv_scenario **out, fv_error *err);

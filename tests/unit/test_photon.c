@@ -43,7 +43,7 @@ static void test_eta(void **st)
     assert_int_equal(fv_photon_map_append(&light, p, 3, &err), FV_OK);
     fv_photon q[2] = {{left, d, {3, 3, 3}, n}, {right, d, {4, 4, 4}, n}};
     assert_int_equal(fv_photon_map_append(&fov, q, 2, &err), FV_OK);
-    double l = fv_photon_focus_flux(&light, &cb, focus, 10, 10), f = fv_photon_focus_flux(&fov, &cb, focus, 10, 10);
+    double l = fv_photon_focus_flux(&light, &cb, focus, NULL, 0, 10, 10), f = fv_photon_focus_flux(&fov, &cb, focus, NULL, 0, 10, 10);
     assert_float_equal(l, 2.0, 1e-5);
     assert_float_equal(f, 3.0, 1e-5);
     assert_float_equal(l / (l + f), 0.4, 1e-6);

@@ -11,6 +11,7 @@
 struct fv_foveated {
     int w, h, n, max_depth;
     uint8_t *focus, *focus_prev, *claimed;
+    float *depth;                  /* distance to the visible surface of each focus pixel */
     int *fbm, *fbm_prev;
     int32_t *fbp, *fbp_prev;       /* w * h * n path ids, -1 for an empty slot */
     /* Pool of static paths: path i owns pool[i * max_depth ..], len[i] photons (0: free). */
@@ -36,13 +37,14 @@ fv_status fv_foveated_create(int w, int h, int n, int max_depth, fv_foveated **o
     f->focus = calloc(np, 1);
     f->focus_prev = calloc(np, 1);
     f->claimed = calloc(np, 1);
+    f->depth = fv_alloc_array(np, sizeof(float));
     f->fbm = calloc(np, sizeof(int));
     f->fbm_prev = calloc(np, sizeof(int));
     f->fbp = fv_alloc_array(np * (size_t)n, sizeof(int32_t));
     f->fbp_prev = fv_alloc_array(np * (size_t)n, sizeof(int32_t));
     fv_photon_map_init(&f->fs);
     fv_photon_map_init(&f->fd);
-    if (!f->focus || !f->focus_prev || !f->claimed || !f->fbm || !f->fbm_prev || !f->fbp || !f->fbp_prev) {
+    if (!f->focus || !f->focus_prev || !f->claimed || !f->depth || !f->fbm || !f->fbm_prev || !f->fbp || !f->fbp_prev) {
         fv_foveated_destroy(f);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the foveated photon buffers of %dx%d", w, h);
     }
@@ -58,6 +60,7 @@ void fv_foveated_destroy(fv_foveated *f)
     free(f->focus);
     free(f->focus_prev);
     free(f->claimed);
+    free(f->depth);
     free(f->fbm);
     free(f->fbm_prev);
     free(f->fbp);
@@ -146,51 +149,56 @@ fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera 
     for (size_t i = 0; i < np; i++) f->fbm[i] = f->focus[i] ? n : 0;
     memset(f->claimed, 0, np);
     fv_camera_basis cb, pb;
-    bool have_prev = f->has_prev && prev && fv_camera_basis_make(cam, &cb, err) == FV_OK && fv_camera_basis_make(prev, &pb, err) == FV_OK;
-    if (have_prev) {
-        /* Lines 5-12, one row per task: back-project with V, project with V'. Each previous
-         * pixel's paths go to at most one current pixel (the first to claim it, in pixel order). */
-        int *src = fv_alloc_array(np, sizeof(int));
-        if (!src) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-        int nthreads = fv_thread_count(threads);
-        #pragma omp parallel for schedule(dynamic, 4) num_threads(nthreads)
-        for (int y = 0; y < f->h; y++)
-            for (int x = 0; x < f->w; x++) {
-                size_t i = (size_t)y * f->w + x;
-                src[i] = -1;
-                if (!f->focus[i]) continue;
-                fv_hit hit;
-                fv_vec3 d = fv_camera_dir(&cb, x + 0.5f, y + 0.5f);
-                if (!fv_scene_intersect(s, FV_TRACE_ALL, cb.pos, d, INFINITY, &hit)) continue;
-                float px, py;
-                if (!fv_camera_project(&pb, hit.p, &px, &py) || px < 0 || py < 0 || px >= f->w || py >= f->h) continue;
-                int q = (int)py * f->w + (int)px;
-                bool ok = !s->objs[hit.obj].dynamic && fv_bsdf_is_smooth(&s->mats[hit.mat]);
-                src[i] = ok ? q : -2 - q; /* -2 - q: v is not on a static diffuse surface */
+    fv_status rc = fv_camera_basis_make(cam, &cb, err);
+    if (rc != FV_OK) return rc;
+    bool have_prev = f->has_prev && prev && fv_camera_basis_make(prev, &pb, err) == FV_OK;
+    /* Lines 5-7, one row per task: back-project each focus pixel with V (its visible surface also
+     * serves Eq. 1), project with V'. */
+    int *src = fv_alloc_array(np, sizeof(int));
+    if (!src) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    int nthreads = fv_thread_count(threads);
+    #pragma omp parallel for schedule(dynamic, 4) num_threads(nthreads)
+    for (int y = 0; y < f->h; y++)
+        for (int x = 0; x < f->w; x++) {
+            size_t i = (size_t)y * f->w + x;
+            src[i] = -1;
+            f->depth[i] = INFINITY;
+            if (!f->focus[i]) continue;
+            fv_hit hit;
+            fv_vec3 d = fv_camera_dir(&cb, x + 0.5f, y + 0.5f);
+            if (!fv_scene_intersect(s, FV_TRACE_ALL, cb.pos, d, INFINITY, &hit)) continue;
+            f->depth[i] = hit.t;
+            float px, py;
+            if (!have_prev || !fv_camera_project(&pb, hit.p, &px, &py) || px < 0 || py < 0 || px >= f->w || py >= f->h) continue;
+            int q = (int)py * f->w + (int)px;
+            bool ok = !s->objs[hit.obj].dynamic && fv_bsdf_is_smooth(&s->mats[hit.mat]);
+            src[i] = ok ? q : -2 - q; /* -2 - q: v is not on a static diffuse surface */
+        }
+    /* Lines 8-12. Each previous pixel's paths go to at most one current pixel (the first to claim
+     * it, in pixel order). */
+    for (size_t i = 0; i < np; i++) {
+        if (src[i] == -1) continue;
+        int q = src[i] >= 0 ? src[i] : -2 - src[i];
+        if (!f->focus_prev[q] || f->claimed[q]) continue;
+        f->claimed[q] = 1;
+        if (src[i] >= 0) {
+            int k = 0;
+            for (int j = 0; j < n; j++) {
+                int32_t id = f->fbp_prev[(size_t)q * n + j];
+                if (id >= 0) f->fbp[i * n + k++] = id;
             }
-        for (size_t i = 0; i < np; i++) {
-            if (src[i] == -1) continue;
-            int q = src[i] >= 0 ? src[i] : -2 - src[i];
-            if (!f->focus_prev[q] || f->claimed[q]) continue;
-            f->claimed[q] = 1;
-            if (src[i] >= 0) {
-                int k = 0;
-                for (int j = 0; j < n; j++) {
-                    int32_t id = f->fbp_prev[(size_t)q * n + j];
-                    if (id >= 0) f->fbp[i * n + k++] = id;
-                }
-                f->fbm[i] = n - k;
-                if (st) st->paths_reused += k;
-            } else {
-                for (int j = 0; j < n; j++) {
-                    int32_t id = f->fbp_prev[(size_t)q * n + j];
-                    if (id >= 0 && st) st->paths_deleted++;
-                    free_path(f, id);
-                }
+            f->fbm[i] = n - k;
+            if (st) st->paths_reused += k;
+        } else {
+            for (int j = 0; j < n; j++) {
+                int32_t id = f->fbp_prev[(size_t)q * n + j];
+                if (id >= 0 && st) st->paths_deleted++;
+                free_path(f, id);
+                f->fbp_prev[(size_t)q * n + j] = -1;
             }
         }
-        free(src);
     }
+    free(src);
     /* Paths of previous pixels no current pixel took over have left the focus region (or are
      * hidden now): delete them so the maps do not grow. */
     for (size_t q = 0; q < np; q++) {
@@ -259,6 +267,10 @@ static void trace_path(const trace_ctx *c, int px, int py, int attempt, path_out
             break;
         }
         const fv_material *m = &s->mats[h.mat];
+        if (out->len > 0 && fv_max3(m->emission) > 0.0f) { /* reached the light: the last photon holds direct light */
+            ended = true;
+            break;
+        }
         if (s->objs[h.obj].dynamic) out->dynamic = true;
         fv_vec3 wo = fv_neg(d), ng = h.ng, ns = h.ns;
         if (m->type != FV_MAT_DIELECTRIC && fv_dot(wo, ng) < 0.0f) {
@@ -422,7 +434,8 @@ fv_status fv_foveated_trace(fv_foveated *f, const fv_scene *s, const fv_camera *
     return rc;
 }
 
-double fv_photon_focus_flux(const fv_photon_map *m, const fv_camera_basis *cb, const uint8_t *focus, int w, int h)
+double fv_photon_focus_flux(const fv_photon_map *m, const fv_camera_basis *cb, const uint8_t *focus, const float *depth, float tol, int w,
+                            int h)
 {
     double sum = 0.0;
     for (int i = 0; i < m->n; i++) {
@@ -430,19 +443,24 @@ double fv_photon_focus_flux(const fv_photon_map *m, const fv_camera_basis *cb, c
         if (!(l > 0.0f)) continue;
         float px, py;
         if (!fv_camera_project(cb, m->p[i].pos, &px, &py) || px < 0 || py < 0 || px >= w || py >= h) continue;
-        if (focus[(size_t)(int)py * w + (int)px]) sum += l;
+        size_t k = (size_t)(int)py * w + (int)px;
+        if (!focus[k]) continue;
+        /* Only photons on the surfaces the focus region shows: hidden ones light nothing there. */
+        if (depth && !(fabsf(fv_length(fv_sub(m->p[i].pos, cb->pos)) - depth[k]) <= tol)) continue;
+        sum += l;
     }
     return sum;
 }
 
-double fv_foveated_eta(const fv_foveated *f, const fv_camera *cam, const fv_eye_model *eye, fv_gaze gaze, const fv_photon_map *m_ls,
-                       const fv_photon_map *m_ld)
+double fv_foveated_eta(const fv_foveated *f, const fv_camera *cam, const fv_photon_map *m_ls, const fv_photon_map *m_ld, float radius)
 {
-    (void)eye, (void)gaze; /* the focus mask of this frame already encodes them */
     fv_camera_basis cb;
     fv_error err;
     if (fv_camera_basis_make(cam, &cb, &err) != FV_OK) return 1.0;
-    double light = fv_photon_focus_flux(m_ls, &cb, f->focus, f->w, f->h) + fv_photon_focus_flux(m_ld, &cb, f->focus, f->w, f->h);
-    double fov = fv_photon_focus_flux(&f->fs, &cb, f->focus, f->w, f->h) + fv_photon_focus_flux(&f->fd, &cb, f->focus, f->w, f->h);
+    float tol = 2.0f * radius;
+    double light = fv_photon_focus_flux(m_ls, &cb, f->focus, f->depth, tol, f->w, f->h) +
+                   fv_photon_focus_flux(m_ld, &cb, f->focus, f->depth, tol, f->w, f->h);
+    double fov = fv_photon_focus_flux(&f->fs, &cb, f->focus, f->depth, tol, f->w, f->h) +
+                 fv_photon_focus_flux(&f->fd, &cb, f->focus, f->depth, tol, f->w, f->h);
     return light + fov > 0.0 && fov > 0.0 ? light / (light + fov) : 1.0;
 }

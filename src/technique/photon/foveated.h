@@ -67,15 +67,17 @@ const fv_photon_map *fv_foveated_dynamic_map(const fv_foveated *f); /* M_fd */
 /* The focus-region mask of the current frame (width * height, 1 inside r_t). */
 const uint8_t *fv_foveated_focus(const fv_foveated *f);
 
-/* Positive flux (luminance) of the photons of m that project into the focus mask through cb. */
-double fv_photon_focus_flux(const fv_photon_map *m, const fv_camera_basis *cb, const uint8_t *focus, int w, int h);
+/* Positive flux (luminance) of the photons of m that project into the focus mask through cb and,
+ * when depth is given, lie within tol of the distance to the surface their pixel shows. */
+double fv_photon_focus_flux(const fv_photon_map *m, const fv_camera_basis *cb, const uint8_t *focus, const float *depth, float tol, int w,
+                            int h);
 
 /* Live static paths and the pool's capacity (memory stays bounded: the tests watch these). */
 void fv_foveated_pool(const fv_foveated *f, int *live, int *capacity);
 
-/* Eq. 1: positive flux of the light photons over positive flux of light + foveated photons,
- * counting photons that project into the focus region of cam. 1 when there is no foveated flux. */
-double fv_foveated_eta(const fv_foveated *f, const fv_camera *cam, const fv_eye_model *eye, fv_gaze gaze,
-                       const fv_photon_map *m_ls, const fv_photon_map *m_ld);
+/* Eq. 1: positive flux of the light photons over positive flux of light + foveated photons in the
+ * focus region: photons that project into it and lie on the surfaces it shows (within 2 radius of
+ * the visible depth; our reading of "in the focus region"). 1 when there is no foveated flux. */
+double fv_foveated_eta(const fv_foveated *f, const fv_camera *cam, const fv_photon_map *m_ls, const fv_photon_map *m_ld, float radius);
 
 #endif

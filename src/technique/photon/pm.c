@@ -410,7 +410,7 @@ static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv
             if (rc == FV_OK)
                 rc = fv_foveated_trace(st->fov, s, frame->camera, &st->ls, &st->ld, c->gamma, cell, frame->seed, frame->index, frame->threads,
                                        &fs, err);
-            if (rc == FV_OK) c->eta = fv_foveated_eta(st->fov, frame->camera, eye, frame->gaze, &st->ls, &st->ld);
+            if (rc == FV_OK) c->eta = fv_foveated_eta(st->fov, frame->camera, &st->ls, &st->ld, c->gamma);
             fv_stats_add_ms(stats, "foveated_tracing", fv_time_ms() - t0);
             fv_stats_add_count(stats, "foveated_photons", fs.photons_static + fs.photons_dynamic);
             fv_stats_add_count(stats, "paths_traced", (double)fs.paths_traced);
