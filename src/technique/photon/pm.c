@@ -41,6 +41,7 @@ typedef struct pm_opts {
     int max_depth;        /* photon bounces (Sec. 4.1: 8) */
     int eye_depth;        /* mirror/glass bounces of eye paths */
     int paths;            /* fpm: N paths per focus pixel; 0: from the budget */
+    int light_photons, fov_photons; /* fpm: absolute counts instead of photons x fraction */
     int passes;           /* pm: independent passes averaged (references) */
     bool filter, tpm;
 } pm_opts;
@@ -83,11 +84,20 @@ static fv_status read_opts(pm_mode mode, fv_params *p, pm_opts *o, fv_error *err
         if ((s = fv_params_float(p, "dyn_fraction", 0.2, 0.0, 0.95, &o->dyn_fraction, err))) return s;
     }
     if (mode == MODE_FPM) {
-        if ((s = fv_params_float(p, "fov_fraction", 0.4, 0.0, 1.0, &o->fov_fraction, err)) ||
+        if ((s = fv_params_int(p, "light_photons", 0, 0, 500000000, &o->light_photons, err)) ||
+            (s = fv_params_int(p, "fov_photons", 0, 0, 500000000, &o->fov_photons, err)) ||
+            (s = fv_params_float(p, "fov_fraction", 0.4, 0.0, 1.0, &o->fov_fraction, err)) ||
             (s = fv_params_int(p, "paths_per_pixel", 0, 0, 64, &o->paths, err)) || (s = fv_params_bool(p, "tpm", true, &o->tpm, err)))
             return s;
         if (o->fov_fraction >= 1.0)
             return fv_error_set(err, FV_ERR_INVALID, "parameter fov_fraction=%g: some light photons are needed (use < 1)", o->fov_fraction);
+        /* Absolute counts (the paper's Fig. 6 b, c vary one at a fixed other) replace the split. */
+        if (o->light_photons > 0 || o->fov_photons > 0) {
+            if (o->light_photons <= 0)
+                return fv_error_set(err, FV_ERR_INVALID, "parameter fov_photons needs light_photons too (light photons feed the foveated ones)");
+            o->photons = o->light_photons + o->fov_photons;
+            o->fov_fraction = (double)o->fov_photons / o->photons;
+        }
     }
     return fv_params_check_used(p, k_mode_names[mode], err);
 }
@@ -480,6 +490,7 @@ const fv_technique_class fv_technique_fpm = {
     "fpm", "foveated photon mapping: foveated photons in the focus region, temporal photon management",
     COMMON_HELP "dyn_fraction=float (0.2): share of light photons sent towards dynamic objects each frame\n"
                 "fov_fraction=float (0.4): share of foveated photons in the total\n"
+                "light_photons=int, fov_photons=int: absolute counts instead of photons and fov_fraction\n"
                 "paths_per_pixel=int (from the budget): N foveated paths per focus pixel\n"
                 "tpm=bool (true): temporal photon management (false: retrace all foveated paths)\n",
     fpm_create, pm_render, pm_destroy,
