@@ -22,33 +22,58 @@ static void test_eq8(void **st)
     assert_float_equal(fv_photon_radius_eq8(fv_v3(0, 0, 0), fv_v3(556.0f, 548.8f, 559.2f), 1080, 1200), 9.73099, 1e-4);
 }
 
-/* Eq. 1 by hand: a 10x10 image whose left half is the focus region, camera at the origin looking
- * down -z with a 90 degree field of view. Light photons: luminance 2 (left, counted), 5 (right,
- * not counted), -1 (left, negative: not counted). Foveated: 3 (left), 4 (right). eta = 2 / (2 + 3)
- * = 0.4. */
+/* Eq. 1 on a hand-built photon set: a diffuse floor (albedo 0.5, f_r = 0.5 / pi), two pixels
+ * seeing it at A = (0,0,0) and B = (10,0,0), photons stored by hand. Gather radius 1:
+ *   A: light photon of flux 2 at 0.5 from A, foveated photon of flux 1 at 0.3 from A;
+ *   B: light photon of flux 6, foveated photon of flux 6; a negative light photon of flux -4
+ *      next to B is left out of the sums (Eq. 1 sums positive flux).
+ * Gathered luminance is flux * 0.5 / pi, and eta is a ratio, so the f_r factor cancels:
+ *   eta over {A} = 2 / (2 + 1) = 0.666667;  eta over {A, B} = (2 + 6) / (2 + 6 + 1 + 6) = 0.533333. */
+static void sum_y(void *ctx, const fv_photon *ph, float d2)
+{
+    (void)d2;
+    *(double *)ctx += ph->flux.y;
+}
+
 static void test_eta(void **st)
 {
     (void)st;
-    fv_camera cam = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 90.0f, 10, 10};
-    fv_camera_basis cb;
-    fv_error err;
-    assert_int_equal(fv_camera_basis_make(&cam, &cb, &err), FV_OK);
-    uint8_t focus[100];
-    for (int i = 0; i < 100; i++) focus[i] = (i % 10) < 5;
     fv_photon_map light, fov;
     fv_photon_map_init(&light);
     fv_photon_map_init(&fov);
-    const fv_vec3 left = {-0.5f, 0, -1}, right = {0.5f, 0, -1}, n = {0, 0, 1}, d = {0, 0, -1};
-    fv_photon p[3] = {{left, d, {2, 2, 2}, n}, {right, d, {5, 5, 5}, n}, {left, d, {-1, -1, -1}, n}};
-    assert_int_equal(fv_photon_map_append(&light, p, 3, &err), FV_OK);
-    fv_photon q[2] = {{left, d, {3, 3, 3}, n}, {right, d, {4, 4, 4}, n}};
+    fv_error err;
+    const fv_vec3 n = {0, 1, 0}, d = {0, -1, 0};
+    fv_photon p[3] = {{{0.5f, 0, 0}, d, {2, 2, 2}, n}, {{10.2f, 0, 0}, d, {6, 6, 6}, n}, {{10.0f, 0, 0.4f}, d, {-4, -4, -4}, n}};
+    fv_photon q[2] = {{{0, 0, 0.3f}, d, {1, 1, 1}, n}, {{9.8f, 0, 0}, d, {6, 6, 6}, n}};
+    assert_int_equal(fv_photon_map_append(&light, p, 2, &err), FV_OK); /* the negative one goes in separately below */
     assert_int_equal(fv_photon_map_append(&fov, q, 2, &err), FV_OK);
-    double l = fv_photon_focus_flux(&light, &cb, focus, NULL, 0, 10, 10), f = fv_photon_focus_flux(&fov, &cb, focus, NULL, 0, 10, 10);
-    assert_float_equal(l, 2.0, 1e-5);
-    assert_float_equal(f, 3.0, 1e-5);
-    assert_float_equal(l / (l + f), 0.4, 1e-6);
+    fv_photon_map neg;
+    fv_photon_map_init(&neg);
+    assert_int_equal(fv_photon_map_append(&neg, &p[2], 1, &err), FV_OK);
+    assert_int_equal(fv_photon_map_build(&light, 1.0f, &err), FV_OK);
+    assert_int_equal(fv_photon_map_build(&fov, 1.0f, &err), FV_OK);
+    assert_int_equal(fv_photon_map_build(&neg, 1.0f, &err), FV_OK);
+    const fv_vec3 px[2] = {{0, 0, 0}, {10, 0, 0}};
+    float l[2], f[2];
+    for (int i = 0; i < 2; i++) {
+        double sl = 0, sf = 0, sn = 0;
+        fv_photon_map_query(&light, px[i], 1.0f, sum_y, &sl);
+        fv_photon_map_query(&fov, px[i], 1.0f, sum_y, &sf);
+        fv_photon_map_query(&neg, px[i], 1.0f, sum_y, &sn);
+        const double fr = 0.5 / FV_PI;
+        l[i] = (float)(fr * (sl + (sn > 0 ? sn : 0)));
+        f[i] = (float)(fr * sf);
+    }
+    const uint8_t only_a[2] = {1, 0}, both[2] = {1, 1};
+    assert_float_equal(fv_foveated_eta(l, f, only_a, 2), 2.0 / 3.0, 1e-6);
+    assert_float_equal(fv_foveated_eta(l, f, both, 2), 8.0 / 15.0, 1e-6);
+    const float none[2] = {0, 0};
+    assert_float_equal(fv_foveated_eta(l, none, both, 2), 1.0, 0.0); /* no foveated flux: eta = 1 */
+    const float negf[2] = {-3, -3};
+    assert_float_equal(fv_foveated_eta(l, negf, both, 2), 1.0, 0.0);
     fv_photon_map_free(&light);
     fv_photon_map_free(&fov);
+    fv_photon_map_free(&neg);
 }
 
 /* A floor (albedo 0.5) under a 20x20 area light at height 100, and a dynamic 20x20x20 box at

@@ -11,7 +11,6 @@
 struct fv_foveated {
     int w, h, n, max_depth;
     uint8_t *focus, *focus_prev, *claimed;
-    float *depth;                  /* distance to the visible surface of each focus pixel */
     int *fbm, *fbm_prev;
     int32_t *fbp, *fbp_prev;       /* w * h * n path ids, -1 for an empty slot */
     /* Pool of static paths: path i owns pool[i * max_depth ..], len[i] photons (0: free). */
@@ -37,14 +36,13 @@ fv_status fv_foveated_create(int w, int h, int n, int max_depth, fv_foveated **o
     f->focus = calloc(np, 1);
     f->focus_prev = calloc(np, 1);
     f->claimed = calloc(np, 1);
-    f->depth = fv_alloc_array(np, sizeof(float));
     f->fbm = calloc(np, sizeof(int));
     f->fbm_prev = calloc(np, sizeof(int));
     f->fbp = fv_alloc_array(np * (size_t)n, sizeof(int32_t));
     f->fbp_prev = fv_alloc_array(np * (size_t)n, sizeof(int32_t));
     fv_photon_map_init(&f->fs);
     fv_photon_map_init(&f->fd);
-    if (!f->focus || !f->focus_prev || !f->claimed || !f->depth || !f->fbm || !f->fbm_prev || !f->fbp || !f->fbp_prev) {
+    if (!f->focus || !f->focus_prev || !f->claimed || !f->fbm || !f->fbm_prev || !f->fbp || !f->fbp_prev) {
         fv_foveated_destroy(f);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the foveated photon buffers of %dx%d", w, h);
     }
@@ -60,7 +58,6 @@ void fv_foveated_destroy(fv_foveated *f)
     free(f->focus);
     free(f->focus_prev);
     free(f->claimed);
-    free(f->depth);
     free(f->fbm);
     free(f->fbm_prev);
     free(f->fbp);
@@ -152,8 +149,7 @@ fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera 
     fv_status rc = fv_camera_basis_make(cam, &cb, err);
     if (rc != FV_OK) return rc;
     bool have_prev = f->has_prev && prev && fv_camera_basis_make(prev, &pb, err) == FV_OK;
-    /* Lines 5-7, one row per task: back-project each focus pixel with V (its visible surface also
-     * serves Eq. 1), project with V'. */
+    /* Lines 5-7, one row per task: back-project each focus pixel with V, project with V'. */
     int *src = fv_alloc_array(np, sizeof(int));
     if (!src) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     int nthreads = fv_thread_count(threads);
@@ -162,14 +158,12 @@ fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera 
         for (int x = 0; x < f->w; x++) {
             size_t i = (size_t)y * f->w + x;
             src[i] = -1;
-            f->depth[i] = INFINITY;
             if (!f->focus[i]) continue;
             fv_hit hit;
             fv_vec3 d = fv_camera_dir(&cb, x + 0.5f, y + 0.5f);
-            if (!fv_scene_intersect(s, FV_TRACE_ALL, cb.pos, d, INFINITY, &hit)) continue;
-            f->depth[i] = hit.t;
+            if (!have_prev || !fv_scene_intersect(s, FV_TRACE_ALL, cb.pos, d, INFINITY, &hit)) continue;
             float px, py;
-            if (!have_prev || !fv_camera_project(&pb, hit.p, &px, &py) || px < 0 || py < 0 || px >= f->w || py >= f->h) continue;
+            if ( !fv_camera_project(&pb, hit.p, &px, &py) || px < 0 || py < 0 || px >= f->w || py >= f->h) continue;
             int q = (int)py * f->w + (int)px;
             bool ok = !s->objs[hit.obj].dynamic && fv_bsdf_is_smooth(&s->mats[hit.mat]);
             src[i] = ok ? q : -2 - q; /* -2 - q: v is not on a static diffuse surface */
@@ -434,33 +428,13 @@ fv_status fv_foveated_trace(fv_foveated *f, const fv_scene *s, const fv_camera *
     return rc;
 }
 
-double fv_photon_focus_flux(const fv_photon_map *m, const fv_camera_basis *cb, const uint8_t *focus, const float *depth, float tol, int w,
-                            int h)
+double fv_foveated_eta(const float *light, const float *fov, const uint8_t *mask, size_t n)
 {
-    double sum = 0.0;
-    for (int i = 0; i < m->n; i++) {
-        float l = fv_luminance(m->p[i].flux);
-        if (!(l > 0.0f)) continue;
-        float px, py;
-        if (!fv_camera_project(cb, m->p[i].pos, &px, &py) || px < 0 || py < 0 || px >= w || py >= h) continue;
-        size_t k = (size_t)(int)py * w + (int)px;
-        if (!focus[k]) continue;
-        /* Only photons on the surfaces the focus region shows: hidden ones light nothing there. */
-        if (depth && !(fabsf(fv_length(fv_sub(m->p[i].pos, cb->pos)) - depth[k]) <= tol)) continue;
-        sum += l;
+    double l = 0.0, f = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        if (!mask[i]) continue;
+        if (light[i] > 0.0f) l += light[i];
+        if (fov[i] > 0.0f) f += fov[i];
     }
-    return sum;
-}
-
-double fv_foveated_eta(const fv_foveated *f, const fv_camera *cam, const fv_photon_map *m_ls, const fv_photon_map *m_ld, float radius)
-{
-    fv_camera_basis cb;
-    fv_error err;
-    if (fv_camera_basis_make(cam, &cb, &err) != FV_OK) return 1.0;
-    float tol = 2.0f * radius;
-    double light = fv_photon_focus_flux(m_ls, &cb, f->focus, f->depth, tol, f->w, f->h) +
-                   fv_photon_focus_flux(m_ld, &cb, f->focus, f->depth, tol, f->w, f->h);
-    double fov = fv_photon_focus_flux(&f->fs, &cb, f->focus, f->depth, tol, f->w, f->h) +
-                 fv_photon_focus_flux(&f->fd, &cb, f->focus, f->depth, tol, f->w, f->h);
-    return light + fov > 0.0 && fov > 0.0 ? light / (light + fov) : 1.0;
+    return f > 0.0 && l > 0.0 ? l / (l + f) : 1.0;
 }

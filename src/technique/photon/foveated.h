@@ -67,17 +67,14 @@ const fv_photon_map *fv_foveated_dynamic_map(const fv_foveated *f); /* M_fd */
 /* The focus-region mask of the current frame (width * height, 1 inside r_t). */
 const uint8_t *fv_foveated_focus(const fv_foveated *f);
 
-/* Positive flux (luminance) of the photons of m that project into the focus mask through cb and,
- * when depth is given, lie within tol of the distance to the surface their pixel shows. */
-double fv_photon_focus_flux(const fv_photon_map *m, const fv_camera_basis *cb, const uint8_t *focus, const float *depth, float tol, int w,
-                            int h);
-
 /* Live static paths and the pool's capacity (memory stays bounded: the tests watch these). */
 void fv_foveated_pool(const fv_foveated *f, int *live, int *capacity);
 
-/* Eq. 1: positive flux of the light photons over positive flux of light + foveated photons in the
- * focus region: photons that project into it and lie on the surfaces it shows (within 2 radius of
- * the visible depth; our reading of "in the focus region"). 1 when there is no foveated flux. */
-double fv_foveated_eta(const fv_foveated *f, const fv_camera *cam, const fv_photon_map *m_ls, const fv_photon_map *m_ld, float radius);
+/* Eq. 1: eta = sumFlux(light photons, r_i) / sumFlux(light + foveated photons, r_i). We sum what
+ * the pixels of the region r_i actually gather (light[i], fov[i]: the luminance of the light and
+ * foveated photons' flux gathered at pixel i, through mirrors and glass too), over the pixels with
+ * mask[i] set: the photons that illuminate the region, counted as often as they are used. Negative
+ * sums are left out. 1 when there is no foveated flux. */
+double fv_foveated_eta(const float *light, const float *fov, const uint8_t *mask, size_t n);
 
 #endif

@@ -44,6 +44,7 @@ typedef struct pm_opts {
     int light_photons, fov_photons; /* fpm: absolute counts instead of photons x fraction */
     int passes;           /* pm: independent passes averaged (references) */
     bool filter, tpm;
+    int eta_region;       /* fpm: 0 fovea, 1 focus region (Eq. 1's r_i) */
 } pm_opts;
 
 typedef struct pm_state {
@@ -89,6 +90,8 @@ static fv_status read_opts(pm_mode mode, fv_params *p, pm_opts *o, fv_error *err
             (s = fv_params_float(p, "fov_fraction", 0.4, 0.0, 1.0, &o->fov_fraction, err)) ||
             (s = fv_params_int(p, "paths_per_pixel", 0, 0, 64, &o->paths, err)) || (s = fv_params_bool(p, "tpm", true, &o->tpm, err)))
             return s;
+        static const char *const regions[] = {"fovea", "focus", NULL};
+        if ((s = fv_params_choice(p, "eta_region", 0, regions, &o->eta_region, err))) return s;
         if (o->fov_fraction >= 1.0)
             return fv_error_set(err, FV_ERR_INVALID, "parameter fov_fraction=%g: some light photons are needed (use < 1)", o->fov_fraction);
         /* Absolute counts (the paper's Fig. 6 b, c vary one at a fixed other) replace the split. */
@@ -139,6 +142,16 @@ static void pm_destroy(void *state)
 
 /* ---- per-pixel radiance ---- */
 
+/* What an fpm or pm-t pixel gathered from each map (f_r-weighted, not yet divided by
+ * pi gamma^2); fpm keeps them until eta (Eq. 1) is known. */
+typedef struct px_sums {
+    fv_vec3 ls, ld, fs, fd;
+    float u_ls, u_ld, u_fs, u_fd;  /* Eq. 4's u sums */
+    fv_vec3 emitted, weight;
+    float b;                       /* Eq. 6: 0 fovea, 1 periphery */
+    bool hit;
+} px_sums;
+
 typedef struct render_ctx {
     const pm_state *st;
     const fv_frame *frame;
@@ -154,6 +167,7 @@ typedef struct render_ctx {
     float *nbuf, *pbuf;
     int32_t *obuf;
     bool right;              /* shading the right eye: reproject from the left first */
+    px_sums *sums;           /* fpm, left eye: gathered sums per pixel */
     const float *left_color;
     const fv_camera_basis *left_cam;
     uint64_t counters[FV_MAX_THREADS][4]; /* rays, reprojected, shaded */
@@ -165,45 +179,54 @@ static float blend_k(double num, double den)
     return (float)(3.0 * w * w - 2.0 * w * w * w);
 }
 
-/* Eq. 5 (light photons only), or plain photon mapping for pm. */
-static fv_vec3 estimate_light(const render_ctx *c, const fv_pm_hit *x)
+/* Plain photon mapping (pm): one map, no blending. */
+static fv_vec3 estimate_plain(const render_ctx *c, const fv_pm_hit *x)
 {
-    const pm_state *st = c->st;
-    if (st->mode == MODE_PM) return fv_scale(fv_pm_gather(st->scene, &st->all, x, c->gamma, NULL), c->norm);
-    double u_ls = 0.0, u_ld = 0.0;
-    fv_vec3 s_ls = fv_pm_gather(st->scene, &st->ls, x, c->gamma, &u_ls);
-    fv_vec3 s_ld = fv_pm_gather(st->scene, &st->ld, x, c->gamma, &u_ld);
-    float k = blend_k(u_ld, u_ls);
-    return fv_scale(fv_madd(s_ls, s_ld, k), c->norm);
+    return fv_scale(fv_pm_gather(c->st->scene, &c->st->all, x, c->gamma, NULL), c->norm);
 }
 
-/* Eq. 3: all four maps, normalised by eta, with Eq. 4's k. */
-static fv_vec3 estimate_foveal(const render_ctx *c, const fv_pm_hit *x)
+/* Gathers what pixel x needs: the light maps, and in the focus region (b < 1) the foveated ones. */
+static void gather_sums(const render_ctx *c, const fv_pm_hit *x, float b, px_sums *o)
 {
     const pm_state *st = c->st;
     double u_ls = 0, u_ld = 0, u_fs = 0, u_fd = 0;
-    fv_vec3 s_ls = fv_pm_gather(st->scene, &st->ls, x, c->gamma, &u_ls);
-    fv_vec3 s_ld = fv_pm_gather(st->scene, &st->ld, x, c->gamma, &u_ld);
-    fv_vec3 s_fs = fv_pm_gather(st->scene, fv_foveated_static_map(st->fov), x, c->gamma, &u_fs);
-    fv_vec3 s_fd = fv_pm_gather(st->scene, fv_foveated_dynamic_map(st->fov), x, c->gamma, &u_fd);
-    float k = blend_k(u_ld + u_fd / c->eta, u_ls + u_fs);
-    return fv_scale(fv_madd(fv_add(s_ls, s_fs), fv_add(s_ld, s_fd), k), (float)c->eta * c->norm);
+    memset(o, 0, sizeof *o);
+    o->emitted = x->emitted;
+    o->weight = x->weight;
+    o->b = b;
+    o->hit = x->hit;
+    if (!x->hit) return;
+    o->ls = fv_pm_gather(st->scene, &st->ls, x, c->gamma, &u_ls);
+    o->ld = fv_pm_gather(st->scene, &st->ld, x, c->gamma, &u_ld);
+    if (b < 1.0f) {
+        o->fs = fv_pm_gather(st->scene, fv_foveated_static_map(st->fov), x, c->gamma, &u_fs);
+        o->fd = fv_pm_gather(st->scene, fv_foveated_dynamic_map(st->fov), x, c->gamma, &u_fd);
+    }
+    o->u_ls = (float)u_ls, o->u_ld = (float)u_ld, o->u_fs = (float)u_fs, o->u_fd = (float)u_fd;
+}
+
+/* Eq. 2-6 from the sums: Eq. 5 (light photons, static/dynamic blend k of Eq. 4) in the periphery,
+ * Eq. 3 (all four maps, times eta) in the fovea, linear in b between. */
+static fv_vec3 estimate_sums(const render_ctx *c, const px_sums *o)
+{
+    if (!o->hit) return o->emitted;
+    float kl = blend_k(o->u_ld, o->u_ls);
+    fv_vec3 g = fv_scale(fv_madd(o->ls, o->ld, kl), c->norm);
+    if (o->b < 1.0f) {
+        float kf = blend_k(o->u_ld + o->u_fd / c->eta, o->u_ls + o->u_fs);
+        fv_vec3 fov = fv_scale(fv_madd(fv_add(o->ls, o->fs), fv_add(o->ld, o->fd), kf), (float)c->eta * c->norm);
+        g = fv_add(fv_scale(fov, 1.0f - o->b), fv_scale(g, o->b));
+    }
+    return fv_add(o->emitted, fv_mul(o->weight, g));
 }
 
 static fv_vec3 shade(const render_ctx *c, const fv_pm_hit *x, float px, float py)
 {
-    fv_vec3 L = x->emitted;
-    if (!x->hit) return L;
-    fv_vec3 g;
-    if (c->st->mode != MODE_FPM) {
-        g = estimate_light(c, x);
-    } else {
-        double b = fv_eye_blend(c->eye, c->gaze, px, py); /* Eq. 6: 0 in the fovea, 1 in the periphery */
-        if (b >= 1.0) g = estimate_light(c, x);
-        else if (b <= 0.0) g = estimate_foveal(c, x);
-        else g = fv_add(fv_scale(estimate_foveal(c, x), (float)(1.0 - b)), fv_scale(estimate_light(c, x), (float)b));
-    }
-    return fv_add(L, fv_mul(x->weight, g));
+    if (c->st->mode == MODE_PM) return x->hit ? fv_add(x->emitted, fv_mul(x->weight, estimate_plain(c, x))) : x->emitted;
+    /* pm-t is fpm's periphery everywhere (b = 1). */
+    px_sums o;
+    gather_sums(c, x, c->st->mode == MODE_FPM ? (float)fv_eye_blend(c->eye, c->gaze, px, py) : 1.0f, &o);
+    return estimate_sums(c, &o);
 }
 
 static void render_tile(void *ctx, const fv_tile *tile)
@@ -234,7 +257,12 @@ static void render_tile(void *ctx, const fv_tile *tile)
                     }
                 }
             }
-            if (!copied) {
+            if (!copied && c->sums) {
+                /* fpm, left eye: the colour waits for eta (finish_fpm). */
+                gather_sums(c, &h, (float)fv_eye_blend(c->eye, c->gaze, x + 0.5, y + 0.5), &c->sums[pix]);
+                L = fv_v3s(0.0f);
+                shaded++;
+            } else if (!copied) {
                 L = shade(c, &h, x + 0.5f, y + 0.5f);
                 shaded++;
             }
@@ -361,6 +389,37 @@ static fv_status render_eye_pass(pm_state *st, render_ctx *c, fv_film *film, con
     return FV_OK;
 }
 
+/* Eq. 1 over what the fovea's pixels gathered (eta_region=fovea) or the focus region's
+ * (=focus), then every fpm pixel's colour. */
+static fv_status finish_fpm(render_ctx *c, fv_film *film, fv_error *err)
+{
+    int w = fv_film_width(film), h = fv_film_height(film);
+    size_t n = (size_t)w * h;
+    float *l = fv_alloc_array(n, sizeof(float)), *f = fv_alloc_array(n, sizeof(float));
+    uint8_t *mask = fv_alloc_array(n, 1);
+    if (!l || !f || !mask) {
+        free(l), free(f), free(mask);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    }
+    bool fovea_only = c->st->o.eta_region == 0;
+    for (size_t i = 0; i < n; i++) {
+        const px_sums *o = &c->sums[i];
+        l[i] = fv_luminance(fv_add(o->ls, o->ld));
+        f[i] = fv_luminance(fv_add(o->fs, o->fd));
+        mask[i] = o->hit && (fovea_only ? o->b <= 0.0f : o->b < 1.0f);
+    }
+    c->eta = fv_foveated_eta(l, f, mask, n);
+    free(l), free(f), free(mask);
+    float *col = fv_film_color(film);
+    #pragma omp parallel for schedule(static)
+    for (long long i = 0; i < (long long)n; i++) {
+        fv_vec3 L = estimate_sums(c, &c->sums[i]);
+        if (!fv_is_finite3(L)) L = fv_v3s(0.0f);
+        col[3 * i] = L.x, col[3 * i + 1] = L.y, col[3 * i + 2] = L.z;
+    }
+    return FV_OK;
+}
+
 static fv_status filter_film(pm_state *st, fv_film *film, float gamma, fv_stats *stats, fv_error *err)
 {
     if (!st->o.filter) return FV_OK;
@@ -420,7 +479,6 @@ static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv
             if (rc == FV_OK)
                 rc = fv_foveated_trace(st->fov, s, frame->camera, &st->ls, &st->ld, c->gamma, cell, frame->seed, frame->index, frame->threads,
                                        &fs, err);
-            if (rc == FV_OK) c->eta = fv_foveated_eta(st->fov, frame->camera, &st->ls, &st->ld, c->gamma);
             fv_stats_add_ms(stats, "foveated_tracing", fv_time_ms() - t0);
             fv_stats_add_count(stats, "foveated_photons", fs.photons_static + fs.photons_dynamic);
             fv_stats_add_count(stats, "paths_traced", (double)fs.paths_traced);
@@ -433,10 +491,19 @@ static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv
             fv_stats_add_count(stats, "path_capacity", cap);
             long denom = fs.paths_reused + fs.paths_traced;
             fv_stats_add_count(stats, "reuse_rate", denom > 0 ? (double)fs.paths_reused / (double)denom : 0.0);
-            fv_stats_add_count(stats, "eta", c->eta);
         }
         c->pass = pass;
+        if (rc == FV_OK && st->mode == MODE_FPM && !(c->sums = fv_alloc_array((size_t)w * h, sizeof *c->sums)))
+            rc = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
         if (rc == FV_OK) rc = render_eye_pass(st, c, film, frame->camera, frame->gaze, false, stats, err);
+        if (rc == FV_OK && c->sums) {
+            double t1 = fv_time_ms();
+            rc = finish_fpm(c, film, err);
+            fv_stats_add_ms(stats, "render", fv_time_ms() - t1);
+            fv_stats_add_count(stats, "eta", c->eta);
+        }
+        free(c->sums);
+        c->sums = NULL;
     }
     if (rc == FV_OK) rc = filter_film(st, film, c->gamma, stats, err);
     if (rc == FV_OK && frame->camera_right && film_right) {
@@ -492,6 +559,7 @@ const fv_technique_class fv_technique_fpm = {
                 "fov_fraction=float (0.4): share of foveated photons in the total\n"
                 "light_photons=int, fov_photons=int: absolute counts instead of photons and fov_fraction\n"
                 "paths_per_pixel=int (from the budget): N foveated paths per focus pixel\n"
-                "tpm=bool (true): temporal photon management (false: retrace all foveated paths)\n",
+                "tpm=bool (true): temporal photon management (false: retrace all foveated paths)\n"
+                "eta_region=fovea|focus (fovea): the pixels whose gathered flux Eq. 1 sums (r_i)\n",
     fpm_create, pm_render, pm_destroy,
 };
