@@ -278,6 +278,47 @@ static void test_memory_flat(void **st)
     fv_scene_destroy(s);
 }
 
+/* Sec. 3.3: the right eye reuses the left eye's colours wherever its pixel shows the same surface.
+ * With an eye separation of 0 both views coincide: every pixel that sees a surface is copied, so the
+ * right image equals the left one there; with a real separation most pixels are still copied. */
+static void test_stereo_reprojection(void **st)
+{
+    (void)st;
+    fv_scene *s;
+    fv_error err;
+    assert_int_equal(fv_scene_load("cornell", NULL, &s, &err), FV_OK);
+    const char *kv[] = {"photons=20000", "filter=false", NULL};
+    fv_technique *t = make(s, "fpm", kv);
+    fv_camera c, l, r;
+    fv_scene_camera(s, 0.0, 40, 40, &c);
+    fv_film *fl, *fr;
+    assert_int_equal(fv_film_create(40, 40, 0, &fl, &err), FV_OK);
+    assert_int_equal(fv_film_create(40, 40, 0, &fr, &err), FV_OK);
+    for (int k = 0; k < 2; k++) {
+        fv_camera_stereo(&c, k == 0 ? 0.0f : 6.4f, &l, &r);
+        fv_frame f;
+        memset(&f, 0, sizeof f);
+        f.camera = &l;
+        f.camera_right = &r;
+        f.seed = 1;
+        f.gaze = f.gaze_right = (fv_gaze){0.5f, 0.5f};
+        fv_stats stats;
+        fv_stats_clear(&stats);
+        assert_int_equal(fv_technique_render(t, &f, fl, fr, &stats, &err), FV_OK);
+        double copied = fv_stats_get_count(&stats, "reprojected_fraction");
+        if (k == 0) {
+            assert_true(copied > 0.95);
+            assert_memory_equal(fv_film_color(fl), fv_film_color(fr), 40 * 40 * 3 * sizeof(float));
+        } else {
+            assert_true(copied > 0.6 && copied < 1.0);
+        }
+    }
+    fv_technique_destroy(t);
+    fv_film_destroy(fl);
+    fv_film_destroy(fr);
+    fv_scene_destroy(s);
+}
+
 static void test_bad_params(void **st)
 {
     (void)st;
@@ -308,7 +349,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_eq8),       cmocka_unit_test(test_eta),         cmocka_unit_test(test_negative_photons),
-        cmocka_unit_test(test_tpm_reuse), cmocka_unit_test(test_memory_flat), cmocka_unit_test(test_bad_params),
+        cmocka_unit_test(test_tpm_reuse), cmocka_unit_test(test_memory_flat), cmocka_unit_test(test_stereo_reprojection),
+        cmocka_unit_test(test_bad_params),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
