@@ -25,7 +25,7 @@
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "core/rng.h"
-/*ATROUS*/
+#include "filter/atrous.h"
 #include "fovea/technique.h"
 #include "technique/photon/foveated.h"
 #include "technique/photon/gather.h"
@@ -423,8 +423,13 @@ static fv_status finish_fpm(render_ctx *c, fv_film *film, fv_error *err)
 static fv_status filter_film(pm_state *st, fv_film *film, float gamma, fv_stats *stats, fv_error *err)
 {
     if (!st->o.filter) return FV_OK;
-    (void)film, (void)gamma, (void)stats, (void)err; /*ATROUS-CALL*/
-    return FV_OK;
+    double t0 = fv_time_ms();
+    fv_atrous_opts ao;
+    fv_atrous_opts_default(&ao);
+    ao.sigma_position = 2.0f * gamma; /* surfaces further apart than the gather disc do not mix */
+    fv_status rc = fv_atrous_filter(fv_film_color(film), st->nbuf, st->pbuf, fv_film_width(film), fv_film_height(film), &ao, err);
+    fv_stats_add_ms(stats, "filter", fv_time_ms() - t0);
+    return rc;
 }
 
 static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv_film *film_right, fv_stats *stats, fv_error *err)

@@ -1,0 +1,100 @@
+/* fovea — edge-avoiding À-Trous wavelet filter (see atrous.h). */
+#include <math.h>
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "filter/atrous.h"
+#include "fovea/math.h"
+
+void fv_atrous_opts_default(fv_atrous_opts *o)
+{
+    o->iterations = 5;
+    o->sigma_color = 0.8f;
+    o->sigma_normal = 0.3f;
+    o->sigma_position = 0.0f;
+}
+
+static const float k_b3[5] = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
+
+static bool has_surface(const float *normal, size_t i)
+{
+    return !normal || normal[3 * i] != 0.0f || normal[3 * i + 1] != 0.0f || normal[3 * i + 2] != 0.0f;
+}
+
+fv_status fv_atrous_filter(float *rgb, const float *normal, const float *position, int w, int h, const fv_atrous_opts *o, fv_error *err)
+{
+    fv_atrous_opts def;
+    if (!o) {
+        fv_atrous_opts_default(&def);
+        o = &def;
+    }
+    if (w < 1 || h < 1) return fv_error_set(err, FV_ERR_INVALID, "A-Trous filter: image size %dx%d", w, h);
+    if (o->iterations < 0 || o->iterations > 12 || !(o->sigma_color > 0.0f) || !(o->sigma_normal > 0.0f) || !(o->sigma_position >= 0.0f))
+        return fv_error_set(err, FV_ERR_INVALID, "A-Trous filter: iterations %d must be in [0, 12] and the sigmas positive", o->iterations);
+    size_t n = (size_t)w * h;
+    float *tmp = fv_alloc_array(n, 3 * sizeof(float));
+    if (!tmp) return fv_error_set(err, FV_ERR_NOMEM, "out of memory filtering a %dx%d image", w, h);
+    /* The colour scale: the mean luminance of the surface pixels. */
+    double lum = 0.0;
+    long count = 0;
+    for (size_t i = 0; i < n; i++)
+        if (has_surface(normal, i)) {
+            float l = 0.2126f * rgb[3 * i] + 0.7152f * rgb[3 * i + 1] + 0.0722f * rgb[3 * i + 2];
+            if (isfinite(l)) lum += l, count++;
+        }
+    float scale = count > 0 && lum > 0.0 ? (float)(lum / count) : 1.0f;
+    float *src = rgb, *dst = tmp;
+    const float inv_n2 = 1.0f / (o->sigma_normal * o->sigma_normal);
+    const float inv_x2 = o->sigma_position > 0.0f ? 1.0f / (o->sigma_position * o->sigma_position) : 0.0f;
+    for (int it = 0; it < o->iterations; it++) {
+        int step = 1 << it;
+        float sc = o->sigma_color * scale / (float)(1 << it); /* halves every iteration */
+        float inv_c2 = 1.0f / (sc * sc);
+        #pragma omp parallel for schedule(static)
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                size_t p = (size_t)y * w + x;
+                const float *cp = &src[3 * p];
+                if (!has_surface(normal, p)) {
+                    memcpy(&dst[3 * p], cp, 3 * sizeof(float));
+                    continue;
+                }
+                float sum[3] = {0, 0, 0}, wsum = 0.0f;
+                for (int j = -2; j <= 2; j++) {
+                    int yy = y + j * step;
+                    if (yy < 0 || yy >= h) continue;
+                    for (int i = -2; i <= 2; i++) {
+                        int xx = x + i * step;
+                        if (xx < 0 || xx >= w) continue;
+                        size_t q = (size_t)yy * w + xx;
+                        if (!has_surface(normal, q)) continue;
+                        const float *cq = &src[3 * q];
+                        float dc = (cp[0] - cq[0]) * (cp[0] - cq[0]) + (cp[1] - cq[1]) * (cp[1] - cq[1]) + (cp[2] - cq[2]) * (cp[2] - cq[2]);
+                        float e = dc * inv_c2;
+                        if (normal) {
+                            const float *np = &normal[3 * p], *nq = &normal[3 * q];
+                            e += ((np[0] - nq[0]) * (np[0] - nq[0]) + (np[1] - nq[1]) * (np[1] - nq[1]) + (np[2] - nq[2]) * (np[2] - nq[2])) * inv_n2;
+                        }
+                        if (position && inv_x2 > 0.0f) {
+                            const float *xp = &position[3 * p], *xq = &position[3 * q];
+                            e += ((xp[0] - xq[0]) * (xp[0] - xq[0]) + (xp[1] - xq[1]) * (xp[1] - xq[1]) + (xp[2] - xq[2]) * (xp[2] - xq[2])) * inv_x2;
+                        }
+                        float wt = k_b3[i + 2] * k_b3[j + 2] * expf(-e);
+                        if (!(wt > 0.0f) || !fv_is_finite3(fv_v3(cq[0], cq[1], cq[2]))) continue;
+                        sum[0] += wt * cq[0];
+                        sum[1] += wt * cq[1];
+                        sum[2] += wt * cq[2];
+                        wsum += wt;
+                    }
+                }
+                for (int c = 0; c < 3; c++) dst[3 * p + c] = wsum > 0.0f ? sum[c] / wsum : cp[c];
+            }
+        float *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != rgb) memcpy(rgb, src, n * 3 * sizeof(float));
+    free(tmp);
+    return FV_OK;
+}

@@ -1,0 +1,30 @@
+/* fovea — the edge-avoiding À-Trous wavelet filter (Dammertz, Sewtz, Hanika, Lensch, HPG 2010),
+ * shared by every technique that post-filters a noisy estimate (Foveated Photon Mapping, Sec. 4.1,
+ * filters pm, pm-t and fpm with it; the Visual-Polar denoiser can reuse it).
+ *
+ * Iteration i convolves with the 5x5 B3-spline kernel (1/16, 1/4, 3/8, 1/4, 1/16)^2 whose taps are
+ * spread 2^i pixels apart ("with holes"), each tap weighted by edge-stopping functions of the colour,
+ * normal and position differences; the colour sigma halves at every iteration so that the coarse
+ * passes smooth less across colour edges. Pixels without a surface (zero normal) are neither
+ * filtered nor used.
+ */
+#ifndef FV_FILTER_ATROUS_H
+#define FV_FILTER_ATROUS_H
+
+#include "fovea/status.h"
+
+typedef struct fv_atrous_opts {
+    int iterations;        /* 5: taps 1, 2, 4, 8, 16 pixels apart (an 81-pixel footprint) */
+    float sigma_color;     /* relative to the image's mean luminance, so exposure does not matter */
+    float sigma_normal;    /* on |n_p - n_q|^2 of unit normals */
+    float sigma_position;  /* in scene units; 0 turns the position term off */
+} fv_atrous_opts;
+
+void fv_atrous_opts_default(fv_atrous_opts *o);
+
+/* Filters rgb (w*h*3 linear floats) in place, guided by normal and position (3 floats per pixel
+ * each, either may be NULL). Deterministic and independent of the thread count. */
+fv_status fv_atrous_filter(float *rgb, const float *normal, const float *position, int w, int h, const fv_atrous_opts *o,
+                           fv_error *err);
+
+#endif
