@@ -61,6 +61,11 @@ typedef struct fv_camera_path {
     int count;
 } fv_camera_path;
 
+/* Reads a camera path from a CSV trace (docs/gaze.md): lines "time,px,py,pz,lx,ly,lz", optionally
+ * followed by "ux,uy,uz" and then "fov"; missing up and fov come from base. *keys is the
+ * caller's to free. Errors name the file and line. */
+fv_status fv_camera_path_load_csv(const char *path, const fv_camera *base, fv_camera_key **keys, int *count, fv_error *err);
+
 /* Camera at time t along path (count >= 1); width/height are taken from base. */
 void fv_camera_path_eval(const fv_camera_path *path, double t, const fv_camera *base, fv_camera *out);
 

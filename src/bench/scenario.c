@@ -292,7 +292,14 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
     } else if ((st = fv_gaze_path_create_fixed((fv_gaze){0.5f, 0.5f}, &s->gaze, err)) != FV_OK) {
         return st;
     }
-    if ((o = cJSON_GetObjectItemCaseSensitive(root, "camera_path")) && (st = parse_camera_path(o, file, s, err))) return st;
+    if ((o = cJSON_GetObjectItemCaseSensitive(root, "camera_path")) && cJSON_IsString(o)) {
+        char full[8192];
+        snprintf(full, sizeof full, "%s%s%s", o->valuestring[0] == '/' ? "" : dir, o->valuestring[0] == '/' ? "" : "/", o->valuestring);
+        fv_camera base = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 45.0f, s->width, s->height};
+        if ((st = fv_camera_path_load_csv(full, &base, &s->cam_keys, &s->ncam_keys, err)) != FV_OK) return st;
+    } else if (o && (st = parse_camera_path(o, file, s, err))) {
+        return st;
+    }
     if ((st = parse_method(cJSON_GetObjectItemCaseSensitive(root, "reference"), file, "reference", false, &s->reference, err)))
         return st;
     snprintf(s->reference.label, sizeof s->reference.label, "reference");

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "core/csv.h"
 #include "fovea/gaze.h"
 
 struct fv_gaze_path {
@@ -92,28 +93,6 @@ void fv_gaze_path_eval(const fv_gaze_path *p, double t, fv_gaze *left, fv_gaze *
     if (right) *right = lerp_gaze(a->right, b->right, u);
 }
 
-/* Splits a CSV line into up to `max` numbers; returns the count, or -1 when a field is not a
- * number. */
-static int parse_numbers(char *line, double *v, int max)
-{
-    int n = 0;
-    char *s = line;
-    for (;;) {
-        while (*s == ' ' || *s == '\t') s++;
-        if (*s == '\0' || *s == '\n' || *s == '\r') return n;
-        if (n == max) return -1;
-        char *end;
-        errno = 0;
-        v[n] = strtod(s, &end);
-        if (end == s) return -1;
-        n++;
-        s = end;
-        while (*s == ' ' || *s == '\t' || *s == '\r' || *s == '\n') s++;
-        if (*s == ',') s++;
-        else if (*s != '\0') return -1;
-    }
-}
-
 fv_status fv_gaze_path_load_csv(const char *path, fv_gaze_path **out, fv_error *err)
 {
     FILE *f = fopen(path, "r");
@@ -126,17 +105,16 @@ fv_status fv_gaze_path_load_csv(const char *path, fv_gaze_path **out, fv_error *
     fv_status st = FV_OK;
     while (getline(&line, &linecap, f) >= 0) {
         lineno++;
-        char *s = line;
-        while (*s == ' ' || *s == '\t') s++;
-        if (*s == '#' || *s == '\n' || *s == '\r' || *s == '\0') continue;
         double v[6];
-        int c = parse_numbers(s, v, 5);
-        if (c < 0 && !seen_data_or_header && !strpbrk(s, "0123456789")) { /* a header such as "time,x,y" */
+        int c = 0;
+        fv_csv_kind kind = fv_csv_line(line, !seen_data_or_header, v, 5, &c);
+        if (kind == FV_CSV_SKIP) continue;
+        if (kind == FV_CSV_HEADER) {
             seen_data_or_header = true;
             continue;
         }
         seen_data_or_header = true;
-        if (c != 3 && c != 5) {
+        if (kind == FV_CSV_BAD || (c != 3 && c != 5)) {
             st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: expected 'time,x,y' or 'time,xl,yl,xr,yr' numbers", path, lineno);
             goto done;
         }

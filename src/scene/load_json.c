@@ -326,7 +326,19 @@ fv_status fv_load_json(const char *path, fv_scene *scene, const fv_log *log, fv_
         fv_camera cam = {k.pos, k.look, k.up, k.fov_y, 512, 512};
         fv_scene_set_camera(scene, &cam);
     }
-    if ((it = cJSON_GetObjectItemCaseSensitive(root, "camera_path"))) {
+    if ((it = cJSON_GetObjectItemCaseSensitive(root, "camera_path")) && cJSON_IsString(it)) {
+        /* A recorded trace next to the scene file. */
+        char full[8192];
+        snprintf(full, sizeof full, "%s%s%s", it->valuestring[0] == '/' ? "" : c.dir, it->valuestring[0] == '/' ? "" : "/", it->valuestring);
+        fv_camera base;
+        fv_scene_camera(scene, 0.0, 512, 512, &base);
+        fv_camera_key *k = NULL;
+        int n = 0;
+        if ((st = fv_camera_path_load_csv(full, &base, &k, &n, err)) == FV_OK && (st = fv_scene_set_camera_path(scene, k, n, err)) != FV_OK)
+            fv_error_prefix(err, "%s: ", path);
+        free(k);
+        if (st != FV_OK) goto done;
+    } else if (it) {
         int n = cJSON_GetArraySize(it);
         if (!cJSON_IsArray(it) || n < 1) {
             st = fv_error_set(err, FV_ERR_INVALID, "%s: camera_path: expected a non-empty array", path);

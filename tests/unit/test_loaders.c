@@ -178,11 +178,43 @@ static void test_json_errors(void **st)
     expect_bad(DATA("bad_gaze.json"), FV_ERR_INVALID, "gaze");
 }
 
+/* Camera traces: CSV keys (with a header and a comment), interpolated; a JSON scene may name one;
+ * a short line is an error with its line number. */
+static void test_camera_trace(void **st)
+{
+    (void)st;
+    fv_camera base = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 30.0f, 64, 48};
+    fv_camera_key *k = NULL;
+    int n = 0;
+    fv_error err;
+    assert_int_equal(fv_camera_path_load_csv(DATA("camera.csv"), &base, &k, &n, &err), FV_OK);
+    assert_int_equal(n, 2);
+    fv_camera_path p = {k, n};
+    fv_camera c;
+    fv_camera_path_eval(&p, 1.0, &base, &c);
+    assert_float_equal(c.pos.x, 1.0f, 1e-6f);
+    assert_float_equal(c.fov_y, 47.5f, 1e-5f);
+    assert_int_equal(c.width, 64);
+    free(k);
+    k = NULL;
+    assert_int_equal(fv_camera_path_load_csv(DATA("camera_bad.csv"), &base, &k, &n, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "camera_bad.csv:2:"));
+    assert_null(k);
+    assert_int_equal(fv_camera_path_load_csv(DATA("nope.csv"), &base, &k, &n, &err), FV_ERR_IO);
+    fv_scene *s;
+    assert_int_equal(fv_scene_load(DATA("scene_trace.json"), NULL, &s, &err), FV_OK);
+    assert_true(fv_scene_has_camera_path(s));
+    fv_scene_camera(s, 2.0, 32, 32, &c);
+    assert_float_equal(c.pos.x, 2.0f, 1e-6f);
+    fv_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_builtin_and_unknown), cmocka_unit_test(test_obj_materials), cmocka_unit_test(test_gltf_and_ply),
         cmocka_unit_test(test_nan_and_empty),       cmocka_unit_test(test_json_scene),    cmocka_unit_test(test_json_errors),
+        cmocka_unit_test(test_camera_trace),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -32,6 +32,7 @@ static void help(void)
            "  --point-light x,y,z,r,g,b  add a point light (intensity W/sr), repeatable\n"
            "  --gaze X,Y            gaze point in normalised screen coordinates [the scene's gaze, or 0.5,0.5]\n"
            "  --gaze-trace FILE     gaze over time from a CSV trace (docs/gaze.md)\n"
+           "  --camera-trace FILE   camera over time from a CSV trace (docs/gaze.md)\n"
            "  --stereo SEP          render a stereo pair with eye separation SEP: OUT_left.ext, OUT_right.ext\n"
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
            "  --quiet               no progress bar, warnings or per-frame lines\n"
@@ -61,7 +62,7 @@ typedef struct render_opts {
     double fps, time0, exposure, stereo;
     unsigned long long seed;
     bool quiet, has_pos, has_look, has_up, has_fov, has_gaze;
-    const char *gaze_trace;
+    const char *gaze_trace, *camera_trace;
     float pos[3], look[3], up[3], fov, gaze[2];
     int nlights;
     float lights[MAX_LIGHTS][6];
@@ -70,12 +71,12 @@ typedef struct render_opts {
 static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
     enum { O_METHOD = 256, O_SPP, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
-           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_STEREO, O_PARAM, O_QUIET, O_HELP };
+           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_HELP };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
         {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
-        {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE},
+        {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE},
         {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"help", 0, 0, O_HELP},
         {0, 0, 0, 0}};
     const char *cmd = "render";
@@ -151,6 +152,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             o->has_gaze = true;
             break;
         case O_TRACE: o->gaze_trace = optarg; break;
+        case O_CTRACE: o->camera_trace = optarg; break;
         case O_STEREO:
             if (!fv_cli_parse_float(optarg, &d) || d <= 0) return fv_cli_usage_error(cmd, "--stereo %s: expected a positive eye separation", optarg);
             o->stereo = d;
@@ -191,6 +193,7 @@ int fv_cmd_render(int argc, char **argv)
     fv_technique *tech = NULL;
     fv_film *film[2] = {NULL, NULL};
     fv_gaze_path *trace = NULL;
+    fv_camera_path ctrace = {NULL, 0};
     int rc = FV_EXIT_OK;
     fv_status s;
 
@@ -258,6 +261,14 @@ int fv_cmd_render(int argc, char **argv)
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
     }
+    if (o.camera_trace) {
+        fv_camera base;
+        fv_scene_camera(scene, o.time0, o.width, o.height, &base);
+        if ((s = fv_camera_path_load_csv(o.camera_trace, &base, &ctrace.keys, &ctrace.count, &err)) != FV_OK) {
+            rc = fv_cli_fail(cmd, s, err.msg);
+            goto done;
+        }
+    }
     const fv_gaze_path *gpath = trace ? trace : o.has_gaze ? NULL : fv_scene_gaze_path(scene);
     fv_eye_model eye;
     fv_eye_model_default(o.width, o.height, &eye);
@@ -282,6 +293,7 @@ int fv_cmd_render(int argc, char **argv)
         if ((s = fv_scene_set_time(scene, t, &err)) != FV_OK) break;
         fv_camera c;
         fv_scene_camera(scene, t, o.width, o.height, &c);
+        if (ctrace.keys) fv_camera_path_eval(&ctrace, t, &c, &c);
         if (o.has_pos) c.pos = fv_v3(o.pos[0], o.pos[1], o.pos[2]);
         if (o.has_look) c.look = fv_v3(o.look[0], o.look[1], o.look[2]);
         if (o.has_up) c.up = fv_v3(o.up[0], o.up[1], o.up[2]);
@@ -342,6 +354,7 @@ int fv_cmd_render(int argc, char **argv)
     if (s != FV_OK) rc = fv_cli_fail(cmd, s, err.msg);
 done:
     fv_gaze_path_destroy(trace);
+    free(ctrace.keys);
     fv_film_destroy(film[0]);
     fv_film_destroy(film[1]);
     fv_technique_destroy(tech);
