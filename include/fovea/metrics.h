@@ -54,7 +54,8 @@ typedef struct fv_temporal fv_temporal;
 fv_status fv_temporal_create(int w, int h, const fv_metric_opts *opts, fv_temporal **out, fv_error *err);
 /* Adds the next frame; each pair (previous, this) is judged with this frame's labels (may be NULL). */
 fv_status fv_temporal_push(fv_temporal *t, const float *rgb, const uint8_t *labels, fv_error *err);
-/* MSE' and E' of a region: the mean over consecutive pairs; 0 with fewer than two frames. */
+/* MSE' and E' of a region: the mean over the consecutive pairs in which the region has pixels;
+ * 0 with fewer than two frames, NaN when the region was empty in every pair. */
 void fv_temporal_result(const fv_temporal *t, fv_region region, double *mse, double *e);
 int fv_temporal_frames(const fv_temporal *t);
 void fv_temporal_destroy(fv_temporal *t);

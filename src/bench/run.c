@@ -64,7 +64,8 @@ static uint64_t fnv1a(const char *s)
 }
 
 /* Everything a reference frame depends on, as text: its hash names the cache file. A scene file's
- * size and modification time stand in for its contents. */
+ * size and modification time stand in for its contents. The gaze is not part of it: a reference
+ * is a non-foveated rendering, shared by every gaze path of a scene. */
 static void reference_key(const fv_scenario *sc, const frame_setup *f, int index, char *buf, size_t n)
 {
     size_t len = 0;
@@ -82,7 +83,6 @@ static void reference_key(const fv_scenario *sc, const frame_setup *f, int index
     const fv_camera *c = &f->cam;
     KEY("|cam=%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", c->pos.x, c->pos.y, c->pos.z, c->look.x, c->look.y, c->look.z,
         c->up.x, c->up.y, c->up.z, c->fov_y);
-    KEY("|gaze=%.9g,%.9g", f->gaze.x, f->gaze.y);
 #undef KEY
 }
 

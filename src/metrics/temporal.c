@@ -1,7 +1,9 @@
 /* fovea — temporal error over a frame sequence: MSE' (Foveated Photon Mapping, Eq. 9) and E'
  * (Foveated Instant Radiosity, Eq. 4) are the means over the n - 1 consecutive pairs of the pair's
  * MSE and E. Each pair is split into regions with the later frame's labels, since the gaze may
- * move. Only the previous frame is kept.
+ * move; a region's mean runs over the pairs in which it has pixels, so a pair where the moving
+ * gaze leaves a region empty does not count as a pair without change. Only the previous frame
+ * is kept.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -15,6 +17,7 @@ struct fv_temporal {
     float *prev, *cur;
     int frames;
     double mse_sum[FV_REGION_COUNT], e_sum[FV_REGION_COUNT];
+    int pairs[FV_REGION_COUNT]; /* pairs in which the region had pixels */
 };
 
 fv_status fv_temporal_create(int w, int h, const fv_metric_opts *opts, fv_temporal **out, fv_error *err)
@@ -46,7 +49,7 @@ void fv_temporal_destroy(fv_temporal *t)
 
 fv_status fv_temporal_push(fv_temporal *t, const float *rgb, const uint8_t *labels, fv_error *err)
 {
-    (void)err;
+    if (!rgb) return fv_error_set(err, FV_ERR_INVALID, "temporal metric: frame %d has no pixels", t->frames);
     size_t n = (size_t)t->w * t->h;
     fv_metrics_prepare(rgb, n, &t->opts, t->cur);
     if (t->frames > 0) {
@@ -70,6 +73,7 @@ fv_status fv_temporal_push(fv_temporal *t, const float *rgb, const uint8_t *labe
             if (cnt[r] > 0) {
                 t->mse_sum[r] += se[r] / cnt[r];
                 t->e_sum[r] += ae[r] / cnt[r];
+                t->pairs[r]++;
             }
     }
     float *sw = t->prev;
@@ -81,11 +85,13 @@ fv_status fv_temporal_push(fv_temporal *t, const float *rgb, const uint8_t *labe
 
 void fv_temporal_result(const fv_temporal *t, fv_region region, double *mse, double *e)
 {
-    int pairs = t->frames - 1;
     double m = 0.0, a = 0.0;
-    if (pairs > 0 && (unsigned)region < FV_REGION_COUNT) {
-        m = t->mse_sum[region] / pairs;
-        a = t->e_sum[region] / pairs;
+    if ((unsigned)region >= FV_REGION_COUNT) {
+        m = a = NAN;
+    } else if (t->frames > 1) {
+        int pairs = t->pairs[region];
+        m = pairs > 0 ? t->mse_sum[region] / pairs : NAN;
+        a = pairs > 0 ? t->e_sum[region] / pairs : NAN;
     }
     if (mse) *mse = m;
     if (e) *e = a;

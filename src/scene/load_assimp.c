@@ -7,6 +7,7 @@
  * material's constant colour is used); lines and points are skipped.
  */
 #include <assimp/cimport.h>
+#include <assimp/version.h>
 #include <assimp/ObjMaterial.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -15,6 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include "core/alloc.h"
 #include "scene/load_impl.h"
 
@@ -221,6 +223,20 @@ static bool find_node(const struct aiNode *node, const char *name, const fv_xfor
     return false;
 }
 
+/* aiCamera.mHorizontalFOV means different things per importer (assimp issues 2256, 4435, 5691):
+ * half the horizontal angle as documented (FBX and most others), the full angle for Collada, and
+ * for glTF the full angle computed from yfov, as yfov * aspect before assimp 5.3 and exactly
+ * after. We invert what the importer did to get back the vertical angle. */
+static float vertical_fov(const char *path, float h, float aspect)
+{
+    const char *dot = strrchr(path, '.');
+    bool gltf = dot && (strcasecmp(dot, ".gltf") == 0 || strcasecmp(dot, ".glb") == 0);
+    bool dae = dot && strcasecmp(dot, ".dae") == 0;
+    if (gltf && aiGetVersionMajor() == 5 && aiGetVersionMinor() < 3) return h / aspect;
+    if (gltf || dae) return 2.0f * atanf(tanf(0.5f * h) / aspect);
+    return 2.0f * atanf(tanf(h) / aspect);
+}
+
 static void import_camera_and_lights(import_ctx *c, const fv_xform *base, fv_error *err)
 {
     const struct aiScene *ai = c->ai;
@@ -231,9 +247,8 @@ static void import_camera_and_lights(import_ctx *c, const fv_xform *base, fv_err
         fv_vec3 p = fv_xform_point(&x, fv_v3(cam->mPosition.x, cam->mPosition.y, cam->mPosition.z));
         fv_vec3 dir = fv_xform_vector(&x, fv_v3(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z));
         fv_vec3 up = fv_xform_vector(&x, fv_v3(cam->mUp.x, cam->mUp.y, cam->mUp.z));
-        /* assimp gives half the horizontal angle; we keep a vertical fov for the camera's aspect. */
         float aspect = cam->mAspect > 0.0f ? cam->mAspect : 1.0f;
-        float fov_y = 2.0f * atanf(tanf(cam->mHorizontalFOV) / aspect);
+        float fov_y = vertical_fov(c->path, cam->mHorizontalFOV, aspect);
         fv_camera fc = {p, fv_add(p, fv_normalize(dir)), up, fv_degrees(fov_y), 512, (int)lroundf(512 / aspect)};
         fv_camera_basis b;
         fv_error e2;

@@ -74,8 +74,8 @@ static fv_status find_material(const cJSON *o, const json_ctx *c, const char *wh
     return FV_OK;
 }
 
-/* "transform" or one animation key: translate, rotate_deg (about x, then y, then z), scale
- * (a number or three). */
+/* "transform" or one animation key: translate, rotate_deg (about x, then y, then z) or
+ * rotate_quat [x, y, z, w] (normalised here), scale (a number or three). */
 static fv_status parse_trs(const cJSON *o, const json_ctx *c, const char *where, const char *const *keys, fv_vec3 *t, fv_quat *q,
                            fv_vec3 *s, fv_error *err)
 {
@@ -94,6 +94,16 @@ static fv_status parse_trs(const cJSON *o, const json_ctx *c, const char *where,
         return st;
     }
     *q = fv_quat_euler_deg(rot);
+    if (cJSON_GetObjectItemCaseSensitive(o, "rotate_quat")) {
+        if (cJSON_GetObjectItemCaseSensitive(o, "rotate_deg"))
+            return fv_error_set(err, FV_ERR_INVALID, "%s: %s: give rotate_deg or rotate_quat, not both", c->file, where);
+        double v[4];
+        if ((st = fv_json_numbers(o, "rotate_quat", 4, -BIG, BIG, c->file, where, v, err))) return st;
+        double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]);
+        if (!(len > 1e-6) || !isfinite(len))
+            return fv_error_set(err, FV_ERR_INVALID, "%s: %s.rotate_quat: not a rotation (length %g)", c->file, where, len);
+        *q = (fv_quat){(float)(v[0] / len), (float)(v[1] / len), (float)(v[2] / len), (float)(v[3] / len)};
+    }
     return FV_OK;
 }
 
@@ -109,13 +119,13 @@ static fv_status parse_shape(const cJSON *o, const json_ctx *c, const char *wher
         fv_vec3 p[4];
         int i = 0;
         for (const cJSON *e = it->child; e; e = e->next, i++) {
-            double v[3];
-            cJSON *wrap = cJSON_CreateObject();
-            cJSON_AddItemReferenceToObject(wrap, "corner", (cJSON *)e);
-            st = fv_json_numbers(wrap, "corner", 3, -BIG, BIG, c->file, w2, v, err);
-            cJSON_Delete(wrap);
-            if (st) return st;
-            p[i] = fv_v3((float)v[0], (float)v[1], (float)v[2]);
+            float v[3];
+            int k = 0;
+            for (const cJSON *n = cJSON_IsArray(e) ? e->child : NULL; n && k < 4; n = n->next, k++)
+                if (k < 3) v[k] = cJSON_IsNumber(n) && fabs(n->valuedouble) <= BIG ? (float)n->valuedouble : NAN;
+            if (k != 3 || !isfinite(v[0]) || !isfinite(v[1]) || !isfinite(v[2]))
+                return fv_error_set(err, FV_ERR_INVALID, "%s: %s[%d]: expected 3 finite numbers", c->file, w2, i);
+            p[i] = fv_v3(v[0], v[1], v[2]);
         }
         fv_mesh_quad(mb, p[0], p[1], p[2], p[3], mat);
         return FV_OK;
@@ -147,7 +157,7 @@ static fv_status parse_shape(const cJSON *o, const json_ctx *c, const char *wher
 
 static fv_status parse_animation(const cJSON *arr, const json_ctx *c, const char *where, int first, int count, fv_error *err)
 {
-    static const char *const keys[] = {"time", "translate", "rotate_deg", "scale", NULL};
+    static const char *const keys[] = {"time", "translate", "rotate_deg", "rotate_quat", "scale", NULL};
     int n = cJSON_GetArraySize(arr);
     if (!cJSON_IsArray(arr) || n < 1 || n > 100000)
         return fv_error_set(err, FV_ERR_INVALID, "%s: %s.animation: expected an array of keys", c->file, where);
@@ -173,7 +183,7 @@ static fv_status parse_animation(const cJSON *arr, const json_ctx *c, const char
 static fv_status parse_object(const cJSON *o, const json_ctx *c, int index, fv_error *err)
 {
     static const char *const keys[] = {"name", "mesh", "quad", "box", "sphere", "material", "transform", "animation", NULL};
-    static const char *const tkeys[] = {"translate", "rotate_deg", "scale", NULL};
+    static const char *const tkeys[] = {"translate", "rotate_deg", "rotate_quat", "scale", NULL};
     char where[64];
     snprintf(where, sizeof where, "objects[%d]", index);
     fv_status st = fv_json_check_keys(o, keys, c->file, where, err);

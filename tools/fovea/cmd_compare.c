@@ -32,10 +32,31 @@ static fv_status load(const char *path, fv_image *img, fv_error *err)
     return s;
 }
 
+/* An empty region has NaN values: the table shows "-" rather than "nan". */
 static void print_value(double v)
 {
-    if (isinf(v)) printf(" %10s", "inf");
+    if (isnan(v)) printf(" %10s", "-");
+    else if (isinf(v)) printf(" %10s", v > 0 ? "inf" : "-inf");
     else printf(" %10.4g", v);
+}
+
+/* JSON has no inf or NaN: an empty region and an infinite PSNR are null. */
+static void json_number(double v)
+{
+    if (isfinite(v)) printf("%.9g", v);
+    else printf("null");
+}
+
+/* File names go into JSON strings: quotes, backslashes and control bytes must be escaped. */
+static void json_string(const char *s)
+{
+    putchar('"');
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\') printf("\\%c", *p);
+        else if (*p < 0x20) printf("\\u%04x", *p);
+        else putchar(*p);
+    }
+    putchar('"');
 }
 
 int fv_cmd_compare(int argc, char **argv)
@@ -176,16 +197,26 @@ int fv_cmd_compare(int argc, char **argv)
         }
     }
     if (json) {
-        printf("{\n  \"ref\": \"%s\",\n  \"test\": \"%s\",\n  \"size\": [%d, %d],\n  \"gaze\": [%g, %g],\n", ref_path, test_path, w, h,
-               g.x, g.y);
+        printf("{\n  \"ref\": ");
+        json_string(ref_path);
+        printf(",\n  \"test\": ");
+        json_string(test_path);
+        printf(",\n  \"size\": [%d, %d],\n  \"gaze\": [%g, %g],\n", w, h, g.x, g.y);
         printf("  \"fovea_radius_px\": %.6g,\n  \"transition_radius_px\": %.6g,\n  \"regions\": {\n", fv_eye_fovea_radius_px(&eye),
                fv_eye_transition_radius_px(&eye));
         for (int r = 0; r < FV_REGION_COUNT; r++) {
             const fv_metric_values *v = &rep.region[r];
-            printf("    \"%s\": {\"pixels\": %lld, \"mse\": %.9g, \"psnr\": ", fv_region_name((fv_region)r), v->pixels, v->mse);
-            if (isfinite(v->psnr)) printf("%.9g", v->psnr);
-            else printf("null");
-            printf(", \"e\": %.9g, \"ssim\": %.9g, \"flip\": %.9g}%s\n", v->e, v->ssim, v->flip, r + 1 < FV_REGION_COUNT ? "," : "");
+            printf("    \"%s\": {\"pixels\": %lld, \"mse\": ", fv_region_name((fv_region)r), v->pixels);
+            json_number(v->mse);
+            printf(", \"psnr\": ");
+            json_number(v->psnr);
+            printf(", \"e\": ");
+            json_number(v->e);
+            printf(", \"ssim\": ");
+            json_number(v->ssim);
+            printf(", \"flip\": ");
+            json_number(v->flip);
+            printf("}%s\n", r + 1 < FV_REGION_COUNT ? "," : "");
         }
         printf("  }\n}\n");
     } else {
