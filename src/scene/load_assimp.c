@@ -211,27 +211,35 @@ static fv_status walk(import_ctx *c, const struct aiNode *node, const fv_xform *
 }
 
 /* The world transform of the node called `name` (identity when there is none). */
-static bool find_node(const struct aiNode *node, const char *name, const fv_xform *parent, fv_xform *out, int depth)
+static const struct aiNode *find_node(const struct aiNode *node, const char *name, const fv_xform *parent, fv_xform *out,
+                                      int depth)
 {
     fv_xform local = ai_to_xform(&node->mTransformation), x = xform_mul(parent, &local);
     if (strcmp(node->mName.data, name) == 0) {
         *out = x;
-        return true;
+        return node;
     }
-    for (unsigned i = 0; i < node->mNumChildren && depth < 256; i++)
-        if (find_node(node->mChildren[i], name, &x, out, depth + 1)) return true;
-    return false;
+    for (unsigned i = 0; i < node->mNumChildren && depth < 256; i++) {
+        const struct aiNode *found = find_node(node->mChildren[i], name, &x, out, depth + 1);
+        if (found) return found;
+    }
+    return NULL;
 }
 
 /* aiCamera.mHorizontalFOV means different things per importer (assimp issues 2256, 4435, 5691):
  * half the horizontal angle as documented (FBX and most others), the full angle for Collada, and
  * for glTF the full angle computed from yfov, as yfov * aspect before assimp 5.3 and exactly
  * after. We invert what the importer did to get back the vertical angle. */
+static bool is_gltf(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    return dot && (strcasecmp(dot, ".gltf") == 0 || strcasecmp(dot, ".glb") == 0);
+}
+
 static float vertical_fov(const char *path, float h, float aspect)
 {
     const char *dot = strrchr(path, '.');
-    bool gltf = dot && (strcasecmp(dot, ".gltf") == 0 || strcasecmp(dot, ".glb") == 0);
-    bool dae = dot && strcasecmp(dot, ".dae") == 0;
+    bool gltf = is_gltf(path), dae = dot && strcasecmp(dot, ".dae") == 0;
     if (gltf && aiGetVersionMajor() == 5 && aiGetVersionMinor() < 3) return h / aspect;
     if (gltf || dae) return 2.0f * atanf(tanf(0.5f * h) / aspect);
     return 2.0f * atanf(tanf(h) / aspect);
@@ -243,8 +251,13 @@ static void import_camera_and_lights(import_ctx *c, const fv_xform *base, fv_err
     if (c->opts->import_camera && ai->mNumCameras > 0) {
         const struct aiCamera *cam = ai->mCameras[0];
         fv_xform x = *base;
-        find_node(ai->mRootNode, cam->mName.data, base, &x, 0);
-        fv_vec3 p = fv_xform_point(&x, fv_v3(cam->mPosition.x, cam->mPosition.y, cam->mPosition.z));
+        const struct aiNode *node = find_node(ai->mRootNode, cam->mName.data, base, &x, 0);
+        fv_vec3 local = fv_v3(cam->mPosition.x, cam->mPosition.y, cam->mPosition.z);
+        /* assimp 5.2's glTF importer copies the node's translation into the camera, which is
+         * relative to that node: the translation would count twice. */
+        const struct aiMatrix4x4 *nt = node ? &node->mTransformation : NULL;
+        if (nt && is_gltf(c->path) && local.x == nt->a4 && local.y == nt->b4 && local.z == nt->c4) local = fv_v3s(0.0f);
+        fv_vec3 p = fv_xform_point(&x, local);
         fv_vec3 dir = fv_xform_vector(&x, fv_v3(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z));
         fv_vec3 up = fv_xform_vector(&x, fv_v3(cam->mUp.x, cam->mUp.y, cam->mUp.z));
         float aspect = cam->mAspect > 0.0f ? cam->mAspect : 1.0f;
@@ -288,8 +301,14 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, const fv_import_opts
         path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType, NULL, props);
     aiReleasePropertyStore(props);
     if (!ai) {
+        /* Our messages are one line; some of assimp's are not. */
         const char *why = aiGetErrorString();
-        return fv_error_set(err, FV_ERR_INVALID, "scene '%s': %s", path, why && why[0] ? why : "assimp could not read it");
+        char line[256];
+        snprintf(line, sizeof line, "%s", why && why[0] ? why : "assimp could not read it");
+        for (char *ch = line; *ch; ch++)
+            if (*ch == '\n' || *ch == '\r' || *ch == '\t') *ch = ' ';
+        for (size_t n = strlen(line); n > 0 && line[n - 1] == ' '; n--) line[n - 1] = '\0';
+        return fv_error_set(err, FV_ERR_INVALID, "scene '%s': %s", path, line);
     }
     import_ctx c;
     memset(&c, 0, sizeof c);

@@ -5,6 +5,9 @@
  * deep in objects, ranges, truncated JSON with its line, bad quads, non-increasing times, bad
  * glTF, directories and unknown file types. Every failure must leave *out NULL and give one line.
  */
+#ifndef _DEFAULT_SOURCE
+#define _DEFAULT_SOURCE /* mkstemps, fdopen */
+#endif
 #include <dirent.h>
 #include <math.h>
 #include <setjmp.h>
@@ -17,6 +20,7 @@
 #include <unistd.h>
 #include <cmocka.h>
 #include "fovea/fovea.h"
+#include "scene/scene_impl.h"
 
 #define DATA(f) FOVEA_TEST_DATA "/" f
 #define EMBREE_CORNELL "/usr/share/doc/embree3/models/cornell_box.obj"
@@ -130,6 +134,18 @@ static void test_gltf_pbr(void **state)
 
     /* Two delta lights and the glowing quad's two triangles. */
     assert_int_equal(fv_scene_light_count(s), 4);
+    assert_int_equal(s->ndelta, 2);
+    const fv_light_desc *l = &s->delta[0];
+    assert_int_equal(l->type, FV_LIGHT_POINT);
+    assert_vec3(l->pos, 1, 4, 11, 1e-5f);
+    assert_vec3(l->intensity, 8, 4, 2, 1e-5f);
+    l = &s->delta[1];
+    assert_int_equal(l->type, FV_LIGHT_SPOT);
+    assert_vec3(l->pos, 3, 6, 11, 1e-5f);
+    assert_vec3(fv_normalize(l->dir), 0, -1, 0, 1e-5f);
+    assert_vec3(l->intensity, 2, 2, 2, 1e-6f);
+    assert_float_equal(l->inner_deg, 11.4592f, 1e-3f); /* 0.2 rad */
+    assert_float_equal(l->outer_deg, 22.9183f, 1e-3f); /* 0.4 rad */
 
     fv_camera cam;
     fv_scene_camera(s, 0.0, 300, 200, &cam);
@@ -142,8 +158,9 @@ static void test_gltf_pbr(void **state)
 
 /* xform.json: the quad [0,1]^2 (y = 0) scaled by 2, turned 90 degrees about +y by a quaternion
  * ((x, z) -> (z, -x)), moved by (10, 0, 0): x in [10, 12], z in [-2, 0]. The OBJ's five quads
- * (x in [0, 9], z in [0, 1]) moved by (0, 0, 5), each object animated: dynamic, and at t = 1 they
- * sit 3 higher. */
+ * (x in [0, 9], z in [0, 1]) moved by (0, 0, 5), each object animated: at t = 1 they sit 3
+ * higher, at t = 3 also turned 180 degrees about y (x in [-9, 0], z in [-6, -5]). The scene's
+ * bounds cover every key. */
 static void test_json_transforms(void **state)
 {
     (void)state;
@@ -155,15 +172,26 @@ static void test_json_transforms(void **state)
     assert_int_equal(fv_scene_dynamic_object_count(s), 5);
     fv_vec3 lo, hi;
     fv_scene_bounds(s, &lo, &hi);
-    assert_vec3(lo, 0, 0, -2, 1e-4f);
-    assert_vec3(hi, 12, 0, 6, 1e-4f);
+    assert_vec3(lo, -9, 0, -6, 1e-4f);
+    assert_vec3(hi, 12, 3, 6, 1e-4f);
     /* The mesh's own materials, named after the object. */
     assert_int_equal(mat_named(s, "rules/water")->type, FV_MAT_DIELECTRIC);
+    /* Straight down onto the first OBJ quad (x in [0, 1], z in [5, 6]) and onto the tile. */
+    fv_hit h;
+    fv_vec3 down = fv_v3(0, -1, 0), above = fv_v3(0.5f, 10, 5.5f), tile = fv_v3(11, 10, -1);
+    assert_true(fv_scene_intersect(s, FV_TRACE_ALL, above, down, 100, &h));
+    assert_float_equal(h.t, 10.0f, 1e-4f);
+    assert_int_equal(h.mat, fv_scene_find_material(s, "rules/polished"));
+    assert_true(fv_scene_intersect(s, FV_TRACE_ALL, tile, down, 100, &h));
+    assert_int_equal(h.mat, fv_scene_find_material(s, "white"));
     fv_error err;
     assert_int_equal(fv_scene_set_time(s, 1.0, &err), FV_OK);
-    fv_scene_bounds(s, &lo, &hi);
-    assert_float_equal(hi.y, 3.0f, 1e-4f);
-    assert_float_equal(lo.y, 0.0f, 1e-4f); /* the static quad */
+    assert_true(fv_scene_intersect(s, FV_TRACE_ALL, above, down, 100, &h));
+    assert_float_equal(h.t, 7.0f, 1e-4f);
+    assert_int_equal(fv_scene_set_time(s, 3.0, &err), FV_OK);
+    assert_false(fv_scene_intersect(s, FV_TRACE_ALL, above, down, 100, &h));
+    assert_true(fv_scene_intersect(s, FV_TRACE_ALL, fv_v3(-0.5f, 10, -5.5f), down, 100, &h));
+    assert_float_equal(h.t, 7.0f, 1e-4f);
     fv_camera cam;
     fv_scene_camera(s, 0.0, 64, 64, &cam);
     assert_vec3(cam.pos, 4, 6, 12, 0);
