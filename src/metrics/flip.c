@@ -15,9 +15,11 @@
  * Convolutions clamp to the edge. Separable kernels are applied as two 1D passes.
  */
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "fovea/film.h"
 #include "fovea/metrics.h"
 
 /* sRGB primaries, D65 white. */
@@ -78,10 +80,10 @@ static void conv1d(const float *in, float *out, int w, int h, const float *k, in
 /* Filters one opponent channel with its CSF, a sum of Gaussian terms
  * a sqrt(pi/b) exp(-pi^2 x^2 / b) with x in degrees (x = pixels / ppd). Each term is separable:
  * exp(-pi^2 (dx^2 + dy^2) / b) = k(dx) k(dy). The 2D kernel as a whole is normalised to sum 1. */
-static void csf_filter(const float *in, float *out, float *tmp, float *tmp2, int w, int h, int r, float ppd, const float *ab, int terms)
+static bool csf_filter(const float *in, float *out, float *tmp, float *tmp2, int w, int h, int r, float ppd, const float *ab, int terms)
 {
     float *k = malloc((size_t)(2 * r + 1) * sizeof *k);
-    if (!k) return;
+    if (!k) return false;
     size_t n = (size_t)w * h;
     double total = 0.0;
     memset(out, 0, n * sizeof *out);
@@ -100,6 +102,7 @@ static void csf_filter(const float *in, float *out, float *tmp, float *tmp2, int
     }
     for (size_t i = 0; i < n; i++) out[i] = (float)(out[i] / total);
     free(k);
+    return true;
 }
 
 /* Gaussian derivative kernels for the feature detectors, normalised so that the positive weights
@@ -146,12 +149,14 @@ static void features(const float *y, float *edge, float *point, float *t0, float
 fv_status fv_metrics_flip_map(const float *ref, const float *test, int w, int h, float ppd, float *map, fv_error *err)
 {
     if (!(ppd > 0.0f) || !isfinite(ppd)) return fv_error_set(err, FV_ERR_INVALID, "FLIP: pixels per degree %g must be positive", ppd);
+    fv_status st = fv_film_check_size(w, h, err);
+    if (st != FV_OK) return st;
     size_t n = (size_t)w * h;
     /* 3 opponent channels x 2 images, filtered copies, temporaries. */
-    float *buf = fv_alloc_array(n, 18 * sizeof(float));
+    float *buf = fv_alloc_array(n, 16 * sizeof(float));
     if (!buf) return fv_error_set(err, FV_ERR_NOMEM, "out of memory computing FLIP of %dx%d", w, h);
     float *opp[2] = {buf, buf + 3 * n}, *filt[2] = {buf + 6 * n, buf + 9 * n}, *t0 = buf + 12 * n, *t1 = buf + 13 * n,
-          *t2 = buf + 14 * n, *t3 = buf + 15 * n, *t4 = buf + 16 * n, *t5 = buf + 17 * n;
+          *t2 = buf + 14 * n, *t3 = buf + 15 * n;
     const float *img[2] = {ref, test};
 
     /* To YyCxCz (planar). */
@@ -171,7 +176,11 @@ fv_status fv_metrics_flip_map(const float *ref, const float *test, int w, int h,
     static const int terms[3] = {1, 1, 2};
     int r = (int)ceilf(3.0f * sqrtf(0.04f / (2.0f * FV_PI * FV_PI)) * ppd);
     for (int k = 0; k < 2; k++)
-        for (int c = 0; c < 3; c++) csf_filter(opp[k] + c * n, filt[k] + c * n, t0, t1, w, h, r, ppd, ab[c], terms[c]);
+        for (int c = 0; c < 3; c++)
+            if (!csf_filter(opp[k] + c * n, filt[k] + c * n, t0, t1, w, h, r, ppd, ab[c], terms[c])) {
+                free(buf);
+                return fv_error_set(err, FV_ERR_NOMEM, "out of memory computing FLIP");
+            }
 
     /* Colour error, compressed by the largest Hunt-adjusted HyAB distance (green vs blue). */
     const float qc = 0.7f, pc = 0.4f, pt = 0.95f;
@@ -212,8 +221,6 @@ fv_status fv_metrics_flip_map(const float *ref, const float *test, int w, int h,
         for (size_t i = 0; i < n; i++) t3[i] = (opp[k][i] + 16.0f) / 116.0f;
         features(t3, edge[k], point[k], t0, t1, t2, w, h, kg, kd1, kd2, rf);
     }
-    (void)t4;
-    (void)t5;
     const float qf = 0.5f;
     for (size_t i = 0; i < n; i++) {
         float de = fmaxf(fabsf(edge[0][i] - edge[1][i]), fabsf(point[0][i] - point[1][i]));

@@ -63,6 +63,8 @@ static void blur_sep(const float *in, float *tmp, float *out, int w, int h, cons
 
 fv_status fv_metrics_ssim_map(const float *a, const float *b, int w, int h, float *map, fv_error *err)
 {
+    fv_status st = fv_film_check_size(w, h, err);
+    if (st != FV_OK) return st;
     size_t n = (size_t)w * h;
     float *buf = fv_alloc_array(n, 8 * sizeof(float));
     if (!buf) return fv_error_set(err, FV_ERR_NOMEM, "out of memory computing SSIM of %dx%d", w, h);
