@@ -6,7 +6,10 @@
  * spread 2^i pixels apart ("with holes"), each tap weighted by edge-stopping functions of the colour,
  * normal and position differences; the colour sigma halves at every iteration so that the coarse
  * passes smooth less across colour edges. Pixels without a surface (zero normal) are neither
- * filtered nor used.
+ * filtered nor used. Defaults and their reasons: atrous.c.
+ *
+ * Limits: the result is the last smoothed level (the detail coefficients are dropped, as in the
+ * paper); the colour sigma is one number per pass, not guided by a per-pixel variance; CPU only.
  */
 #ifndef FV_FILTER_ATROUS_H
 #define FV_FILTER_ATROUS_H
@@ -14,7 +17,7 @@
 #include "fovea/status.h"
 
 typedef struct fv_atrous_opts {
-    int iterations;        /* 5: taps 1, 2, 4, 8, 16 pixels apart (an 81-pixel footprint) */
+    int iterations;        /* 5: taps 1, 2, 4, 8, 16 pixels apart (reach 2*31 = 62 pixels) */
     float sigma_color;     /* relative to the image's mean luminance, so exposure does not matter */
     float sigma_normal;    /* on |n_p - n_q|^2 of unit normals */
     float sigma_position;  /* in scene units; 0 turns the position term off */
@@ -23,7 +26,9 @@ typedef struct fv_atrous_opts {
 void fv_atrous_opts_default(fv_atrous_opts *o);
 
 /* Filters rgb (w*h*3 linear floats) in place, guided by normal and position (3 floats per pixel
- * each, either may be NULL). Deterministic and independent of the thread count. */
+ * each, either may be NULL: its weight is then 1). o NULL means the defaults; an infinite sigma
+ * turns its term off. Deterministic and independent of the thread count. Bad sizes or sigmas ->
+ * FV_ERR_INVALID, no scratch memory -> FV_ERR_NOMEM (rgb is then unchanged). */
 fv_status fv_atrous_filter(float *rgb, const float *normal, const float *position, int w, int h, const fv_atrous_opts *o,
                            fv_error *err);
 
