@@ -72,7 +72,6 @@ void fv_foveated_destroy(fv_foveated *f)
 
 const fv_photon_map *fv_foveated_static_map(const fv_foveated *f) { return &f->fs; }
 const fv_photon_map *fv_foveated_dynamic_map(const fv_foveated *f) { return &f->fd; }
-const uint8_t *fv_foveated_focus(const fv_foveated *f) { return f->focus; }
 
 void fv_foveated_pool(const fv_foveated *f, int *live, int *capacity)
 {
@@ -115,15 +114,6 @@ static void focus_mask(const fv_eye_model *eye, fv_gaze g, uint8_t *mask, int w,
     double rt = fv_eye_transition_radius_px(eye);
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) mask[(size_t)y * w + x] = fv_eye_gaze_dist_px(eye, g, x + 0.5, y + 0.5) <= rt;
-}
-
-void fv_foveated_reset(fv_foveated *f)
-{
-    size_t np = (size_t)f->w * f->h;
-    for (size_t i = 0; i < np * (size_t)f->n; i++) free_path(f, f->fbp[i]);
-    memset(f->fbp, 0xff, np * (size_t)f->n * sizeof(int32_t));
-    memset(f->fbm, 0, np * sizeof(int));
-    f->has_prev = false;
 }
 
 fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera *cam, const fv_camera *prev, const fv_eye_model *eye,

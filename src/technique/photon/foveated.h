@@ -48,12 +48,11 @@ typedef struct fv_foveated fv_foveated;
 fv_status fv_foveated_create(int width, int height, int n_paths, int max_depth, fv_foveated **out, fv_error *err);
 void fv_foveated_destroy(fv_foveated *f);
 
-/* Alg. 2: carries the paths over from the previous frame (call before tracing, from the second
- * frame on; with prev == NULL everything is traced anew). */
+/* Alg. 2: carries the paths over from the previous frame. Call every frame before tracing; with
+ * prev == NULL (the first frame, or fpm's tpm=false) every old path is deleted and all are traced
+ * anew. */
 fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera *cam, const fv_camera *prev,
                              const fv_eye_model *eye, fv_gaze gaze, int threads, fv_fov_stats *st, fv_error *err);
-/* Forgets every path (the "without temporal photon management" variant calls this each frame). */
-void fv_foveated_reset(fv_foveated *f);
 
 /* Alg. 1 line 9: traces the paths fbm asks for and rebuilds the grids of M_fs and M_fd with cell
  * size `cell`. light maps are M_ls and M_ld (built); radius bounds the nearest-photon search. */
@@ -64,8 +63,6 @@ fv_status fv_foveated_trace(fv_foveated *f, const fv_scene *s, const fv_camera *
 const fv_photon_map *fv_foveated_static_map(const fv_foveated *f);  /* M_fs */
 const fv_photon_map *fv_foveated_dynamic_map(const fv_foveated *f); /* M_fd */
 
-/* The focus-region mask of the current frame (width * height, 1 inside r_t). */
-const uint8_t *fv_foveated_focus(const fv_foveated *f);
 
 /* Live static paths and the pool's capacity (memory stays bounded: the tests watch these). */
 void fv_foveated_pool(const fv_foveated *f, int *live, int *capacity);
