@@ -64,9 +64,18 @@ static void list_scenarios(void)
     int nd = bench_dirs(dirs);
     char cmd[8192] = "";
     /* Listing through ls keeps this simple and the order stable. */
+    char seen[4][4096];
+    int nseen = 0;
     for (int i = 0; i < nd; i++) {
         struct stat sb;
         if (stat(dirs[i], &sb) != 0 || !S_ISDIR(sb.st_mode)) continue;
+        /* ./bench and the source tree's bench/ are often the same folder: list it once. */
+        char real[4096];
+        if (!realpath(dirs[i], real)) continue;
+        bool dup = false;
+        for (int k = 0; k < nseen && !dup; k++) dup = strcmp(seen[k], real) == 0;
+        if (dup) continue;
+        snprintf(seen[nseen++], sizeof seen[0], "%s", real);
         printf("%s:\n", dirs[i]);
         snprintf(cmd, sizeof cmd, "ls -1 '%s' | sed -n 's/\\.json$//p' | sed 's/^/  /'", dirs[i]);
         fflush(stdout);
