@@ -42,10 +42,14 @@ static inline fv_vec3 fv_normalize(fv_vec3 a)
     float l = fv_length(a);
     return l > 0.0f ? fv_scale(a, 1.0f / l) : a;
 }
-static inline float fv_max3(fv_vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
-static inline float fv_min3(fv_vec3 a) { return fminf(a.x, fminf(a.y, a.z)); }
-static inline fv_vec3 fv_vmin(fv_vec3 a, fv_vec3 b) { return fv_v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
-static inline fv_vec3 fv_vmax(fv_vec3 a, fv_vec3 b) { return fv_v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
+/* Plain comparisons rather than fmaxf/fminf: without -ffinite-math-only those stay library calls
+ * on hot paths. Like fmaxf, a NaN operand yields the other one. */
+static inline float fv_maxf(float a, float b) { return a > b || b != b ? a : b; }
+static inline float fv_minf(float a, float b) { return a < b || b != b ? a : b; }
+static inline float fv_max3(fv_vec3 a) { return fv_maxf(a.x, fv_maxf(a.y, a.z)); }
+static inline float fv_min3(fv_vec3 a) { return fv_minf(a.x, fv_minf(a.y, a.z)); }
+static inline fv_vec3 fv_vmin(fv_vec3 a, fv_vec3 b) { return fv_v3(fv_minf(a.x, b.x), fv_minf(a.y, b.y), fv_minf(a.z, b.z)); }
+static inline fv_vec3 fv_vmax(fv_vec3 a, fv_vec3 b) { return fv_v3(fv_maxf(a.x, b.x), fv_maxf(a.y, b.y), fv_maxf(a.z, b.z)); }
 static inline fv_vec3 fv_lerp3(fv_vec3 a, fv_vec3 b, float t) { return fv_add(fv_scale(a, 1.0f - t), fv_scale(b, t)); }
 static inline float fv_luminance(fv_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 static inline bool fv_is_finite3(fv_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }

@@ -108,6 +108,10 @@ typedef struct fv_technique_class {
     void (*destroy)(void *state);
 } fv_technique_class;
 
+/* The first step of every technique's render: the camera's basis, and a check that the camera and
+ * the film have the same size. */
+fv_status fv_frame_camera(const fv_camera *cam, const fv_film *film, fv_camera_basis *out, fv_error *err);
+
 int fv_technique_count(void);
 const fv_technique_class *fv_technique_at(int i);
 /* NULL when unknown. */

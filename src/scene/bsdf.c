@@ -12,7 +12,7 @@
 fv_vec3 fv_sample_cosine_hemisphere(float u0, float u1)
 {
     float r = sqrtf(u0), phi = 2.0f * FV_PI * u1;
-    return fv_v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u0)));
+    return fv_v3(r * cosf(phi), r * sinf(phi), sqrtf(fv_maxf(0.0f, 1.0f - u0)));
 }
 
 float fv_fresnel_dielectric(float cos_i, float eta)
@@ -102,7 +102,7 @@ static bool sample_dielectric(const fv_material *m, fv_vec3 wo, fv_transport mod
         return true;
     }
     float sin2_t = (1.0f - cos_o * cos_o) / (eta * eta);
-    float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2_t));
+    float cos_t = sqrtf(fv_maxf(0.0f, 1.0f - sin2_t));
     /* Snell: wi = -wo / eta + (cos_o / eta - cos_t) n, with n on wo's side. */
     float sgn = entering ? 1.0f : -1.0f;
     out->wi = fv_normalize(fv_v3(-wo.x / eta, -wo.y / eta, -sgn * cos_t));
@@ -135,8 +135,8 @@ bool fv_bsdf_sample_dir(const fv_material *m, fv_vec3 wo, fv_transport mode, flo
         float ps = glossy_spec_prob(m);
         if (u2 < ps) {
             float a2 = m->roughness * m->roughness;
-            float t2 = a2 * u0 / fmaxf(1e-12f, 1.0f - u0); /* tan^2 of the half-vector angle */
-            float ch = 1.0f / sqrtf(1.0f + t2), sh = sqrtf(fmaxf(0.0f, 1.0f - ch * ch));
+            float t2 = a2 * u0 / fv_maxf(1e-12f, 1.0f - u0); /* tan^2 of the half-vector angle */
+            float ch = 1.0f / sqrtf(1.0f + t2), sh = sqrtf(fv_maxf(0.0f, 1.0f - ch * ch));
             float phi = 2.0f * FV_PI * u1;
             fv_vec3 h = fv_v3(sh * cosf(phi), sh * sinf(phi), ch);
             out->wi = fv_sub(fv_scale(h, 2.0f * fv_dot(wo, h)), wo);

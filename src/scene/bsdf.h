@@ -21,6 +21,32 @@ typedef struct fv_bsdf_sample {
     bool delta;      /* sampled from a specular (delta) lobe */
 } fv_bsdf_sample;
 
+/* The local shading frame at a surface hit, for a ray arriving from direction wo (unit, pointing
+ * away from the surface). Two-sided materials turn to face the arriving ray; dielectrics keep
+ * their orientation so the BSDF can tell entering from leaving. A shading normal that faces away
+ * from the view (interpolated normals can) is clamped to grazing. Every technique builds its
+ * frames here, so they all treat surfaces alike. */
+typedef struct fv_shading {
+    fv_vec3 ng, n, t, b; /* oriented geometric normal, shading normal, tangents */
+    fv_vec3 wo;          /* wo in the local frame */
+} fv_shading;
+
+static inline void fv_shading_make(const fv_material *m, fv_vec3 ng, fv_vec3 ns, fv_vec3 wo, fv_shading *sh)
+{
+    if (m->type != FV_MAT_DIELECTRIC && fv_dot(wo, ng) < 0.0f) {
+        ng = fv_neg(ng);
+        ns = fv_neg(ns);
+    }
+    sh->ng = ng;
+    sh->n = ns;
+    fv_basis(ns, &sh->t, &sh->b);
+    sh->wo = fv_to_local(wo, sh->t, sh->b, ns);
+    if (m->type != FV_MAT_DIELECTRIC && sh->wo.z <= 0.0f) sh->wo.z = 1e-4f;
+}
+
+static inline fv_vec3 fv_shading_to_local(const fv_shading *sh, fv_vec3 v) { return fv_to_local(v, sh->t, sh->b, sh->n); }
+static inline fv_vec3 fv_shading_to_world(const fv_shading *sh, fv_vec3 v) { return fv_from_local(v, sh->t, sh->b, sh->n); }
+
 /* True when the material has a non-delta lobe, i.e. light sampling (NEE) makes sense there. */
 static inline bool fv_bsdf_is_smooth(const fv_material *m)
 {

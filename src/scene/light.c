@@ -99,7 +99,7 @@ bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *orig
         *origin = l->desc.pos;
         *normal = fv_v3s(0.0f);
         /* Uniform sphere direction: pdf 1/(4 pi), so power = I * 4 pi * falloff / pmf. */
-        float z = 1.0f - 2.0f * u[1], r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * FV_PI * u[2];
+        float z = 1.0f - 2.0f * u[1], r = sqrtf(fv_maxf(0.0f, 1.0f - z * z)), phi = 2.0f * FV_PI * u[2];
         *dir = fv_v3(r * cosf(phi), r * sinf(phi), z);
         float fall = l->desc.type == FV_LIGHT_SPOT ? spot_falloff(&l->desc, *dir) : 1.0f;
         *power = fv_scale(l->desc.intensity, 4.0f * FV_PI * fall / pmf);

@@ -569,20 +569,18 @@ bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 
     fv_vec3 a = ob->pos[ix[0]], b = ob->pos[ix[1]], c = ob->pos[ix[2]];
     fv_vec3 ng = fv_cross(fv_sub(b, a), fv_sub(c, a));
     float u = rh.hit.u, v = rh.hit.v;
-    fv_vec3 ns = ng;
+    if (ob->dynamic) ng = fv_xform_normal(&ob->inv, ng);
+    hit->ng = fv_normalize(ng);
+    hit->ns = hit->ng; /* flat shading unless the mesh has vertex normals */
     if (ob->nrm) {
         fv_vec3 n = fv_add(fv_add(fv_scale(ob->nrm[ix[0]], 1.0f - u - v), fv_scale(ob->nrm[ix[1]], u)), fv_scale(ob->nrm[ix[2]], v));
-        if (fv_length(n) > 1e-6f) ns = n;
-    }
-    if (ob->dynamic) {
-        ng = fv_xform_normal(&ob->inv, ng);
-        ns = fv_xform_normal(&ob->inv, ns);
+        if (ob->dynamic) n = fv_xform_normal(&ob->inv, n);
+        float len = fv_length(n);
+        if (len > 1e-6f) hit->ns = fv_scale(n, 1.0f / len);
+        if (fv_dot(hit->ns, hit->ng) < 0.0f) hit->ns = fv_neg(hit->ns);
     }
     hit->t = rh.ray.tfar;
     hit->p = fv_madd(o, d, rh.ray.tfar);
-    hit->ng = fv_normalize(ng);
-    hit->ns = fv_normalize(ns);
-    if (fv_dot(hit->ns, hit->ng) < 0.0f) hit->ns = fv_neg(hit->ns);
     hit->obj = obj;
     hit->prim = prim;
     hit->mat = ob->mat[prim];

@@ -76,3 +76,12 @@ void fv_technique_destroy(fv_technique *t)
     t->cls->destroy(t->state);
     free(t);
 }
+
+fv_status fv_frame_camera(const fv_camera *cam, const fv_film *film, fv_camera_basis *out, fv_error *err)
+{
+    fv_status s = fv_camera_basis_make(cam, out, err);
+    if (s == FV_OK && (cam->width != fv_film_width(film) || cam->height != fv_film_height(film)))
+        s = fv_error_set(err, FV_ERR_INVALID, "camera size %dx%d differs from the film's %dx%d", cam->width, cam->height,
+                         fv_film_width(film), fv_film_height(film));
+    return s;
+}

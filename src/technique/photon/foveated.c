@@ -256,24 +256,18 @@ static void trace_path(const trace_ctx *c, int px, int py, int attempt, path_out
             break;
         }
         if (s->objs[h.obj].dynamic) out->dynamic = true;
-        fv_vec3 wo = fv_neg(d), ng = h.ng, ns = h.ns;
-        if (m->type != FV_MAT_DIELECTRIC && fv_dot(wo, ng) < 0.0f) {
-            ng = fv_neg(ng);
-            ns = fv_neg(ns);
-        }
+        fv_shading sh;
+        fv_shading_make(m, h.ng, h.ns, fv_neg(d), &sh);
+        fv_vec3 ng = sh.ng;
         if (!fv_bsdf_is_smooth(m)) {
             /* Mirrors and glass: the laws of reflection and refraction (Sec. 3.1). */
-            fv_vec3 t, b;
-            fv_basis(ns, &t, &b);
-            fv_vec3 wo_l = fv_to_local(wo, t, b, ns);
-            if (m->type != FV_MAT_DIELECTRIC && wo_l.z <= 0.0f) wo_l.z = 1e-4f;
             fv_bsdf_sample bs;
             float u0 = fv_rng_next(&rng), u1 = fv_rng_next(&rng), u2 = fv_rng_next(&rng);
-            if (!fv_bsdf_sample_dir(m, wo_l, FV_TRANSPORT_IMPORTANCE, u0, u1, u2, &bs)) {
+            if (!fv_bsdf_sample_dir(m, sh.wo, FV_TRANSPORT_IMPORTANCE, u0, u1, u2, &bs)) {
                 ended = true;
                 break;
             }
-            fv_vec3 wi = fv_from_local(bs.wi, t, b, ns);
+            fv_vec3 wi = fv_shading_to_world(&sh, bs.wi);
             chain = fv_mul(chain, bs.weight);
             o = fv_offset_point(s, h.p, h.ng, wi);
             d = wi;
@@ -298,7 +292,7 @@ static void trace_path(const trace_ctx *c, int px, int py, int attempt, path_out
         /* The flux a photon keeps when a diffuse or glossy surface reflects it. */
         transfer[k] = fv_vmin(fv_add(m->albedo, m->type == FV_MAT_GLOSSY ? m->specular : fv_v3s(0.0f)), fv_v3s(1.0f));
         last_q = q;
-        float survive = fminf(0.95f, fv_max3(transfer[k]));
+        float survive = fv_minf(0.95f, fv_max3(transfer[k]));
         if (!(fv_rng_next(&rng) < survive)) {
             dout[k] = fv_neg(q->dir);
             ended = true;

@@ -27,29 +27,22 @@ void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_r
         }
         if (s->objs[h.obj].dynamic) out->dynamic = true;
         if (fv_max3(m->emission) > 0.0f) out->emitted = fv_add(out->emitted, fv_mul(out->weight, fv_light_emitted(s, m, h.ng, wo)));
-        fv_vec3 ng = h.ng, ns = h.ns;
-        if (m->type != FV_MAT_DIELECTRIC && fv_dot(wo, ng) < 0.0f) {
-            ng = fv_neg(ng);
-            ns = fv_neg(ns);
-        }
+        fv_shading sh;
+        fv_shading_make(m, h.ng, h.ns, wo, &sh);
         if (fv_bsdf_is_smooth(m)) {
             out->hit = true;
             out->p = h.p;
-            out->n = ns;
-            out->ng = ng;
+            out->n = sh.n;
+            out->ng = sh.ng;
             out->wo = wo;
             out->mat = h.mat;
             out->obj = h.obj;
             return;
         }
-        fv_vec3 t, b;
-        fv_basis(ns, &t, &b);
-        fv_vec3 wo_l = fv_to_local(wo, t, b, ns);
-        if (m->type != FV_MAT_DIELECTRIC && wo_l.z <= 0.0f) wo_l.z = 1e-4f;
         fv_bsdf_sample bs;
         float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), u2 = fv_rng_next(rng);
-        if (!fv_bsdf_sample_dir(m, wo_l, FV_TRANSPORT_RADIANCE, u0, u1, u2, &bs)) return;
-        fv_vec3 wi = fv_from_local(bs.wi, t, b, ns);
+        if (!fv_bsdf_sample_dir(m, sh.wo, FV_TRANSPORT_RADIANCE, u0, u1, u2, &bs)) return;
+        fv_vec3 wi = fv_shading_to_world(&sh, bs.wi);
         out->weight = fv_mul(out->weight, bs.weight);
         o = fv_offset_point(s, h.p, h.ng, wi);
         d = wi;
@@ -58,7 +51,7 @@ void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_r
 
 typedef struct gather_ctx {
     const fv_material *m;
-    fv_vec3 t, b, n, wo_l;
+    fv_shading sh;
     fv_vec3 sum;
     double u;
 } gather_ctx;
@@ -69,11 +62,11 @@ static void gather_one(void *user, const fv_photon *ph, float d2)
     gather_ctx *c = user;
     /* Photons on another surface (the other side of a thin wall, a nearby perpendicular face)
      * would leak light: keep those whose surface faces the same way. */
-    if (fv_dot(ph->n, c->n) <= 0.5f) return;
-    fv_vec3 wi_l = fv_to_local(fv_neg(ph->dir), c->t, c->b, c->n);
+    if (fv_dot(ph->n, c->sh.n) <= 0.5f) return;
+    fv_vec3 wi_l = fv_shading_to_local(&c->sh, fv_neg(ph->dir));
     if (wi_l.z <= 0.0f) return;
     float pdf;
-    fv_vec3 f = fv_bsdf_eval(c->m, c->wo_l, wi_l, &pdf);
+    fv_vec3 f = fv_bsdf_eval(c->m, c->sh.wo, wi_l, &pdf);
     c->sum = fv_add(c->sum, fv_mul(f, ph->flux));
     c->u += fmax(fabs(ph->flux.x), fmax(fabs(ph->flux.y), fabs(ph->flux.z)));
 }
@@ -82,10 +75,7 @@ fv_vec3 fv_pm_gather(const fv_scene *s, const fv_photon_map *m, const fv_pm_hit 
 {
     gather_ctx c;
     c.m = &s->mats[x->mat];
-    c.n = x->n;
-    fv_basis(x->n, &c.t, &c.b);
-    c.wo_l = fv_to_local(x->wo, c.t, c.b, c.n);
-    if (c.wo_l.z <= 0.0f) c.wo_l.z = 1e-4f;
+    fv_shading_make(c.m, x->ng, x->n, x->wo, &c.sh);
     c.sum = fv_v3s(0.0f);
     c.u = 0.0;
     fv_photon_map_query(m, x->p, r, gather_one, &c);

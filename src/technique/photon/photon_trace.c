@@ -40,25 +40,19 @@ static bool store_and_scatter(const fv_scene *s, const fv_hit *h, fv_vec3 *o, fv
 {
     const fv_material *m = &s->mats[h->mat];
     if (fv_bsdf_is_smooth(m)) deposit(out, h->p, *d, *flux, h->ng);
-    fv_vec3 wo = fv_neg(*d), ng = h->ng, ns = h->ns;
-    if (m->type != FV_MAT_DIELECTRIC && fv_dot(wo, ng) < 0.0f) {
-        ng = fv_neg(ng);
-        ns = fv_neg(ns);
-    }
-    fv_vec3 t, b;
-    fv_basis(ns, &t, &b);
-    fv_vec3 wo_l = fv_to_local(wo, t, b, ns);
-    if (m->type != FV_MAT_DIELECTRIC && wo_l.z <= 0.0f) wo_l.z = 1e-4f;
+    fv_vec3 wo = fv_neg(*d);
+    fv_shading sh;
+    fv_shading_make(m, h->ng, h->ns, wo, &sh);
     fv_bsdf_sample bs;
     float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), u2 = fv_rng_next(rng);
-    if (!fv_bsdf_sample_dir(m, wo_l, FV_TRANSPORT_IMPORTANCE, u0, u1, u2, &bs)) return false;
-    fv_vec3 wi = fv_from_local(bs.wi, t, b, ns);
-    bool reflect = bs.wi.z * wo_l.z > 0.0f;
+    if (!fv_bsdf_sample_dir(m, sh.wo, FV_TRANSPORT_IMPORTANCE, u0, u1, u2, &bs)) return false;
+    fv_vec3 wi = fv_shading_to_world(&sh, bs.wi);
+    bool reflect = bs.wi.z * sh.wo.z > 0.0f;
     if ((fv_dot(wi, h->ng) * fv_dot(wo, h->ng) > 0.0f) != reflect) return false;
     /* Russian roulette on the change of power: the surviving photon keeps about the flux it had. */
     fv_vec3 nf = fv_mul(*flux, bs.weight);
     float before = fv_max3(fv_vmax(*flux, fv_neg(*flux))), after = fv_max3(fv_vmax(nf, fv_neg(nf)));
-    float q = before > 0.0f ? fminf(1.0f, after / before) : 0.0f;
+    float q = before > 0.0f ? fv_minf(1.0f, after / before) : 0.0f;
     if (!(fv_rng_next(rng) < q)) return false;
     *flux = fv_scale(nf, 1.0f / q);
     *o = fv_offset_point(s, h->p, h->ng, wi);
@@ -197,7 +191,7 @@ static float cone_cos(const dyn_sphere *k, fv_vec3 x, fv_vec3 *axis)
     }
     float d = sqrtf(d2);
     *axis = fv_scale(v, 1.0f / d);
-    return sqrtf(fmaxf(0.0f, 1.0f - k->r * k->r / d2));
+    return sqrtf(fv_maxf(0.0f, 1.0f - k->r * k->r / d2));
 }
 
 /* Samples origin, direction and the power of a PT_d photon (to be divided by the photon count):
@@ -239,7 +233,7 @@ static bool dyn_sample(const fv_scene *s, const fv_dyn_dirs *d, fv_rng *rng, fv_
     int k = 0;
     while (k + 1 < n && pick >= omega[k]) pick -= omega[k++];
     /* Uniform direction in the cone around axis[k]. */
-    float ct = 1.0f - fv_rng_next(rng) * (1.0f - cosm[k]), st = sqrtf(fmaxf(0.0f, 1.0f - ct * ct)), ph = 2.0f * FV_PI * fv_rng_next(rng);
+    float ct = 1.0f - fv_rng_next(rng) * (1.0f - cosm[k]), st = sqrtf(fv_maxf(0.0f, 1.0f - ct * ct)), ph = 2.0f * FV_PI * fv_rng_next(rng);
     fv_vec3 t, bt;
     fv_basis(axis[k], &t, &bt);
     *dir = fv_normalize(fv_from_local(fv_v3(st * cosf(ph), st * sinf(ph), ct), t, bt, axis[k]));

@@ -364,11 +364,8 @@ static int paths_per_pixel(const pm_state *st, const fv_eye_model *eye, fv_gaze 
 static fv_status render_eye_pass(pm_state *st, render_ctx *c, fv_film *film, const fv_camera *cam, fv_gaze gaze, bool right,
                                  fv_stats *stats, fv_error *err)
 {
-    fv_status rc = fv_camera_basis_make(cam, &c->cam, err);
+    fv_status rc = fv_frame_camera(cam, film, &c->cam, err);
     if (rc != FV_OK) return rc;
-    if (cam->width != fv_film_width(film) || cam->height != fv_film_height(film))
-        return fv_error_set(err, FV_ERR_INVALID, "camera size %dx%d differs from the film's %dx%d", cam->width, cam->height, fv_film_width(film),
-                            fv_film_height(film));
     c->gaze = gaze;
     c->right = right;
     c->color = fv_film_color(film);

@@ -53,28 +53,19 @@ fv_vec3 fv_pt_trace(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_v
             if (!delta_prev) w = mis_weight(pdf_prev, fv_light_pdf_li(s, h.obj, h.prim, p_prev, h.p, h.ng, d));
             L = fv_add(L, fv_mul(beta, fv_scale(le, w)));
         }
-        /* Shading frame: two-sided surfaces face the incoming ray; glass keeps its orientation
-         * so the BSDF can tell entering from leaving. */
-        fv_vec3 ng = h.ng, ns = h.ns;
-        if (m->type != FV_MAT_DIELECTRIC && fv_dot(wo, ng) < 0.0f) {
-            ng = fv_neg(ng);
-            ns = fv_neg(ns);
-        }
-        fv_vec3 t, b;
-        fv_basis(ns, &t, &b);
-        fv_vec3 wo_l = fv_to_local(wo, t, b, ns);
-        if (m->type != FV_MAT_DIELECTRIC && wo_l.z <= 0.0f) wo_l.z = 1e-4f; /* shading normal past the view: clamp */
+        fv_shading sh;
+        fv_shading_make(m, h.ng, h.ns, wo, &sh);
 
         if (fv_bsdf_is_smooth(m)) {
             fv_light_sample ls;
             float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), u2 = fv_rng_next(rng);
-            if (fv_light_sample_li(s, h.p, u0, u1, u2, &ls) && fv_dot(ls.wi, ng) > 0.0f) {
+            if (fv_light_sample_li(s, h.p, u0, u1, u2, &ls) && fv_dot(ls.wi, sh.ng) > 0.0f) {
                 float pdf_b;
-                fv_vec3 f = fv_bsdf_eval(m, wo_l, fv_to_local(ls.wi, t, b, ns), &pdf_b);
-                float cosv = fabsf(fv_dot(ls.wi, ns));
+                fv_vec3 f = fv_bsdf_eval(m, sh.wo, fv_shading_to_local(&sh, ls.wi), &pdf_b);
+                float cosv = fabsf(fv_dot(ls.wi, sh.n));
                 if (fv_max3(f) > 0.0f) {
                     nrays++;
-                    if (fv_scene_visible(s, FV_TRACE_ALL, h.p, ng, fv_madd(h.p, ls.wi, ls.dist))) {
+                    if (fv_scene_visible(s, FV_TRACE_ALL, h.p, sh.ng, fv_madd(h.p, ls.wi, ls.dist))) {
                         /* At the last vertex BSDF sampling does not continue, so light sampling
                          * is the only strategy for these paths and takes the full weight. */
                         float w = ls.delta || depth == opt->max_depth ? 1.0f : mis_weight(ls.pdf, pdf_b);
@@ -90,11 +81,11 @@ fv_vec3 fv_pt_trace(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_v
 
         fv_bsdf_sample bs;
         float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), u2 = fv_rng_next(rng);
-        if (!fv_bsdf_sample_dir(m, wo_l, FV_TRANSPORT_RADIANCE, u0, u1, u2, &bs)) break;
-        fv_vec3 wi = fv_from_local(bs.wi, t, b, ns);
+        if (!fv_bsdf_sample_dir(m, sh.wo, FV_TRANSPORT_RADIANCE, u0, u1, u2, &bs)) break;
+        fv_vec3 wi = fv_shading_to_world(&sh, bs.wi);
         /* Reflection must leave on the geometric side it arrived on (and refraction cross it);
          * shading normals can disagree, which would leak light through surfaces. */
-        bool reflect = bs.wi.z * wo_l.z > 0.0f;
+        bool reflect = bs.wi.z * sh.wo.z > 0.0f;
         if ((fv_dot(wi, h.ng) * fv_dot(wo, h.ng) > 0.0f) != reflect) break;
         beta = fv_mul(beta, bs.weight);
         delta_prev = bs.delta;
@@ -103,7 +94,7 @@ fv_vec3 fv_pt_trace(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_v
         o = fv_offset_point(s, h.p, h.ng, wi);
         d = wi;
         if (depth >= opt->rr_depth) {
-            float q = fminf(0.95f, fv_max3(beta));
+            float q = fv_minf(0.95f, fv_max3(beta));
             if (!(fv_rng_next(rng) < q)) break;
             beta = fv_scale(beta, 1.0f / q);
         } else {
@@ -206,10 +197,7 @@ static fv_status render_eye(const pt_state *st, const fv_frame *frame, const fv_
 {
     pt_job *j = calloc(1, sizeof *j);
     if (!j) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    fv_status s = fv_camera_basis_make(cam, &j->cam, err);
-    if (s == FV_OK && (cam->width != fv_film_width(film) || cam->height != fv_film_height(film)))
-        s = fv_error_set(err, FV_ERR_INVALID, "camera size %dx%d differs from the film's %dx%d", cam->width, cam->height,
-                         fv_film_width(film), fv_film_height(film));
+    fv_status s = fv_frame_camera(cam, film, &j->cam, err);
     if (s != FV_OK) {
         free(j);
         return s;
