@@ -566,9 +566,10 @@ bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 
     const fv_object *ob = &s->objs[obj];
     int prim = (int)rh.hit.primID;
     const uint32_t *ix = &ob->idx[3 * prim];
-    fv_vec3 a = ob->pos[ix[0]], b = ob->pos[ix[1]], c = ob->pos[ix[2]];
-    fv_vec3 ng = fv_cross(fv_sub(b, a), fv_sub(c, a));
     float u = rh.hit.u, v = rh.hit.v;
+    /* Embree's geometric normal (object space, as wound: (v1 - v0) x (v2 - v0)) saves reading the
+     * vertices back. */
+    fv_vec3 ng = fv_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
     if (ob->dynamic) ng = fv_xform_normal(&ob->inv, ng);
     hit->ng = fv_normalize(ng);
     hit->ns = hit->ng; /* flat shading unless the mesh has vertex normals */
