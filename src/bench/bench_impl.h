@@ -14,6 +14,7 @@ typedef struct fv_bench_result {
     fv_stats stages;            /* per stage: median over repeats of the mean per frame */
     fv_stats counters;          /* mean per frame, last repeat */
     fv_metric_report error;     /* mean over frames, per region */
+    fv_metric_report error_vs[FV_BENCH_MAX_EXTRA]; /* the same against each extra reference */
     bool has_temporal;
     double temporal_mse[FV_REGION_COUNT], temporal_e[FV_REGION_COUNT];
     char img[4096], heat[4096], crop[4096]; /* paths relative to the output folder */
@@ -26,6 +27,8 @@ typedef struct fv_bench_run_info {
     const char *out_dir;
     double ref_ms;              /* reference render time per frame (0 when cached) */
     int ref_cached;             /* how many reference frames came from the cache */
+    double extra_ms[FV_BENCH_MAX_EXTRA];
+    int extra_cached[FV_BENCH_MAX_EXTRA];
     char ref_img[4096];
     fv_gaze last_gaze;          /* gaze at the last frame (the images show it) */
 } fv_bench_run_info;

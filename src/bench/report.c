@@ -104,6 +104,21 @@ static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *
         cJSON_AddItemToObject(e, "ssim", num(v->ssim));
         cJSON_AddItemToObject(e, "flip", num(v->flip));
     }
+    if (info->sc->nextra > 0) {
+        cJSON *ev = cJSON_AddObjectToObject(o, "error_vs");
+        for (int k = 0; k < info->sc->nextra; k++) {
+            cJSON *one = cJSON_AddObjectToObject(ev, info->sc->extra[k].label);
+            for (int g = 0; g < FV_REGION_COUNT; g++) {
+                const fv_metric_values *v = &r->error_vs[k].region[g];
+                cJSON *e = cJSON_AddObjectToObject(one, fv_region_name((fv_region)g));
+                cJSON_AddItemToObject(e, "mse", num(v->mse));
+                cJSON_AddItemToObject(e, "psnr", num(v->psnr));
+                cJSON_AddItemToObject(e, "e", num(v->e));
+                cJSON_AddItemToObject(e, "ssim", num(v->ssim));
+                cJSON_AddItemToObject(e, "flip", num(v->flip));
+            }
+        }
+    }
     cJSON *te = cJSON_AddObjectToObject(o, "temporal");
     for (int g = 0; g < FV_REGION_COUNT; g++) {
         cJSON *e = cJSON_AddObjectToObject(te, fv_region_name((fv_region)g));
@@ -196,6 +211,15 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
                 sci(d, v[FV_REGION_FOVEA].ssim), sci(e, v[FV_REGION_FOVEA].flip), sci(f, v[FV_REGION_ALL].flip),
                 sci(g, r->has_temporal ? r->temporal_mse[FV_REGION_FOVEA] : NAN),
                 sci(h, r->has_temporal ? r->temporal_mse[FV_REGION_PERIPHERY] : NAN));
+    }
+    for (int k = 0; k < sc->nextra; k++) {
+        tprintf(&t, "\nAgainst `%s` (%s):\n\n| method | MSE fovea | MSE transition | MSE periphery | FLIP fovea | FLIP all |\n|---|---:|---:|---:|---:|---:|\n",
+                sc->extra[k].label, sc->extra[k].method);
+        for (int i = 0; i < n; i++) {
+            const fv_metric_values *v = res[i].error_vs[k].region;
+            tprintf(&t, "| %s | %s | %s | %s | %s | %s |\n", res[i].m->label, sci(a, v[FV_REGION_FOVEA].mse), sci(b, v[FV_REGION_TRANSITION].mse),
+                    sci(c, v[FV_REGION_PERIPHERY].mse), sci(d, v[FV_REGION_FOVEA].flip), sci(e, v[FV_REGION_ALL].flip));
+        }
     }
     tprintf(&t, "\n| method | last frame | FLIP error (rings: fovea, transition) | around the gaze |\n|---|---|---|---|\n");
     tprintf(&t, "| reference | ![](%s) | | |\n", info->ref_img);

@@ -21,7 +21,7 @@ typedef struct frame_setup {
     fv_camera cam;
     fv_gaze gaze;
     uint8_t *labels;
-    float *ref;
+    float *ref[1 + FV_BENCH_MAX_EXTRA]; /* the reference, then the extra ones */
 } frame_setup;
 
 static void say(const fv_bench_options *opt, const char *fmt, ...)
@@ -66,7 +66,7 @@ static uint64_t fnv1a(const char *s)
 /* Everything a reference frame depends on, as text: its hash names the cache file. A scene file's
  * size and modification time stand in for its contents. The gaze is not part of it: a reference
  * is a non-foveated rendering, shared by every gaze path of a scene. */
-static void reference_key(const fv_scenario *sc, const frame_setup *f, int index, char *buf, size_t n)
+static void reference_key(const fv_scenario *sc, const fv_bench_method *m, const frame_setup *f, int index, char *buf, size_t n)
 {
     size_t len = 0;
 #define KEY(...)                                                                      \
@@ -77,9 +77,8 @@ static void reference_key(const fv_scenario *sc, const frame_setup *f, int index
     KEY("fovea %s|scene=%s", FOVEA_VERSION_STRING, sc->scene);
     struct stat sb;
     if (stat(sc->scene, &sb) == 0) KEY("|bytes=%lld|mtime=%lld", (long long)sb.st_size, (long long)sb.st_mtime);
-    KEY("|%dx%d|frame=%d|t=%.9g|seed=%llu|method=%s", sc->width, sc->height, index, f->time, sc->seed, sc->reference.method);
-    for (int i = 0; i < fv_params_count(sc->reference.params); i++)
-        KEY("|%s=%s", fv_params_key(sc->reference.params, i), fv_params_value(sc->reference.params, i));
+    KEY("|%dx%d|frame=%d|t=%.9g|seed=%llu|method=%s", sc->width, sc->height, index, f->time, sc->seed, m->method);
+    for (int i = 0; i < fv_params_count(m->params); i++) KEY("|%s=%s", fv_params_key(m->params, i), fv_params_value(m->params, i));
     const fv_camera *c = &f->cam;
     KEY("|cam=%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", c->pos.x, c->pos.y, c->pos.z, c->look.x, c->look.y, c->look.z,
         c->up.x, c->up.y, c->up.z, c->fov_y);
@@ -143,6 +142,7 @@ static fv_status render_sequence(const render_job *j, int nframes, frame_fn on_f
 typedef struct ref_ctx {
     frame_setup *frames;
     const char *const *paths;
+    int slot;
     double ms;
 } ref_ctx;
 
@@ -152,15 +152,18 @@ static fv_status on_reference_frame(void *user, int i, fv_film *film, double ms,
     ref_ctx *c = user;
     c->ms += ms;
     size_t n = (size_t)fv_film_width(film) * fv_film_height(film) * 3;
-    memcpy(c->frames[i].ref, fv_film_color(film), n * sizeof(float));
+    memcpy(c->frames[i].ref[c->slot], fv_film_color(film), n * sizeof(float));
     if (!c->paths[i]) return FV_OK;
-    return fv_image_write(c->paths[i], c->frames[i].ref, fv_film_width(film), fv_film_height(film), 1.0f, err);
+    return fv_image_write(c->paths[i], c->frames[i].ref[c->slot], fv_film_width(film), fv_film_height(film), 1.0f, err);
 }
 
-static fv_status load_references(fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, const char *cache_dir,
-                                 fv_error *err)
+/* Reference `slot` (0: the scenario's reference, k: extra reference k - 1) for every frame, from
+ * the cache or rendered. */
+static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, const char *cache_dir, int slot,
+                                 int *cached, double *ms, fv_error *err)
 {
     const fv_scenario *sc = info->sc;
+    const fv_bench_method *m = slot == 0 ? &sc->reference : &sc->extra[slot - 1];
     int n = sc->frames;
     char **paths = calloc((size_t)n, sizeof *paths);
     if (!paths) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
@@ -168,15 +171,15 @@ static fv_status load_references(fv_bench_run_info *info, fv_scene *scene, frame
     int missing = 0;
     for (int i = 0; i < n && st == FV_OK; i++) {
         char key[2048];
-        reference_key(sc, &frames[i], i, key, sizeof key);
+        reference_key(sc, m, &frames[i], i, key, sizeof key);
         char path[4096 + 64];
         snprintf(path, sizeof path, "%s/ref-%016llx.pfm", cache_dir, (unsigned long long)fnv1a(key));
         fv_image img;
         fv_error e2;
         if (fv_file_exists(path) && fv_image_read(path, &img, &e2) == FV_OK) {
             if (img.width == sc->width && img.height == sc->height) {
-                memcpy(frames[i].ref, img.rgb, (size_t)sc->width * sc->height * 3 * sizeof(float));
-                info->ref_cached++;
+                memcpy(frames[i].ref[slot], img.rgb, (size_t)sc->width * sc->height * 3 * sizeof(float));
+                (*cached)++;
                 fv_image_free(&img);
                 continue;
             }
@@ -188,14 +191,14 @@ static fv_status load_references(fv_bench_run_info *info, fv_scene *scene, frame
     if (st == FV_OK && missing > 0) {
         /* Render the whole sequence (a temporal reference needs its history); frames already cached
          * are simply not written again. */
-        say(info->opt, "reference: rendering %d frame(s) with %s (%d cached)", n, sc->reference.method, info->ref_cached);
-        render_job j = {sc, scene, frames, info->threads, &sc->reference, info->opt->log};
-        ref_ctx c = {frames, (const char *const *)paths, 0.0};
+        say(info->opt, "%s: rendering %d frame(s) with %s (%d cached)", m->label, n, m->method, *cached);
+        render_job j = {sc, scene, frames, info->threads, m, info->opt->log};
+        ref_ctx c = {frames, (const char *const *)paths, slot, 0.0};
         st = render_sequence(&j, n, on_reference_frame, &c, err);
-        info->ref_ms = c.ms / n;
-        if (st != FV_OK) fv_error_prefix(err, "reference: ");
+        *ms = c.ms / n;
+        if (st != FV_OK) fv_error_prefix(err, "%s: ", m->label);
     } else if (st == FV_OK) {
-        say(info->opt, "reference: %d frame(s) from the cache", n);
+        say(info->opt, "%s: %d frame(s) from the cache", m->label, n);
     }
     for (int i = 0; i < n; i++) free(paths[i]);
     free(paths);
@@ -233,9 +236,22 @@ static fv_status on_method_frame(void *user, int i, fv_film *film, double ms, co
     if (!c->measure) return FV_OK;
     const float *rgb = fv_film_color(film);
     fv_metric_report rep;
-    fv_status st = fv_metrics_compare(c->frames[i].ref, rgb, sc->width, sc->height, c->frames[i].labels, &c->mopts, &rep,
+    fv_status st = fv_metrics_compare(c->frames[i].ref[0], rgb, sc->width, sc->height, c->frames[i].labels, &c->mopts, &rep,
                                       i == sc->frames - 1 ? c->flip_map : NULL, err);
     if (st != FV_OK) return st;
+    for (int k = 0; k < sc->nextra; k++) {
+        fv_metric_report ex;
+        if ((st = fv_metrics_compare(c->frames[i].ref[1 + k], rgb, sc->width, sc->height, c->frames[i].labels, &c->mopts, &ex, NULL, err)) != FV_OK)
+            return st;
+        for (int r = 0; r < FV_REGION_COUNT; r++) {
+            fv_metric_values *d = &c->res->error_vs[k].region[r];
+            d->pixels = ex.region[r].pixels;
+            d->mse += ex.region[r].mse / sc->frames;
+            d->e += ex.region[r].e / sc->frames;
+            d->ssim += ex.region[r].ssim / sc->frames;
+            d->flip += ex.region[r].flip / sc->frames;
+        }
+    }
     for (int r = 0; r < FV_REGION_COUNT; r++) {
         fv_metric_values *d = &c->res->error.region[r];
         const fv_metric_values *v = &rep.region[r];
@@ -309,6 +325,7 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
         fv_stats_clear(&c.counter_sum);
         if (c.measure) {
             memset(&res->error, 0, sizeof res->error);
+            memset(res->error_vs, 0, sizeof res->error_vs);
             if (sc->frames > 1 && (st = fv_temporal_create(sc->width, sc->height, &c.mopts, &c.temporal, err)) != FV_OK) break;
         }
         if ((st = render_sequence(&j, sc->frames, on_method_frame, &c, err)) != FV_OK) break;
@@ -333,10 +350,11 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
         fv_stats_clear(&res->counters);
         for (int k = 0; k < c.counter_sum.n_counters; k++)
             fv_stats_add_count(&res->counters, c.counter_sum.counter[k].name, c.counter_sum.counter[k].value / sc->frames);
-        for (int r = 0; r < FV_REGION_COUNT; r++) {
-            fv_metric_values *v = &res->error.region[r];
-            v->psnr = v->mse > 0.0 ? 10.0 * log10(1.0 / v->mse) : v->mse == 0.0 ? INFINITY : NAN;
-        }
+        for (int k = -1; k < sc->nextra; k++)
+            for (int r = 0; r < FV_REGION_COUNT; r++) {
+                fv_metric_values *v = k < 0 ? &res->error.region[r] : &res->error_vs[k].region[r];
+                v->psnr = v->mse > 0.0 ? 10.0 * log10(1.0 / v->mse) : v->mse == 0.0 ? INFINITY : NAN;
+            }
         if (c.temporal) {
             res->has_temporal = true;
             for (int r = 0; r < FV_REGION_COUNT; r++)
@@ -438,8 +456,8 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
         sc->nmethods);
     if ((st = fv_scene_load(sc->scene, opt->log, &scene, err)) != FV_OK) goto done;
     /* Every method's parameters are checked before anything is rendered. */
-    for (int i = -1; i < sc->nmethods && st == FV_OK; i++) {
-        const fv_bench_method *m = i < 0 ? &sc->reference : &sc->methods[i];
+    for (int i = -1 - sc->nextra; i < sc->nmethods && st == FV_OK; i++) {
+        const fv_bench_method *m = i >= 0 ? &sc->methods[i] : i == -1 ? &sc->reference : &sc->extra[-2 - i];
         fv_params *p = NULL;
         fv_technique *t = NULL;
         if ((st = fv_params_clone(m->params, &p, err)) == FV_OK && (st = fv_technique_create(m->method, scene, p, opt->log, &t, err)) != FV_OK)
@@ -461,20 +479,24 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
         if (sc->ncam_keys) fv_camera_path_eval(&cpath, f->time, &f->cam, &f->cam);
         fv_gaze_path_eval(sc->gaze, f->time, &f->gaze, NULL);
         f->labels = fv_alloc_array(npix, 1);
-        f->ref = fv_alloc_array(npix, 3 * sizeof(float));
-        if (!f->labels || !f->ref) {
+        bool ok = f->labels != NULL;
+        for (int k = 0; k <= sc->nextra; k++) ok = ok && (f->ref[k] = fv_alloc_array(npix, 3 * sizeof(float))) != NULL;
+        if (!ok) {
             st = fv_error_set(err, FV_ERR_NOMEM, "out of memory for %d frames of %dx%d", sc->frames, sc->width, sc->height);
             goto done;
         }
         fv_eye_region_labels(&sc->eye, f->gaze, f->labels);
     }
-    if ((st = load_references(&info, scene, frames, cache_dir, err)) != FV_OK) goto done;
+    if ((st = load_references(&info, scene, frames, cache_dir, 0, &info.ref_cached, &info.ref_ms, err)) != FV_OK) goto done;
+    for (int k = 0; k < sc->nextra && st == FV_OK; k++)
+        st = load_references(&info, scene, frames, cache_dir, 1 + k, &info.extra_cached[k], &info.extra_ms[k], err);
+    if (st != FV_OK) goto done;
     snprintf(info.ref_img, sizeof info.ref_img, "%s/reference.png", sc->name);
     info.last_gaze = frames[sc->frames - 1].gaze;
     {
         char p[4096 + 160];
         snprintf(p, sizeof p, "%s/%s", info.out_dir, info.ref_img);
-        if ((st = fv_image_write(p, frames[sc->frames - 1].ref, sc->width, sc->height, sc->exposure, err)) != FV_OK) goto done;
+        if ((st = fv_image_write(p, frames[sc->frames - 1].ref[0], sc->width, sc->height, sc->exposure, err)) != FV_OK) goto done;
     }
 
     nrows = sc->nmethods + sc->nmatches;
@@ -498,7 +520,7 @@ done:
     if (frames)
         for (int i = 0; i < sc->frames; i++) {
             free(frames[i].labels);
-            free(frames[i].ref);
+            for (int k = 0; k <= sc->nextra; k++) free(frames[i].ref[k]);
         }
     free(frames);
     if (res)

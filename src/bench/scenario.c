@@ -246,7 +246,7 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
 {
     static const char *const keys[] = {"name", "description", "scene", "size", "frames", "fps", "start_time", "repeats",
                                        "exposure", "seed", "eye", "gaze", "camera_path", "reference", "baseline", "methods",
-                                       "sweep", "match", "quick", "full", NULL};
+                                       "sweep", "match", "extra_references", "quick", "full", NULL};
     fv_status st = fv_json_check_keys(root, keys, file, "", err);
     if (st != FV_OK) return st;
     const char *name = NULL, *desc = NULL, *scene = NULL, *baseline = NULL;
@@ -303,6 +303,21 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
     if ((st = parse_method(cJSON_GetObjectItemCaseSensitive(root, "reference"), file, "reference", false, &s->reference, err)))
         return st;
     snprintf(s->reference.label, sizeof s->reference.label, "reference");
+    const cJSON *ex = cJSON_GetObjectItemCaseSensitive(root, "extra_references");
+    if (ex) {
+        int n = cJSON_GetArraySize(ex);
+        if (!cJSON_IsArray(ex) || n > FV_BENCH_MAX_EXTRA)
+            return fv_error_set(err, FV_ERR_INVALID, "%s: extra_references: expected an array of at most %d references", file, FV_BENCH_MAX_EXTRA);
+        int k = 0;
+        for (const cJSON *e = ex->child; e; e = e->next, k++) {
+            char where[40];
+            snprintf(where, sizeof where, "extra_references[%d]", k);
+            if ((st = parse_method(e, file, where, true, &s->extra[k], err)) != FV_OK) return st;
+            s->nextra++;
+            if (!strcmp(s->extra[k].label, "reference"))
+                return fv_error_set(err, FV_ERR_INVALID, "%s: %s.label: 'reference' is taken", file, where);
+        }
+    }
 
     int cap = 0;
     const cJSON *methods = cJSON_GetObjectItemCaseSensitive(root, "methods");
@@ -397,6 +412,7 @@ void fv_scenario_destroy(fv_scenario *s)
     for (int i = 0; i < s->nmatches; i++) fv_params_destroy(s->matches[i].base.params);
     free(s->matches);
     fv_params_destroy(s->reference.params);
+    for (int i = 0; i < s->nextra; i++) fv_params_destroy(s->extra[i].params);
     fv_gaze_path_destroy(s->gaze);
     free(s->methods);
     free(s->cam_keys);

@@ -8,6 +8,7 @@
 #include "fovea/technique.h"
 
 #define FV_BENCH_LABEL_MAX 64
+#define FV_BENCH_MAX_EXTRA 4   /* extra references a scenario may measure errors against */
 
 typedef struct fv_bench_method {
     char label[FV_BENCH_LABEL_MAX];
@@ -47,6 +48,8 @@ typedef struct fv_scenario {
     fv_camera_key *cam_keys; /* optional camera path overriding the scene's */
     int ncam_keys;
     fv_bench_method reference;
+    fv_bench_method extra[FV_BENCH_MAX_EXTRA]; /* "extra_references": more errors, e.g. against pt */
+    int nextra;
     char baseline[FV_BENCH_LABEL_MAX]; /* label of the method speed-ups are relative to */
     fv_bench_method *methods;          /* listed methods, then the sweep's */
     int nmethods;

@@ -46,4 +46,13 @@ expect 2 "unknown parameter 'sp'" -- $B "$TMP/bad5.json" --out "$OUT" --quiet
 printf '{"scene": "cornell", "reference": {"method": "pt"}, "methods": [{"method": "pt"}], "size": [100000, 8]}' > "$TMP/bad6.json"
 expect 2 "size" -- $B "$TMP/bad6.json" --out "$OUT"
 expect 0 "" -- $B pt-cornell --check
+
+# A second reference: every row also reports its error against it.
+printf '{"scene": "cornell", "size": [16, 16], "repeats": 1, "reference": {"method": "pt", "params": {"spp": 16}},
+ "extra_references": [{"label": "pt-hi", "method": "pt", "params": {"spp": 32}}], "methods": [{"method": "pt", "params": {"spp": 1}}]}' > "$TMP/extra.json"
+expect 0 "" -- $B "$TMP/extra.json" --out "$OUT" --quiet
+python3 -c 'import json,sys; r=json.load(open(sys.argv[1]))["results"][0]; e=r["error_vs"]["pt-hi"]; assert e["all"]["mse"] > 0 and e["fovea"]["pixels"] if "pixels" in e["fovea"] else True' "$OUT/extra.json" \
+  || fail "no error_vs block in extra.json"
+printf '{"scene": "cornell", "reference": {"method": "pt"}, "extra_references": [{"label": "reference", "method": "pt"}], "methods": [{"method": "pt"}]}' > "$TMP/bad7.json"
+expect 2 "'reference' is taken" -- $B "$TMP/bad7.json" --out "$OUT"
 finish
