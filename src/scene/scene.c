@@ -535,6 +535,37 @@ static RTCScene pick(const fv_scene *s, fv_trace_set set)
     }
 }
 
+/* An fv_hit from what Embree reported. */
+static void fill_hit(const fv_scene *s, unsigned geom, unsigned prim_id, unsigned inst, float u, float v, fv_vec3 ng, float t, fv_vec3 o,
+                     fv_vec3 d, fv_hit *hit)
+{
+    /* Static triangles are found directly or through the static instance; dynamic ones through
+     * their own instance, whose id is the object index. */
+    int obj = (inst == RTC_INVALID_GEOMETRY_ID || inst == s->static_inst_id) ? (int)geom : (int)inst;
+    const fv_object *ob = &s->objs[obj];
+    int prim = (int)prim_id;
+    const uint32_t *ix = &ob->idx[3 * prim];
+    /* Embree's geometric normal (object space, as wound: (v1 - v0) x (v2 - v0)) saves reading the
+     * vertices back. */
+    if (ob->dynamic) ng = fv_xform_normal(&ob->inv, ng);
+    hit->ng = fv_normalize(ng);
+    hit->ns = hit->ng; /* flat shading unless the mesh has vertex normals */
+    if (ob->nrm) {
+        fv_vec3 n = fv_add(fv_add(fv_scale(ob->nrm[ix[0]], 1.0f - u - v), fv_scale(ob->nrm[ix[1]], u)), fv_scale(ob->nrm[ix[2]], v));
+        if (ob->dynamic) n = fv_xform_normal(&ob->inv, n);
+        float len = fv_length(n);
+        if (len > 1e-6f) hit->ns = fv_scale(n, 1.0f / len);
+        if (fv_dot(hit->ns, hit->ng) < 0.0f) hit->ns = fv_neg(hit->ns);
+    }
+    hit->t = t;
+    hit->p = fv_madd(o, d, t);
+    hit->obj = obj;
+    hit->prim = prim;
+    hit->mat = ob->mat[prim];
+    hit->u = u;
+    hit->v = v;
+}
+
 bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax, fv_hit *hit)
 {
     RTCScene scn = pick(s, set);
@@ -559,35 +590,47 @@ bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 
     rtcIntersect1(scn, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
-    unsigned inst = rh.hit.instID[0];
-    /* Static triangles are found directly or through the static instance; dynamic ones through
-     * their own instance, whose id is the object index. */
-    int obj = (inst == RTC_INVALID_GEOMETRY_ID || inst == s->static_inst_id) ? (int)rh.hit.geomID : (int)inst;
-    const fv_object *ob = &s->objs[obj];
-    int prim = (int)rh.hit.primID;
-    const uint32_t *ix = &ob->idx[3 * prim];
-    float u = rh.hit.u, v = rh.hit.v;
-    /* Embree's geometric normal (object space, as wound: (v1 - v0) x (v2 - v0)) saves reading the
-     * vertices back. */
-    fv_vec3 ng = fv_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-    if (ob->dynamic) ng = fv_xform_normal(&ob->inv, ng);
-    hit->ng = fv_normalize(ng);
-    hit->ns = hit->ng; /* flat shading unless the mesh has vertex normals */
-    if (ob->nrm) {
-        fv_vec3 n = fv_add(fv_add(fv_scale(ob->nrm[ix[0]], 1.0f - u - v), fv_scale(ob->nrm[ix[1]], u)), fv_scale(ob->nrm[ix[2]], v));
-        if (ob->dynamic) n = fv_xform_normal(&ob->inv, n);
-        float len = fv_length(n);
-        if (len > 1e-6f) hit->ns = fv_scale(n, 1.0f / len);
-        if (fv_dot(hit->ns, hit->ng) < 0.0f) hit->ns = fv_neg(hit->ns);
-    }
-    hit->t = rh.ray.tfar;
-    hit->p = fv_madd(o, d, rh.ray.tfar);
-    hit->obj = obj;
-    hit->prim = prim;
-    hit->mat = ob->mat[prim];
-    hit->u = u;
-    hit->v = v;
+    fill_hit(s, rh.hit.geomID, rh.hit.primID, rh.hit.instID[0], rh.hit.u, rh.hit.v, fv_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z),
+             rh.ray.tfar, o, d, hit);
     return true;
+}
+
+int fv_scene_intersect8(const fv_scene *s, fv_vec3 o, const fv_vec3 *d, int n, fv_hit *hits, bool *ok)
+{
+    /* A packet of camera rays sharing one origin: coherent, so Embree traverses them together. */
+    struct RTCRayHit8 rh __attribute__((aligned(32)));
+    int valid[8] __attribute__((aligned(32)));
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (int i = 0; i < 8; i++) {
+        valid[i] = i < n ? -1 : 0;
+        fv_vec3 di = d[i < n ? i : 0];
+        rh.ray.org_x[i] = o.x;
+        rh.ray.org_y[i] = o.y;
+        rh.ray.org_z[i] = o.z;
+        rh.ray.dir_x[i] = di.x;
+        rh.ray.dir_y[i] = di.y;
+        rh.ray.dir_z[i] = di.z;
+        rh.ray.tnear[i] = 0.0f;
+        rh.ray.tfar[i] = INFINITY;
+        rh.ray.time[i] = 0.0f;
+        rh.ray.mask[i] = 0xffffffffu;
+        rh.ray.id[i] = (unsigned)i;
+        rh.ray.flags[i] = 0;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, s->rtc_all, &ctx, &rh);
+    int count = 0;
+    for (int i = 0; i < n; i++) {
+        ok[i] = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+        if (!ok[i]) continue;
+        fill_hit(s, rh.hit.geomID[i], rh.hit.primID[i], rh.hit.instID[0][i], rh.hit.u[i], rh.hit.v[i],
+                 fv_v3(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]), rh.ray.tfar[i], o, d[i], &hits[i]);
+        count++;
+    }
+    return count;
 }
 
 bool fv_scene_occluded(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax)

@@ -93,6 +93,9 @@ typedef struct fv_hit {
 
 /* Closest hit along o + t d, t in (eps, tmax). d need not be unit (t is then in units of d). */
 bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax, fv_hit *hit);
+/* Closest hits of n <= 8 camera rays from one origin (all geometry, no distance limit), traced as
+ * one coherent packet; ok[i] says whether ray i hit. Returns the number of hits. */
+int fv_scene_intersect8(const fv_scene *s, fv_vec3 o, const fv_vec3 *d, int n, fv_hit *hits, bool *ok);
 /* Any hit in (eps, tmax). */
 bool fv_scene_occluded(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax);
 /* True when nothing blocks the segment from surface point p (geometric normal ng, either side)

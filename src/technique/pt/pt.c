@@ -28,6 +28,12 @@ static float mis_weight(float a, float b) { return a / (a + b); }
 fv_vec3 fv_pt_trace(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_vec3 d, fv_rng *rng,
                     fv_pt_first_hit *first, uint64_t *rays)
 {
+    return fv_pt_trace_from(s, opt, o, d, NULL, false, rng, first, rays);
+}
+
+fv_vec3 fv_pt_trace_from(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_vec3 d, const fv_hit *pre, bool pre_ok, fv_rng *rng,
+                         fv_pt_first_hit *first, uint64_t *rays)
+{
     fv_vec3 L = fv_v3s(0.0f), beta = fv_v3s(1.0f);
     bool delta_prev = true;
     float pdf_prev = 1.0f;
@@ -36,7 +42,12 @@ fv_vec3 fv_pt_trace(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_v
     for (int depth = 1; depth <= opt->max_depth; depth++) {
         fv_hit h;
         nrays++;
-        if (!fv_scene_intersect(s, FV_TRACE_ALL, o, d, INFINITY, &h)) break;
+        if (depth == 1 && pre) {
+            if (!pre_ok) break;
+            h = *pre;
+        } else if (!fv_scene_intersect(s, FV_TRACE_ALL, o, d, INFINITY, &h)) {
+            break;
+        }
         const fv_material *m = &s->mats[h.mat];
         fv_vec3 wo = fv_neg(d);
         if (depth == 1 && first) {
@@ -143,6 +154,9 @@ typedef struct pt_job {
     } counters[FV_MAX_THREADS];
 } pt_job;
 
+/* Pixels go eight at a time: their camera rays share an origin and a direction, so Embree traces
+ * them as one packet; the rest of each path is traced alone. Each pixel keeps its own random
+ * stream, so the image does not depend on the packing. */
 static void pt_tile(void *ctx, const fv_tile *tile)
 {
     pt_job *j = ctx;
@@ -150,31 +164,47 @@ static void pt_tile(void *ctx, const fv_tile *tile)
     const int w = j->cam.width;
     uint64_t rays = 0, bad = 0;
     for (int y = tile->y0; y < tile->y1; y++) {
-        for (int x = tile->x0; x < tile->x1; x++) {
-            size_t pix = (size_t)y * (size_t)w + (size_t)x;
-            fv_vec3 sum = fv_v3s(0.0f);
-            fv_pt_first_hit first = {0};
+        for (int x0 = tile->x0; x0 < tile->x1; x0 += 8) {
+            int n = tile->x1 - x0 < 8 ? tile->x1 - x0 : 8;
+            fv_vec3 sum[8], dir[8];
+            fv_pt_first_hit first[8];
+            fv_rng rng[8];
+            fv_hit hits[8];
+            bool ok[8];
+            memset(first, 0, sizeof first);
+            for (int k = 0; k < n; k++) sum[k] = fv_v3s(0.0f);
             for (int sidx = 0; sidx < opt->spp; sidx++) {
-                /* The eye is folded into the pixel index so both eyes get independent noise. */
-                fv_rng rng = fv_rng_make(j->frame->seed, pix * 2 + (size_t)j->eye, (uint64_t)sidx, (uint64_t)j->frame->index);
-                float jx = fv_rng_next(&rng), jy = fv_rng_next(&rng);
-                fv_vec3 dir = fv_camera_dir(&j->cam, (float)x + jx, (float)y + jy);
-                fv_vec3 L = fv_pt_trace(j->st->scene, opt, j->cam.pos, dir, &rng, sidx == 0 ? &first : NULL, &rays);
-                if (!fv_is_finite3(L)) { /* the NaN/Inf guard: count it, keep it off the film */
-                    bad++;
-                    continue;
+                for (int k = 0; k < n; k++) {
+                    size_t pix = (size_t)y * (size_t)w + (size_t)(x0 + k);
+                    /* The eye is folded into the pixel index so both eyes get independent noise. */
+                    rng[k] = fv_rng_make(j->frame->seed, pix * 2 + (size_t)j->eye, (uint64_t)sidx, (uint64_t)j->frame->index);
+                    float jx = fv_rng_next(&rng[k]), jy = fv_rng_next(&rng[k]);
+                    dir[k] = fv_camera_dir(&j->cam, (float)(x0 + k) + jx, (float)y + jy);
                 }
-                sum = fv_add(sum, L);
+                fv_scene_intersect8(j->st->scene, j->cam.pos, dir, n, hits, ok);
+                for (int k = 0; k < n; k++) {
+                    fv_vec3 L = fv_pt_trace_from(j->st->scene, opt, j->cam.pos, dir[k], &hits[k], ok[k], &rng[k], sidx == 0 ? &first[k] : NULL,
+                                                 &rays);
+                    if (!fv_is_finite3(L)) { /* the NaN/Inf guard: count it, keep it off the film */
+                        bad++;
+                        continue;
+                    }
+                    sum[k] = fv_add(sum[k], L);
+                }
             }
-            sum = fv_scale(sum, 1.0f / (float)opt->spp);
-            j->color[3 * pix] = sum.x;
-            j->color[3 * pix + 1] = sum.y;
-            j->color[3 * pix + 2] = sum.z;
-            if (j->depth) j->depth[pix] = first.hit ? first.t : INFINITY;
-            if (j->normal) memcpy(&j->normal[3 * pix], first.hit ? &first.n : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
-            if (j->albedo) memcpy(&j->albedo[3 * pix], first.hit ? &first.albedo : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
-            if (j->position) memcpy(&j->position[3 * pix], first.hit ? &first.p : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
-            if (j->id) j->id[pix] = first.hit ? (uint32_t)first.obj + 1u : 0u;
+            for (int k = 0; k < n; k++) {
+                size_t pix = (size_t)y * (size_t)w + (size_t)(x0 + k);
+                fv_vec3 v = fv_scale(sum[k], 1.0f / (float)opt->spp);
+                const fv_pt_first_hit *f = &first[k];
+                j->color[3 * pix] = v.x;
+                j->color[3 * pix + 1] = v.y;
+                j->color[3 * pix + 2] = v.z;
+                if (j->depth) j->depth[pix] = f->hit ? f->t : INFINITY;
+                if (j->normal) memcpy(&j->normal[3 * pix], f->hit ? &f->n : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
+                if (j->albedo) memcpy(&j->albedo[3 * pix], f->hit ? &f->albedo : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
+                if (j->position) memcpy(&j->position[3 * pix], f->hit ? &f->p : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
+                if (j->id) j->id[pix] = f->hit ? (uint32_t)f->obj + 1u : 0u;
+            }
         }
     }
     j->counters[tile->thread].rays += rays;

@@ -28,5 +28,9 @@ fv_status fv_pt_read_options(fv_params *p, fv_pt_options *opt, fv_error *err);
  * *rays (optional) is increased by the number of rays cast. */
 fv_vec3 fv_pt_trace(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_vec3 d, fv_rng *rng,
                     fv_pt_first_hit *first, uint64_t *rays);
+/* The same when the first hit is already known (pre; pre_ok false: the ray missed), as for
+ * camera rays traced in packets. */
+fv_vec3 fv_pt_trace_from(const fv_scene *s, const fv_pt_options *opt, fv_vec3 o, fv_vec3 d, const fv_hit *pre, bool pre_ok, fv_rng *rng,
+                         fv_pt_first_hit *first, uint64_t *rays);
 
 #endif
