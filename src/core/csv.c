@@ -1,4 +1,7 @@
 /* fovea — numeric CSV lines (see csv.h). */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/csv.h"
@@ -23,4 +26,41 @@ fv_csv_kind fv_csv_line(const char *line, bool before_rows, double *v, int max, 
     }
     /* Not a row of numbers: a header is allowed once, before the samples, and has no digits. */
     return before_rows && !strpbrk(line, "0123456789") ? FV_CSV_HEADER : FV_CSV_BAD;
+}
+
+fv_status fv_csv_read(const char *path, const char *what, int max, const char *expect, fv_csv_row_fn row, void *ctx, fv_error *err)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) return fv_error_set(err, FV_ERR_IO, "cannot open %s '%s': %s", what, path, strerror(errno));
+    char *line = NULL;
+    size_t cap = 0;
+    int lineno = 0, rows = 0;
+    bool before = true;
+    double prev = 0.0, v[32];
+    if (max > 32) max = 32;
+    fv_status st = FV_OK;
+    while (st == FV_OK && getline(&line, &cap, f) >= 0) {
+        lineno++;
+        int n = 0;
+        fv_csv_kind kind = fv_csv_line(line, before, v, max, &n);
+        if (kind == FV_CSV_SKIP) continue;
+        before = false;
+        if (kind == FV_CSV_HEADER) continue;
+        if (kind == FV_CSV_BAD) {
+            st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: expected %s", path, lineno, expect);
+        } else if (!isfinite(v[0])) {
+            st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: time must be finite", path, lineno);
+        } else if (rows > 0 && !(v[0] > prev)) {
+            st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: time %g does not increase (previous %g)", path, lineno, v[0], prev);
+        } else {
+            st = row(ctx, v, n, path, lineno, err);
+            prev = v[0];
+            rows++;
+        }
+    }
+    if (st == FV_OK && ferror(f)) st = fv_error_set(err, FV_ERR_IO, "cannot read %s '%s': %s", what, path, strerror(errno));
+    if (st == FV_OK && rows == 0) st = fv_error_set(err, FV_ERR_INVALID, "%s: the %s has no samples", path, what);
+    free(line);
+    fclose(f);
+    return st;
 }

@@ -5,11 +5,22 @@
 #define FV_CORE_CSV_H
 
 #include <stdbool.h>
+#include "fovea/status.h"
 
 typedef enum fv_csv_kind { FV_CSV_SKIP = 0, FV_CSV_HEADER, FV_CSV_ROW, FV_CSV_BAD } fv_csv_kind;
 
 /* Classifies one line; for a row, the numbers go to v (at most max) and their count to *n.
  * `before_rows` says no sample or header has been seen yet (only then is a header accepted). */
 fv_csv_kind fv_csv_line(const char *line, bool before_rows, double *v, int max, int *n);
+
+/* Called for each sample line with its numbers (v[0] is the time, finite and increasing: the
+ * reader checks it); returns FV_OK or an error naming path:line. */
+typedef fv_status (*fv_csv_row_fn)(void *ctx, const double *v, int n, const char *path, int line, fv_error *err);
+
+/* Reads a trace file line by line: comments, blank lines and one header are skipped; a line that is
+ * not a row of at most `max` numbers fails with "path:line: expected <expect>"; a time that is not
+ * finite or does not increase fails too; so does a file without samples. `what` names the file
+ * in messages ("gaze trace"). */
+fv_status fv_csv_read(const char *path, const char *what, int max, const char *expect, fv_csv_row_fn row, void *ctx, fv_error *err);
 
 #endif

@@ -93,66 +93,34 @@ void fv_gaze_path_eval(const fv_gaze_path *p, double t, fv_gaze *left, fv_gaze *
     if (right) *right = lerp_gaze(a->right, b->right, u);
 }
 
+typedef struct gaze_rows {
+    fv_gaze_key *keys;
+    int n, cap, columns;
+} gaze_rows;
+
+static fv_status gaze_row(void *ctx, const double *v, int c, const char *path, int line, fv_error *err)
+{
+    gaze_rows *g = ctx;
+    if (c != 3 && c != 5) return fv_error_set(err, FV_ERR_INVALID, "%s:%d: expected 'time,x,y' or 'time,xl,yl,xr,yr' numbers", path, line);
+    if (g->columns && c != g->columns)
+        return fv_error_set(err, FV_ERR_INVALID, "%s:%d: %d columns where earlier lines have %d", path, line, c, g->columns);
+    g->columns = c;
+    fv_gaze_key k;
+    k.time = v[0];
+    k.left = (fv_gaze){(float)v[1], (float)v[2]};
+    k.right = c == 5 ? (fv_gaze){(float)v[3], (float)v[4]} : k.left;
+    if (!gaze_ok(k.left) || !gaze_ok(k.right))
+        return fv_error_set(err, FV_ERR_INVALID, "%s:%d: gaze coordinates must be in [0,1]", path, line);
+    if (fv_grow((void **)&g->keys, &g->cap, g->n + 1, sizeof *g->keys)) return fv_error_set(err, FV_ERR_NOMEM, "out of memory reading '%s'", path);
+    g->keys[g->n++] = k;
+    return FV_OK;
+}
+
 fv_status fv_gaze_path_load_csv(const char *path, fv_gaze_path **out, fv_error *err)
 {
-    FILE *f = fopen(path, "r");
-    if (!f) return fv_error_set(err, FV_ERR_IO, "cannot open gaze trace '%s': %s", path, strerror(errno));
-    fv_gaze_key *keys = NULL;
-    int n = 0, cap = 0, columns = 0, lineno = 0;
-    bool seen_data_or_header = false;
-    char *line = NULL;
-    size_t linecap = 0;
-    fv_status st = FV_OK;
-    while (getline(&line, &linecap, f) >= 0) {
-        lineno++;
-        double v[6];
-        int c = 0;
-        fv_csv_kind kind = fv_csv_line(line, !seen_data_or_header, v, 5, &c);
-        if (kind == FV_CSV_SKIP) continue;
-        if (kind == FV_CSV_HEADER) {
-            seen_data_or_header = true;
-            continue;
-        }
-        seen_data_or_header = true;
-        if (kind == FV_CSV_BAD || (c != 3 && c != 5)) {
-            st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: expected 'time,x,y' or 'time,xl,yl,xr,yr' numbers", path, lineno);
-            goto done;
-        }
-        if (columns && c != columns) {
-            st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: %d columns where earlier lines have %d", path, lineno, c, columns);
-            goto done;
-        }
-        columns = c;
-        fv_gaze_key k;
-        k.time = v[0];
-        k.left = (fv_gaze){(float)v[1], (float)v[2]};
-        k.right = c == 5 ? (fv_gaze){(float)v[3], (float)v[4]} : k.left;
-        if (!isfinite(k.time) || !gaze_ok(k.left) || !gaze_ok(k.right)) {
-            st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: time must be finite and gaze coordinates in [0,1]", path, lineno);
-            goto done;
-        }
-        if (n > 0 && !(k.time > keys[n - 1].time)) {
-            st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: time %g does not increase (previous %g)", path, lineno, k.time, keys[n - 1].time);
-            goto done;
-        }
-        if (fv_grow((void **)&keys, &cap, n + 1, sizeof *keys)) {
-            st = fv_error_set(err, FV_ERR_NOMEM, "out of memory reading '%s'", path);
-            goto done;
-        }
-        keys[n++] = k;
-    }
-    if (ferror(f)) {
-        st = fv_error_set(err, FV_ERR_IO, "cannot read gaze trace '%s': %s", path, strerror(errno));
-        goto done;
-    }
-    if (n == 0) {
-        st = fv_error_set(err, FV_ERR_INVALID, "%s: the gaze trace has no samples", path);
-        goto done;
-    }
-    st = fv_gaze_path_create_keys(keys, n, out, err);
-done:
-    free(line);
-    free(keys);
-    fclose(f);
+    gaze_rows g = {NULL, 0, 0, 0};
+    fv_status st = fv_csv_read(path, "gaze trace", 6, "'time,x,y' or 'time,xl,yl,xr,yr' numbers", gaze_row, &g, err);
+    if (st == FV_OK) st = fv_gaze_path_create_keys(g.keys, g.n, out, err);
+    free(g.keys);
     return st;
 }
