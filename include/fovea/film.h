@@ -10,6 +10,7 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include "fovea/math.h"
 #include "fovea/status.h"
 
 #ifdef __cplusplus
@@ -51,6 +52,27 @@ uint32_t *fv_film_id(fv_film *film);
 /* Read-only views: depth/normal/albedo/position by flag (NULL when absent), and the ids. */
 const float *fv_film_aux_const(const fv_film *film, fv_film_aux which);
 const uint32_t *fv_film_id_const(const fv_film *film);
+
+/* All buffers at once (absent ones NULL), for a technique's inner loop. */
+typedef struct fv_film_views {
+    float *color, *depth, *normal, *albedo, *position;
+    uint32_t *id;
+} fv_film_views;
+fv_film_views fv_film_views_of(fv_film *film);
+
+/* Writes pixel pix's auxiliary buffers (those the film has) from the first surface its camera ray
+ * met; with hit false, the "nothing" values: depth +inf, zero vectors, id 0. */
+static inline void fv_film_store_first_hit(const fv_film_views *v, size_t pix, bool hit, float t, fv_vec3 p, fv_vec3 n, fv_vec3 albedo,
+                                           int obj)
+{
+    const fv_vec3 zero = {0.0f, 0.0f, 0.0f};
+    if (!hit) p = n = albedo = zero;
+    if (v->depth) v->depth[pix] = hit ? t : INFINITY;
+    if (v->normal) v->normal[3 * pix] = n.x, v->normal[3 * pix + 1] = n.y, v->normal[3 * pix + 2] = n.z;
+    if (v->albedo) v->albedo[3 * pix] = albedo.x, v->albedo[3 * pix + 1] = albedo.y, v->albedo[3 * pix + 2] = albedo.z;
+    if (v->position) v->position[3 * pix] = p.x, v->position[3 * pix + 1] = p.y, v->position[3 * pix + 2] = p.z;
+    if (v->id) v->id[pix] = hit ? (uint32_t)obj + 1u : 0u;
+}
 
 /* ---- image files ---- */
 

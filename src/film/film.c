@@ -104,6 +104,12 @@ const float *fv_film_aux_const(const fv_film *f, fv_film_aux which)
 
 const uint32_t *fv_film_id_const(const fv_film *f) { return f->id; }
 
+fv_film_views fv_film_views_of(fv_film *f)
+{
+    fv_film_views v = {f->color, f->depth, f->normal, f->albedo, f->position, f->id};
+    return v;
+}
+
 float fv_srgb_encode(float x)
 {
     if (!(x > 0.0f)) return 0.0f;

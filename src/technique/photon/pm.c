@@ -161,9 +161,7 @@ typedef struct render_ctx {
     float gamma, norm;       /* gather radius and 1 / (pi gamma^2) */
     double eta;
     int pass;
-    float *color;            /* accumulates (passes) */
-    float *depth, *normal, *albedo, *position;
-    uint32_t *id;
+    fv_film_views out;       /* colour accumulates over passes */
     float *nbuf, *pbuf;
     int32_t *obuf;
     bool right;              /* shading the right eye: reproject from the left first */
@@ -267,7 +265,7 @@ static void render_tile(void *ctx, const fv_tile *tile)
                 shaded++;
             }
             if (!fv_is_finite3(L)) L = fv_v3s(0.0f);
-            float *col = &c->color[3 * pix];
+            float *col = &c->out.color[3 * pix];
             float wgt = 1.0f / (float)(c->pass + 1); /* running mean over passes */
             col[0] += (L.x - col[0]) * wgt;
             col[1] += (L.y - col[1]) * wgt;
@@ -275,11 +273,7 @@ static void render_tile(void *ctx, const fv_tile *tile)
             if (c->pass > 0) continue;
             bool any = h.first_obj >= 0;
             fv_vec3 zero = fv_v3s(0.0f), n = any ? h.first_n : zero, p = any ? h.first_p : zero;
-            if (c->depth) c->depth[pix] = h.first_t;
-            if (c->normal) memcpy(&c->normal[3 * pix], &n, sizeof n);
-            if (c->albedo) memcpy(&c->albedo[3 * pix], any ? &h.albedo : &zero, sizeof zero);
-            if (c->position) memcpy(&c->position[3 * pix], &p, sizeof p);
-            if (c->id) c->id[pix] = any ? (uint32_t)h.first_obj + 1u : 0u;
+            fv_film_store_first_hit(&c->out, pix, any, h.first_t, h.first_p, h.first_n, h.albedo, h.first_obj);
             if (!c->right) {
                 memcpy(&c->nbuf[3 * pix], &n, sizeof n);
                 memcpy(&c->pbuf[3 * pix], &p, sizeof p);
@@ -368,12 +362,7 @@ static fv_status render_eye_pass(pm_state *st, render_ctx *c, fv_film *film, con
     if (rc != FV_OK) return rc;
     c->gaze = gaze;
     c->right = right;
-    c->color = fv_film_color(film);
-    c->depth = fv_film_depth(film);
-    c->normal = fv_film_normal(film);
-    c->albedo = fv_film_albedo(film);
-    c->position = fv_film_position(film);
-    c->id = fv_film_id(film);
+    c->out = fv_film_views_of(film);
     memset(c->counters, 0, sizeof c->counters);
     double t0 = fv_time_ms();
     fv_parallel_tiles(cam->width, cam->height, c->frame->threads, render_tile, c, NULL, NULL);

@@ -145,8 +145,7 @@ typedef struct pt_job {
     const fv_frame *frame;
     fv_camera_basis cam;
     fv_film *film;
-    float *color, *depth, *normal, *albedo, *position;
-    uint32_t *id;
+    fv_film_views out;
     int eye;
     struct {
         uint64_t rays, bad;
@@ -196,14 +195,10 @@ static void pt_tile(void *ctx, const fv_tile *tile)
                 size_t pix = (size_t)y * (size_t)w + (size_t)(x0 + k);
                 fv_vec3 v = fv_scale(sum[k], 1.0f / (float)opt->spp);
                 const fv_pt_first_hit *f = &first[k];
-                j->color[3 * pix] = v.x;
-                j->color[3 * pix + 1] = v.y;
-                j->color[3 * pix + 2] = v.z;
-                if (j->depth) j->depth[pix] = f->hit ? f->t : INFINITY;
-                if (j->normal) memcpy(&j->normal[3 * pix], f->hit ? &f->n : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
-                if (j->albedo) memcpy(&j->albedo[3 * pix], f->hit ? &f->albedo : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
-                if (j->position) memcpy(&j->position[3 * pix], f->hit ? &f->p : &(fv_vec3){0, 0, 0}, sizeof(fv_vec3));
-                if (j->id) j->id[pix] = f->hit ? (uint32_t)f->obj + 1u : 0u;
+                j->out.color[3 * pix] = v.x;
+                j->out.color[3 * pix + 1] = v.y;
+                j->out.color[3 * pix + 2] = v.z;
+                fv_film_store_first_hit(&j->out, pix, f->hit, f->t, f->p, f->n, f->albedo, f->obj);
             }
         }
     }
@@ -236,12 +231,7 @@ static fv_status render_eye(const pt_state *st, const fv_frame *frame, const fv_
     j->frame = frame;
     j->film = film;
     j->eye = eye;
-    j->color = fv_film_color(film);
-    j->depth = fv_film_depth(film);
-    j->normal = fv_film_normal(film);
-    j->albedo = fv_film_albedo(film);
-    j->position = fv_film_position(film);
-    j->id = fv_film_id(film);
+    j->out = fv_film_views_of(film);
     pt_progress prog = {frame, (double)eye / neyes, 1.0 / neyes};
     double t0 = fv_time_ms();
     fv_parallel_tiles(cam->width, cam->height, frame->threads, pt_tile, j, frame->progress ? pt_report : NULL, &prog);
