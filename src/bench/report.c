@@ -147,6 +147,7 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     cJSON_AddItemToArray(size, cJSON_CreateNumber(sc->width));
     cJSON_AddItemToArray(size, cJSON_CreateNumber(sc->height));
     cJSON_AddNumberToObject(root, "frames", sc->frames);
+    cJSON_AddNumberToObject(root, "measure_from", sc->measure_from);
     cJSON_AddNumberToObject(root, "fps", sc->fps);
     cJSON_AddNumberToObject(root, "repeats", info->opt->repeats > 0 ? info->opt->repeats : sc->repeats);
     cJSON_AddNumberToObject(root, "threads", info->threads);
@@ -187,9 +188,9 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
     char a[32], b[32], c[32], d[32], e[32], f[32], g[32], h[32];
     tprintf(&t, "# Benchmark `%s`\n\n", sc->name);
     if (sc->description) tprintf(&t, "%s\n\n", sc->description);
-    tprintf(&t, "Scene `%s`, %dx%d, %d frame(s) at %g fps, gaze (%.2f, %.2f) at the last frame, fovea radius %.0f px, "
+    tprintf(&t, "Scene `%s`, %dx%d, %d frame(s) at %g fps (errors from frame %d on), gaze (%.2f, %.2f) at the last frame, fovea radius %.0f px, "
                 "transition %.0f px. Reference: `%s`",
-            sc->scene, sc->width, sc->height, sc->frames, sc->fps, info->last_gaze.x, info->last_gaze.y, fv_eye_fovea_radius_px(&sc->eye),
+            sc->scene, sc->width, sc->height, sc->frames, sc->fps, sc->measure_from, info->last_gaze.x, info->last_gaze.y, fv_eye_fovea_radius_px(&sc->eye),
             fv_eye_transition_radius_px(&sc->eye), sc->reference.method);
     for (int i = 0; i < fv_params_count(sc->reference.params); i++)
         tprintf(&t, " %s=%s", fv_params_key(sc->reference.params, i), fv_params_value(sc->reference.params, i));

@@ -85,7 +85,7 @@ static void reference_key(const fv_scenario *sc, const fv_bench_method *m, const
 #undef KEY
 }
 
-/* Renders frames [0, nframes) of one method with a fresh technique; calls back per frame. */
+/* Renders frames [first, nframes) of one method with a fresh technique; calls back per frame. */
 typedef struct render_job {
     const fv_scenario *sc;
     fv_scene *scene;
@@ -97,7 +97,7 @@ typedef struct render_job {
 
 typedef fv_status (*frame_fn)(void *user, int index, fv_film *film, double ms, const fv_stats *stats, fv_error *err);
 
-static fv_status render_sequence(const render_job *j, int nframes, frame_fn on_frame, void *user, fv_error *err)
+static fv_status render_sequence(const render_job *j, int first, int nframes, frame_fn on_frame, void *user, fv_error *err)
 {
     fv_params *params = NULL;
     fv_technique *t = NULL;
@@ -106,7 +106,7 @@ static fv_status render_sequence(const render_job *j, int nframes, frame_fn on_f
     if (st == FV_OK && (st = fv_technique_create(j->m->method, j->scene, params, j->log, &t, err)) != FV_OK)
         fv_error_prefix(err, "%s: ", j->m->label);
     if (st == FV_OK) st = fv_film_create(j->sc->width, j->sc->height, 0, &film, err);
-    for (int i = 0; i < nframes && st == FV_OK; i++) {
+    for (int i = first; i < nframes && st == FV_OK; i++) {
         const frame_setup *f = &j->frames[i];
         if ((st = fv_scene_set_time(j->scene, f->time, err)) != FV_OK) break;
         fv_frame fr;
@@ -116,7 +116,7 @@ static fv_status render_sequence(const render_job *j, int nframes, frame_fn on_f
         fr.seed = j->sc->seed;
         fr.threads = j->threads;
         fr.camera = &f->cam;
-        fr.prev_camera = i > 0 ? &j->frames[i - 1].cam : NULL;
+        fr.prev_camera = i > first ? &j->frames[i - 1].cam : NULL;
         fr.gaze = fr.gaze_right = f->gaze;
         fr.eye = &j->sc->eye;
         fv_stats stats;
@@ -164,12 +164,12 @@ static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene,
 {
     const fv_scenario *sc = info->sc;
     const fv_bench_method *m = slot == 0 ? &sc->reference : &sc->extra[slot - 1];
-    int n = sc->frames;
+    int n = sc->frames, first = sc->measure_from;
     char **paths = calloc((size_t)n, sizeof *paths);
     if (!paths) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_status st = FV_OK;
     int missing = 0;
-    for (int i = 0; i < n && st == FV_OK; i++) {
+    for (int i = first; i < n && st == FV_OK; i++) {
         char key[2048];
         reference_key(sc, m, &frames[i], i, key, sizeof key);
         char path[4096 + 64];
@@ -189,16 +189,17 @@ static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene,
         missing++;
     }
     if (st == FV_OK && missing > 0) {
-        /* Render the whole sequence (a temporal reference needs its history); frames already cached
-         * are simply not written again. */
-        say(info->opt, "%s: rendering %d frame(s) with %s (%d cached)", m->label, n, m->method, *cached);
+        /* Render the whole measured sequence (a temporal reference needs its history); frames
+         * already cached are simply not written again. Frames before measure_from are never
+         * compared, so they need no reference. */
+        say(info->opt, "%s: rendering %d frame(s) with %s (%d cached)", m->label, n - first, m->method, *cached);
         render_job j = {sc, scene, frames, info->threads, m, info->opt->log};
         ref_ctx c = {frames, (const char *const *)paths, slot, 0.0};
-        st = render_sequence(&j, n, on_reference_frame, &c, err);
-        *ms = c.ms / n;
+        st = render_sequence(&j, first, n, on_reference_frame, &c, err);
+        *ms = c.ms / (n - first);
         if (st != FV_OK) fv_error_prefix(err, "%s: ", m->label);
     } else if (st == FV_OK) {
-        say(info->opt, "%s: %d frame(s) from the cache", m->label, n);
+        say(info->opt, "%s: %d frame(s) from the cache", m->label, n - first);
     }
     for (int i = 0; i < n; i++) free(paths[i]);
     free(paths);
@@ -233,7 +234,8 @@ static fv_status on_method_frame(void *user, int i, fv_film *film, double ms, co
     c->ms_sum += ms;
     stats_accumulate(&c->stage_sum, stats);
     stats_accumulate(&c->counter_sum, stats);
-    if (!c->measure) return FV_OK;
+    if (!c->measure || i < sc->measure_from) return FV_OK;
+    const double nm = sc->frames - sc->measure_from; /* measured frames */
     const float *rgb = fv_film_color(film);
     fv_metric_report rep;
     fv_status st = fv_metrics_compare(c->frames[i].ref[0], rgb, sc->width, sc->height, c->frames[i].labels, &c->mopts, &rep,
@@ -246,20 +248,20 @@ static fv_status on_method_frame(void *user, int i, fv_film *film, double ms, co
         for (int r = 0; r < FV_REGION_COUNT; r++) {
             fv_metric_values *d = &c->res->error_vs[k].region[r];
             d->pixels = ex.region[r].pixels;
-            d->mse += ex.region[r].mse / sc->frames;
-            d->e += ex.region[r].e / sc->frames;
-            d->ssim += ex.region[r].ssim / sc->frames;
-            d->flip += ex.region[r].flip / sc->frames;
+            d->mse += ex.region[r].mse / nm;
+            d->e += ex.region[r].e / nm;
+            d->ssim += ex.region[r].ssim / nm;
+            d->flip += ex.region[r].flip / nm;
         }
     }
     for (int r = 0; r < FV_REGION_COUNT; r++) {
         fv_metric_values *d = &c->res->error.region[r];
         const fv_metric_values *v = &rep.region[r];
         d->pixels = v->pixels;
-        d->mse += v->mse / sc->frames;
-        d->e += v->e / sc->frames;
-        d->ssim += v->ssim / sc->frames;
-        d->flip += v->flip / sc->frames;
+        d->mse += v->mse / nm;
+        d->e += v->e / nm;
+        d->ssim += v->ssim / nm;
+        d->flip += v->flip / nm;
     }
     if (c->temporal && (st = fv_temporal_push(c->temporal, rgb, c->frames[i].labels, err)) != FV_OK) return st;
     if (i == sc->frames - 1) memcpy(c->last, rgb, (size_t)sc->width * sc->height * 3 * sizeof(float));
@@ -316,7 +318,7 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
     render_job j = {sc, scene, frames, info->threads, m, info->opt->log};
     /* One untimed frame first: thread start-up and cold caches would otherwise land in the
      * first repeat of whichever method runs first. */
-    if (st == FV_OK) st = render_sequence(&j, 1, on_warmup_frame, NULL, err);
+    if (st == FV_OK) st = render_sequence(&j, 0, 1, on_warmup_frame, NULL, err);
     for (int r = 0; r < reps && st == FV_OK; r++) {
         say(info->opt, "[%d/%d] %s: repeat %d/%d, %d frame(s)", index + 1, total, m->label, r + 1, reps, sc->frames);
         c.measure = r == reps - 1;
@@ -326,9 +328,9 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
         if (c.measure) {
             memset(&res->error, 0, sizeof res->error);
             memset(res->error_vs, 0, sizeof res->error_vs);
-            if (sc->frames > 1 && (st = fv_temporal_create(sc->width, sc->height, &c.mopts, &c.temporal, err)) != FV_OK) break;
+            if (sc->frames - sc->measure_from > 1 && (st = fv_temporal_create(sc->width, sc->height, &c.mopts, &c.temporal, err)) != FV_OK) break;
         }
-        if ((st = render_sequence(&j, sc->frames, on_method_frame, &c, err)) != FV_OK) break;
+        if ((st = render_sequence(&j, 0, sc->frames, on_method_frame, &c, err)) != FV_OK) break;
         res->ms[r] = c.ms_sum / sc->frames;
         for (int k = 0; k < c.stage_sum.n_stages; k++) {
             fv_stats_add_ms(&stage_names, c.stage_sum.stage[k].name, 0.0);

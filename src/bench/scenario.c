@@ -244,7 +244,7 @@ static fv_status parse_match(const cJSON *o, const char *file, int index, fv_sce
 
 static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_scenario *s, fv_error *err)
 {
-    static const char *const keys[] = {"name", "description", "scene", "size", "frames", "fps", "start_time", "repeats",
+    static const char *const keys[] = {"name", "description", "scene", "size", "frames", "measure_from", "fps", "start_time", "repeats",
                                        "exposure", "seed", "eye", "gaze", "camera_path", "reference", "baseline", "methods",
                                        "sweep", "match", "extra_references", "quick", "full", NULL};
     fv_status st = fv_json_check_keys(root, keys, file, "", err);
@@ -256,12 +256,15 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
         (st = fv_json_string(root, "scene", file, "", &scene, err)) || (st = fv_json_string(root, "baseline", file, "", &baseline, err)) ||
         (st = fv_json_numbers(root, "size", 2, 1, FV_FILM_MAX_DIM, file, "", size, err)) ||
         (st = fv_json_int(root, "frames", 1, 100000, file, "", &s->frames, err)) ||
+        (st = fv_json_int(root, "measure_from", 0, 100000, file, "", &s->measure_from, err)) ||
         (st = fv_json_number(root, "fps", 1e-3, 1e4, file, "", &s->fps, err)) ||
         (st = fv_json_number(root, "start_time", -1e9, 1e9, file, "", &s->start_time, err)) ||
         (st = fv_json_int(root, "repeats", 1, 1000, file, "", &s->repeats, err)) ||
         (st = fv_json_number(root, "exposure", 0, 1e9, file, "", &exposure, err)) ||
         (st = fv_json_number(root, "seed", 0, 9007199254740992.0, file, "", &seed, err)))
         return st;
+    if (s->measure_from >= s->frames)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: measure_from %d must be below frames (%d)", file, s->measure_from, s->frames);
     if (size[0] != floor(size[0]) || size[1] != floor(size[1]))
         return fv_error_set(err, FV_ERR_INVALID, "%s: size: expected two integers [width, height]", file);
     s->width = (int)size[0];

@@ -39,6 +39,7 @@ typedef struct fv_scenario {
     char *scene;             /* built-in name or a path resolved against the scenario's folder */
     int width, height;
     int frames;
+    int measure_from;        /* errors over frames [measure_from, frames): earlier ones build history */
     double fps, start_time;
     int repeats;
     float exposure;

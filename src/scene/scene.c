@@ -597,15 +597,29 @@ bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 
 
 int fv_scene_intersect8(const fv_scene *s, fv_vec3 o, const fv_vec3 *d, int n, fv_hit *hits, bool *ok)
 {
-    /* A packet of camera rays sharing one origin: coherent, so Embree traverses them together. */
+    bool active[8];
+    for (int i = 0; i < 8; i++) active[i] = i < n;
+    return fv_scene_intersect8_active(s, o, d, active, hits, ok);
+}
+
+int fv_scene_intersect8_active(const fv_scene *s, fv_vec3 o, const fv_vec3 *d, const bool *active, fv_hit *hits, bool *ok)
+{
+    /* A packet of camera rays sharing one origin: coherent, so Embree traverses them together.
+     * Inactive lanes stay in the packet and idle, as on SIMD hardware. */
     struct RTCRayHit8 rh __attribute__((aligned(32)));
     int valid[8] __attribute__((aligned(32)));
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    int first = 0;
+    while (first < 8 && !active[first]) first++;
+    if (first == 8) {
+        for (int i = 0; i < 8; i++) ok[i] = false;
+        return 0;
+    }
     for (int i = 0; i < 8; i++) {
-        valid[i] = i < n ? -1 : 0;
-        fv_vec3 di = d[i < n ? i : 0];
+        valid[i] = active[i] ? -1 : 0;
+        fv_vec3 di = d[active[i] ? i : first];
         rh.ray.org_x[i] = o.x;
         rh.ray.org_y[i] = o.y;
         rh.ray.org_z[i] = o.z;
@@ -623,8 +637,8 @@ int fv_scene_intersect8(const fv_scene *s, fv_vec3 o, const fv_vec3 *d, int n, f
     }
     rtcIntersect8(valid, s->rtc_all, &ctx, &rh);
     int count = 0;
-    for (int i = 0; i < n; i++) {
-        ok[i] = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+    for (int i = 0; i < 8; i++) {
+        ok[i] = active[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         if (!ok[i]) continue;
         fill_hit(s, rh.hit.geomID[i], rh.hit.primID[i], rh.hit.instID[0][i], rh.hit.u[i], rh.hit.v[i],
                  fv_v3(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]), rh.ray.tfar[i], o, d[i], &hits[i]);

@@ -96,6 +96,9 @@ bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 
 /* Closest hits of n <= 8 camera rays from one origin (all geometry, no distance limit), traced as
  * one coherent packet; ok[i] says whether ray i hit. Returns the number of hits. */
 int fv_scene_intersect8(const fv_scene *s, fv_vec3 o, const fv_vec3 *d, int n, fv_hit *hits, bool *ok);
+/* The same for the lanes marked in active[8] (the others idle; ok is false for them). d must hold
+ * eight directions; those of inactive lanes are not read. */
+int fv_scene_intersect8_active(const fv_scene *s, fv_vec3 o, const fv_vec3 *d, const bool *active, fv_hit *hits, bool *ok);
 /* Any hit in (eps, tmax). */
 bool fv_scene_occluded(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax);
 /* True when nothing blocks the segment from surface point p (geometric normal ng, either side)

@@ -12,9 +12,16 @@ extern const fv_technique_class fv_technique_pt;
 extern const fv_technique_class fv_technique_pm;
 extern const fv_technique_class fv_technique_pm_t;
 extern const fv_technique_class fv_technique_fpm;
+extern const fv_technique_class fv_technique_vpolar;
+extern const fv_technique_class fv_technique_cartesian;
+extern const fv_technique_class fv_technique_cartesian_full;
+extern const fv_technique_class fv_technique_linear_falloff;
+extern const fv_technique_class fv_technique_logpolar;
 
 static const fv_technique_class *const k_classes[] = {
-    &fv_technique_pt, &fv_technique_pm, &fv_technique_pm_t, &fv_technique_fpm,
+    &fv_technique_pt,       &fv_technique_pm,        &fv_technique_pm_t,           &fv_technique_fpm,
+    &fv_technique_vpolar,   &fv_technique_cartesian, &fv_technique_cartesian_full, &fv_technique_linear_falloff,
+    &fv_technique_logpolar,
 };
 
 #define N_CLASSES ((int)(sizeof k_classes / sizeof k_classes[0]))

@@ -1,0 +1,87 @@
+/* fovea — spatiotemporal variance-guided filtering (SVGF: Schied, Kaplanyan, Wyman et al., HPG
+ * 2017), the real-time denoiser of 1-sample-per-pixel path tracing, on any fv_grid: screen space
+ * for the Cartesian baselines, Visual-Polar or log-polar space for the foveated techniques
+ * (Visual-Polar Sec. 3.3: wrap-around on φ, clamp on ρ, columns of different heights).
+ *
+ * One call per frame:
+ *  1. demodulate: illumination = colour / albedo (albedo below 1e-3 counts as 1), so texture and
+ *     material colour are not blurred;
+ *  2. temporal accumulation: each pixel fetches its history at prev_coord (continuous coordinates in
+ *     the previous frame's grid, computed by the caller through its own reprojection and
+ *     screen-to-grid map) with a bilinear lookup; a tap counts only if it is consistent (same object
+ *     id, normals within ~25 degrees, world positions within a depth-relative distance) and the
+ *     weights of the consistent taps are renormalised. Colour and the first two luminance moments
+ *     are blended with weight max(alpha, 1 / (history length + 1));
+ *  3. variance: from the temporal moments when the history is at least 4 frames long, otherwise
+ *     from a 7x7 spatial bilateral estimate of the moments;
+ *  4. edge-avoiding À-Trous: `iterations` passes of the 5x5 B3 kernel with taps 2^i apart, weights
+ *     w_z = exp(-|z_p - z_q| / (sigma_depth |grad z . (p - q)| + eps)),
+ *     w_n = max(0, n_p . n_q)^sigma_normal,
+ *     w_l = exp(-|l_p - l_q| / (sigma_lum sqrt(gauss3x3(var_p)) + eps)),
+ *     and the variance filtered alongside with the squared weights. The output of the first pass is
+ *     what the next frame reprojects (the paper's choice);
+ *  5. remodulate by the albedo.
+ *
+ * Pixels without a surface (zero normal, e.g. the background) and rows beyond a column's height are
+ * left as they are and never used as taps. Pixels marked 0 in `sampled` (no path this frame: linear
+ * fall-off's killed rays) have no colour and no features and keep no history: after the last pass
+ * each takes the B3-kernel-weighted average (no edge-stopping: its own features are unknown) of the
+ * filtered sampled surface pixels among its 5x5 taps 1 apart, or if there are none 2 apart, then
+ * 4, ... up to 2^(iterations-1) (at least 1); beyond that it stays black.
+ *
+ * Limits: one colour buffer (direct and indirect light are not separated as in the paper); no
+ * adaptive temporal weights (A-SVGF); results independent of the thread count.
+ */
+#ifndef FV_FILTER_SVGF_H
+#define FV_FILTER_SVGF_H
+
+#include <stdint.h>
+#include "filter/grid.h"
+#include "fovea/status.h"
+
+typedef struct fv_svgf_opts {
+    float alpha_color;    /* 0.2: lowest weight of the new sample in the colour average */
+    float alpha_moments;  /* 0.2: the same for the moments */
+    int iterations;       /* 5 À-Trous passes (taps 1, 2, 4, 8, 16 apart) */
+    float sigma_depth;    /* 1 */
+    float sigma_normal;   /* 128: exponent on the normals' cosine */
+    float sigma_lum;      /* 4: luminance edge-stopping, in standard deviations */
+} fv_svgf_opts;
+
+void fv_svgf_opts_default(fv_svgf_opts *o);
+/* Every field finite and in range (alphas in (0, 1], iterations 0..10, sigmas > 0): FV_ERR_INVALID
+ * naming the field otherwise. */
+fv_status fv_svgf_opts_validate(const fv_svgf_opts *o, fv_error *err);
+
+/* The filter and its history for one grid. The grid is copied; its col_h array is not and must
+ * outlive the filter. */
+typedef struct fv_svgf fv_svgf;
+
+fv_status fv_svgf_create(const fv_grid *grid, const fv_svgf_opts *o, fv_svgf **out, fv_error *err);
+void fv_svgf_destroy(fv_svgf *f);
+/* Forgets the history (the next frame starts a new sequence). */
+void fv_svgf_reset(fv_svgf *f);
+
+/* One frame's buffers, all on the filter's grid (storage w * h pixels). */
+typedef struct fv_svgf_frame {
+    float *color;              /* 3 per pixel: in the noisy radiance, out the filtered radiance */
+    const float *albedo;       /* 3 per pixel */
+    const float *normal;       /* 3 per pixel, unit; zero vector: no surface */
+    const float *depth;        /* 1 per pixel: distance along the camera ray */
+    const float *position;     /* 3 per pixel: world position of the first hit */
+    const uint32_t *id;        /* 1 per pixel: object id + 1, 0 for none */
+    const float *prev_coord;   /* 2 per pixel: (X, V) in the previous frame's grid, NaN when the
+                                  point was not seen then; NULL: no history for this frame */
+    const uint8_t *sampled;    /* NULL: every pixel was sampled; else 0 where no path was traced */
+} fv_svgf_frame;
+
+/* Statistics of the last frame, for the technique's counters. */
+typedef struct fv_svgf_info {
+    double history_fraction;   /* sampled surface pixels that found a consistent history */
+    double mean_history;       /* their mean history length, in frames */
+} fv_svgf_info;
+
+/* Filters fr->color in place. threads 0 = all. FV_ERR_INVALID for missing buffers. */
+fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_svgf_info *info, fv_error *err);
+
+#endif

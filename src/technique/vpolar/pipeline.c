@@ -1,0 +1,290 @@
+/* fovea — the Visual-Polar frame pipeline for one eye (see pipeline.h).
+ *
+ * Reprojection for the denoiser's history (Sec. 3.3, "Temporal accumulation"): each sample's first
+ * hit is projected into the previous frame's camera and the resulting screen position is mapped
+ * into the previous frame's sample space (the previous gaze's view), where SVGF fetches its history
+ * bilinearly. Static geometry reprojects exactly; a moving object's samples fail the denoiser's
+ * position test and restart their history (no motion vectors).
+ */
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "core/parallel.h"
+#include "filter/blur.h"
+#include "filter/phi_mips.h"
+#include "technique/vpolar/pipeline.h"
+
+#define MAX_MIP_LEVELS 12
+
+struct fv_vp_pipeline {
+    const fv_scene *scene;
+    fv_vp_opts o;
+    int sw, sh;             /* screen size the buffers are for, 0 before the first frame */
+    double ppd;
+    fv_space *space;
+    fv_svgf *svgf;
+    fv_phi_mips *mips;
+    fv_vp_gbuf g;
+    float *prev_coord;
+    float *sigma;           /* per screen pixel */
+    uint32_t *perm;
+    long nperm;
+    bool have_prev;
+    fv_camera_basis prev_cam;
+    fv_space_view prev_view;
+    bool have_image;
+};
+
+fv_status fv_vp_pipeline_create(const fv_scene *scene, const fv_vp_opts *o, fv_vp_pipeline **out, fv_error *err)
+{
+    *out = NULL;
+    fv_status s = fv_svgf_opts_validate(&o->svgf, err);
+    if (s != FV_OK) return s;
+    fv_vp_pipeline *p = calloc(1, sizeof *p);
+    if (!p) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    p->scene = scene;
+    p->o = *o;
+    *out = p;
+    return FV_OK;
+}
+
+static void free_buffers(fv_vp_pipeline *p)
+{
+    fv_space_destroy(p->space);
+    fv_svgf_destroy(p->svgf);
+    fv_phi_mips_destroy(p->mips);
+    free(p->g.color), free(p->g.albedo), free(p->g.normal), free(p->g.depth), free(p->g.position), free(p->g.id);
+    free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm);
+    memset(&p->g, 0, sizeof p->g);
+    p->space = NULL, p->svgf = NULL, p->mips = NULL, p->prev_coord = NULL, p->sigma = NULL, p->perm = NULL;
+    p->sw = p->sh = 0;
+    p->have_prev = p->have_image = false;
+}
+
+void fv_vp_pipeline_destroy(fv_vp_pipeline *p)
+{
+    if (!p) return;
+    free_buffers(p);
+    free(p);
+}
+
+/* (Re)builds the space and every buffer for a sw x sh screen. */
+static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *eye, uint64_t seed, fv_error *err)
+{
+    free_buffers(p);
+    p->ppd = fv_eye_view_dist_px(eye) * FV_PI_D / 180.0;
+    fv_status s = fv_space_create(&p->o.space, sw, sh, p->ppd, &p->space, err);
+    if (s != FV_OK) return s;
+    const fv_grid *g = fv_space_grid(p->space);
+    size_t n = (size_t)g->w * g->h, ns = (size_t)sw * sh;
+    p->g.color = fv_alloc_array(n, 3 * sizeof(float));
+    p->g.albedo = fv_alloc_array(n, 3 * sizeof(float));
+    p->g.normal = fv_alloc_array(n, 3 * sizeof(float));
+    p->g.position = fv_alloc_array(n, 3 * sizeof(float));
+    p->g.depth = fv_alloc_array(n, sizeof(float));
+    p->g.id = fv_alloc_array(n, sizeof(uint32_t));
+    p->g.sampled = fv_alloc_array(n, 1);
+    p->prev_coord = fv_alloc_array(n, 2 * sizeof(float));
+    p->sigma = fv_alloc_array(ns, sizeof(float));
+    if (!p->g.color || !p->g.albedo || !p->g.normal || !p->g.position || !p->g.depth || !p->g.id || !p->g.sampled ||
+        !p->prev_coord || !p->sigma) {
+        free_buffers(p);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d sample grid", g->w, g->h);
+    }
+    if (p->o.denoise && (s = fv_svgf_create(g, &p->o.svgf, &p->svgf, err)) != FV_OK) {
+        free_buffers(p);
+        return s;
+    }
+    /* Only the polar spaces need mipmaps along φ; the Cartesian grid is only ever magnified. */
+    int levels = fv_space_kind_of(p->space) == FV_SPACE_CARTESIAN ? 1 : MAX_MIP_LEVELS;
+    if ((s = fv_phi_mips_create(g, levels, &p->mips, err)) != FV_OK) {
+        free_buffers(p);
+        return s;
+    }
+    if (p->o.order == FV_VP_ORDER_RANDOM) {
+        p->perm = fv_vp_random_order(g, seed, &p->nperm);
+        if (!p->perm) {
+            free_buffers(p);
+            return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        }
+    }
+    p->sw = sw;
+    p->sh = sh;
+    return FV_OK;
+}
+
+/* Where each sample's first hit was in the previous frame's sample space. */
+typedef struct reproject_ctx {
+    fv_vp_pipeline *p;
+} reproject_ctx;
+
+static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
+{
+    fv_vp_pipeline *p = ((reproject_ctx *)ctx)->p;
+    for (int64_t i = b; i < e; i++) {
+        float *pc = &p->prev_coord[2 * i];
+        pc[0] = pc[1] = NAN;
+        if (!p->g.sampled[i] || p->g.id[i] == 0) continue;
+        fv_vec3 x = fv_v3(p->g.position[3 * i], p->g.position[3 * i + 1], p->g.position[3 * i + 2]);
+        float px, py;
+        if (!fv_camera_project(&p->prev_cam, x, &px, &py)) continue;
+        if (px < 0.0f || py < 0.0f || px > (float)p->sw || py > (float)p->sh) continue;
+        fv_space_from_screen(&p->prev_view, px, py, &pc[0], &pc[1], NULL);
+    }
+}
+
+typedef struct map_ctx {
+    fv_vp_pipeline *p;
+    const fv_space_view *view;
+    fv_film_views out;
+    bool identity;
+    double sigma_px, blur_scale;
+} map_ctx;
+
+/* Screen pixel colours from the sample space (Sec. 3.4), the film's first-hit buffers from the
+ * nearest sample, and the blur's sigma (Sec. 3.5). */
+static void map_rows(void *ctx, int64_t b, int64_t e, int thread)
+{
+    map_ctx *c = ctx;
+    fv_vp_pipeline *p = c->p;
+    const fv_grid *g = fv_space_grid(p->space);
+    for (int64_t y = b; y < e; y++)
+        for (int x = 0; x < p->sw; x++) {
+            size_t pix = (size_t)y * p->sw + x;
+            float px = (float)x + 0.5f, py = (float)y + 0.5f;
+            long near;
+            if (c->identity) {
+                near = (long)pix;
+                memcpy(&c->out.color[3 * pix], &p->g.color[3 * pix], 3 * sizeof(float));
+            } else {
+                float X, V, rows;
+                fv_space_from_screen(c->view, px, py, &X, &V, &rows);
+                float level = rows > 1.0f ? log2f(rows) : 0.0f;
+                fv_phi_mips_sample(p->mips, X, V, level, &c->out.color[3 * pix]);
+                int gx = (int)X;
+                gx = gx < 0 ? 0 : (gx >= g->w ? g->w - 1 : gx);
+                int n = fv_grid_col_h(g, gx);
+                int gy = (int)(V * (float)n);
+                gy = gy < 0 ? 0 : (gy >= n ? n - 1 : gy);
+                near = (long)gy * g->w + gx;
+            }
+            bool hit = p->g.id[near] != 0;
+            fv_film_store_first_hit(&c->out, pix, hit, p->g.depth[near],
+                                    fv_v3(p->g.position[3 * near], p->g.position[3 * near + 1], p->g.position[3 * near + 2]),
+                                    fv_v3(p->g.normal[3 * near], p->g.normal[3 * near + 1], p->g.normal[3 * near + 2]),
+                                    fv_v3(p->g.albedo[3 * near], p->g.albedo[3 * near + 1], p->g.albedo[3 * near + 2]),
+                                    hit ? (int)p->g.id[near] - 1 : 0);
+            if (p->o.blur) {
+                float dx = px - c->view->gx, dy = py - c->view->gy;
+                double ecc = sqrt((double)dx * dx + (double)dy * dy) / p->ppd * c->blur_scale;
+                p->sigma[pix] = (float)fv_blur_sigma_at(ecc, p->o.blur_fovea_deg, p->o.blur_ramp_deg, c->sigma_px);
+            }
+        }
+}
+
+fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const fv_camera *cam, const fv_camera *prev_cam,
+                                fv_gaze gaze, int eye, fv_film *film, fv_stats *stats, fv_error *err)
+{
+    fv_camera_basis basis;
+    fv_status s = fv_frame_camera(cam, film, &basis, err);
+    if (s != FV_OK) return s;
+    fv_eye_model def;
+    const fv_eye_model *em = frame->eye;
+    if (!em) {
+        fv_eye_model_default(cam->width, cam->height, &def);
+        em = &def;
+    }
+    if (p->sw != cam->width || p->sh != cam->height) {
+        if ((s = setup(p, cam->width, cam->height, em, frame->seed, err)) != FV_OK) return s;
+    }
+    const fv_grid *g = fv_space_grid(p->space);
+    fv_space_view view = fv_space_view_at(p->space, gaze);
+
+    /* 1. trace */
+    fv_vp_trace_job job;
+    memset(&job, 0, sizeof job);
+    job.scene = p->scene;
+    job.pt = p->o.pt;
+    job.cam = basis;
+    job.view = view;
+    job.screen_w = p->sw;
+    job.screen_h = p->sh;
+    job.order = p->o.order;
+    job.perm = p->perm;
+    job.nperm = p->nperm;
+    job.skip_offscreen = p->o.skip_offscreen;
+    job.kill = p->o.kill;
+    job.kill_e0 = p->o.kill_e0, job.kill_e1 = p->o.kill_e1, job.kill_p = p->o.kill_p;
+    job.px_per_deg = p->ppd;
+    job.seed = frame->seed;
+    job.frame = frame->index;
+    job.eye = eye;
+    job.threads = frame->threads;
+    job.progress = frame->progress;
+    job.progress_user = frame->progress_user;
+    fv_vp_trace_result tr;
+    double t0 = fv_time_ms();
+    fv_vp_trace(&job, &p->g, &tr);
+    double t_trace = fv_time_ms() - t0;
+    fv_stats_add_ms(stats, "trace", t_trace);
+    fv_stats_add_count(stats, "rays", (double)tr.rays);
+    fv_stats_add_count(stats, "samples", (double)tr.paths);
+    fv_stats_add_count(stats, "grid_samples", (double)fv_space_sample_count(p->space));
+    fv_stats_add_count(stats, "sample_share", (double)tr.paths / ((double)p->sw * p->sh));
+    fv_stats_add_count(stats, "mrays_per_s", t_trace > 0.0 ? (double)tr.rays / t_trace / 1000.0 : 0.0);
+    fv_stats_add_count(stats, "nan_samples", (double)tr.nan_paths);
+
+    /* 2. denoise in the sample space */
+    t0 = fv_time_ms();
+    if (p->o.denoise) {
+        bool hist = p->have_prev && prev_cam != NULL;
+        if (hist) {
+            reproject_ctx rc = {p};
+            fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
+        }
+        fv_svgf_frame fr = {p->g.color, p->g.albedo, p->g.normal, p->g.depth, p->g.position, p->g.id,
+                            hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL};
+        fv_svgf_info info;
+        if ((s = fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err)) != FV_OK) return s;
+        fv_stats_add_count(stats, "history_fraction", info.history_fraction);
+    }
+    fv_stats_add_ms(stats, "denoise", fv_time_ms() - t0);
+    p->prev_cam = basis;
+    p->prev_view = view;
+    p->have_prev = true;
+    p->have_image = true;
+
+    /* 3. mipmaps along φ (Sec. 3.4) */
+    bool identity = fv_space_kind_of(p->space) == FV_SPACE_CARTESIAN && g->w == p->sw && g->h == p->sh;
+    t0 = fv_time_ms();
+    if (!identity) fv_phi_mips_build(p->mips, p->g.color, frame->threads);
+    fv_stats_add_ms(stats, "mip", fv_time_ms() - t0);
+
+    /* 4. back to the screen */
+    t0 = fv_time_ms();
+    map_ctx mc;
+    mc.p = p;
+    mc.view = &view;
+    mc.out = fv_film_views_of(film);
+    mc.identity = identity;
+    mc.sigma_px = p->o.blur_sigma * (double)p->sw / 1280.0;
+    /* Visual-Polar stretches its profile (and so its fovea) from the centre gaze's largest ρ to
+     * this gaze's; the blur's fovea follows. */
+    mc.blur_scale = 1.0;
+    if (p->o.blur_follows_space) mc.blur_scale = 0.5 * sqrt((double)p->sw * p->sw + (double)p->sh * p->sh) / view.rho_max;
+    fv_parallel_for(p->sh, 8, frame->threads, map_rows, &mc);
+    fv_stats_add_ms(stats, "map", fv_time_ms() - t0);
+
+    /* 5. foveated blur (Sec. 3.5) */
+    t0 = fv_time_ms();
+    if (p->o.blur && (s = fv_blur_variable(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, err)) != FV_OK) return s;
+    fv_stats_add_ms(stats, "blur", fv_time_ms() - t0);
+    return FV_OK;
+}
+
+const float *fv_vp_pipeline_space_image(const fv_vp_pipeline *p, const fv_grid **grid)
+{
+    if (!p->have_image) return NULL;
+    *grid = fv_space_grid(p->space);
+    return p->g.color;
+}

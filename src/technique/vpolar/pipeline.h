@@ -1,0 +1,48 @@
+/* fovea — the frame pipeline of Visual-Polar path tracing (Foveated Real-Time Path Tracing in
+ * Visual-Polar Space, Fig. 2) for one eye, shared by `vpolar` and every baseline it is compared
+ * with; they differ only in their sample space and launch:
+ *
+ *   trace (Sec. 3.1)  ->  denoise in the sample space (SVGF, Sec. 3.3)  ->  mip along φ and map
+ *   to the screen (Sec. 3.4)  ->  foveated blur (Sec. 3.5)
+ *
+ * The pipeline keeps its temporal state (the denoiser's history, last frame's camera and sample
+ * space view) between frames and rebuilds its buffers when the film size changes. Stage times go
+ * to fv_stats as "trace", "denoise", "mip", "map", "blur".
+ */
+#ifndef FV_TECHNIQUE_VPOLAR_PIPELINE_H
+#define FV_TECHNIQUE_VPOLAR_PIPELINE_H
+
+#include "filter/svgf.h"
+#include "fovea/technique.h"
+#include "technique/vpolar/space.h"
+#include "technique/vpolar/trace.h"
+
+typedef struct fv_vp_opts {
+    fv_space_opts space;
+    fv_pt_options pt;          /* spp 1, max_depth = 1 + bounces */
+    fv_vp_order order;
+    bool skip_offscreen;
+    bool kill;                 /* linear fall-off launch (screen grid only) */
+    double kill_e0, kill_e1, kill_p;
+    bool denoise;
+    fv_svgf_opts svgf;
+    bool blur;
+    double blur_sigma;         /* at 1280 pixels wide; scaled with the width (Sec. 3.5: 6.8) */
+    double blur_fovea_deg, blur_ramp_deg;
+    bool blur_follows_space;   /* Visual-Polar: the blur's fovea stretches with the space (Sec. 3.2) */
+} fv_vp_opts;
+
+typedef struct fv_vp_pipeline fv_vp_pipeline;
+
+fv_status fv_vp_pipeline_create(const fv_scene *scene, const fv_vp_opts *o, fv_vp_pipeline **out, fv_error *err);
+void fv_vp_pipeline_destroy(fv_vp_pipeline *p);
+
+/* Renders one eye: cam and gaze of this frame, prev_cam of the last one (NULL: no history). */
+fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const fv_camera *cam, const fv_camera *prev_cam,
+                                fv_gaze gaze, int eye, fv_film *film, fv_stats *stats, fv_error *err);
+
+/* The last frame's sample-space image (denoised when denoising is on) and its grid, for pictures
+ * of the space itself (docs/results.md). NULL before the first frame. */
+const float *fv_vp_pipeline_space_image(const fv_vp_pipeline *p, const fv_grid **grid);
+
+#endif

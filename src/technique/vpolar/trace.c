@@ -1,0 +1,184 @@
+/* fovea — the trace stage of Visual-Polar path tracing and its baselines (see trace.h). */
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "technique/vpolar/trace.h"
+
+#define KILL_STREAM 0x6b696c6cULL /* separate random stream for the kill decision */
+
+typedef struct trace_ctx {
+    const fv_vp_trace_job *job;
+    const fv_vp_gbuf *g;
+    const fv_grid *grid;
+    struct {
+        uint64_t rays, paths, bad;
+        char pad[40];
+    } counters[FV_MAX_THREADS];
+} trace_ctx;
+
+/* Survival probability of the linear fall-off at pixel position (px, py). */
+static float survival(const fv_vp_trace_job *j, float px, float py)
+{
+    float dx = px - j->view.gx, dy = py - j->view.gy;
+    double e = sqrt((double)dx * dx + (double)dy * dy) / j->px_per_deg;
+    return (float)fv_acuity_linear(e, j->kill_e0, j->kill_e1, j->kill_p);
+}
+
+static void store_miss(const fv_vp_gbuf *g, long i)
+{
+    memset(&g->color[3 * i], 0, 3 * sizeof(float));
+    memset(&g->albedo[3 * i], 0, 3 * sizeof(float));
+    memset(&g->normal[3 * i], 0, 3 * sizeof(float));
+    memset(&g->position[3 * i], 0, 3 * sizeof(float));
+    g->depth[i] = INFINITY;
+    g->id[i] = 0;
+}
+
+/* Traces up to eight samples (grid pixel indices, -1 for an empty lane) as one camera packet. */
+static void trace_packet(trace_ctx *c, const long *pix, int thread)
+{
+    const fv_vp_trace_job *j = c->job;
+    const fv_vp_gbuf *g = c->g;
+    const int w = c->grid->w;
+    fv_vec3 dir[8];
+    fv_rng rng[8];
+    bool active[8];
+    fv_hit hits[8];
+    bool ok[8];
+    int nactive = 0;
+    for (int k = 0; k < 8; k++) {
+        active[k] = false;
+        dir[k] = j->cam.forward;
+        if (pix[k] < 0) continue;
+        long i = pix[k];
+        int x = (int)(i % w), y = (int)(i / w);
+        rng[k] = fv_rng_make(j->seed, (uint64_t)i * 2 + (uint64_t)j->eye, 0, (uint64_t)j->frame);
+        /* Jitter inside the grid cell: the temporal accumulation of the denoiser then integrates
+         * over the cell instead of converging to one aliased point. */
+        float X = (float)x + fv_rng_next(&rng[k]);
+        float V = ((float)y + fv_rng_next(&rng[k])) / (float)fv_grid_col_h(c->grid, x);
+        float px, py;
+        fv_space_to_screen(&j->view, X, V, &px, &py);
+        bool on = px >= -1.0f && py >= -1.0f && px <= (float)j->screen_w + 1.0f && py <= (float)j->screen_h + 1.0f;
+        bool go = !(j->skip_offscreen && !on);
+        if (go && j->kill) {
+            fv_rng kr = fv_rng_make(j->seed ^ KILL_STREAM, (uint64_t)i * 2 + (uint64_t)j->eye, 0, (uint64_t)j->frame);
+            go = fv_rng_next(&kr) < survival(j, px, py);
+        }
+        g->sampled[i] = go;
+        if (!go) {
+            store_miss(g, i);
+            continue;
+        }
+        dir[k] = fv_camera_dir(&j->cam, px, py);
+        active[k] = true;
+        nactive++;
+    }
+    if (!nactive) return;
+    fv_scene_intersect8_active(j->scene, j->cam.pos, dir, active, hits, ok);
+    uint64_t rays = 0, bad = 0;
+    for (int k = 0; k < 8; k++) {
+        if (!active[k]) continue;
+        long i = pix[k];
+        fv_pt_first_hit first;
+        memset(&first, 0, sizeof first);
+        fv_vec3 L = fv_pt_trace_from(j->scene, &j->pt, j->cam.pos, dir[k], &hits[k], ok[k], &rng[k], &first, &rays);
+        if (!fv_is_finite3(L)) { /* the NaN/Inf guard of every technique: counted, kept off the film */
+            bad++;
+            L = fv_v3s(0.0f);
+        }
+        g->color[3 * i] = L.x, g->color[3 * i + 1] = L.y, g->color[3 * i + 2] = L.z;
+        if (first.hit) {
+            g->albedo[3 * i] = first.albedo.x, g->albedo[3 * i + 1] = first.albedo.y, g->albedo[3 * i + 2] = first.albedo.z;
+            g->normal[3 * i] = first.n.x, g->normal[3 * i + 1] = first.n.y, g->normal[3 * i + 2] = first.n.z;
+            g->position[3 * i] = first.p.x, g->position[3 * i + 1] = first.p.y, g->position[3 * i + 2] = first.p.z;
+            g->depth[i] = first.t;
+            g->id[i] = (uint32_t)first.obj + 1u;
+        } else {
+            fv_vec3 keep = L;
+            store_miss(g, i);
+            g->color[3 * i] = keep.x, g->color[3 * i + 1] = keep.y, g->color[3 * i + 2] = keep.z;
+        }
+    }
+    c->counters[thread].rays += rays;
+    c->counters[thread].paths += (uint64_t)nactive;
+    c->counters[thread].bad += bad;
+}
+
+static void grid_tile(void *ctx, const fv_tile *t)
+{
+    trace_ctx *c = ctx;
+    const int w = c->grid->w;
+    for (int y = t->y0; y < t->y1; y++)
+        for (int x0 = t->x0; x0 < t->x1; x0 += 8) {
+            long pix[8];
+            for (int k = 0; k < 8; k++) {
+                int x = x0 + k;
+                pix[k] = x < t->x1 && fv_grid_valid(c->grid, x, y) ? (long)y * w + x : -1;
+            }
+            trace_packet(c, pix, t->thread);
+        }
+}
+
+static void random_range(void *ctx, int64_t b, int64_t e, int thread)
+{
+    trace_ctx *c = ctx;
+    for (int64_t i = b; i < e; i += 8) {
+        long pix[8];
+        for (int k = 0; k < 8; k++) pix[k] = i + k < e ? (long)c->job->perm[i + k] : -1;
+        trace_packet(c, pix, thread);
+    }
+}
+
+void fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_result *res)
+{
+    trace_ctx *c = calloc(1, sizeof *c);
+    memset(res, 0, sizeof *res);
+    if (!c) return; /* the caller checks res->paths against the grid */
+    c->job = job;
+    c->g = g;
+    c->grid = fv_space_grid(job->view.space);
+    const fv_grid *grid = c->grid;
+    /* Unused rows (beyond a column's height) must read as "no surface" to the filters. */
+    for (int x = 0; x < grid->w; x++)
+        for (int y = fv_grid_col_h(grid, x); y < grid->h; y++) {
+            store_miss(g, (long)y * grid->w + x);
+            g->sampled[(long)y * grid->w + x] = 0;
+        }
+    if (job->order == FV_VP_ORDER_RANDOM && job->perm)
+        fv_parallel_for(job->nperm, 4096, job->threads, random_range, c);
+    else
+        fv_parallel_tiles(grid->w, grid->h, job->threads, grid_tile, c, job->progress, job->progress_user);
+    for (int i = 0; i < FV_MAX_THREADS; i++) {
+        res->rays += c->counters[i].rays;
+        res->paths += c->counters[i].paths;
+        res->nan_paths += c->counters[i].bad;
+    }
+    free(c);
+}
+
+uint32_t *fv_vp_random_order(const fv_grid *g, uint64_t seed, long *n)
+{
+    long count = 0;
+    for (int x = 0; x < g->w; x++) count += fv_grid_col_h(g, x);
+    uint32_t *p = fv_alloc_array((size_t)count, sizeof(uint32_t));
+    if (!p) return NULL;
+    long k = 0;
+    for (int y = 0; y < g->h; y++)
+        for (int x = 0; x < g->w; x++)
+            if (fv_grid_valid(g, x, y)) p[k++] = (uint32_t)((long)y * g->w + x);
+    /* Fisher-Yates with the counter-based generator. */
+    fv_rng r = fv_rng_make(seed, 0x7065726dULL, 0, 0);
+    for (long i = count - 1; i > 0; i--) {
+        uint64_t hi = fv_rng_u32(&r);
+        uint64_t lo = fv_rng_u32(&r);
+        long j = (long)((hi << 32 | lo) % (uint64_t)(i + 1));
+        uint32_t t = p[i];
+        p[i] = p[j];
+        p[j] = t;
+    }
+    *n = count;
+    return p;
+}

@@ -1,0 +1,62 @@
+/* fovea — the trace stage shared by Visual-Polar path tracing and its baselines: one path per
+ * sample of a sample space (Foveated Real-Time Path Tracing in Visual-Polar Space, Sec. 3.1: a
+ * primary ray, one indirect bounce, a shadow ray from each hit), with the path tracing kernel of
+ * `pt` (technique/pt/pt.h) and its first-hit features for the denoiser.
+ *
+ * Launch orders (Sec. 6):
+ *  - grid order: samples are taken in tiles of the grid, camera rays eight neighbours at a time as
+ *    one packet (coherent: neighbours in the grid are neighbours on the screen);
+ *  - random order: the same samples in a random permutation, eight at a time (incoherent packets);
+ *  - kill: every pixel of a full-resolution screen grid is launched and a path survives with the
+ *    linear fall-off probability (Weier et al. 2016); killed lanes idle in their packet.
+ * Every sample draws its random numbers from (seed, sample index, frame), so the image does not
+ * depend on the order, the packing or the thread count.
+ */
+#ifndef FV_TECHNIQUE_VPOLAR_TRACE_H
+#define FV_TECHNIQUE_VPOLAR_TRACE_H
+
+#include <stdint.h>
+#include "fovea/camera.h"
+#include "technique/pt/pt.h"
+#include "technique/vpolar/space.h"
+
+typedef enum fv_vp_order { FV_VP_ORDER_GRID = 0, FV_VP_ORDER_RANDOM } fv_vp_order;
+
+/* Buffers on the grid's storage (w * h pixels). */
+typedef struct fv_vp_gbuf {
+    float *color, *albedo, *normal, *depth, *position;
+    uint32_t *id;
+    uint8_t *sampled;   /* 1 where a path was traced */
+} fv_vp_gbuf;
+
+typedef struct fv_vp_trace_job {
+    const fv_scene *scene;
+    fv_pt_options pt;
+    fv_camera_basis cam;
+    fv_space_view view;
+    int screen_w, screen_h;
+    fv_vp_order order;
+    const uint32_t *perm;  /* random order: the grid's valid pixel indices, permuted */
+    long nperm;
+    bool skip_offscreen;   /* samples whose screen position is more than a pixel off screen are not traced */
+    bool kill;             /* linear fall-off: survival 1 up to kill_e0, kill_p from kill_e1 on */
+    double kill_e0, kill_e1, kill_p, px_per_deg;
+    uint64_t seed;
+    int frame, eye, threads;
+    fv_progress_fn progress;
+    void *progress_user;
+} fv_vp_trace_job;
+
+typedef struct fv_vp_trace_result {
+    uint64_t rays, paths;
+    uint64_t nan_paths;
+} fv_vp_trace_result;
+
+/* Traces every valid sample of job->view's grid into g. */
+void fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_result *res);
+
+/* A permutation of the grid's valid pixel indices drawn from seed (for FV_VP_ORDER_RANDOM);
+ * *n receives the count. NULL when out of memory. */
+uint32_t *fv_vp_random_order(const fv_grid *g, uint64_t seed, long *n);
+
+#endif

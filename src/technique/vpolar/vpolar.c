@@ -1,0 +1,316 @@
+/* fovea — `vpolar` (Foveated Real-Time Path Tracing in Visual-Polar Space) and the sample
+ * distributions it is compared with (Sec. 4.3), each a technique of its own on one pipeline
+ * (pipeline.h): they differ only in the sample space and the launch.
+ *
+ *   vpolar          Visual-Polar space, 61% fewer samples than pixels, foveated blur
+ *   cartesian       a uniform screen grid with the same sample count, bilinear upscaling
+ *   cartesian-full  1 sample per pixel at full resolution: the cost reference of Fig. 12
+ *   linear-falloff  full-resolution launch, paths killed at random outside a 10-degree fovea,
+ *                   20% survive from 20 degrees on (Weier et al. 2016), foveated blur
+ *   log-polar       kernel log-polar space (Meng et al. 2018), sigma 1.8, alpha 4
+ * All share the 1-sample path tracing of Sec. 3.1 and the same SVGF settings.
+ *
+ * `show=space` puts the sample-space image itself in the film's top-left corner (Fig. 1, left;
+ * the clipped part of Visual-Polar space white, as in Fig. 3); `show=density` writes the samples
+ * per screen pixel (Fig. 1, right, and Fig. 8), averaged over a 13x13 window.
+ */
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "technique/vpolar/pipeline.h"
+
+typedef enum vp_show { SHOW_SCREEN = 0, SHOW_SPACE, SHOW_DENSITY } vp_show;
+
+typedef struct vp_state {
+    const char *name;
+    fv_vp_opts o;
+    vp_show show;
+    fv_vp_pipeline *eye[2];
+} vp_state;
+
+typedef enum vp_kind { K_VPOLAR, K_CARTESIAN, K_CARTESIAN_FULL, K_LINEAR_FALLOFF, K_LOGPOLAR } vp_kind;
+
+static const char *const k_orders[] = {"grid", "random", NULL};
+static const char *const k_offscreen[] = {"trace", "skip", NULL};
+static const char *const k_show[] = {"screen", "space", "density", NULL};
+
+/* A float parameter that must lie strictly inside (lo, hi). */
+static fv_status open_range(fv_params *p, const char *key, double def, double lo, double hi, double *out, fv_error *err)
+{
+    fv_status s = fv_params_float(p, key, def, lo, hi, out, err);
+    if (s == FV_OK && !(*out > lo && *out < hi))
+        s = fv_error_set(err, FV_ERR_INVALID, "parameter %s=%g must be in (%g, %g)", key, *out, lo, hi);
+    return s;
+}
+
+static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *show, fv_error *err)
+{
+    memset(o, 0, sizeof *o);
+    fv_space_kind sk = kind == K_VPOLAR ? FV_SPACE_VPOLAR : (kind == K_LOGPOLAR ? FV_SPACE_LOGPOLAR : FV_SPACE_CARTESIAN);
+    fv_space_opts_default(sk, &o->space);
+    fv_svgf_opts_default(&o->svgf);
+    fv_status s;
+    int bounces, order, offscreen, sh;
+    double blur_fovea_def = kind == K_LINEAR_FALLOFF ? 10.0 : 5.79;
+    bool blur_def = kind == K_VPOLAR || kind == K_LINEAR_FALLOFF;
+    if ((s = fv_params_int(p, "bounces", 1, 0, 64, &bounces, err)) ||
+        (s = fv_params_choice(p, "order", 0, k_orders, &order, err)) ||
+        (s = fv_params_choice(p, "offscreen", 0, k_offscreen, &offscreen, err)) ||
+        (s = fv_params_choice(p, "show", 0, k_show, &sh, err)) || (s = fv_params_bool(p, "denoise", true, &o->denoise, err)) ||
+        (s = fv_params_int(p, "svgf_iterations", o->svgf.iterations, 0, 10, &o->svgf.iterations, err)))
+        return s;
+    double v;
+    if ((s = fv_params_float(p, "svgf_alpha", o->svgf.alpha_color, 0.0, 1.0, &v, err))) return s;
+    o->svgf.alpha_color = o->svgf.alpha_moments = (float)v;
+    if ((s = fv_params_float(p, "sigma_lum", o->svgf.sigma_lum, 0.0, 1e6, &v, err))) return s;
+    o->svgf.sigma_lum = (float)v;
+    if ((s = fv_params_float(p, "sigma_normal", o->svgf.sigma_normal, 0.0, 1e6, &v, err))) return s;
+    o->svgf.sigma_normal = (float)v;
+    if ((s = fv_params_float(p, "sigma_depth", o->svgf.sigma_depth, 0.0, 1e6, &v, err))) return s;
+    o->svgf.sigma_depth = (float)v;
+    if ((s = fv_params_bool(p, "blur", blur_def, &o->blur, err)) ||
+        (s = fv_params_float(p, "blur_sigma", 6.8, 0.0, 100.0, &o->blur_sigma, err)) ||
+        (s = fv_params_float(p, "blur_fovea_deg", blur_fovea_def, 0.0, 180.0, &o->blur_fovea_deg, err)) ||
+        (s = fv_params_float(p, "blur_ramp_deg", 30.0, 0.0, 180.0, &o->blur_ramp_deg, err)))
+        return s;
+    if (!(o->blur_ramp_deg > o->blur_fovea_deg))
+        return fv_error_set(err, FV_ERR_INVALID, "parameter blur_ramp_deg=%g must be greater than blur_fovea_deg=%g", o->blur_ramp_deg,
+                            o->blur_fovea_deg);
+    switch (kind) {
+    case K_VPOLAR:
+        if ((s = open_range(p, "reduction", 0.61, 0.0, 1.0, &o->space.reduction, err)) ||
+            (s = fv_params_float(p, "fovea_deg", 5.79, 0.01, 90.0, &o->space.fovea_deg, err)) ||
+            (s = fv_params_int(p, "fit_degree", 6, 2, 10, &o->space.fit_degree, err)))
+            return s;
+        o->blur_follows_space = true;
+        break;
+    case K_CARTESIAN:
+        if ((s = open_range(p, "reduction", 0.61, 0.0, 1.0, &o->space.reduction, err))) return s;
+        break;
+    case K_LOGPOLAR:
+        if ((s = fv_params_float(p, "sigma", 1.8, 1.0, 100.0, &o->space.lp_sigma, err)) ||
+            (s = fv_params_float(p, "alpha", 4.0, 0.0, 100.0, &o->space.lp_alpha, err)))
+            return s;
+        if (!(o->space.lp_sigma > 1.0))
+            return fv_error_set(err, FV_ERR_INVALID, "parameter sigma=%g must be greater than 1 (the grid is the screen / sigma)",
+                                o->space.lp_sigma);
+        if (!(o->space.lp_alpha > 0.0))
+            return fv_error_set(err, FV_ERR_INVALID, "parameter alpha=%g must be positive", o->space.lp_alpha);
+        break;
+    case K_LINEAR_FALLOFF:
+        o->kill = true;
+        if ((s = fv_params_float(p, "falloff_fovea_deg", 10.0, 0.0, 180.0, &o->kill_e0, err)) ||
+            (s = fv_params_float(p, "falloff_periphery_deg", 20.0, 0.0, 180.0, &o->kill_e1, err)) ||
+            (s = fv_params_float(p, "falloff_probability", 0.2, 0.0, 1.0, &o->kill_p, err)))
+            return s;
+        if (!(o->kill_e1 > o->kill_e0))
+            return fv_error_set(err, FV_ERR_INVALID, "parameter falloff_periphery_deg=%g must be greater than falloff_fovea_deg=%g",
+                                o->kill_e1, o->kill_e0);
+        if (!(o->kill_p > 0.0))
+            return fv_error_set(err, FV_ERR_INVALID, "parameter falloff_probability=%g must be positive", o->kill_p);
+        break;
+    case K_CARTESIAN_FULL:
+        break;
+    }
+    o->pt.spp = 1;
+    o->pt.max_depth = 1 + bounces;
+    o->pt.rr_depth = 1 << 20; /* Sec. 3.1: a fixed path length, no Russian roulette */
+    o->order = (fv_vp_order)order;
+    o->skip_offscreen = offscreen == 1;
+    *show = (vp_show)sh;
+    return FV_OK;
+}
+
+static fv_status create_kind(vp_kind kind, const char *name, const fv_scene *scene, fv_params *params, void **state, fv_error *err)
+{
+    vp_state *st = calloc(1, sizeof *st);
+    if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    st->name = name;
+    fv_status s = read_opts(kind, params, &st->o, &st->show, err);
+    if (s == FV_OK) s = fv_params_check_used(params, name, err);
+    for (int e = 0; s == FV_OK && e < 2; e++) s = fv_vp_pipeline_create(scene, &st->o, &st->eye[e], err);
+    if (s != FV_OK) {
+        fv_vp_pipeline_destroy(st->eye[0]);
+        fv_vp_pipeline_destroy(st->eye[1]);
+        free(st);
+        return s;
+    }
+    *state = st;
+    return FV_OK;
+}
+
+/* show=space: the sample-space image in the top-left corner, clipped rows white. */
+static void show_space(const fv_vp_pipeline *p, fv_film *film)
+{
+    const fv_grid *g;
+    const float *img = fv_vp_pipeline_space_image(p, &g);
+    float *out = fv_film_color(film);
+    int w = fv_film_width(film), h = fv_film_height(film);
+    memset(out, 0, sizeof(float) * 3 * (size_t)w * h);
+    if (!img) return;
+    for (int y = 0; y < g->h && y < h; y++)
+        for (int x = 0; x < g->w && x < w; x++) {
+            float *o = &out[3 * ((size_t)y * w + x)];
+            if (!fv_grid_valid(g, x, y)) {
+                o[0] = o[1] = o[2] = 1e3f;
+                continue;
+            }
+            memcpy(o, &img[3 * ((size_t)y * g->w + x)], 3 * sizeof(float));
+        }
+}
+
+/* show=density: traced samples per screen pixel, from the grid positions of the traced samples. */
+static fv_status show_density(const vp_state *st, const fv_vp_pipeline *p, const fv_frame *frame, fv_gaze gaze, fv_film *film,
+                              fv_error *err)
+{
+    int w = fv_film_width(film), h = fv_film_height(film);
+    fv_eye_model def;
+    const fv_eye_model *em = frame->eye;
+    if (!em) {
+        fv_eye_model_default(w, h, &def);
+        em = &def;
+    }
+    fv_space *sp;
+    fv_status s = fv_space_create(&st->o.space, w, h, fv_eye_view_dist_px(em) * FV_PI_D / 180.0, &sp, err);
+    if (s != FV_OK) return s;
+    const fv_grid *g = fv_space_grid(sp);
+    fv_space_view view = fv_space_view_at(sp, gaze);
+    double *count = fv_calloc_array((size_t)(w + 1) * (h + 1), sizeof(double));
+    if (!count) {
+        fv_space_destroy(sp);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    }
+    double ppd = fv_eye_view_dist_px(em) * FV_PI_D / 180.0;
+    for (int y = 0; y < g->h; y++)
+        for (int x = 0; x < g->w; x++) {
+            if (!fv_grid_valid(g, x, y)) continue;
+            float px, py, X, V;
+            fv_grid_centre(g, x, y, &X, &V);
+            fv_space_to_screen(&view, X, V, &px, &py);
+            if (px < 0.0f || py < 0.0f || px >= (float)w || py >= (float)h) continue;
+            double weight = 1.0;
+            if (st->o.kill) { /* expected count: the survival probability */
+                double e = hypot(px - view.gx, py - view.gy) / ppd;
+                weight = fv_acuity_linear(e, st->o.kill_e0, st->o.kill_e1, st->o.kill_p);
+            }
+            count[(size_t)((int)py + 1) * (w + 1) + (int)px + 1] += weight;
+        }
+    /* Summed-area table, then the mean over a 13x13 window. */
+    for (int y = 1; y <= h; y++)
+        for (int x = 1; x <= w; x++)
+            count[(size_t)y * (w + 1) + x] +=
+                count[(size_t)(y - 1) * (w + 1) + x] + count[(size_t)y * (w + 1) + x - 1] - count[(size_t)(y - 1) * (w + 1) + x - 1];
+    float *out = fv_film_color(film);
+    const int r = 6;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            int x0 = x - r < 0 ? 0 : x - r, x1 = x + r + 1 > w ? w : x + r + 1;
+            int y0 = y - r < 0 ? 0 : y - r, y1 = y + r + 1 > h ? h : y + r + 1;
+            double sum = count[(size_t)y1 * (w + 1) + x1] - count[(size_t)y0 * (w + 1) + x1] - count[(size_t)y1 * (w + 1) + x0] +
+                         count[(size_t)y0 * (w + 1) + x0];
+            float d = (float)(sum / ((double)(x1 - x0) * (y1 - y0)));
+            out[3 * ((size_t)y * w + x)] = out[3 * ((size_t)y * w + x) + 1] = out[3 * ((size_t)y * w + x) + 2] = d;
+        }
+    free(count);
+    fv_space_destroy(sp);
+    return FV_OK;
+}
+
+static fv_status vp_render(void *state, const fv_frame *frame, fv_film *film, fv_film *film_right, fv_stats *stats, fv_error *err)
+{
+    vp_state *st = state;
+    const fv_camera *cams[2] = {frame->camera, frame->camera_right};
+    const fv_camera *prev[2] = {frame->prev_camera, frame->prev_camera_right};
+    fv_gaze gaze[2] = {frame->gaze, frame->camera_right ? frame->gaze_right : frame->gaze};
+    fv_film *films[2] = {film, film_right};
+    for (int e = 0; e < (frame->camera_right ? 2 : 1); e++) {
+        fv_status s = fv_vp_pipeline_render(st->eye[e], frame, cams[e], prev[e], gaze[e], e, films[e], stats, err);
+        if (s != FV_OK) return s;
+        if (st->show == SHOW_SPACE) show_space(st->eye[e], films[e]);
+        if (st->show == SHOW_DENSITY && (s = show_density(st, st->eye[e], frame, gaze[e], films[e], err)) != FV_OK) return s;
+    }
+    return FV_OK;
+}
+
+static void vp_destroy(void *state)
+{
+    vp_state *st = state;
+    if (!st) return;
+    fv_vp_pipeline_destroy(st->eye[0]);
+    fv_vp_pipeline_destroy(st->eye[1]);
+    free(st);
+}
+
+static fv_status create_vpolar(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
+{
+    return create_kind(K_VPOLAR, "vpolar", s, p, st, e);
+}
+static fv_status create_cartesian(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
+{
+    return create_kind(K_CARTESIAN, "cartesian", s, p, st, e);
+}
+static fv_status create_cartesian_full(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
+{
+    return create_kind(K_CARTESIAN_FULL, "cartesian-full", s, p, st, e);
+}
+static fv_status create_linear_falloff(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
+{
+    return create_kind(K_LINEAR_FALLOFF, "linear-falloff", s, p, st, e);
+}
+static fv_status create_logpolar(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
+{
+    return create_kind(K_LOGPOLAR, "log-polar", s, p, st, e);
+}
+
+#define COMMON_HELP                                                                                                      \
+    "bounces=int (1): indirect bounces per path (Sec. 3.1: one)\n"                                                       \
+    "denoise=bool (true): SVGF in the sample space\n"                                                                    \
+    "svgf_iterations=int (5), svgf_alpha=float (0.2), sigma_lum=float (4), sigma_normal=float (128), sigma_depth=float (1)\n" \
+    "blur_sigma=float (6.8): blur sigma in pixels at blur_ramp_deg, for 1280 pixels wide (scaled with the width)\n"     \
+    "blur_fovea_deg=float, blur_ramp_deg=float (30): the blur is 0 inside the first, rises linearly to the second\n"    \
+    "order=grid|random (grid): launch order of the samples (random: Sec. 6's incoherent launch)\n"                       \
+    "offscreen=trace|skip (trace): trace the samples of the polar grids that fall off the screen, or not\n"              \
+    "show=screen|space|density (screen): the image, the sample-space image, or samples per pixel\n"
+
+const fv_technique_class fv_technique_vpolar = {
+    "vpolar",
+    "foveated path tracing in Visual-Polar space: 1 spp on the VP grid, SVGF in VP space, φ-mipmapped mapping, foveated blur",
+    COMMON_HELP "reduction=float (0.61): share of screen pixels not sampled, in (0,1) (the paper: 0.61, 0.71, 0.88)\n"
+                "fovea_deg=float (5.79): radius of the linear, clipped fovea in planar degrees\n"
+                "fit_degree=int (6): degree of the polynomial inverse of Eq. 2\n"
+                "blur=bool (true): foveated blur (blur_fovea_deg default 5.79, stretched with the space)\n",
+    create_vpolar, vp_render, vp_destroy,
+};
+
+const fv_technique_class fv_technique_cartesian = {
+    "cartesian",
+    "uniform screen grid with vpolar's sample count, SVGF, bilinear upscaling (Visual-Polar Sec. 4.3 baseline)",
+    COMMON_HELP "reduction=float (0.61): share of screen pixels not sampled, in (0,1)\n"
+                "blur=bool (false)\n",
+    create_cartesian, vp_render, vp_destroy,
+};
+
+const fv_technique_class fv_technique_cartesian_full = {
+    "cartesian-full",
+    "1 spp at full resolution with SVGF: the cost reference of Visual-Polar Fig. 12",
+    COMMON_HELP "blur=bool (false)\n",
+    create_cartesian_full, vp_render, vp_destroy,
+};
+
+const fv_technique_class fv_technique_linear_falloff = {
+    "linear-falloff",
+    "full-resolution launch, paths killed at random outside the fovea (Weier et al. 2016), SVGF, blur",
+    COMMON_HELP "falloff_fovea_deg=float (10), falloff_periphery_deg=float (20): survival 1 inside, falloff_probability beyond\n"
+                "falloff_probability=float (0.2)\n"
+                "blur=bool (true): foveated blur (blur_fovea_deg default 10)\n",
+    create_linear_falloff, vp_render, vp_destroy,
+};
+
+const fv_technique_class fv_technique_logpolar = {
+    "log-polar",
+    "kernel log-polar space (Meng et al. 2018), SVGF in log-polar space, φ-mipmapped mapping",
+    COMMON_HELP "sigma=float (1.8): screen / grid size ratio per axis, > 1\n"
+                "alpha=float (4): kernel exponent\n"
+                "blur=bool (false)\n",
+    create_logpolar, vp_render, vp_destroy,
+};
