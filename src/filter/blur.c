@@ -1,72 +1,104 @@
 /* fovea — the foveated Gaussian blur of Visual-Polar path tracing (Koskela et al., Sec. 3.5; see
  * blur.h for the contract).
  *
- * How it is made cheap enough to run every frame on 1280x1440 images:
- *  - Sigma is quantised to 1/32 pixel (q = round(32 sigma)), at most 1/64 pixel from the request: far
- *    below what the eye sees, and the paper's profile changes sigma by that much only every few
- *    pixels. All kernels up to sigma 32 are built once per call (a few thousand exp calls for the
- *    paper's 6.8); wider ones, which no sensible profile asks for, are built per run of pixels.
- *  - Along a row, neighbouring pixels nearly always share q (the whole periphery beyond the ramp
- *    does). A run of equal q is filtered as a sum of shifted, scaled copies of the row segment:
- *    o = k0 c + sum_d k_d (c[-d] + c[+d]). That loop is channel-agnostic on interleaved RGB and
- *    vectorises across pixels, whereas a per-pixel tap loop would be 3-wide scalar code. The
- *    vertical pass is the same loop with the taps one row apart, so it needs no transpose: the
- *    2 r + 1 rows it reads (at most 41 for sigma 6.8) stay in cache from one output row to the next.
- *  - Pixels whose kernel is the centre tap alone (truncation at 3 sigma leaves no other tap for
- *    sigma < 1/3) are copied by the horizontal pass and left alone by the vertical one, so the fovea
- *    costs nothing and stays bit-identical.
- *  - Border renormalisation is needed only within r pixels of the image edge: per pixel in the
- *    horizontal pass, and per run (all pixels of a run share the same valid rows) in the vertical one.
- * Every output pixel is computed by one thread in a fixed order of operations, so the result does not
- * depend on the thread count. Memory: one image-sized scratch buffer.
+ * The work is the direct separable convolution, 2 r + 1 taps per pixel per axis (41 for the
+ * paper's sigma of 6.8). What makes it cheap enough to run on every 1280x1440 frame:
+ *  - Sigma is rounded to a grid (see quantise), so kernels are built once per call and neighbouring
+ *    pixels share one: the whole periphery beyond the ramp, and runs of a few pixels within it.
+ *  - A run of pixels with the same kernel is filtered as a sum of shifted, scaled copies of the row
+ *    segment, o = k0 c + sum_d k_d (c[-d] + c[+d]): channel-agnostic on interleaved RGB, so it
+ *    vectorises across pixels, with 32 outputs held in registers across all taps (SSE, or AVX2
+ *    where the CPU has it). The symmetric pairs halve the multiplications.
+ *  - The two passes are fused per slab of rows: a ring of horizontally blurred rows (2 r + BATCH
+ *    of them) is consumed by the vertical pass strip by strip, so the intermediate image never
+ *    leaves the cache and rgb is read once and written once. The rows a slab needs from its
+ *    neighbours (r above, r below) are blurred horizontally before any slab writes, because their
+ *    owners overwrite them.
+ *  - Taps outside the image read zeros (a zero-padded copy of the row, a zero row), and the pixels
+ *    within r of the edge are then divided by the weight of the taps that were inside: the border
+ *    renormalisation costs nothing in the interior.
+ *  - Pixels whose kernel is the centre tap alone are copied by the horizontal pass and not written
+ *    by the vertical one, so the fovea costs nothing and keeps its bits.
+ * Every output value is the same sequence of IEEE operations whichever thread, slab, vector width
+ * or code path computes it, so the result depends neither on the thread count nor on the CPU.
  */
+#include <float.h>
 #include <math.h>
 #include <omp.h>
+#include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "filter/blur.h"
 
-#define Q_PER_PX 32                  /* sigma quantisation steps per pixel */
-#define Q_TABLE (32 * Q_PER_PX)      /* kernels up to sigma 32 px are precomputed */
-#define Q_CLAMP 100000000            /* sigma beyond ~3e6 px acts as 3e6 px (keeps q in an int) */
-#define ROW_CHUNK 16                 /* rows per scheduling chunk: interleaved, so an off-centre
-                                        gaze still splits the work evenly */
+#define Q_BITS 5                     /* sigma grid: 2^Q_BITS values per octave (see quantise) */
+#define Q_STEPS (1 << Q_BITS)
+#define Q_TABLE (6 * Q_STEPS)        /* kernels up to sigma 32 px are built up front */
+#define BATCH 64                     /* output rows per batch of a slab */
+#define STRIP 32                     /* columns per strip of the vertical pass: its 2 r + 1 rows
+                                        (16 KB for sigma 6.8) stay in L1 */
+#define PAD 8                        /* floats after every buffer: the last block of a run reads up
+                                        to 7 floats beyond it */
 
 double fv_blur_sigma_at(double e_deg, double fovea_deg, double ramp_deg, double sigma_max)
 {
-    /* Written as negated comparisons so that a NaN eccentricity gets no blur and a ramp that ends at
-     * (or before) the fovea's edge becomes a step instead of a division by zero. */
+    /* Negated comparisons, so that a NaN eccentricity gets no blur and a ramp that ends at (or
+     * before) the fovea's edge becomes a step instead of a division by zero. */
     if (!(e_deg > fovea_deg)) return 0.0;
     if (!(e_deg < ramp_deg)) return sigma_max;
     return sigma_max * (e_deg - fovea_deg) / (ramp_deg - fovea_deg);
 }
 
+/* Sigma is rounded to a grid: multiples of 1/32 up to 2 pixels, then 32 values per octave
+ * (2^o (1 + i/32): multiples of 1/16 up to 4, of 1/8 up to 8, ...), so it moves by at most 1/64
+ * pixel or 1/64 of itself, far below what anyone can see. Relative steps keep runs of equal kernels
+ * a few pixels long even where the paper's profile ramps up (uniform steps of 1/32 would cut the
+ * ramp into runs of one or two pixels). q indexes the grid: q / 32 pixels below 64, above it octave
+ * q / 32 - 1, step q % 32. Integer arithmetic on the float's bits keeps the rounding exact and cheap:
+ * it runs for every pixel of the ramp. */
 static int quantise(float s)
 {
-    float t = s * (float)Q_PER_PX + 0.5f;
-    return t < (float)Q_CLAMP ? (int)t : Q_CLAMP;
+    if (s < 1.0f) return (int)(s * (float)Q_STEPS + 0.5f);
+    uint32_t b;
+    memcpy(&b, &s, sizeof b);
+    int octave = (int)(b >> 23) - 127;                                           /* s >= 1: normal */
+    int step = (int)(((b & 0x7FFFFFu) + (1u << (22 - Q_BITS))) >> (23 - Q_BITS)); /* 0..Q_STEPS */
+    return Q_STEPS * (1 + octave) + step;
+}
+
+static double sigma_of(int q)
+{
+    if (q < 2 * Q_STEPS) return (double)q / Q_STEPS;
+    return ldexp(1.0 + (double)(q % Q_STEPS) / Q_STEPS, q / Q_STEPS - 1);
 }
 
 /* Taps reach 3 sigma (floor), but never further than the image: beyond rcap every tap is outside it
- * and would be dropped by the border renormalisation anyway. */
+ * and carries no weight after the border renormalisation anyway. */
 static int radius_of(int q, int rcap)
 {
-    int r = (int)((3LL * q) / Q_PER_PX);
-    return r < rcap ? r : rcap;
+    long long r;
+    if (q < 2 * Q_STEPS) {
+        r = 3LL * q / Q_STEPS;
+    } else {
+        int octave = q / Q_STEPS - 1;
+        if (octave > 40) return rcap;
+        r = (3LL * (Q_STEPS + q % Q_STEPS) << octave) >> Q_BITS;
+    }
+    return r < rcap ? (int)r : rcap;
 }
 
-/* k[d] for d = 0..r: exp(-d^2 / 2 sigma^2), normalised so that k[0] + 2 sum k[d] = 1. Double
- * precision keeps the normalisation exact to float rounding even for r in the thousands. */
+/* k[d] for d = 0..r: exp(-d^2 / 2 sigma^2), normalised so that k[0] + 2 sum k[d] = 1 (double
+ * precision, so the normalisation is exact to float rounding even for thousands of taps). */
 static void make_kernel(int q, int r, float *k)
 {
     if (r == 0) {
         k[0] = 1.0f;
         return;
     }
-    double s = (double)q / Q_PER_PX, c = -0.5 / (s * s), sum = 1.0;
+    double s = sigma_of(q), c = -0.5 / (s * s), sum = 1.0;
     for (int d = 1; d <= r; d++) sum += 2.0 * exp(c * d * d);
     for (int d = 0; d <= r; d++) k[d] = (float)(exp(c * d * d) / sum);
 }
@@ -83,177 +115,444 @@ static int kernel_set_init(kernel_set *ks, int qmax, int rcap)
     ks->rcap = rcap;
     ks->nq = (qmax < Q_TABLE ? qmax : Q_TABLE) + 1;
     ks->off = fv_alloc_array((size_t)ks->nq, sizeof(int));
+    if (!ks->off) return -1;
     size_t total = 0;
-    if (ks->off)
-        for (int q = 0; q < ks->nq; q++) {
-            ks->off[q] = (int)total;
-            total += (size_t)radius_of(q, rcap) + 1;
-        }
-    ks->k = ks->off ? fv_alloc_array(total, sizeof(float)) : NULL;
+    for (int q = 0; q < ks->nq; q++) {
+        ks->off[q] = (int)total;
+        total += (size_t)radius_of(q, rcap) + 1;
+    }
+    ks->k = fv_alloc_array(total, sizeof(float));
     if (!ks->k) return -1;
     for (int q = 0; q < ks->nq; q++) make_kernel(q, radius_of(q, rcap), ks->k + ks->off[q]);
     return 0;
 }
 
-/* The kernel of q: from the table, or built into the thread's scratch (kept while q repeats). */
-static const float *kernel_of(const kernel_set *ks, int q, float *scratch, int *scratch_q)
+/* The weight of the taps of a radius-r kernel centred at pos that fall inside [0, n). */
+static float inside_weight(const float *k, int r, int pos, int n)
 {
-    if (q < ks->nq) return ks->k + ks->off[q];
-    if (*scratch_q != q) {
-        make_kernel(q, radius_of(q, ks->rcap), scratch);
-        *scratch_q = q;
-    }
-    return scratch;
+    float wsum = k[0];
+    for (int d = 1; d <= r; d++) wsum += k[d] * (float)((pos - d >= 0) + (pos + d < n));
+    return wsum;
 }
 
-/* o[i] = k[0] c[i] + sum_{d=1..r} k[d] (c[i - d step] + c[i + d step]), i in [0, n): the interior of
- * a run, every tap inside the image. */
-static void taps_symmetric(float *restrict o, const float *restrict c, ptrdiff_t step, const float *k, int r, size_t n)
+/* The kernels below compute, for the run of n pixels starting at float offset off of the rows,
+ *   o[i] = k[0] rows[0][off + i] + sum_{d=1..r} k[d] (rows[-d][off + i] + rows[d][off + i]),
+ * where rows[d] is the row of tap d: the zero-padded source row shifted by d pixels in the
+ * horizontal pass, the blurred row d below in the vertical one. Every output float gets exactly
+ * these IEEE operations in this order on every path (blocks of 32 floats, then one last block of up
+ * to 32 whose extra lanes are computed from the padding and dropped), and there is no FMA (ISO C
+ * mode does not contract), so the SSE and AVX2 copies give the same bits. */
+typedef void (*taps_fn)(float *restrict o, const float *const *rows, size_t off, const float *k, int r, size_t n);
+
+#if defined(__GNUC__)
+/* Four and eight floats loaded from or stored to any float address (GCC and Clang vector
+ * extensions). */
+typedef float v4f __attribute__((vector_size(16), aligned(4), may_alias));
+#define LD4(p) (*(const v4f *)(const void *)(p))
+#define ST4(p, v) (*(v4f *)(void *)(p) = (v))
+
+/* The last rem (< 32) floats of a run as nv vectors of four, all accumulated at once so that short
+ * runs (the ramp of the sigma profile) are not one long chain of dependent adds. The loads may run
+ * up to 3 floats past the run (every buffer has PAD floats after it); only rem floats are stored. */
+__attribute__((always_inline)) static inline void taps_tail4(float *restrict o, const float *const *rows, size_t off,
+                                                              const float *k, int r, size_t rem, const int nv)
+{
+    v4f a[8];
+#pragma GCC unroll 8
+    for (int v = 0; v < nv; v++) a[v] = k[0] * LD4(rows[0] + off + 4 * v);
+    for (int d = 1; d <= r; d++) {
+        const float *m = rows[-d] + off, *p = rows[d] + off;
+        const float kd = k[d];
+#pragma GCC unroll 8
+        for (int v = 0; v < nv; v++) a[v] += kd * (LD4(m + 4 * v) + LD4(p + 4 * v));
+    }
+#pragma GCC unroll 8
+    for (int v = 0; v < nv; v++)
+        if (4 * (size_t)v + 4 <= rem)
+            ST4(o + 4 * v, a[v]);
+        else
+            for (size_t l = 0; l < rem - 4 * (size_t)v; l++) o[4 * v + l] = a[v][l];
+}
+
+/* Baseline: 4-wide vectors (SSE2 on x86-64, NEON on ARM), eight accumulators. */
+static void taps_v4(float *restrict o, const float *const *rows, size_t off, const float *k, int r, size_t n)
 {
     const float k0 = k[0];
-#pragma omp simd
-    for (size_t i = 0; i < n; i++) o[i] = k0 * c[i];
-    for (int d = 1; d <= r; d++) {
-        const float *m = c - d * step, *p = c + d * step;
-        const float kd = k[d];
-#pragma omp simd
-        for (size_t i = 0; i < n; i++) o[i] += kd * (m[i] + p[i]);
+    const size_t nf = 3 * n;
+    size_t i0 = 0;
+    for (; i0 + 32 <= nf; i0 += 32) {
+        const float *c = rows[0] + off + i0;
+        v4f a0 = k0 * LD4(c), a1 = k0 * LD4(c + 4), a2 = k0 * LD4(c + 8), a3 = k0 * LD4(c + 12);
+        v4f a4 = k0 * LD4(c + 16), a5 = k0 * LD4(c + 20), a6 = k0 * LD4(c + 24), a7 = k0 * LD4(c + 28);
+        for (int d = 1; d <= r; d++) {
+            const float *m = rows[-d] + off + i0, *p = rows[d] + off + i0;
+            const float kd = k[d];
+            a0 += kd * (LD4(m) + LD4(p));
+            a1 += kd * (LD4(m + 4) + LD4(p + 4));
+            a2 += kd * (LD4(m + 8) + LD4(p + 8));
+            a3 += kd * (LD4(m + 12) + LD4(p + 12));
+            a4 += kd * (LD4(m + 16) + LD4(p + 16));
+            a5 += kd * (LD4(m + 20) + LD4(p + 20));
+            a6 += kd * (LD4(m + 24) + LD4(p + 24));
+            a7 += kd * (LD4(m + 28) + LD4(p + 28));
+        }
+        float *oo = o + i0;
+        ST4(oo, a0), ST4(oo + 4, a1), ST4(oo + 8, a2), ST4(oo + 12, a3);
+        ST4(oo + 16, a4), ST4(oo + 20, a5), ST4(oo + 24, a6), ST4(oo + 28, a7);
     }
-}
-
-/* The same sum over the taps d in [dlo, dhi] only, renormalised by their weights: a run of the
- * vertical pass whose row is within r of the top or bottom edge. */
-static void taps_clipped(float *restrict o, const float *restrict c, ptrdiff_t step, const float *k, int dlo, int dhi, size_t n)
-{
-    float wsum = 0.0f;
-    for (int d = dlo; d <= dhi; d++) wsum += k[d < 0 ? -d : d];
-    for (int d = dlo; d <= dhi; d++) {
-        const float *p = c + d * step;
-        const float kd = k[d < 0 ? -d : d] / wsum;
-        if (d == dlo) {
-#pragma omp simd
-            for (size_t i = 0; i < n; i++) o[i] = kd * p[i];
-        } else {
-#pragma omp simd
-            for (size_t i = 0; i < n; i++) o[i] += kd * p[i];
+    if (i0 < nf) {
+        const size_t rem = nf - i0;
+        switch ((rem + 3) / 4) {
+        case 1: taps_tail4(o + i0, rows, off + i0, k, r, rem, 1); break;
+        case 2: taps_tail4(o + i0, rows, off + i0, k, r, rem, 2); break;
+        case 3: taps_tail4(o + i0, rows, off + i0, k, r, rem, 3); break;
+        case 4: taps_tail4(o + i0, rows, off + i0, k, r, rem, 4); break;
+        case 5: taps_tail4(o + i0, rows, off + i0, k, r, rem, 5); break;
+        case 6: taps_tail4(o + i0, rows, off + i0, k, r, rem, 6); break;
+        case 7: taps_tail4(o + i0, rows, off + i0, k, r, rem, 7); break;
+        default: taps_tail4(o + i0, rows, off + i0, k, r, rem, 8); break;
         }
     }
 }
 
-/* One pixel of the horizontal pass within r of the left or right edge. */
-static void pixel_clipped(float *o, const float *row, int x, int w, const float *k, int r)
+#if defined(__x86_64__)
+#define FV_BLUR_AVX2 1
+/* AVX2: the same sums eight floats at a time. The library is built for baseline x86-64, so this
+ * copy is compiled for AVX2 alone and picked at run time; it halves the instructions of the loop
+ * that is nearly all of the blur's time. */
+typedef float v8f __attribute__((vector_size(32), aligned(4), may_alias));
+#define LD8(p) (*(const v8f *)(const void *)(p))
+#define ST8(p, v) (*(v8f *)(void *)(p) = (v))
+
+/* The last rem (< 32) floats of a run as nv vectors of eight, all accumulated at once so that
+ * short runs (the ramp of the sigma profile) are not one long chain of dependent adds. Loads may run
+ * up to 7 floats past the run (every buffer has PAD floats after it); only rem floats are stored. */
+__attribute__((target("avx2"), always_inline)) static inline void taps_tail8(float *restrict o, const float *const *rows,
+                                                                               size_t off, const float *k, int r,
+                                                                               size_t rem, const int nv)
 {
-    int dlo = x < r ? -x : -r, dhi = x + r >= w ? w - 1 - x : r;
-    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, wsum = 0.0f;
-    for (int d = dlo; d <= dhi; d++) {
-        const float kd = k[d < 0 ? -d : d], *p = row + 3 * (ptrdiff_t)(x + d);
-        s0 += kd * p[0];
-        s1 += kd * p[1];
-        s2 += kd * p[2];
-        wsum += kd;
+    v8f a[4];
+#pragma GCC unroll 4
+    for (int v = 0; v < nv; v++) a[v] = k[0] * LD8(rows[0] + off + 8 * v);
+    for (int d = 1; d <= r; d++) {
+        const float *m = rows[-d] + off, *p = rows[d] + off;
+        const float kd = k[d];
+#pragma GCC unroll 4
+        for (int v = 0; v < nv; v++) a[v] += kd * (LD8(m + 8 * v) + LD8(p + 8 * v));
     }
-    o[0] = s0 / wsum;
-    o[1] = s1 / wsum;
-    o[2] = s2 / wsum;
+#pragma GCC unroll 4
+    for (int v = 0; v < nv; v++)
+        if (8 * (size_t)v + 8 <= rem)
+            ST8(o + 8 * v, a[v]);
+        else
+            for (size_t l = 0; l < rem - 8 * (size_t)v; l++) o[8 * v + l] = a[v][l];
 }
 
-/* The run of pixels starting at x whose quantised sigma equals that of x: returns its end. */
-static int run_end(const float *sig, int x, int w, int *q)
+__attribute__((target("avx2"))) static void taps_v8(float *restrict o, const float *const *rows, size_t off,
+                                                    const float *k, int r, size_t n)
+{
+    const float k0 = k[0];
+    const size_t nf = 3 * n;
+    size_t i0 = 0;
+    for (; i0 + 32 <= nf; i0 += 32) {
+        const float *c = rows[0] + off + i0;
+        v8f a0 = k0 * LD8(c), a1 = k0 * LD8(c + 8), a2 = k0 * LD8(c + 16), a3 = k0 * LD8(c + 24);
+        for (int d = 1; d <= r; d++) {
+            const float *m = rows[-d] + off + i0, *p = rows[d] + off + i0;
+            const float kd = k[d];
+            a0 += kd * (LD8(m) + LD8(p));
+            a1 += kd * (LD8(m + 8) + LD8(p + 8));
+            a2 += kd * (LD8(m + 16) + LD8(p + 16));
+            a3 += kd * (LD8(m + 24) + LD8(p + 24));
+        }
+        ST8(o + i0, a0), ST8(o + i0 + 8, a1), ST8(o + i0 + 16, a2), ST8(o + i0 + 24, a3);
+    }
+    if (i0 < nf) {
+        const size_t rem = nf - i0;
+        switch ((rem + 7) / 8) {
+        case 1: taps_tail8(o + i0, rows, off + i0, k, r, rem, 1); break;
+        case 2: taps_tail8(o + i0, rows, off + i0, k, r, rem, 2); break;
+        case 3: taps_tail8(o + i0, rows, off + i0, k, r, rem, 3); break;
+        default: taps_tail8(o + i0, rows, off + i0, k, r, rem, 4); break;
+        }
+    }
+}
+#endif
+
+#else
+/* Other compilers: plain C, element by element. */
+static void taps_v4(float *restrict o, const float *const *rows, size_t off, const float *k, int r, size_t n)
+{
+    for (size_t i = 0; i < 3 * n; i++) {
+        float a = k[0] * rows[0][off + i];
+        for (int d = 1; d <= r; d++) a += k[d] * (rows[-d][off + i] + rows[d][off + i]);
+        o[i] = a;
+    }
+}
+#endif
+
+static taps_fn pick_taps(void)
+{
+#if defined(FV_BLUR_AVX2)
+    if (__builtin_cpu_supports("avx2")) return taps_v8;
+#endif
+    return taps_v4;
+}
+
+/* The run of pixels in [x, end) whose quantised sigma equals that of x: returns where it stops.
+ * Eight pixels bitwise equal to their left neighbours (the whole periphery beyond the ramp, the
+ * whole fovea) are skipped at once, without rounding. */
+static int run_end(const float *sig, int x, int end, int *q)
 {
     *q = quantise(sig[x]);
     int e = x + 1;
-    while (e < w && quantise(sig[e]) == *q) e++;
-    return e;
+    for (;;) {
+        while (e + 8 <= end && memcmp(sig + e, sig + e - 1, 8 * sizeof(float)) == 0) e += 8;
+        if (e >= end || quantise(sig[e]) != *q) return e;
+        e++;
+    }
 }
 
-static void horizontal_row(const float *src, float *dst, const float *sig, int w, const kernel_set *ks, float *scratch,
-                           int *scratch_q)
+typedef struct blur_job {
+    float *rgb;
+    const float *sigma;
+    int w, h;
+    int R;                 /* the largest radius in the image */
+    size_t w3;             /* floats per image row */
+    int nstrips;           /* strips of STRIP columns (the last may be narrower) */
+    kernel_set ks;
+    taps_fn taps;
+    const float *zero;     /* a strip row of zeros: the vertical taps outside the image */
+} blur_job;
+
+/* A band of output rows [y0, y1) and what it works with; one thread at a time.
+ * The horizontally blurred rows live in a ring stored strip by strip: strip t holds its rb ring
+ * rows (row y in slot (y - y0 + R) % rb), then the `below` rows under the slab, each STRIP pixels
+ * wide. The 2 r + 1 rows a vertical tap loop reads are then a few KB apart and stay in L1: rows
+ * of the whole image, 15 KB apart, thrash the TLB and run at half the speed. */
+typedef struct slab {
+    int y0, y1;
+    int rb, below;
+    size_t region;         /* floats per strip: (rb + below) rows of 3 STRIP floats */
+    float *ring;
+    float *srow;           /* the source row with R pixels of zeros on each side */
+    const float **hrows;   /* 2 R + 1 pointers into srow: tap d of the horizontal pass */
+    const float **vrows;   /* BATCH + 2 R pointers: the rows around a batch in one strip */
+    float *kscratch;       /* a kernel wider than the table */
+    int kq;                /* ... for this q (-1: none yet) */
+} slab;
+
+#define STRIP_FLOATS (3 * (size_t)STRIP)
+
+static const float *kernel_of(const blur_job *j, slab *s, int q)
 {
+    if (q < j->ks.nq) return j->ks.k + j->ks.off[q];
+    if (s->kq != q) {
+        make_kernel(q, radius_of(q, j->ks.rcap), s->kscratch);
+        s->kq = q;
+    }
+    return s->kscratch;
+}
+
+/* Where row y (y0 - R <= y < y1 + below) starts within every strip's region. */
+static size_t ring_offset(const blur_job *j, const slab *s, int y)
+{
+    int slot = y >= s->y1 ? s->rb + (y - s->y1) : (y - s->y0 + j->R) % s->rb;
+    return (size_t)slot * STRIP_FLOATS;
+}
+
+/* Row y through the horizontal pass (each pixel with its own sigma) into the ring. */
+static void horizontal(const blur_job *j, slab *s, int y)
+{
+    const int w = j->w;
+    const float *src = j->rgb + (size_t)y * j->w3, *sig = j->sigma + (size_t)y * w;
+    memcpy(s->srow + 3 * (size_t)j->R, src, j->w3 * sizeof(float));
+    const float *const *rows = s->hrows + j->R;
+    float *out_row = s->ring + ring_offset(j, s, y);
     for (int x = 0, e, q; x < w; x = e) {
         e = run_end(sig, x, w, &q);
-        int r = radius_of(q, ks->rcap);
-        if (r == 0) {
-            memcpy(dst + 3 * (ptrdiff_t)x, src + 3 * (ptrdiff_t)x, 3 * sizeof(float) * (size_t)(e - x));
-            continue;
+        const int r = radius_of(q, j->ks.rcap);
+        const float *k = r > 0 ? kernel_of(j, s, q) : NULL;
+        for (int a = x, b; a < e; a = b) { /* the run, cut where it crosses into the next strip */
+            const int t = a / STRIP;
+            b = (t + 1) * STRIP < e ? (t + 1) * STRIP : e;
+            float *out = out_row + (size_t)t * s->region + 3 * (size_t)(a - t * STRIP);
+            if (r == 0) {
+                memcpy(out, src + 3 * (size_t)a, 3 * sizeof(float) * (size_t)(b - a));
+                continue;
+            }
+            j->taps(out, rows, 3 * (size_t)a, k, r, (size_t)(b - a));
+            /* Pixels within r of the left or right edge: divide by the weight of the taps that
+             * fell inside the image (the others read zeros). */
+            if (a < r || b > w - r)
+                for (int i = a; i < b; i++)
+                    if (i < r || i >= w - r) {
+                        const float wsum = inside_weight(k, r, i, w);
+                        for (int c = 0; c < 3; c++) out[3 * (i - a) + c] /= wsum;
+                    }
         }
-        const float *k = kernel_of(ks, q, scratch, scratch_q);
-        int a = x > r ? x : r, b = e < w - r ? e : w - r; /* interior part [a, b) of the run */
-        if (b <= a) a = b = e;
-        for (int i = x; i < a; i++) pixel_clipped(dst + 3 * (ptrdiff_t)i, src, i, w, k, r);
-        if (b > a) taps_symmetric(dst + 3 * (ptrdiff_t)a, src + 3 * (ptrdiff_t)a, 3, k, r, 3 * (size_t)(b - a));
-        for (int i = b; i < e; i++) pixel_clipped(dst + 3 * (ptrdiff_t)i, src, i, w, k, r);
     }
 }
 
-/* Row y of the vertical pass, from the horizontally blurred tmp into rgb. Runs with no taps besides
- * the centre are skipped: tmp holds a copy of rgb there. */
-static void vertical_row(const float *tmp, float *rgb, const float *sig, int y, int w, int h, const kernel_set *ks,
-                         float *scratch, int *scratch_q)
+/* Strip t of output row y from the horizontally blurred rows; rows[d] is row y + d of the strip.
+ * Runs whose kernel is the centre alone are not written: rgb already holds the value. */
+static void vertical(const blur_job *j, slab *s, int y, int t, const float *const *rows)
 {
-    const ptrdiff_t step = 3 * (ptrdiff_t)w;
-    for (int x = 0, e, q; x < w; x = e) {
-        e = run_end(sig, x, w, &q);
-        int r = radius_of(q, ks->rcap);
+    const int x0 = t * STRIP, x1 = x0 + STRIP < j->w ? x0 + STRIP : j->w;
+    const float *sig = j->sigma + (size_t)y * j->w;
+    float *orow = j->rgb + (size_t)y * j->w3;
+    for (int x = x0, e, q; x < x1; x = e) {
+        e = run_end(sig, x, x1, &q);
+        const int r = radius_of(q, j->ks.rcap);
         if (r == 0) continue;
-        const float *k = kernel_of(ks, q, scratch, scratch_q);
-        size_t at = 3 * ((size_t)y * w + x), n = 3 * (size_t)(e - x);
-        if (y >= r && y + r < h)
-            taps_symmetric(rgb + at, tmp + at, step, k, r, n);
-        else
-            taps_clipped(rgb + at, tmp + at, step, k, y < r ? -y : -r, y + r >= h ? h - 1 - y : r, n);
+        const float *k = kernel_of(j, s, q);
+        float *o = orow + 3 * (size_t)x;
+        j->taps(o, rows, 3 * (size_t)(x - x0), k, r, (size_t)(e - x));
+        if (y < r || y + r >= j->h) {
+            const float wsum = inside_weight(k, r, y, j->h);
+            for (size_t i = 0; i < 3 * (size_t)(e - x); i++) o[i] /= wsum;
+        }
     }
+}
+
+/* Before any slab writes: the rows above and below the slab, which their owners will overwrite. */
+static void slab_halos(const blur_job *j, slab *s)
+{
+    for (int y = s->y0 - j->R > 0 ? s->y0 - j->R : 0; y < s->y0; y++) horizontal(j, s, y);
+    for (int y = s->y1; y < s->y1 + s->below; y++) horizontal(j, s, y);
+}
+
+/* Batches of BATCH output rows: blur the rows the batch needs horizontally (rgb rows not yet
+ * overwritten: a row is read here at least one batch before it is written), then walk down each
+ * strip of the batch vertically. */
+static void slab_run(const blur_job *j, slab *s)
+{
+    const int R = j->R;
+    int next = s->y0; /* the next row of the slab to blur horizontally */
+    for (int yb = s->y0; yb < s->y1; yb += BATCH) {
+        const int ye = yb + BATCH < s->y1 ? yb + BATCH : s->y1;
+        for (; next < s->y1 && next < ye + R; next++) horizontal(j, s, next);
+        for (int t = 0; t < j->nstrips; t++) {
+            const float *base = s->ring + (size_t)t * s->region;
+            for (int y = yb - R; y < ye + R; y++)
+                s->vrows[y - (yb - R)] = y >= 0 && y < j->h ? base + ring_offset(j, s, y) : j->zero;
+            for (int y = yb; y < ye; y++) vertical(j, s, y, t, s->vrows + (y - yb) + R);
+        }
+    }
+}
+
+static void slab_free(slab *s)
+{
+    free(s->ring), free(s->srow), free(s->hrows), free(s->vrows), free(s->kscratch);
+}
+
+static int slab_alloc(const blur_job *j, slab *s, bool wide_kernels)
+{
+    const int R = j->R;
+    const int above = R < s->y0 ? R : s->y0;
+    s->below = R < j->h - s->y1 ? R : j->h - s->y1;
+    /* The ring holds every row of the slab (and above it) that a batch reads: at most BATCH + 2 R
+     * rows, and never more than the slab and the rows above it. */
+    const int live = s->y1 - s->y0 + above;
+    s->rb = BATCH + 2 * R < live ? BATCH + 2 * R : live;
+    s->region = (size_t)(s->rb + s->below) * STRIP_FLOATS;
+    s->kq = -1;
+    /* Zeroed: the last block of a run reads up to PAD floats beyond it (the next row, an unused
+     * part of the last strip, the padding), which must be defined memory. */
+    s->ring = fv_calloc_array((size_t)j->nstrips * s->region + PAD, sizeof(float));
+    s->srow = fv_calloc_array(j->w3 + 6 * (size_t)R + PAD, sizeof(float));
+    s->hrows = fv_alloc_array(2 * (size_t)R + 1, sizeof(float *));
+    s->vrows = fv_alloc_array(BATCH + 2 * (size_t)R, sizeof(float *));
+    s->kscratch = wide_kernels ? fv_alloc_array((size_t)j->ks.rcap + 1, sizeof(float)) : NULL;
+    if (!s->ring || !s->srow || !s->hrows || !s->vrows || (wide_kernels && !s->kscratch)) return -1;
+    for (int d = -R; d <= R; d++) s->hrows[d + R] = s->srow + 3 * (size_t)(R + d);
+    return 0;
 }
 
 fv_status fv_blur_variable(float *rgb, int w, int h, const float *sigma, int threads, fv_error *err)
 {
     if (!rgb || !sigma) return fv_error_set(err, FV_ERR_INVALID, "blur: no %s", rgb ? "sigma buffer" : "image");
     if (w < 1 || h < 1) return fv_error_set(err, FV_ERR_INVALID, "blur: image size %dx%d", w, h);
-    const size_t n = (size_t)w * h;
     const int nt = fv_thread_count(threads);
 
-    /* Validate before touching rgb, and find the widest kernel. */
+    /* Validate before touching rgb; find the widest kernel and each row's share of the work. */
+    float *cost = fv_alloc_array((size_t)h + 1, sizeof(float));
+    if (!cost) return fv_error_set(err, FV_ERR_NOMEM, "out of memory blurring a %dx%d image", w, h);
     float smax = 0.0f;
     int bad = 0;
 #pragma omp parallel for schedule(static) num_threads(nt) reduction(max : smax) reduction(| : bad)
-    for (int y = 0; y < h; y++)
+    for (int y = 0; y < h; y++) {
+        const float *row = sigma + (size_t)y * w;
+        float m = 0.0f, sum = 0.0f;
+        int b = 0;
+        /* simd: the sum only steers the split into slabs, so its order does not matter */
+#pragma omp simd reduction(max : m) reduction(+ : sum) reduction(| : b)
         for (int x = 0; x < w; x++) {
-            float s = sigma[(size_t)y * w + x];
-            if (s >= 0.0f && s <= 3.4e38f) /* false for NaN, negatives and infinities */
-                smax = s > smax ? s : smax;
-            else
-                bad = 1;
+            float s = row[x];
+            b |= (s >= 0.0f) + (s <= FLT_MAX) != 2; /* NaN, negative or infinite (no branch) */
+            m = s > m ? s : m;
+            sum += s < 1e6f ? s : 1e6f;
         }
-    if (bad)
-        for (size_t i = 0; i < n; i++)
-            if (!(sigma[i] >= 0.0f && sigma[i] <= 3.4e38f))
+        cost[y] = (float)w + 3.0f * sum; /* ~ taps per row: r = 3 sigma, plus a per-pixel cost */
+        smax = m > smax ? m : smax;
+        bad |= b;
+    }
+    if (bad) {
+        free(cost);
+        for (size_t i = 0; i < (size_t)w * h; i++)
+            if (!(sigma[i] >= 0.0f && sigma[i] <= FLT_MAX))
                 return fv_error_set(err, FV_ERR_INVALID, "blur: sigma %g at pixel (%d, %d) is not a finite value >= 0",
                                     (double)sigma[i], (int)(i % (size_t)w), (int)(i / (size_t)w));
+    }
 
-    const int rcap = (w > h ? w : h) - 1;
-    const int qmax = quantise(smax);
-    if (radius_of(qmax, rcap) == 0) return FV_OK; /* no pixel has a tap besides its centre */
+    blur_job j = {.rgb = rgb, .sigma = sigma, .w = w, .h = h, .w3 = 3 * (size_t)w, .nstrips = (w + STRIP - 1) / STRIP,
+                  .taps = pick_taps()};
+    const int rcap = (w > h ? w : h) - 1, qmax = quantise(smax);
+    j.R = radius_of(qmax, rcap);
+    if (j.R == 0) { /* no pixel has a tap besides its centre */
+        free(cost);
+        return FV_OK;
+    }
 
-    kernel_set ks = {0};
-    float *tmp = fv_alloc_array(n, 3 * sizeof(float));
-    float *scratch = qmax >= Q_TABLE ? fv_alloc_array((size_t)nt * ((size_t)rcap + 1), sizeof(float)) : NULL;
-    if (!tmp || kernel_set_init(&ks, qmax, rcap) != 0 || (qmax >= Q_TABLE && !scratch)) {
-        free(tmp), free(ks.off), free(ks.k), free(scratch);
+    /* One slab per thread, split so that each gets the same estimated work (the fovea is cheap). */
+    int nslab = nt < h ? nt : h;
+    slab *slabs = fv_calloc_array((size_t)nslab, sizeof(slab));
+    float *zero = fv_calloc_array(STRIP_FLOATS + PAD, sizeof(float));
+    int fail = !slabs || !zero || kernel_set_init(&j.ks, qmax, rcap) != 0;
+    if (!fail) {
+        double total = 0.0, acc = 0.0;
+        for (int y = 0; y < h; y++) total += cost[y];
+        for (int i = 0, y = 0; i < nslab; i++) {
+            slabs[i].y0 = y;
+            if (i == nslab - 1) {
+                y = h;
+            } else { /* at least one row, and one left for every later slab */
+                const double target = total * (i + 1) / nslab;
+                const int ymax = h - (nslab - 1 - i);
+                do acc += cost[y++];
+                while (y < ymax && acc + 0.5 * cost[y] < target);
+            }
+            slabs[i].y1 = y;
+        }
+        j.zero = zero;
+        for (int i = 0; i < nslab && !fail; i++) fail = slab_alloc(&j, &slabs[i], qmax >= Q_TABLE) != 0;
+    }
+    free(cost);
+    if (fail) {
+        for (int i = 0; slabs && i < nslab; i++) slab_free(&slabs[i]);
+        free(slabs), free(zero), free(j.ks.off), free(j.ks.k);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory blurring a %dx%d image", w, h);
     }
 
 #pragma omp parallel num_threads(nt)
     {
-        int t = omp_get_thread_num(), scratch_q = -1;
-        float *my_scratch = scratch ? scratch + (size_t)t * ((size_t)rcap + 1) : NULL;
-#pragma omp for schedule(static, ROW_CHUNK)
-        for (int y = 0; y < h; y++) {
-            size_t at = 3 * (size_t)y * w;
-            horizontal_row(rgb + at, tmp + at, sigma + (size_t)y * w, w, &ks, my_scratch, &scratch_q);
-        }
-        /* the implicit barrier: every row of tmp is ready before any column is read */
-#pragma omp for schedule(static, ROW_CHUNK)
-        for (int y = 0; y < h; y++) vertical_row(tmp, rgb, sigma + (size_t)y * w, y, w, h, &ks, my_scratch, &scratch_q);
+#pragma omp for schedule(static, 1)
+        for (int i = 0; i < nslab; i++) slab_halos(&j, &slabs[i]);
+        /* the implicit barrier: no slab writes before every slab has read its neighbours' rows */
+#pragma omp for schedule(static, 1)
+        for (int i = 0; i < nslab; i++) slab_run(&j, &slabs[i]);
     }
-    free(tmp), free(ks.off), free(ks.k), free(scratch);
+    for (int i = 0; i < nslab; i++) slab_free(&slabs[i]);
+    free(slabs), free(zero), free(j.ks.off), free(j.ks.k);
     return FV_OK;
 }

@@ -4,7 +4,7 @@
  * One frame is a few sweeps over the grid, each an OpenMP loop over rows; every pixel is computed
  * from its inputs alone, in a fixed order, so the result does not depend on the thread count:
  *  A. classify each pixel, demodulate, fetch and blend its history (Sec. 4.1), keep its features;
- *  B. depth gradient, then the variance: temporal, or the 7x7 spatial estimate (Sec. 4.2);
+ *  B. depth gradient and variance: temporal, or the 7x7 spatial estimate (Sec. 4.2);
  *  C. per À-Trous pass (Sec. 4.3): the 3x3-prefiltered variance, then the pass itself, ping-ponging
  *     between two buffers; the first pass also writes the history;
  *  D. remodulate and store this frame's G-buffer as the next frame's history;
@@ -14,10 +14,12 @@
  * pixels a tap is a plain shift in memory (screen grids; in polar grids, between full-height
  * columns away from the clamped edges), so the inner loop runs over contiguous pixels and the
  * compiler vectorises it (omp simd) from buffers kept as one array per channel. The other pixels
- * (the fovea's short columns, the clamped edges) take the same arithmetic one tap at a time through
- * fv_grid_tap. Each pixel adds its taps in the same order either way, so the two paths give the
- * same bits. The normal weight's cosine^128 is seven squarings (any power of two is squarings; other
- * exponents fall back to powf) and the exponential is an inline approximation (exp_neg).
+ * (the fovea's short columns, the clamped edges) look their taps up as fv_grid_tap does, from a
+ * per-chunk table, and run the same arithmetic on gathered loads. Each pixel adds its taps in the
+ * same order either way, so the two paths give the same bits. The normal weight's cosine^128 is
+ * seven squarings, unrolled and vectorised; other powers of two are squarings in a plain loop, other
+ * exponents powf. The exponential is an inline approximation (exp_neg). Spans of a chunk with no
+ * surface (background, rows beyond short columns) are skipped.
  *
  * Choices the paper leaves open, and why:
  *  - Depth gradient: per axis (along the column and across columns, through the grid's own taps) the
@@ -204,8 +206,8 @@ static inline void tap_run(const fv_svgf *f, int y, int dx, int dy, int x0, int 
     *off = (long)row * g->w + dx;
 }
 
-/* The span [*lo, *hi) of [x0, x1) in row y from its first to its last surface pixel; false when the
- * chunk has none. Only the span is filtered (the fovea's short columns leave most of a chunk's row
+/* The span [*lo, *hi) of the chunk [x0, x1) (pixel x0 at index p0) from its first to its last
+ * surface pixel; false when the chunk has none. Only the span is filtered (the fovea's short columns leave most of a chunk's row
  * beyond their heights, and a background stays out of the loops). */
 static inline bool surface_span(const uint8_t *kind, size_t p0, int x0, int x1, int *lo, int *hi)
 {
@@ -222,7 +224,7 @@ static inline bool surface_span(const uint8_t *kind, size_t p0, int x0, int x1, 
  * column offset here rather than once per tap. */
 typedef struct chunk_cols {
     int x[7][CHUNK], row[7][CHUNK], n[7][CHUNK];
-    int ready_for;  /* the step the table was built for, 0: not built */
+    bool ready;     /* built for the current chunk (only chunks that need it build it) */
 } chunk_cols;
 
 static void chunk_columns(const fv_grid *g, int y, int x0, int nc, int step, int ncols, chunk_cols *cc)
@@ -236,7 +238,7 @@ static void chunk_columns(const fv_grid *g, int y, int x0, int nc, int step, int
             if (hs != hd) row = (int)(((long)y * 2 + 1) * hd / (2L * hs));
             cc->x[i][k] = xx, cc->row[i][k] = row, cc->n[i][k] = hd;
         }
-    cc->ready_for = step;
+    cc->ready = true;
 }
 
 /* fv_grid_tap(g, x0 + k, y, (ci - ncols / 2) * step, dy) on a polar grid, from the table. */
@@ -375,13 +377,14 @@ static bool fetch_history(const fv_svgf *f, const float *pc, const float *np, co
         /* Columns clamp (the lookup would clamp them anyway; this keeps floorf's result in int
          * range), rows wrap. */
         X = X < 0.0f ? 0.0f : (X > (float)g->w ? (float)g->w : X);
-        V -= floorf(V);
+        if (V < 0.0f || V >= 1.0f) V -= floorf(V);
     }
     long idx[4];
     float wt[4];
     fv_grid_bilinear(g, X, V, idx, wt);
-    float tol = HIST_POS_REL * fmaxf(depth, HIST_DEPTH_MIN) +
-                HIST_POS_ULP * fmaxf(fabsf(xp[0]), fmaxf(fabsf(xp[1]), fabsf(xp[2])));
+    float ax = fabsf(xp[0]), ay = fabsf(xp[1]), az = fabsf(xp[2]), big = ax > ay ? ax : ay;
+    big = big > az ? big : az;
+    float tol = HIST_POS_REL * (depth > HIST_DEPTH_MIN ? depth : HIST_DEPTH_MIN) + HIST_POS_ULP * big;
     float tol2 = tol * tol;
     const float *pnx = f->nx[1], *pny = f->ny[1], *pnz = f->nz[1], *plen = f->len[1];
     float acc[6] = {0, 0, 0, 0, 0, 0}, wsum = 0.0f;
@@ -450,9 +453,9 @@ static void sweep_accumulate(fv_svgf *f, const fv_svgf_frame *fr, bool history, 
             float l = luminance(il[0], il[1], il[2]), m1 = l, m2 = l * l, n_len = 1.0f;
             float hst[6];
             if (history && fetch_history(f, &fr->prev_coord[2 * p], np, &fr->position[3 * p], fr->depth[p], fr->id[p], hst)) {
-                n_len = fminf(hst[5] + 1.0f, LEN_MAX);
+                n_len = hst[5] + 1.0f < LEN_MAX ? hst[5] + 1.0f : LEN_MAX;
                 /* The new sample's weight: 1 / length (a plain mean) until that falls below alpha. */
-                float wc = fmaxf(ac, 1.0f / n_len), wm = fmaxf(am, 1.0f / n_len);
+                float inv = 1.0f / n_len, wc = ac > inv ? ac : inv, wm = am > inv ? am : inv;
                 for (int ch = 0; ch < 3; ch++) il[ch] = hst[ch] + wc * (il[ch] - hst[ch]);
                 m1 = hst[3] + wm * (m1 - hst[3]);
                 m2 = hst[4] + wm * (m2 - hst[4]);
@@ -505,17 +508,6 @@ static void sweep_variance(fv_svgf *f, int nt)
     const int sq = f->normal_squarings;
     float *var = f->val[0][V_VAR], *grad = f->grad;
     const float *m1 = f->m1[0], *m2 = f->m2[0], *len = f->len[0];
-    /* The gradient first, for every pixel, since the spatial estimate reads the centre's only. */
-    #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            size_t p = (size_t)y * w + x;
-            if (kind[p] != KIND_SURFACE) continue;
-            float zc = f->z[0][p];
-            float gx = axis_gradient(f, fv_grid_tap(g, x, y, -1, 0), fv_grid_tap(g, x, y, 1, 0), zc);
-            float gy = axis_gradient(f, fv_grid_tap(g, x, y, 0, -1), fv_grid_tap(g, x, y, 0, 1), zc);
-            grad[p] = fmaxf(gx, gy);
-        }
     /* The 48 taps of the 7x7 window, the distance classes of their squared distances
      * (1, 2, 4, 5, 8, 9, 10, 13, 18). */
     int di[NTAP7], dj[NTAP7], cls[NTAP7];
@@ -539,11 +531,19 @@ static void sweep_variance(fv_svgf *f, int nt)
         for (int x0 = 0; x0 < w; x0 += CHUNK) {
             const int x1 = imin(x0 + CHUNK, w), nc = x1 - x0;
             const size_t p0 = (size_t)y * w + x0;
+            /* Every pixel's depth gradient (each reads only its neighbours' depths) and temporal
+             * variance; the 7x7 estimate below replaces the variance of the young ones. */
             bool young = false;
             for (int k = 0; k < nc; k++) {
                 size_t p = p0 + k;
                 if (kind[p] != KIND_SURFACE) continue;
-                var[p] = fmaxf(0.0f, m2[p] - m1[p] * m1[p]);
+                const int x = x0 + k;
+                const float zc = f->z[0][p];
+                float gx = axis_gradient(f, fv_grid_tap(g, x, y, -1, 0), fv_grid_tap(g, x, y, 1, 0), zc);
+                float gy = axis_gradient(f, fv_grid_tap(g, x, y, 0, -1), fv_grid_tap(g, x, y, 0, 1), zc);
+                grad[p] = gx > gy ? gx : gy;
+                float tv = m2[p] - m1[p] * m1[p];
+                var[p] = tv > 0.0f ? tv : 0.0f;
                 young = young || len[p] < VAR_TEMPORAL_LEN;
             }
             int s0, s1;
@@ -554,7 +554,7 @@ static void sweep_variance(fv_svgf *f, int nt)
                 for (int c = 0; c < 9; c++) rz[c][k] = 1.0f / (zs * dist[c] + ze);
                 a1[k] = m1[p], a2[k] = m2[p], aw[k] = 1.0f; /* the centre, weight 1 */
             }
-            cc.ready_for = 0;
+            cc.ready = false;
             for (int t = 0; t < NTAP7; t++) {
                 int a, b;
                 long off;
@@ -569,7 +569,7 @@ static void sweep_variance(fv_svgf *f, int nt)
                         moments_tap(f, p0 + (x - x0), (int)off + x, x - x0, rzc[x - x0], sq, sn, a1, a2, aw);
                 }
                 if (!g->wrap || (a == s0 && b == s1)) continue;
-                if (!cc.ready_for) chunk_columns(g, y, x0, nc, 1, 7, &cc);
+                if (!cc.ready) chunk_columns(g, y, x0, nc, 1, 7, &cc);
                 fallback_taps(g, &cc, di[t] + 3, dj[t], x0, s0, s1, a, b, fq);
                 for (int r = 0; r < 2; r++) {
                     const int lo = r ? b : s0, hi = r ? s1 : a;
@@ -586,8 +586,8 @@ static void sweep_variance(fv_svgf *f, int nt)
             for (int k = 0; k < nc; k++) {
                 size_t p = p0 + k;
                 if (kind[p] != KIND_SURFACE || len[p] >= VAR_TEMPORAL_LEN) continue;
-                float mean1 = a1[k] / aw[k], mean2 = a2[k] / aw[k];
-                var[p] = fmaxf(0.0f, mean2 - mean1 * mean1);
+                float mean1 = a1[k] / aw[k], mean2 = a2[k] / aw[k], sv = mean2 - mean1 * mean1;
+                var[p] = sv > 0.0f ? sv : 0.0f;
             }
         }
     }
@@ -618,7 +618,7 @@ static void sweep_prefilter(fv_svgf *f, const float *var, int nt)
                 continue;
             }
             for (int k = 0; k < nc; k++) av[k] = aw[k] = 0.0f;
-            cc.ready_for = 0;
+            cc.ready = false;
             for (int i = 0; i < 3; i++)
                 for (int j = 0; j < 3; j++) {
                     const float kk = k_g3[i] * k_g3[j];
@@ -631,7 +631,7 @@ static void sweep_prefilter(fv_svgf *f, const float *var, int nt)
                         aw[x - x0] += kk * surf[off + x];
                     }
                     if (!g->wrap || (a == s0 && b == s1)) continue;
-                    if (!cc.ready_for) chunk_columns(g, y, x0, nc, 1, 3, &cc);
+                    if (!cc.ready) chunk_columns(g, y, x0, nc, 1, 3, &cc);
                     fallback_taps(g, &cc, i, j - 1, x0, s0, s1, a, b, fq);
                     for (int r = 0; r < 2; r++) {
                         const int lo = r ? b : s0, hi = r ? s1 : a;
@@ -724,7 +724,7 @@ static void sweep_atrous(fv_svgf *f, int step, int src, bool write_hist, int nt)
                 acc.r[k] = wc * s.r[p], acc.g[k] = wc * s.g[p], acc.b[k] = wc * s.b[p];
                 acc.v[k] = wc * wc * s.v[p], acc.w[k] = wc;
             }
-            cc.ready_for = 0;
+            cc.ready = false;
             for (int t = 0; t < NTAP; t++) {
                 int a, b;
                 long off;
@@ -738,7 +738,7 @@ static void sweep_atrous(fv_svgf *f, int step, int src, bool write_hist, int nt)
                     for (int x = a; x < b; x++) atrous_tap(&s, p0 + (x - x0), (int)off + x, x - x0, kw[t], rz, sq, sn, &acc);
                 }
                 if (!g->wrap || (a == s0 && b == s1)) continue;
-                if (!cc.ready_for) chunk_columns(g, y, x0, nc, step, 5, &cc);
+                if (!cc.ready) chunk_columns(g, y, x0, nc, step, 5, &cc);
                 fallback_taps(g, &cc, di[t] / step + 2, dj[t], x0, s0, s1, a, b, fq);
                 for (int r = 0; r < 2; r++) {
                     const int lo = r ? b : s0, hi = r ? s1 : a;
@@ -864,8 +864,8 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
     }
     if (n_holes) sweep_holes(f, fr->color, nt);
 
-    /* This frame's features, moments and lengths become the history. The values ping-pong between
-     * frames too: val[0] is where sweep A writes, so the final buffer is just left as it is. */
+    /* This frame's features, moments and lengths become the history (the working values need no
+     * swap: sweep A rewrites val[0] whole every frame). */
     swap_buffers(f->nx);
     swap_buffers(f->ny);
     swap_buffers(f->nz);

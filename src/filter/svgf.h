@@ -10,12 +10,16 @@
  *     the previous frame's grid, computed by the caller through its own reprojection and
  *     screen-to-grid map) with a bilinear lookup; a tap counts only if it is consistent (same object
  *     id, normals within ~25 degrees, world positions within a depth-relative distance) and the
- *     weights of the consistent taps are renormalised. Colour and the first two luminance moments
- *     are blended with weight max(alpha, 1 / (history length + 1));
- *  3. variance: from the temporal moments when the history is at least 4 frames long, otherwise
- *     from a 7x7 spatial bilateral estimate of the moments;
+ *     weights of the consistent taps are renormalised (below 0.01 in all: no history). Colour and
+ *     the first two luminance moments are blended with weight max(alpha, 1 / (history length + 1));
+ *     on a screen grid a coordinate outside [0, w] x [0, 1] has no history, on a polar grid X clamps
+ *     and V wraps;
+ *  3. variance: from the temporal moments when the history is at least 4 frames long (counting this
+ *     one), otherwise from a 7x7 spatial bilateral estimate of the moments (depth and normal weights);
  *  4. edge-avoiding À-Trous: `iterations` passes of the 5x5 B3 kernel with taps 2^i apart, weights
- *     w_z = exp(-|z_p - z_q| / (sigma_depth |grad z . (p - q)| + eps)),
+ *     w_z = exp(-|z_p - z_q| / (sigma_depth |grad z . (p - q)| + eps)), with |grad z . (p - q)|
+ *     approximated as max(|dz/dx|, |dz/dy|) |p - q|, as common implementations do (the gradient
+ *     from one-sided differences, see svgf.c),
  *     w_n = max(0, n_p . n_q)^sigma_normal,
  *     w_l = exp(-|l_p - l_q| / (sigma_lum sqrt(gauss3x3(var_p)) + eps)),
  *     and the variance filtered alongside with the squared weights. The output of the first pass is
@@ -27,7 +31,8 @@
  * fall-off's killed rays) have no colour and no features and keep no history: after the last pass
  * each takes the B3-kernel-weighted average (no edge-stopping: its own features are unknown) of the
  * filtered sampled surface pixels among its 5x5 taps 1 apart, or if there are none 2 apart, then
- * 4, ... up to 2^(iterations-1) (at least 1); beyond that it stays black.
+ * 4, ... up to 2^(iterations-1) (at least 1); beyond that it stays black. A sampled surface pixel
+ * whose colour, albedo, normal, depth or position is not finite is treated as not sampled.
  *
  * Limits: one colour buffer (direct and indirect light are not separated as in the paper); no
  * adaptive temporal weights (A-SVGF); results independent of the thread count.
@@ -54,7 +59,9 @@ void fv_svgf_opts_default(fv_svgf_opts *o);
 fv_status fv_svgf_opts_validate(const fv_svgf_opts *o, fv_error *err);
 
 /* The filter and its history for one grid. The grid is copied; its col_h array is not and must
- * outlive the filter. */
+ * outlive the filter. o NULL: the defaults. Bad options, a column height outside [1, h] or more
+ * than 2^31 - 1 pixels -> FV_ERR_INVALID; FV_ERR_NOMEM (nothing leaked). Every buffer is allocated
+ * here (about 140 bytes per pixel), none per frame. */
 typedef struct fv_svgf fv_svgf;
 
 fv_status fv_svgf_create(const fv_grid *grid, const fv_svgf_opts *o, fv_svgf **out, fv_error *err);
@@ -78,10 +85,11 @@ typedef struct fv_svgf_frame {
 /* Statistics of the last frame, for the technique's counters. */
 typedef struct fv_svgf_info {
     double history_fraction;   /* sampled surface pixels that found a consistent history */
-    double mean_history;       /* their mean history length, in frames */
+    double mean_history;       /* their mean history length, in frames counting this one (0: none) */
 } fv_svgf_info;
 
-/* Filters fr->color in place. threads 0 = all. FV_ERR_INVALID for missing buffers. */
+/* Filters fr->color in place. threads 0 = all. FV_ERR_INVALID for missing buffers (nothing
+ * changes, the history included). info may be NULL. */
 fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_svgf_info *info, fv_error *err);
 
 #endif
