@@ -66,6 +66,6 @@ for k in c:
     assert c[k]["mrays_per_s"] > 0, k
 PY
 
-sed 's/"measure_from": 4/"measure_from": 10/' "$SRC/bench/vp-quality.json" > "$TMP/bad.json"
+sed 's/"measure_from": 5/"measure_from": 10/' "$SRC/bench/vp-quality.json" > "$TMP/bad.json"
 expect 2 "measure_from" -- $FOVEA bench "$TMP/bad.json" --out "$TMP/b2" --quiet
 finish

@@ -15,6 +15,7 @@
 #include "technique/vpolar/pipeline.h"
 
 #define MAX_MIP_LEVELS 12
+#define LUT_STEP 0.5f /* pixels between the entries of the per-frame radial tables */
 
 struct fv_vp_pipeline {
     const fv_scene *scene;
@@ -27,6 +28,8 @@ struct fv_vp_pipeline {
     fv_vp_gbuf g;
     float *prev_coord;
     float *sigma;           /* per screen pixel */
+    float *lut;             /* per frame, per radius step: column X, mip level, blur sigma */
+    int nlut;
     uint32_t *perm;
     long nperm;
     bool have_prev;
@@ -54,9 +57,9 @@ static void free_buffers(fv_vp_pipeline *p)
     fv_svgf_destroy(p->svgf);
     fv_phi_mips_destroy(p->mips);
     free(p->g.color), free(p->g.albedo), free(p->g.normal), free(p->g.depth), free(p->g.position), free(p->g.id);
-    free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm);
+    free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm), free(p->lut);
     memset(&p->g, 0, sizeof p->g);
-    p->space = NULL, p->svgf = NULL, p->mips = NULL, p->prev_coord = NULL, p->sigma = NULL, p->perm = NULL;
+    p->space = NULL, p->svgf = NULL, p->mips = NULL, p->prev_coord = NULL, p->sigma = NULL, p->perm = NULL, p->lut = NULL;
     p->sw = p->sh = 0;
     p->have_prev = p->have_image = false;
 }
@@ -86,8 +89,11 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
     p->g.sampled = fv_alloc_array(n, 1);
     p->prev_coord = fv_alloc_array(n, 2 * sizeof(float));
     p->sigma = fv_alloc_array(ns, sizeof(float));
+    /* The largest radius from any gaze is the diagonal. */
+    p->nlut = (int)(sqrt((double)sw * sw + (double)sh * sh) / LUT_STEP) + 3;
+    p->lut = fv_alloc_array((size_t)p->nlut, 3 * sizeof(float));
     if (!p->g.color || !p->g.albedo || !p->g.normal || !p->g.position || !p->g.depth || !p->g.id || !p->g.sampled ||
-        !p->prev_coord || !p->sigma) {
+        !p->prev_coord || !p->sigma || !p->lut) {
         free_buffers(p);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d sample grid", g->w, g->h);
     }
@@ -137,9 +143,29 @@ typedef struct map_ctx {
     fv_vp_pipeline *p;
     const fv_space_view *view;
     fv_film_views out;
-    bool identity;
-    double sigma_px, blur_scale;
+    bool identity, polar;
 } map_ctx;
+
+/* Everything the map stage needs that depends only on the distance from the gaze, tabulated for
+ * this frame every LUT_STEP pixels: the column X, the φ-mip level (log2 of the rows one pixel spans
+ * along φ) and the blur's sigma (Sec. 3.5). The per-pixel work is then a square root, an arc
+ * tangent and two table lookups instead of Eq. 2's logarithm. */
+static void build_radial_lut(fv_vp_pipeline *p, const fv_space_view *view)
+{
+    double sigma_px = p->o.blur_sigma * (double)p->sw / 1280.0;
+    /* Visual-Polar stretches its profile (and so its fovea) from the centre gaze's largest ρ to
+     * this gaze's; the blur's fovea follows. */
+    double scale = 1.0;
+    if (p->o.blur_follows_space) scale = 0.5 * sqrt((double)p->sw * p->sw + (double)p->sh * p->sh) / view->rho_max;
+    for (int i = 0; i < p->nlut; i++) {
+        float r = (float)i * LUT_STEP, X, V, rows;
+        fv_space_from_screen(view, view->gx + r, view->gy, &X, &V, &rows);
+        float *e = &p->lut[3 * i];
+        e[0] = X;
+        e[1] = rows > 1.0f ? log2f(rows) : 0.0f;
+        e[2] = p->o.blur ? (float)fv_blur_sigma_at((double)r / p->ppd * scale, p->o.blur_fovea_deg, p->o.blur_ramp_deg, sigma_px) : 0.0f;
+    }
+}
 
 /* Screen pixel colours from the sample space (Sec. 3.4), the film's first-hit buffers from the
  * nearest sample, and the blur's sigma (Sec. 3.5). */
@@ -148,19 +174,35 @@ static void map_rows(void *ctx, int64_t b, int64_t e, int thread)
     map_ctx *c = ctx;
     fv_vp_pipeline *p = c->p;
     const fv_grid *g = fv_space_grid(p->space);
+    const bool aux = c->out.depth || c->out.normal || c->out.albedo || c->out.position || c->out.id;
+    const float inv_step = 1.0f / LUT_STEP, inv_2pi = 1.0f / (2.0f * FV_PI);
     for (int64_t y = b; y < e; y++)
         for (int x = 0; x < p->sw; x++) {
             size_t pix = (size_t)y * p->sw + x;
-            float px = (float)x + 0.5f, py = (float)y + 0.5f;
+            float dx = (float)x + 0.5f - c->view->gx, dy = (float)y + 0.5f - c->view->gy;
+            float t = sqrtf(dx * dx + dy * dy) * inv_step;
+            int i = (int)t;
+            i = i < p->nlut - 2 ? i : p->nlut - 2;
+            float f = t - (float)i;
+            const float *l0 = &p->lut[3 * i], *l1 = l0 + 3;
+            if (p->o.blur) p->sigma[pix] = l0[2] + f * (l1[2] - l0[2]);
             long near;
             if (c->identity) {
                 near = (long)pix;
                 memcpy(&c->out.color[3 * pix], &p->g.color[3 * pix], 3 * sizeof(float));
             } else {
-                float X, V, rows;
-                fv_space_from_screen(c->view, px, py, &X, &V, &rows);
-                float level = rows > 1.0f ? log2f(rows) : 0.0f;
+                float X, V, level = 0.0f;
+                if (c->polar) {
+                    X = l0[0] + f * (l1[0] - l0[0]);
+                    level = l0[1] + f * (l1[1] - l0[1]);
+                    V = atan2f(dy, dx) * inv_2pi;
+                    V = V < 0.0f ? V + 1.0f : V;
+                    V = V < 1.0f ? V : 0.0f;
+                } else {
+                    fv_space_from_screen(c->view, (float)x + 0.5f, (float)y + 0.5f, &X, &V, NULL);
+                }
                 fv_phi_mips_sample(p->mips, X, V, level, &c->out.color[3 * pix]);
+                if (!aux) continue;
                 int gx = (int)X;
                 gx = gx < 0 ? 0 : (gx >= g->w ? g->w - 1 : gx);
                 int n = fv_grid_col_h(g, gx);
@@ -168,17 +210,13 @@ static void map_rows(void *ctx, int64_t b, int64_t e, int thread)
                 gy = gy < 0 ? 0 : (gy >= n ? n - 1 : gy);
                 near = (long)gy * g->w + gx;
             }
+            if (!aux) continue;
             bool hit = p->g.id[near] != 0;
             fv_film_store_first_hit(&c->out, pix, hit, p->g.depth[near],
                                     fv_v3(p->g.position[3 * near], p->g.position[3 * near + 1], p->g.position[3 * near + 2]),
                                     fv_v3(p->g.normal[3 * near], p->g.normal[3 * near + 1], p->g.normal[3 * near + 2]),
                                     fv_v3(p->g.albedo[3 * near], p->g.albedo[3 * near + 1], p->g.albedo[3 * near + 2]),
                                     hit ? (int)p->g.id[near] - 1 : 0);
-            if (p->o.blur) {
-                float dx = px - c->view->gx, dy = py - c->view->gy;
-                double ecc = sqrt((double)dx * dx + (double)dy * dy) / p->ppd * c->blur_scale;
-                p->sigma[pix] = (float)fv_blur_sigma_at(ecc, p->o.blur_fovea_deg, p->o.blur_ramp_deg, c->sigma_px);
-            }
         }
 }
 
@@ -267,11 +305,8 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const 
     mc.view = &view;
     mc.out = fv_film_views_of(film);
     mc.identity = identity;
-    mc.sigma_px = p->o.blur_sigma * (double)p->sw / 1280.0;
-    /* Visual-Polar stretches its profile (and so its fovea) from the centre gaze's largest ρ to
-     * this gaze's; the blur's fovea follows. */
-    mc.blur_scale = 1.0;
-    if (p->o.blur_follows_space) mc.blur_scale = 0.5 * sqrt((double)p->sw * p->sw + (double)p->sh * p->sh) / view.rho_max;
+    mc.polar = fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN;
+    build_radial_lut(p, &view);
     fv_parallel_for(p->sh, 8, frame->threads, map_rows, &mc);
     fv_stats_add_ms(stats, "map", fv_time_ms() - t0);
 
