@@ -57,6 +57,9 @@ fv_status fv_eye_model_validate(const fv_eye_model *m, fv_error *err);
 
 /* Viewing distance D in pixels. */
 double fv_eye_view_dist_px(const fv_eye_model *m);
+/* Pixels per degree at the gaze point, D pi / 180: the scale of the "planar degrees" (a screen
+ * distance over this) that Visual-Polar Eq. 2 and the linear fall-off are written in. */
+double fv_eye_px_per_deg(const fv_eye_model *m);
 /* Foveal and transition radii r_f <= r_t in pixels (Eq. 7 in angle mode). */
 double fv_eye_fovea_radius_px(const fv_eye_model *m);
 double fv_eye_transition_radius_px(const fv_eye_model *m);

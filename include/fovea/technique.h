@@ -111,6 +111,9 @@ typedef struct fv_technique_class {
 /* The first step of every technique's render: the camera's basis, and a check that the camera and
  * the film have the same size. */
 fv_status fv_frame_camera(const fv_camera *cam, const fv_film *film, fv_camera_basis *out, fv_error *err);
+/* The frame's display/eye model, or when it has none the default one for a width x height film,
+ * built in *def. */
+const fv_eye_model *fv_frame_eye(const fv_frame *frame, int width, int height, fv_eye_model *def);
 
 int fv_technique_count(void);
 const fv_technique_class *fv_technique_at(int i);

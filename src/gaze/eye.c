@@ -57,6 +57,8 @@ double fv_eye_view_dist_px(const fv_eye_model *m)
     return (double)m->eye_dist_mm / MM_PER_INCH * m->ppi;
 }
 
+double fv_eye_px_per_deg(const fv_eye_model *m) { return fv_eye_view_dist_px(m) * FV_PI_D / 180.0; }
+
 double fv_eye_fovea_radius_px(const fv_eye_model *m)
 {
     if (m->mode == FV_FOVEA_WIDTH) return (double)m->fovea_frac * m->width;

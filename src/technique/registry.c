@@ -84,6 +84,13 @@ void fv_technique_destroy(fv_technique *t)
     free(t);
 }
 
+const fv_eye_model *fv_frame_eye(const fv_frame *frame, int width, int height, fv_eye_model *def)
+{
+    if (frame->eye) return frame->eye;
+    fv_eye_model_default(width, height, def);
+    return def;
+}
+
 fv_status fv_frame_camera(const fv_camera *cam, const fv_film *film, fv_camera_basis *out, fv_error *err)
 {
     fv_status s = fv_camera_basis_make(cam, out, err);

@@ -22,6 +22,8 @@ static void test_eq7_radii(void **st)
     fv_error err;
     assert_int_equal(fv_eye_model_validate(&m, &err), FV_OK);
     assert_float_equal(fv_eye_view_dist_px(&m), 435.827, 1e-3);
+    /* pixels per degree at the gaze: 435.827 * pi / 180 = 7.60662 */
+    assert_float_equal(fv_eye_px_per_deg(&m), 7.60662, 1e-4);
     assert_float_equal(fv_eye_fovea_radius_px(&m), 75.124, 1e-3);
     assert_float_equal(fv_eye_transition_radius_px(&m), 154.848, 1e-3);
     /* The same panel rendered 270 px wide: ppi 615/4, every radius a quarter. */

@@ -19,7 +19,7 @@ static double ppd_for(int w, int h)
 {
     fv_eye_model m;
     fv_eye_model_default(w, h, &m);
-    return fv_eye_view_dist_px(&m) * FV_PI_D / 180.0;
+    return fv_eye_px_per_deg(&m);
 }
 
 static fv_space *make(fv_space_kind kind, double reduction)

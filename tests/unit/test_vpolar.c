@@ -95,7 +95,7 @@ static double expected_falloff_share(void)
 {
     fv_eye_model m;
     fv_eye_model_default(W, H, &m);
-    double ppd = fv_eye_view_dist_px(&m) * FV_PI_D / 180.0, sum = 0.0;
+    double ppd = fv_eye_px_per_deg(&m), sum = 0.0;
     for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++) {
             double e = hypot(x + 0.5 - 0.5 * W, y + 0.5 - 0.5 * H) / ppd;
@@ -194,7 +194,7 @@ static void test_show_modes(void **st)
     fv_space_opts_default(FV_SPACE_VPOLAR, &o);
     fv_space *s;
     fv_error err;
-    assert_int_equal(fv_space_create(&o, W, H, fv_eye_view_dist_px(&eye) * FV_PI_D / 180.0, &s, &err), FV_OK);
+    assert_int_equal(fv_space_create(&o, W, H, fv_eye_px_per_deg(&eye), &s, &err), FV_OK);
     fv_space_info info;
     fv_space_get_info(s, &info);
     float centre = img[3 * (size_t)(H / 2 * W + W / 2)], corner = img[3 * (size_t)(2 * W + 2)];

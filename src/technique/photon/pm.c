@@ -424,11 +424,7 @@ static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv
     const fv_scene *s = st->scene;
     int w = fv_film_width(film), h = fv_film_height(film);
     fv_eye_model def;
-    const fv_eye_model *eye = frame->eye;
-    if (!eye) {
-        fv_eye_model_default(w, h, &def);
-        eye = &def;
-    }
+    const fv_eye_model *eye = fv_frame_eye(frame, w, h, &def);
     render_ctx *c = calloc(1, sizeof *c);
     if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_status rc = ensure_buffers(st, w, h, err);

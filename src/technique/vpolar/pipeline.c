@@ -75,7 +75,7 @@ void fv_vp_pipeline_destroy(fv_vp_pipeline *p)
 static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *eye, uint64_t seed, fv_error *err)
 {
     free_buffers(p);
-    p->ppd = fv_eye_view_dist_px(eye) * FV_PI_D / 180.0;
+    p->ppd = fv_eye_px_per_deg(eye);
     fv_status s = fv_space_create(&p->o.space, sw, sh, p->ppd, &p->space, err);
     if (s != FV_OK) return s;
     const fv_grid *g = fv_space_grid(p->space);
@@ -97,6 +97,15 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
         free_buffers(p);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d sample grid", g->w, g->h);
     }
+    /* "No surface, not sampled" everywhere: the rows beyond a column's height keep it for good,
+     * since the trace stage writes only the valid cells. */
+    memset(p->g.color, 0, n * 3 * sizeof(float));
+    memset(p->g.albedo, 0, n * 3 * sizeof(float));
+    memset(p->g.normal, 0, n * 3 * sizeof(float));
+    memset(p->g.position, 0, n * 3 * sizeof(float));
+    memset(p->g.id, 0, n * sizeof(uint32_t));
+    memset(p->g.sampled, 0, n);
+    for (size_t i = 0; i < n; i++) p->g.depth[i] = INFINITY;
     if (p->o.denoise && (s = fv_svgf_create(g, &p->o.svgf, &p->svgf, err)) != FV_OK) {
         free_buffers(p);
         return s;
@@ -227,11 +236,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const 
     fv_status s = fv_frame_camera(cam, film, &basis, err);
     if (s != FV_OK) return s;
     fv_eye_model def;
-    const fv_eye_model *em = frame->eye;
-    if (!em) {
-        fv_eye_model_default(cam->width, cam->height, &def);
-        em = &def;
-    }
+    const fv_eye_model *em = fv_frame_eye(frame, cam->width, cam->height, &def);
     if (p->sw != cam->width || p->sh != cam->height) {
         if ((s = setup(p, cam->width, cam->height, em, frame->seed, err)) != FV_OK) return s;
     }
@@ -317,9 +322,11 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const 
     return FV_OK;
 }
 
-const float *fv_vp_pipeline_space_image(const fv_vp_pipeline *p, const fv_grid **grid)
+const fv_space *fv_vp_pipeline_space(const fv_vp_pipeline *p, fv_space_view *view, const float **image, double *px_per_deg)
 {
     if (!p->have_image) return NULL;
-    *grid = fv_space_grid(p->space);
-    return p->g.color;
+    *view = p->prev_view; /* set by the frame just rendered */
+    *image = p->g.color;
+    *px_per_deg = p->ppd;
+    return p->space;
 }

@@ -41,8 +41,9 @@ void fv_vp_pipeline_destroy(fv_vp_pipeline *p);
 fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const fv_camera *cam, const fv_camera *prev_cam,
                                 fv_gaze gaze, int eye, fv_film *film, fv_stats *stats, fv_error *err);
 
-/* The last frame's sample-space image (denoised when denoising is on) and its grid, for pictures
- * of the space itself (docs/results.md). NULL before the first frame. */
-const float *fv_vp_pipeline_space_image(const fv_vp_pipeline *p, const fv_grid **grid);
+/* The last frame's sample space, its view (where the gaze was), the sample-space image (denoised
+ * when denoising is on) and the display's pixels per degree, for pictures of the space itself
+ * (docs/results.md). NULL before the first frame. */
+const fv_space *fv_vp_pipeline_space(const fv_vp_pipeline *p, fv_space_view *view, const float **image, double *px_per_deg);
 
 #endif

@@ -18,12 +18,10 @@ typedef struct trace_ctx {
     } counters[FV_MAX_THREADS];
 } trace_ctx;
 
-/* Survival probability of the linear fall-off at pixel position (px, py). */
-static float survival(const fv_vp_trace_job *j, float px, float py)
+double fv_vp_survival(const fv_space_view *v, float px, float py, double px_per_deg, double e0, double e1, double p)
 {
-    float dx = px - j->view.gx, dy = py - j->view.gy;
-    double e = sqrt((double)dx * dx + (double)dy * dy) / j->px_per_deg;
-    return (float)fv_acuity_linear(e, j->kill_e0, j->kill_e1, j->kill_p);
+    float dx = px - v->gx, dy = py - v->gy;
+    return fv_acuity_linear(sqrt((double)dx * dx + (double)dy * dy) / px_per_deg, e0, e1, p);
 }
 
 static void store_miss(const fv_vp_gbuf *g, long i)
@@ -65,7 +63,7 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
         bool go = !(j->skip_offscreen && !on);
         if (go && j->kill) {
             fv_rng kr = fv_rng_make(j->seed ^ KILL_STREAM, (uint64_t)i * 2 + (uint64_t)j->eye, 0, (uint64_t)j->frame);
-            go = fv_rng_next(&kr) < survival(j, px, py);
+            go = fv_rng_next(&kr) < (float)fv_vp_survival(&j->view, px, py, j->px_per_deg, j->kill_e0, j->kill_e1, j->kill_p);
         }
         g->sampled[i] = go;
         if (!go) {
@@ -141,12 +139,6 @@ void fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_re
     c->g = g;
     c->grid = fv_space_grid(job->view.space);
     const fv_grid *grid = c->grid;
-    /* Unused rows (beyond a column's height) must read as "no surface" to the filters. */
-    for (int x = 0; x < grid->w; x++)
-        for (int y = fv_grid_col_h(grid, x); y < grid->h; y++) {
-            store_miss(g, (long)y * grid->w + x);
-            g->sampled[(long)y * grid->w + x] = 0;
-        }
     if (job->order == FV_VP_ORDER_RANDOM && job->perm)
         fv_parallel_for(job->nperm, 4096, job->threads, random_range, c);
     else

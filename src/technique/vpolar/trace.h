@@ -52,7 +52,12 @@ typedef struct fv_vp_trace_result {
     uint64_t nan_paths;
 } fv_vp_trace_result;
 
-/* Traces every valid sample of job->view's grid into g. */
+/* Linear fall-off (Weier et al. 2016): the probability that a path at screen position (px, py)
+ * survives, 1 up to e0 planar degrees from the gaze, p from e1 on, linear between. */
+double fv_vp_survival(const fv_space_view *v, float px, float py, double px_per_deg, double e0, double e1, double p);
+
+/* Traces every valid sample of job->view's grid into g (every valid cell is written, traced or not;
+ * rows beyond a column's height are left as they are). */
 void fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_result *res);
 
 /* A permutation of the grid's valid pixel indices drawn from seed (for FV_VP_ORDER_RANDOM);

@@ -142,12 +142,15 @@ static fv_status create_kind(vp_kind kind, const char *name, const fv_scene *sce
 /* show=space: the sample-space image in the top-left corner, clipped rows white. */
 static void show_space(const fv_vp_pipeline *p, fv_film *film)
 {
-    const fv_grid *g;
-    const float *img = fv_vp_pipeline_space_image(p, &g);
+    fv_space_view view;
+    const float *img;
+    double ppd;
+    const fv_space *sp = fv_vp_pipeline_space(p, &view, &img, &ppd);
     float *out = fv_film_color(film);
     int w = fv_film_width(film), h = fv_film_height(film);
     memset(out, 0, sizeof(float) * 3 * (size_t)w * h);
-    if (!img) return;
+    if (!sp) return;
+    const fv_grid *g = fv_space_grid(sp);
     for (int y = 0; y < g->h && y < h; y++)
         for (int x = 0; x < g->w && x < w; x++) {
             float *o = &out[3 * ((size_t)y * w + x)];
@@ -159,28 +162,19 @@ static void show_space(const fv_vp_pipeline *p, fv_film *film)
         }
 }
 
-/* show=density: traced samples per screen pixel, from the grid positions of the traced samples. */
-static fv_status show_density(const vp_state *st, const fv_vp_pipeline *p, const fv_frame *frame, fv_gaze gaze, fv_film *film,
-                              fv_error *err)
+/* show=density: samples per screen pixel, from the positions of the grid's samples in the frame
+ * just rendered (linear fall-off: their expected survival). */
+static fv_status show_density(const vp_state *st, const fv_vp_pipeline *p, fv_film *film, fv_error *err)
 {
     int w = fv_film_width(film), h = fv_film_height(film);
-    fv_eye_model def;
-    const fv_eye_model *em = frame->eye;
-    if (!em) {
-        fv_eye_model_default(w, h, &def);
-        em = &def;
-    }
-    fv_space *sp;
-    fv_status s = fv_space_create(&st->o.space, w, h, fv_eye_view_dist_px(em) * FV_PI_D / 180.0, &sp, err);
-    if (s != FV_OK) return s;
+    fv_space_view view;
+    const float *img;
+    double ppd;
+    const fv_space *sp = fv_vp_pipeline_space(p, &view, &img, &ppd);
+    if (!sp) return fv_error_set(err, FV_ERR_INTERNAL, "show=density before a frame was rendered");
     const fv_grid *g = fv_space_grid(sp);
-    fv_space_view view = fv_space_view_at(sp, gaze);
     double *count = fv_calloc_array((size_t)(w + 1) * (h + 1), sizeof(double));
-    if (!count) {
-        fv_space_destroy(sp);
-        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    }
-    double ppd = fv_eye_view_dist_px(em) * FV_PI_D / 180.0;
+    if (!count) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     for (int y = 0; y < g->h; y++)
         for (int x = 0; x < g->w; x++) {
             if (!fv_grid_valid(g, x, y)) continue;
@@ -188,11 +182,7 @@ static fv_status show_density(const vp_state *st, const fv_vp_pipeline *p, const
             fv_grid_centre(g, x, y, &X, &V);
             fv_space_to_screen(&view, X, V, &px, &py);
             if (px < 0.0f || py < 0.0f || px >= (float)w || py >= (float)h) continue;
-            double weight = 1.0;
-            if (st->o.kill) { /* expected count: the survival probability */
-                double e = hypot(px - view.gx, py - view.gy) / ppd;
-                weight = fv_acuity_linear(e, st->o.kill_e0, st->o.kill_e1, st->o.kill_p);
-            }
+            double weight = st->o.kill ? fv_vp_survival(&view, px, py, ppd, st->o.kill_e0, st->o.kill_e1, st->o.kill_p) : 1.0;
             count[(size_t)((int)py + 1) * (w + 1) + (int)px + 1] += weight;
         }
     /* Summed-area table, then the mean over a 13x13 window. */
@@ -212,7 +202,6 @@ static fv_status show_density(const vp_state *st, const fv_vp_pipeline *p, const
             out[3 * ((size_t)y * w + x)] = out[3 * ((size_t)y * w + x) + 1] = out[3 * ((size_t)y * w + x) + 2] = d;
         }
     free(count);
-    fv_space_destroy(sp);
     return FV_OK;
 }
 
@@ -227,7 +216,7 @@ static fv_status vp_render(void *state, const fv_frame *frame, fv_film *film, fv
         fv_status s = fv_vp_pipeline_render(st->eye[e], frame, cams[e], prev[e], gaze[e], e, films[e], stats, err);
         if (s != FV_OK) return s;
         if (st->show == SHOW_SPACE) show_space(st->eye[e], films[e]);
-        if (st->show == SHOW_DENSITY && (s = show_density(st, st->eye[e], frame, gaze[e], films[e], err)) != FV_OK) return s;
+        if (st->show == SHOW_DENSITY && (s = show_density(st, st->eye[e], films[e], err)) != FV_OK) return s;
     }
     return FV_OK;
 }
