@@ -19,7 +19,8 @@ typedef enum fv_status {
     FV_ERR_INVALID,  /* bad input from the user: value, name, size, file contents */
     FV_ERR_IO,       /* file missing, unreadable or unwritable */
     FV_ERR_NOMEM,    /* an allocation failed or a requested size overflows */
-    FV_ERR_INTERNAL  /* a bug or an unexpected failure of a library we use */
+    FV_ERR_INTERNAL, /* a bug or an unexpected failure of a library we use */
+    FV_ERR_CANCELLED /* the caller's progress callback asked to stop */
 } fv_status;
 
 #define FV_ERROR_MSG_MAX 512

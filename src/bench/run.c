@@ -110,20 +110,19 @@ static fv_status render_sequence(const render_job *j, int first, int nframes, fr
         const frame_setup *f = &j->frames[i];
         if ((st = fv_scene_set_time(j->scene, f->time, err)) != FV_OK) break;
         fv_frame fr;
-        memset(&fr, 0, sizeof fr);
+        fv_frame_init(&fr, &f->cam);
         fr.time = f->time;
         fr.index = i;
         fr.seed = j->sc->seed;
         fr.threads = j->threads;
-        fr.camera = &f->cam;
         fr.prev_camera = i > first ? &j->frames[i - 1].cam : NULL;
-        fr.gaze = fr.gaze_right = f->gaze;
-        fr.eye = &j->sc->eye;
+        fr.gaze = f->gaze;
+        fr.eye_model = &j->sc->eye;
         fv_stats stats;
         fv_stats_clear(&stats);
         fv_film_clear(film);
         double t0 = fv_time_ms();
-        st = fv_technique_render(t, &fr, film, NULL, &stats, err);
+        st = fv_technique_render(t, &fr, film, &stats, err);
         double ms = fv_time_ms() - t0;
         if (st != FV_OK) {
             fv_error_prefix(err, "%s, frame %d: ", j->m->label, i);

@@ -65,11 +65,11 @@ static fv_status parse_method(const cJSON *obj, const char *file, const char *wh
         (st = fv_json_string(obj, "method", file, where, &method, err)) != FV_OK ||
         (st = fv_json_string(obj, "label", file, where, &label, err)) != FV_OK)
         return st;
-    if (!fv_technique_find(method)) {
+    if (fv_technique_index(method) < 0) {
         char known[256] = "";
         size_t len = 0;
         for (int i = 0; i < fv_technique_count(); i++) {
-            int w = snprintf(known + len, sizeof known - len, "%s%s", i ? ", " : "", fv_technique_at(i)->name);
+            int w = snprintf(known + len, sizeof known - len, "%s%s", i ? ", " : "", fv_technique_name(i));
             if (w < 0 || (size_t)w >= sizeof known - len) break;
             len += (size_t)w;
         }

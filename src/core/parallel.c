@@ -10,16 +10,20 @@ int fv_thread_count(int requested)
     return n;
 }
 
-void fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *ctx,
+bool fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *ctx,
                        fv_progress_fn progress, void *progress_user)
 {
     const int tx = (width + FV_TILE_SIZE - 1) / FV_TILE_SIZE;
     const int ty = (height + FV_TILE_SIZE - 1) / FV_TILE_SIZE;
     const int ntiles = tx * ty;
     const int nthreads = fv_thread_count(threads);
-    int done = 0;
+    int done = 0, stop = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
     for (int i = 0; i < ntiles; i++) {
+        int halt;
+#pragma omp atomic read
+        halt = stop;
+        if (halt) continue; /* cancelled: an OpenMP loop cannot break, so the rest run empty */
         fv_tile t;
         t.x0 = (i % tx) * FV_TILE_SIZE;
         t.y0 = (i / tx) * FV_TILE_SIZE;
@@ -31,9 +35,13 @@ void fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *
 #pragma omp atomic capture
         d = ++done;
         /* Only thread 0 reports, so the callback never runs concurrently with itself. */
-        if (progress && t.thread == 0) progress(progress_user, (double)d / ntiles);
+        if (progress && t.thread == 0 && !progress(progress_user, (double)d / ntiles)) {
+#pragma omp atomic write
+            stop = 1;
+        }
     }
-    if (progress) progress(progress_user, 1.0);
+    if (stop) return false;
+    return !progress || progress(progress_user, 1.0);
 }
 
 void fv_parallel_for(int64_t n, int64_t chunk, int threads, fv_range_fn fn, void *ctx)

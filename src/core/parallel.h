@@ -8,7 +8,8 @@
 #define FV_CORE_PARALLEL_H
 
 #include <stdint.h>
-#include "fovea/technique.h"
+#include <stdbool.h>
+#include "fovea/frame.h"
 
 #define FV_TILE_SIZE 16
 #define FV_MAX_THREADS 256
@@ -24,8 +25,9 @@ typedef void (*fv_tile_fn)(void *ctx, const fv_tile *tile);
 int fv_thread_count(int requested);
 
 /* Runs fn over all tiles of a width x height image with `threads` threads (0: all), calling
- * progress(user, fraction) now and then from one thread. */
-void fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *ctx,
+ * progress(user, fraction) now and then from one thread, and last with 1. When progress returns
+ * false, tiles not yet started are skipped and the call returns false (cancelled). */
+bool fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *ctx,
                        fv_progress_fn progress, void *progress_user);
 
 /* Runs fn(ctx, begin, end, thread) over [0, n) in chunks of `chunk`. */

@@ -1,4 +1,4 @@
-/* fovea — the technique parameter bag (see include/fovea/technique.h).
+/* fovea — the parameter bag (include/fovea/params.h) and its readers (core/params_read.h).
  *
  * Values are kept as strings and parsed when a technique reads them, so the message for a bad
  * value can name both the key and the text the user typed. Reads mark keys as used; a key no
@@ -12,7 +12,7 @@
 #include <string.h>
 #include <strings.h>
 #include "core/alloc.h"
-#include "fovea/technique.h"
+#include "core/params_read.h"
 
 typedef struct fv_param_entry {
     char *key, *value;
@@ -181,6 +181,8 @@ fv_status fv_params_choice(fv_params *p, const char *key, int def, const char *c
     }
     return fv_error_set(err, FV_ERR_INVALID, "parameter %s=%s: expected one of %s", key, e->value, list);
 }
+
+bool fv_params_has(const fv_params *p, const char *key) { return p && find(p, key) != NULL; }
 
 fv_status fv_params_check_used(const fv_params *p, const char *technique, fv_error *err)
 {

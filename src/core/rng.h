@@ -43,6 +43,29 @@ static inline uint32_t fv_rng_u32(fv_rng *r)
     return (uint32_t)(fv_hash64(r->key + 0x632be59bd9b4e019ULL * (uint64_t)(++r->dim)) >> 32);
 }
 
+/* ---- named streams ----
+ *
+ * Every random draw in the library belongs to one of these purposes. A stream's key is xor-ed into
+ * the frame seed before hashing, so two purposes never share draws even for the same (pixel,
+ * sample, frame). Camera paths use the plain seed (key 0).
+ */
+#define FV_STREAM_CAMERA 0x0ULL                  /* camera paths: (pixel * 2 + eye, sample, frame) */
+#define FV_STREAM_KILL 0x6b696c6cULL             /* linear fall-off: the kill decision per sample */
+#define FV_STREAM_FOVEATED 0x5851f42d4c957f2dULL /* fpm: foveated photon paths (pixel, attempt, frame) */
+#define FV_STREAM_ORDER 0x6f72646572ULL          /* a random launch order (one permutation per seed) */
+/* Light photon map k (1: static M_ls, 2: dynamic M_ld, 100 + pass: pm's maps): (photon, sub, frame). */
+#define FV_STREAM_PHOTONS(k) ((uint64_t)(k) * 0x9e3779b97f4a7c15ULL)
+
+static inline fv_rng fv_rng_stream(uint64_t seed, uint64_t stream, uint64_t index, uint64_t sample, uint64_t frame)
+{
+    return fv_rng_make(seed ^ stream, index, sample, frame);
+}
+
+/* The seed a reference image is rendered with, from a scenario's seed: no measured method ever
+ * draws from it, so a 1-sample method's first sample is not the reference's first sample (which
+ * would understate its error). */
+static inline uint64_t fv_seed_reference(uint64_t seed) { return fv_hash_combine(fv_hash64(seed), 0x7265666572656e63ULL); }
+
 /* Uniform float in [0, 1): 24 random mantissa bits. */
 static inline float fv_rng_next(fv_rng *r)
 {

@@ -1,8 +1,8 @@
-/* fovea — per-frame stage timings and counters (see include/fovea/technique.h). */
+/* fovea — per-frame stage timings and counters (see include/fovea/stats.h). */
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
-#include "fovea/technique.h"
+#include "fovea/stats.h"
 
 void fv_stats_clear(fv_stats *s) { memset(s, 0, sizeof *s); }
 

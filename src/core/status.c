@@ -50,6 +50,7 @@ const char *fv_status_name(fv_status status)
     case FV_ERR_IO: return "i/o error";
     case FV_ERR_NOMEM: return "out of memory";
     case FV_ERR_INTERNAL: return "internal error";
+    case FV_ERR_CANCELLED: return "cancelled";
     }
     return "unknown status";
 }

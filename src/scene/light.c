@@ -2,6 +2,7 @@
  * the inner and outer cone; point lights are isotropic. */
 #include "scene/light.h"
 #include "scene/bsdf.h"
+#include "scene/scene_impl.h"
 
 static int pick_light(const fv_scene *s, float u, float *pmf)
 {
@@ -120,6 +121,37 @@ bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *orig
     *normal = n;
     /* L cos / (pmf * (1/A) * cos/pi * side prob) = L pi A / (pmf * side prob) */
     *power = fv_scale(l->emission, FV_PI * l->area * (l->two_sided ? 2.0f : 1.0f) / pmf);
+    return true;
+}
+
+bool fv_light_pick_point(const fv_scene *s, fv_rng *rng, fv_light_point *out)
+{
+    if (s->nlights == 0) return false;
+    out->light = pick_light(s, fv_rng_next(rng), &out->pmf);
+    if (!(out->pmf > 0.0f)) return false;
+    const fv_light *l = &s->lights[out->light];
+    out->delta = l->kind == 0;
+    if (out->delta) {
+        out->p = l->desc.pos;
+        out->n = fv_v3s(0.0f);
+    } else {
+        float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng);
+        out->p = sample_triangle(s, l, u0, u1);
+        out->n = l->n;
+    }
+    return true;
+}
+
+bool fv_light_point_power(const fv_scene *s, const fv_light_point *lp, fv_vec3 dir, float pdf, fv_vec3 *power)
+{
+    const fv_light *l = &s->lights[lp->light];
+    if (lp->delta) {
+        *power = fv_scale(fv_light_delta_intensity(l, dir), 1.0f / pdf);
+        return true;
+    }
+    float c = fv_dot(l->n, dir);
+    if (!(c > 0.0f || (l->two_sided && c < 0.0f))) return false;
+    *power = fv_scale(l->emission, fabsf(c) * l->area / pdf);
     return true;
 }
 

@@ -7,7 +7,10 @@
 #ifndef FV_SCENE_LIGHT_H
 #define FV_SCENE_LIGHT_H
 
-#include "scene/scene_impl.h"
+#include "core/rng.h"
+#include "scene/query.h"
+
+typedef struct fv_light fv_light;
 
 typedef struct fv_light_sample {
     fv_vec3 wi;      /* unit direction from the shading point to the light */
@@ -33,6 +36,22 @@ float fv_light_pdf_li(const fv_scene *s, int obj, int prim, fv_vec3 p, fv_vec3 h
  * by the pick and sampling densities; divide by the number of photons emitted). u[5]. */
 bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *origin, fv_vec3 *dir, fv_vec3 *power,
                               fv_vec3 *normal);
+
+/* A point on a light picked by power (the walk's start when it must aim somewhere itself, as
+ * photons towards the dynamic objects do): the light index, its pick probability, the point, and
+ * for an area light its unit normal (zero for a delta light). Draws one number, two more for an
+ * area light. False when the scene has no light or the pick has zero probability. */
+typedef struct fv_light_point {
+    int light;
+    float pmf;
+    bool delta;
+    fv_vec3 p, n;
+} fv_light_point;
+bool fv_light_pick_point(const fv_scene *s, fv_rng *rng, fv_light_point *out);
+/* Power carried by a walk leaving the picked point along unit dir, divided by `pdf` (the pick
+ * probability times the direction's density): intensity / pdf for a delta light, emission |cos|
+ * area / pdf for an area light. False when an area light does not emit towards dir. */
+bool fv_light_point_power(const fv_scene *s, const fv_light_point *lp, fv_vec3 dir, float pdf, fv_vec3 *power);
 
 /* Radiant intensity of delta light l towards unit direction w (spot fall-off applied). */
 fv_vec3 fv_light_delta_intensity(const fv_light *l, fv_vec3 w);

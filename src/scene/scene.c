@@ -696,6 +696,30 @@ void fv_scene_bounds(const fv_scene *s, fv_vec3 *lo, fv_vec3 *hi)
     *hi = s->hi;
 }
 
+float fv_scene_ray_eps(const fv_scene *s) { return s->eps; }
+
+fv_object_kind fv_scene_object_kind(const fv_scene *s, int obj)
+{
+    (void)s, (void)obj;
+    return FV_OBJECT_MESH;
+}
+
+bool fv_scene_object_dynamic(const fv_scene *s, int obj) { return obj >= 0 && obj < s->nobj && s->objs[obj].dynamic; }
+
+void fv_scene_object_bounds(const fv_scene *s, int obj, fv_vec3 *lo, fv_vec3 *hi)
+{
+    const fv_object *o = &s->objs[obj];
+    *lo = fv_v3s(INFINITY);
+    *hi = fv_v3s(-INFINITY);
+    /* The object-space box's corners moved to the current time. */
+    for (int k = 0; k < 8; k++) {
+        fv_vec3 p = fv_v3(k & 1 ? o->hi.x : o->lo.x, k & 2 ? o->hi.y : o->lo.y, k & 4 ? o->hi.z : o->lo.z);
+        p = fv_xform_point(&o->xf, p);
+        *lo = fv_vmin(*lo, p);
+        *hi = fv_vmax(*hi, p);
+    }
+}
+
 int fv_scene_triangle_count(const fv_scene *s)
 {
     int n = 0;

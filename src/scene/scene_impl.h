@@ -13,6 +13,7 @@
 
 #include <embree3/rtcore.h>
 #include "fovea/scene.h"
+#include "scene/query.h"
 
 typedef struct fv_object {
     char name[FV_NAME_MAX];
@@ -73,47 +74,5 @@ struct fv_scene {
     fv_eye_model eye;
     fv_gaze_path *gaze;        /* owned */
 };
-
-/* ---- ray queries (scene.c) ---- */
-
-typedef enum fv_trace_set {
-    FV_TRACE_ALL = 0,     /* static and dynamic objects at the current time */
-    FV_TRACE_STATIC,      /* static objects only */
-    FV_TRACE_DYNAMIC      /* dynamic objects only */
-} fv_trace_set;
-
-typedef struct fv_hit {
-    float t;
-    fv_vec3 p;      /* world position */
-    fv_vec3 ng;     /* unit geometric normal, world, as wound (not flipped toward the ray) */
-    fv_vec3 ns;     /* unit shading normal, world, same hemisphere as ng */
-    int obj, prim, mat;
-    float u, v;     /* barycentrics of vertices 1 and 2 */
-} fv_hit;
-
-/* Closest hit along o + t d, t in (eps, tmax). d need not be unit (t is then in units of d). */
-bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax, fv_hit *hit);
-/* Closest hits of n <= 8 camera rays from one origin (all geometry, no distance limit), traced as
- * one coherent packet; ok[i] says whether ray i hit. Returns the number of hits. */
-int fv_scene_intersect8(const fv_scene *s, fv_vec3 o, const fv_vec3 *d, int n, fv_hit *hits, bool *ok);
-/* The same for the lanes marked in active[8] (the others idle; ok is false for them). d must hold
- * eight directions; those of inactive lanes are not read. */
-int fv_scene_intersect8_active(const fv_scene *s, fv_vec3 o, const fv_vec3 *d, const bool *active, fv_hit *hits, bool *ok);
-/* Any hit in (eps, tmax). */
-bool fv_scene_occluded(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax);
-/* True when nothing blocks the segment from surface point p (geometric normal ng, either side)
- * to point q, q excluded: the shadow ray of next-event estimation and of every light connection.
- * The ray starts off the surface and stops eps short of q, so q may lie on a light's surface. */
-bool fv_scene_visible(const fv_scene *s, fv_trace_set set, fv_vec3 p, fv_vec3 ng, fv_vec3 q);
-
-/* A point just off the surface on the side of direction d, to start the next ray from. */
-static inline fv_vec3 fv_offset_point(const fv_scene *s, fv_vec3 p, fv_vec3 ng, fv_vec3 d)
-{
-    float e = s->eps;
-    return fv_madd(p, ng, fv_dot(ng, d) >= 0.0f ? e : -e);
-}
-
-/* World-space vertices of triangle `prim` of object `obj` at the current time. */
-void fv_scene_triangle(const fv_scene *s, int obj, int prim, fv_vec3 *a, fv_vec3 *b, fv_vec3 *c);
 
 #endif

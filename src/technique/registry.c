@@ -1,12 +1,18 @@
 /* fovea — the registry of rendering techniques, and the instance wrapper every driver uses.
  *
- * Adding a technique: define its fv_technique_class in its own folder and list it here. Nothing
- * else in the project switches on a technique's name.
+ * Adding a technique: define its fv_technique_class (class.h) in its family's folder and list it
+ * here. Nothing else in the project switches on a technique's name; the conformance suite
+ * (tests/conformance) runs every class listed here.
+ *
+ * What every method shares is done here once: parameters are validated on a private copy of the
+ * caller's bag (the caller's bag is never marked or changed) and keys the method never read are
+ * refused; the film is checked against the frame; a cancel asked through the progress callback is
+ * reported as FV_ERR_CANCELLED even by a method that did not notice it.
  */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "fovea/technique.h"
+#include "technique/class.h"
 
 extern const fv_technique_class fv_technique_pt;
 extern const fv_technique_class fv_technique_pm;
@@ -28,37 +34,52 @@ static const fv_technique_class *const k_classes[] = {
 
 int fv_technique_count(void) { return N_CLASSES; }
 
-const fv_technique_class *fv_technique_at(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i] : NULL; }
+const fv_technique_class *fv_technique_class_at(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i] : NULL; }
 
-const fv_technique_class *fv_technique_find(const char *name)
+int fv_technique_index(const char *name)
 {
-    for (int i = 0; i < N_CLASSES; i++)
-        if (strcmp(k_classes[i]->name, name) == 0) return k_classes[i];
-    return NULL;
+    for (int i = 0; name && i < N_CLASSES; i++)
+        if (strcmp(k_classes[i]->name, name) == 0) return i;
+    return -1;
 }
+
+const fv_technique_class *fv_technique_class_find(const char *name) { return fv_technique_class_at(fv_technique_index(name)); }
+
+const char *fv_technique_name(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->name : NULL; }
+const char *fv_technique_summary(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->summary : NULL; }
+const char *fv_technique_params_help(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->params_help : NULL; }
 
 struct fv_technique {
     const fv_technique_class *cls;
     void *state;
 };
 
-fv_status fv_technique_create(const char *name, const fv_scene *scene, fv_params *params,
-                              const fv_log *log, fv_technique **out, fv_error *err)
+fv_status fv_technique_create(const char *name, const fv_scene *scene, const fv_params *params, const fv_log *log,
+                              fv_technique **out, fv_error *err)
 {
     *out = NULL;
-    const fv_technique_class *cls = fv_technique_find(name);
+    const fv_technique_class *cls = fv_technique_class_find(name);
     if (!cls) {
         char list[512] = "";
         for (int i = 0; i < N_CLASSES; i++) {
             size_t l = strlen(list);
             snprintf(list + l, sizeof list - l, "%s%s", i ? ", " : "", k_classes[i]->name);
         }
-        return fv_error_set(err, FV_ERR_INVALID, "unknown method '%s' (known: %s)", name, list);
+        return fv_error_set(err, FV_ERR_INVALID, "unknown method '%s' (known: %s)", name ? name : "(null)", list);
     }
+    if (!scene) return fv_error_set(err, FV_ERR_INVALID, "method '%s': no scene", name);
+    fv_params *own = NULL;
+    fv_status s = fv_params_clone(params, &own, err);
+    if (s != FV_OK) return s;
     fv_technique *t = calloc(1, sizeof *t);
-    if (!t) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (!t) {
+        fv_params_destroy(own);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    }
     t->cls = cls;
-    fv_status s = cls->create(scene, params, log, &t->state, err);
+    s = cls->create(scene, own, log, &t->state, err);
+    if (s == FV_OK && (s = fv_params_check_used(own, cls->name, err)) != FV_OK) cls->destroy(t->state);
+    fv_params_destroy(own);
     if (s != FV_OK) {
         free(t);
         return s;
@@ -67,35 +88,45 @@ fv_status fv_technique_create(const char *name, const fv_scene *scene, fv_params
     return FV_OK;
 }
 
-fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_film *film, fv_film *film_right,
-                              fv_stats *stats, fv_error *err)
+/* Forwards progress to the caller and remembers whether it asked to stop. */
+typedef struct relay {
+    fv_progress_fn fn;
+    void *user;
+    bool cancelled;
+} relay;
+
+static bool relay_progress(void *user, double fraction)
 {
-    if (frame->camera_right && !film_right)
-        return fv_error_set(err, FV_ERR_INVALID, "stereo frame without a right-eye film");
-    return t->cls->render(t->state, frame, film, film_right, stats, err);
+    relay *r = user;
+    if (!r->cancelled && !r->fn(r->user, fraction)) r->cancelled = true;
+    return !r->cancelled;
 }
 
-const fv_technique_class *fv_technique_class_of(const fv_technique *t) { return t->cls; }
+fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+{
+    if (!t || !frame || !film || !stats) return fv_error_set(err, FV_ERR_INVALID, "render: missing technique, frame, film or stats");
+    if (!frame->camera) return fv_error_set(err, FV_ERR_INVALID, "render: the frame has no camera");
+    if (frame->eye_count < 1 || frame->eye_count > 2 || frame->eye < 0 || frame->eye >= frame->eye_count)
+        return fv_error_set(err, FV_ERR_INVALID, "render: eye %d of %d (expected eye 0, or 0 and 1 of a stereo pair)", frame->eye,
+                            frame->eye_count);
+    if (frame->camera->width != fv_film_width(film) || frame->camera->height != fv_film_height(film))
+        return fv_error_set(err, FV_ERR_INVALID, "render: camera size %dx%d differs from the film's %dx%d", frame->camera->width,
+                            frame->camera->height, fv_film_width(film), fv_film_height(film));
+    if (!frame->progress) return t->cls->render(t->state, frame, film, stats, err);
+    relay r = {frame->progress, frame->progress_user, false};
+    fv_frame f = *frame;
+    f.progress = relay_progress;
+    f.progress_user = &r;
+    fv_status s = t->cls->render(t->state, &f, film, stats, err);
+    if (s == FV_OK && r.cancelled) s = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    return s;
+}
+
+const char *fv_technique_name_of(const fv_technique *t) { return t->cls->name; }
 
 void fv_technique_destroy(fv_technique *t)
 {
     if (!t) return;
     t->cls->destroy(t->state);
     free(t);
-}
-
-const fv_eye_model *fv_frame_eye(const fv_frame *frame, int width, int height, fv_eye_model *def)
-{
-    if (frame->eye) return frame->eye;
-    fv_eye_model_default(width, height, def);
-    return def;
-}
-
-fv_status fv_frame_camera(const fv_camera *cam, const fv_film *film, fv_camera_basis *out, fv_error *err)
-{
-    fv_status s = fv_camera_basis_make(cam, out, err);
-    if (s == FV_OK && (cam->width != fv_film_width(film) || cam->height != fv_film_height(film)))
-        s = fv_error_set(err, FV_ERR_INVALID, "camera size %dx%d differs from the film's %dx%d", cam->width, cam->height,
-                         fv_film_width(film), fv_film_height(film));
-    return s;
 }

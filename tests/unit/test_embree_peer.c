@@ -72,12 +72,12 @@ static void test_embree_pathtracer_peer(void **st)
     fv_film *film;
     assert_int_equal(fv_film_create(SIZE, SIZE, 0, &film, &err), FV_OK);
     fv_frame fr;
-    memset(&fr, 0, sizeof fr);
+    fv_frame_init(&fr, NULL);
     fr.seed = 1;
     fr.camera = &cam;
     fv_stats stats;
     fv_stats_clear(&stats);
-    assert_int_equal(fv_technique_render(t, &fr, film, NULL, &stats, &err), FV_OK);
+    assert_int_equal(fv_technique_render(t, &fr, film, &stats, &err), FV_OK);
     const float *c = fv_film_color(film);
     double sum = 0;
     for (int i = 0; i < SIZE * SIZE * 3; i++) {

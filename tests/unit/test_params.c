@@ -5,6 +5,7 @@
 #include <string.h>
 #include <cmocka.h>
 #include "core/rng.h"
+#include "core/params_read.h"
 #include "fovea/technique.h"
 
 static void test_params_read_and_validate(void **st)

@@ -135,7 +135,7 @@ static void test_negative_photons(void **st)
     fv_photon_map_init(&all);
     fv_photon_map_init(&ls);
     fv_photon_map_init(&ld);
-    fv_photon_job job = {s, 400000, 7, 0, 1, 0, 0};
+    fv_photon_job job = {s, 400000, 7, 0, 1, 0, 0, NULL};
     assert_int_equal(fv_photon_trace_lights(&job, FV_TRACE_ALL, &all, NULL, &err), FV_OK);
     job.stream = 1;
     assert_int_equal(fv_photon_trace_lights(&job, FV_TRACE_STATIC, &ls, NULL, &err), FV_OK);
@@ -190,15 +190,15 @@ static void frame_stats(fv_technique *t, fv_scene *s, fv_film *f, const fv_camer
 {
     fv_error err;
     fv_frame fr;
-    memset(&fr, 0, sizeof fr);
+    fv_frame_init(&fr, NULL);
     fr.camera = cam;
     fr.prev_camera = prev;
     fr.index = index;
     fr.seed = 3;
-    fr.gaze = fr.gaze_right = g;
+    fr.gaze = g;
     fr.time = fv_scene_time(s);
     fv_stats_clear(stats);
-    fv_status rc = fv_technique_render(t, &fr, f, NULL, stats, &err);
+    fv_status rc = fv_technique_render(t, &fr, f, stats, &err);
     if (rc != FV_OK) fail_msg("%s", err.msg);
 }
 
@@ -297,14 +297,18 @@ static void test_stereo_reprojection(void **st)
     for (int k = 0; k < 2; k++) {
         fv_camera_stereo(&c, k == 0 ? 0.0f : 6.4f, &l, &r);
         fv_frame f;
-        memset(&f, 0, sizeof f);
+        fv_frame_init(&f, NULL);
         f.camera = &l;
-        f.camera_right = &r;
+        f.eye_count = 2;
         f.seed = 1;
-        f.gaze = f.gaze_right = (fv_gaze){0.5f, 0.5f};
+        f.gaze = (fv_gaze){0.5f, 0.5f};
         fv_stats stats;
         fv_stats_clear(&stats);
-        assert_int_equal(fv_technique_render(t, &f, fl, fr, &stats, &err), FV_OK);
+        assert_int_equal(fv_technique_render(t, &f, fl, &stats, &err), FV_OK);
+        f.eye = 1;
+        f.camera = &r;
+        f.left_camera = &l;
+        assert_int_equal(fv_technique_render(t, &f, fr, &stats, &err), FV_OK);
         double copied = fv_stats_get_count(&stats, "reprojected_fraction");
         if (k == 0) {
             assert_true(copied > 0.95);

@@ -26,14 +26,14 @@ static fv_film *render(fv_scene *s, const fv_camera *cam, const char *const *kv,
     fv_film *film;
     assert_int_equal(fv_film_create(cam->width, cam->height, FV_AUX_DEPTH | FV_AUX_ID, &film, &err), FV_OK);
     fv_frame fr;
-    memset(&fr, 0, sizeof fr);
+    fv_frame_init(&fr, NULL);
     fr.seed = seed;
     fr.threads = threads;
     fr.camera = cam;
     fr.gaze.x = fr.gaze.y = 0.5f;
     fv_stats stats;
     fv_stats_clear(&stats);
-    assert_int_equal(fv_technique_render(t, &fr, film, NULL, &stats, &err), FV_OK);
+    assert_int_equal(fv_technique_render(t, &fr, film, &stats, &err), FV_OK);
     assert_true(fv_stats_get_count(&stats, "rays") > 0);
     assert_true(fv_stats_get_count(&stats, "nan_samples") == 0);
     fv_technique_destroy(t);

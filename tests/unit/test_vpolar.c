@@ -50,7 +50,7 @@ static float *render(const char *method, const char *const *kv, int frames, int 
     fv_stats stats;
     for (int i = 0; i < frames; i++) {
         fv_frame fr;
-        memset(&fr, 0, sizeof fr);
+        fv_frame_init(&fr, NULL);
         fr.index = i;
         fr.seed = 5;
         fr.threads = threads;
@@ -59,7 +59,7 @@ static float *render(const char *method, const char *const *kv, int frames, int 
         fr.gaze = gaze;
         fv_stats_clear(&stats);
         fv_film_clear(film);
-        if (fv_technique_render(t, &fr, film, NULL, &stats, &err) != FV_OK) fail_msg("%s", err.msg);
+        if (fv_technique_render(t, &fr, film, &stats, &err) != FV_OK) fail_msg("%s", err.msg);
     }
     float *img = malloc(sizeof(float) * 3 * W * H);
     memcpy(img, fv_film_color_const(film), sizeof(float) * 3 * W * H);
@@ -221,14 +221,18 @@ static void test_stereo(void **st)
     fv_scene_camera(g_scene, 0.0, W, H, &c);
     fv_camera_stereo(&c, 60.0f, &l, &r);
     fv_frame fr;
-    memset(&fr, 0, sizeof fr);
+    fv_frame_init(&fr, NULL);
     fr.camera = &l;
-    fr.camera_right = &r;
+    fr.eye_count = 2;
     fr.gaze = (fv_gaze){0.45f, 0.5f};
-    fr.gaze_right = (fv_gaze){0.55f, 0.5f};
     fv_stats stats;
     fv_stats_clear(&stats);
-    assert_int_equal(fv_technique_render(t, &fr, fl, fr_, &stats, &err), FV_OK);
+    assert_int_equal(fv_technique_render(t, &fr, fl, &stats, &err), FV_OK);
+    fr.eye = 1;
+    fr.camera = &r;
+    fr.left_camera = &l;
+    fr.gaze = (fv_gaze){0.55f, 0.5f};
+    assert_int_equal(fv_technique_render(t, &fr, fr_, &stats, &err), FV_OK);
     double sl = 0, sr = 0;
     for (int i = 0; i < 3 * W * H; i++) sl += fv_film_color(fl)[i], sr += fv_film_color(fr_)[i];
     assert_true(sl > 0.0 && sr > 0.0);

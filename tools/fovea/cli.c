@@ -109,13 +109,13 @@ void fv_cli_progress_init(fv_cli_progress *p, bool quiet, int frames)
     p->last_percent = -1;
 }
 
-void fv_cli_progress_frame(void *user, double fraction)
+bool fv_cli_progress_frame(void *user, double fraction)
 {
     fv_cli_progress *p = user;
-    if (!p->enabled) return;
+    if (!p->enabled) return true;
     double total = (p->frame + fraction) / p->frames;
     int percent = (int)(total * 100.0);
-    if (percent == p->last_percent) return;
+    if (percent == p->last_percent) return true;
     p->last_percent = percent;
     double el = (fv_time_ms() - p->t0) / 1000.0;
     double eta = total > 0.001 ? el * (1.0 - total) / total : 0.0;
@@ -125,6 +125,7 @@ void fv_cli_progress_frame(void *user, double fraction)
     bar[30] = '\0';
     fprintf(stderr, "\r[%s] %3d%%  frame %d/%d  %.0fs elapsed, ETA %.0fs ", bar, percent, p->frame + 1, p->frames, el, eta);
     fflush(stderr);
+    return true;
 }
 
 void fv_cli_progress_done(fv_cli_progress *p)

@@ -34,7 +34,7 @@ typedef struct fv_cli_progress {
     int last_percent;
 } fv_cli_progress;
 void fv_cli_progress_init(fv_cli_progress *p, bool quiet, int frames);
-void fv_cli_progress_frame(void *user, double fraction); /* fv_progress_fn */
+bool fv_cli_progress_frame(void *user, double fraction); /* fv_progress_fn; never cancels */
 void fv_cli_progress_done(fv_cli_progress *p);
 
 /* Subcommands. */

@@ -10,10 +10,9 @@ int fv_cmd_methods(int argc, char **argv)
     }
     if (argc > 2) return fv_cli_usage_error("methods", "too many arguments");
     for (int i = 0; i < fv_technique_count(); i++) {
-        const fv_technique_class *c = fv_technique_at(i);
-        if (argc == 2 && strcmp(argv[1], c->name)) continue;
-        printf("%-16s %s\n", c->name, c->summary);
-        const char *h = c->params_help;
+        if (argc == 2 && strcmp(argv[1], fv_technique_name(i))) continue;
+        printf("%-16s %s\n", fv_technique_name(i), fv_technique_summary(i));
+        const char *h = fv_technique_params_help(i);
         while (h && *h) {
             const char *nl = strchr(h, '\n');
             int len = nl ? (int)(nl - h) : (int)strlen(h);

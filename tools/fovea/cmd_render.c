@@ -217,7 +217,7 @@ int fv_cmd_render(int argc, char **argv)
         rc = fv_cli_usage_error(cmd, "--out %s: cannot write there (%s)", o.out, strerror(errno));
         goto done;
     }
-    if (!fv_technique_find(o.method)) {
+    if (fv_technique_index(o.method) < 0) {
         s = fv_technique_create(o.method, NULL, NULL, NULL, &tech, &err); /* builds the message listing methods */
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
@@ -300,27 +300,32 @@ int fv_cmd_render(int argc, char **argv)
         if (o.has_fov) c.fov_y = o.fov;
         if (neyes == 2) fv_camera_stereo(&c, (float)o.stereo, &cam[0], &cam[1]);
         else cam[0] = c;
-        fv_frame fr;
-        memset(&fr, 0, sizeof fr);
-        fr.time = t;
-        fr.index = f;
-        fr.seed = o.seed;
-        fr.threads = o.threads;
-        fr.camera = &cam[0];
-        fr.prev_camera = f > 0 ? &prev[0] : NULL;
-        fr.camera_right = neyes == 2 ? &cam[1] : NULL;
-        fr.prev_camera_right = neyes == 2 && f > 0 ? &prev[1] : NULL;
-        fr.gaze.x = fr.gaze_right.x = o.gaze[0];
-        fr.gaze.y = fr.gaze_right.y = o.gaze[1];
-        if (gpath) fv_gaze_path_eval(gpath, t, &fr.gaze, &fr.gaze_right);
-        fr.eye = &eye;
-        fr.progress = fv_cli_progress_frame;
-        fr.progress_user = &prog;
-        prog.frame = f;
         fv_stats stats;
         fv_stats_clear(&stats);
         double t0 = fv_time_ms();
-        if ((s = fv_technique_render(tech, &fr, film[0], film[1], &stats, &err)) != FV_OK) break;
+        fv_gaze gz[2];
+        gz[0].x = gz[1].x = o.gaze[0];
+        gz[0].y = gz[1].y = o.gaze[1];
+        if (gpath) fv_gaze_path_eval(gpath, t, &gz[0], &gz[1]);
+        prog.frame = f;
+        for (int e = 0; e < neyes && s == FV_OK; e++) {
+            fv_frame fr;
+            fv_frame_init(&fr, &cam[e]);
+            fr.time = t;
+            fr.index = f;
+            fr.seed = o.seed;
+            fr.threads = o.threads;
+            fr.eye = e;
+            fr.eye_count = neyes;
+            fr.prev_camera = f > 0 ? &prev[e] : NULL;
+            fr.left_camera = e == 1 ? &cam[0] : NULL;
+            fr.gaze = gz[e];
+            fr.eye_model = &eye;
+            fr.progress = fv_cli_progress_frame;
+            fr.progress_user = &prog;
+            s = fv_technique_render(tech, &fr, film[e], &stats, &err);
+        }
+        if (s != FV_OK) break;
         double ms = fv_time_ms() - t0;
         for (int e = 0; e < neyes && s == FV_OK; e++) {
             char path[4096], tmp[4096];

@@ -155,7 +155,7 @@ fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera 
             float px, py;
             if ( !fv_camera_project(&pb, hit.p, &px, &py) || px < 0 || py < 0 || px >= f->w || py >= f->h) continue;
             int q = (int)py * f->w + (int)px;
-            bool ok = !s->objs[hit.obj].dynamic && fv_bsdf_is_smooth(&s->mats[hit.mat]);
+            bool ok = !fv_scene_object_dynamic(s, hit.obj) && fv_bsdf_is_smooth(fv_scene_material(s, hit.mat));
             src[i] = ok ? q : -2 - q; /* -2 - q: v is not on a static diffuse surface */
         }
     /* Lines 8-12. Each previous pixel's paths go to at most one current pixel (the first to claim
@@ -238,7 +238,7 @@ static void trace_path(const trace_ctx *c, int px, int py, int attempt, path_out
     const fv_scene *s = c->s;
     out->len = 0;
     out->dynamic = false;
-    fv_rng rng = fv_rng_make(c->seed ^ 0x5851f42d4c957f2dULL, (uint64_t)py * c->cb->width + px, (uint64_t)attempt, (uint64_t)c->frame);
+    fv_rng rng = fv_rng_stream(c->seed, FV_STREAM_FOVEATED, (uint64_t)py * c->cb->width + px, (uint64_t)attempt, (uint64_t)c->frame);
     fv_vec3 o = c->cb->pos, d = fv_camera_dir(c->cb, px + fv_rng_next(&rng), py + fv_rng_next(&rng));
     fv_vec3 chain = fv_v3s(1.0f);             /* mirror/glass weights since the last vertex */
     fv_vec3 chains[FV_FOV_MAX_DEPTH], transfer[FV_FOV_MAX_DEPTH], dout[FV_FOV_MAX_DEPTH];
@@ -250,12 +250,12 @@ static void trace_path(const trace_ctx *c, int px, int py, int attempt, path_out
             ended = true;
             break;
         }
-        const fv_material *m = &s->mats[h.mat];
+        const fv_material *m = fv_scene_material(s, h.mat);
         if (out->len > 0 && fv_max3(m->emission) > 0.0f) { /* reached the light: the last photon holds direct light */
             ended = true;
             break;
         }
-        if (s->objs[h.obj].dynamic) out->dynamic = true;
+        if (fv_scene_object_dynamic(s, h.obj)) out->dynamic = true;
         fv_shading sh;
         fv_shading_make(m, h.ng, h.ns, fv_neg(d), &sh);
         fv_vec3 ng = sh.ng;

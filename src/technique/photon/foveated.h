@@ -26,7 +26,7 @@
 #include "fovea/camera.h"
 #include "fovea/gaze.h"
 #include "technique/photon/photon_map.h"
-#include "scene/scene_impl.h"
+#include "scene/query.h"
 
 #define FV_FOV_MAX_DEPTH 16
 

@@ -16,7 +16,7 @@ void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_r
     for (int depth = 0; depth <= max_depth; depth++) {
         fv_hit h;
         if (!fv_scene_intersect(s, FV_TRACE_ALL, o, d, INFINITY, &h)) return;
-        const fv_material *m = &s->mats[h.mat];
+        const fv_material *m = fv_scene_material(s, h.mat);
         fv_vec3 wo = fv_neg(d);
         if (depth == 0) {
             out->first_t = h.t;
@@ -25,7 +25,7 @@ void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_r
             out->first_obj = h.obj;
             out->albedo = fv_bsdf_is_smooth(m) ? m->albedo : m->specular;
         }
-        if (s->objs[h.obj].dynamic) out->dynamic = true;
+        if (fv_scene_object_dynamic(s, h.obj)) out->dynamic = true;
         if (fv_max3(m->emission) > 0.0f) out->emitted = fv_add(out->emitted, fv_mul(out->weight, fv_light_emitted(s, m, h.ng, wo)));
         fv_shading sh;
         fv_shading_make(m, h.ng, h.ns, wo, &sh);
@@ -74,7 +74,7 @@ static void gather_one(void *user, const fv_photon *ph, float d2)
 fv_vec3 fv_pm_gather(const fv_scene *s, const fv_photon_map *m, const fv_pm_hit *x, float r, double *u_sum)
 {
     gather_ctx c;
-    c.m = &s->mats[x->mat];
+    c.m = fv_scene_material(s, x->mat);
     fv_shading_make(c.m, x->ng, x->n, x->wo, &c.sh);
     c.sum = fv_v3s(0.0f);
     c.u = 0.0;

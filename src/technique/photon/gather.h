@@ -10,7 +10,7 @@
 #define FV_PHOTON_GATHER_H
 
 #include "core/rng.h"
-#include "scene/scene_impl.h"
+#include "scene/query.h"
 #include "technique/photon/photon_map.h"
 
 typedef struct fv_pm_hit {

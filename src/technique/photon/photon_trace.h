@@ -1,9 +1,8 @@
 /* fovea — light photon tracing shared by pm, pm-t and fpm (Foveated Photon Mapping, Sec. 3).
  *
- * PT_s / full tracing: photons leave the lights in proportion to power, bounce with the shared
- * BSDFs (importance transport), Russian roulette keeps the flux per photon near constant, and a
- * photon is stored at every hit on a diffuse or glossy surface (mirrors and glass only redirect,
- * so caustics form), up to `max_depth` bounces (8 in the paper, Sec. 4.1).
+ * PT_s / full tracing: light paths of the shared transport (transport/light_path.h), a photon
+ * stored at each of their diffuse or glossy vertices, up to `max_depth` bounces (8 in the paper,
+ * Sec. 4.1).
  *
  * PT_d: photons for the dynamic objects. The paper renders a cube map of the dynamic objects from
  * the light and samples directions from its covered pixels. Our CPU equivalent samples, from each
@@ -22,7 +21,8 @@
 #ifndef FV_PHOTON_TRACE_H
 #define FV_PHOTON_TRACE_H
 
-#include "scene/scene_impl.h"
+#include "scene/query.h"
+#include "technique/kit.h"
 #include "technique/photon/photon_map.h"
 
 /* Where the dynamic objects are: their bounding spheres at the scene's current time. */
@@ -39,7 +39,9 @@ typedef struct fv_photon_job {
     int frame;             /* decorrelates frames; use 0 for maps traced once */
     int max_depth;
     int threads;
-    uint64_t stream;       /* distinguishes several maps traced in one frame */
+    uint64_t stream;       /* distinguishes several maps traced in one frame: FV_STREAM_PHOTONS(stream) */
+    fv_kit_progress *progress; /* optional: reported as blocks of photons finish; a cancel stops
+                                  the tracing with FV_ERR_CANCELLED */
 } fv_photon_job;
 
 /* Traces job->count photons from the lights through `set` (FV_TRACE_ALL for plain photon mapping,

@@ -229,14 +229,15 @@ static void map_rows(void *ctx, int64_t b, int64_t e, int thread)
         }
 }
 
-fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const fv_camera *cam, const fv_camera *prev_cam,
-                                fv_gaze gaze, int eye, fv_film *film, fv_stats *stats, fv_error *err)
+fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
+    const fv_camera *cam = frame->camera, *prev_cam = frame->prev_camera;
+    const fv_gaze gaze = frame->gaze;
     fv_camera_basis basis;
     fv_status s = fv_frame_camera(cam, film, &basis, err);
     if (s != FV_OK) return s;
     fv_eye_model def;
-    const fv_eye_model *em = fv_frame_eye(frame, cam->width, cam->height, &def);
+    const fv_eye_model *em = fv_frame_eye_model(frame, cam->width, cam->height, &def);
     if (p->sw != cam->width || p->sh != cam->height) {
         if ((s = setup(p, cam->width, cam->height, em, frame->seed, err)) != FV_OK) return s;
     }
@@ -259,15 +260,14 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const 
     job.kill = p->o.kill;
     job.kill_e0 = p->o.kill_e0, job.kill_e1 = p->o.kill_e1, job.kill_p = p->o.kill_p;
     job.px_per_deg = p->ppd;
-    job.seed = frame->seed;
-    job.frame = frame->index;
-    job.eye = eye;
-    job.threads = frame->threads;
-    job.progress = frame->progress;
-    job.progress_user = frame->progress_user;
+    job.frame = frame;
+    /* Progress: the trace is most of a frame; the filters report at their end. */
+    fv_kit_progress prog = {0};
+    fv_kit_phase(&prog, frame, 0.0, 0.8);
+    job.progress = &prog;
     fv_vp_trace_result tr;
     double t0 = fv_time_ms();
-    fv_vp_trace(&job, &p->g, &tr);
+    bool traced = fv_vp_trace(&job, &p->g, &tr);
     double t_trace = fv_time_ms() - t0;
     fv_stats_add_ms(stats, "trace", t_trace);
     fv_stats_add_count(stats, "rays", (double)tr.rays);
@@ -276,6 +276,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const 
     fv_stats_add_count(stats, "sample_share", (double)tr.paths / ((double)p->sw * p->sh));
     fv_stats_add_count(stats, "mrays_per_s", t_trace > 0.0 ? (double)tr.rays / t_trace / 1000.0 : 0.0);
     fv_stats_add_count(stats, "nan_samples", (double)tr.nan_paths);
+    if (!traced) return fv_error_set(err, FV_ERR_CANCELLED, "render cancelled"); /* history left as it was */
 
     /* 2. denoise in the sample space */
     t0 = fv_time_ms();
@@ -319,7 +320,8 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const 
     t0 = fv_time_ms();
     if (p->o.blur && (s = fv_blur_variable(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, err)) != FV_OK) return s;
     fv_stats_add_ms(stats, "blur", fv_time_ms() - t0);
-    return FV_OK;
+    fv_kit_phase(&prog, frame, 0.8, 0.2);
+    return fv_kit_phase_end(&prog, err);
 }
 
 const fv_space *fv_vp_pipeline_space(const fv_vp_pipeline *p, fv_space_view *view, const float **image, double *px_per_deg)

@@ -13,13 +13,15 @@
 #define FV_TECHNIQUE_VPOLAR_PIPELINE_H
 
 #include "filter/svgf.h"
-#include "fovea/technique.h"
+#include "fovea/film.h"
+#include "fovea/frame.h"
+#include "fovea/stats.h"
 #include "technique/vpolar/space.h"
 #include "technique/vpolar/trace.h"
 
 typedef struct fv_vp_opts {
     fv_space_opts space;
-    fv_pt_options pt;          /* spp 1, max_depth = 1 + bounces */
+    fv_path_opts pt;            /* spp 1, max_depth = 1 + bounces */
     fv_vp_order order;
     bool skip_offscreen;
     bool kill;                 /* linear fall-off launch (screen grid only) */
@@ -37,9 +39,8 @@ typedef struct fv_vp_pipeline fv_vp_pipeline;
 fv_status fv_vp_pipeline_create(const fv_scene *scene, const fv_vp_opts *o, fv_vp_pipeline **out, fv_error *err);
 void fv_vp_pipeline_destroy(fv_vp_pipeline *p);
 
-/* Renders one eye: cam and gaze of this frame, prev_cam of the last one (NULL: no history). */
-fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, const fv_camera *cam, const fv_camera *prev_cam,
-                                fv_gaze gaze, int eye, fv_film *film, fv_stats *stats, fv_error *err);
+/* Renders one eye of a frame (its camera and gaze; its previous camera, NULL: no history). */
+fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);
 
 /* The last frame's sample space, its view (where the gaze was), the sample-space image (denoised
  * when denoising is on) and the display's pixels per degree, for pictures of the space itself

@@ -6,16 +6,11 @@
 #include "core/rng.h"
 #include "technique/vpolar/trace.h"
 
-#define KILL_STREAM 0x6b696c6cULL /* separate random stream for the kill decision */
-
 typedef struct trace_ctx {
     const fv_vp_trace_job *job;
     const fv_vp_gbuf *g;
     const fv_grid *grid;
-    struct {
-        uint64_t rays, paths, bad;
-        char pad[40];
-    } counters[FV_MAX_THREADS];
+    fv_kit_counters *counters; /* rays, NaN, paths (FV_KIT_USER0) */
 } trace_ctx;
 
 double fv_vp_survival(const fv_space_view *v, float px, float py, double px_per_deg, double e0, double e1, double p)
@@ -52,7 +47,7 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
         if (pix[k] < 0) continue;
         long i = pix[k];
         int x = (int)(i % w), y = (int)(i / w);
-        rng[k] = fv_rng_make(j->seed, (uint64_t)i * 2 + (uint64_t)j->eye, 0, (uint64_t)j->frame);
+        rng[k] = fv_kit_rng(j->frame, (uint64_t)i, 0);
         /* Jitter inside the grid cell: the temporal accumulation of the denoiser then integrates
          * over the cell instead of converging to one aliased point. */
         float X = (float)x + fv_rng_next(&rng[k]);
@@ -62,7 +57,7 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
         bool on = px >= -1.0f && py >= -1.0f && px <= (float)j->screen_w + 1.0f && py <= (float)j->screen_h + 1.0f;
         bool go = !(j->skip_offscreen && !on);
         if (go && j->kill) {
-            fv_rng kr = fv_rng_make(j->seed ^ KILL_STREAM, (uint64_t)i * 2 + (uint64_t)j->eye, 0, (uint64_t)j->frame);
+            fv_rng kr = fv_rng_stream(j->frame->seed, FV_STREAM_KILL, (uint64_t)i * 2 + (uint64_t)j->frame->eye, 0, (uint64_t)j->frame->index);
             go = fv_rng_next(&kr) < (float)fv_vp_survival(&j->view, px, py, j->px_per_deg, j->kill_e0, j->kill_e1, j->kill_p);
         }
         g->sampled[i] = go;
@@ -80,13 +75,9 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
     for (int k = 0; k < 8; k++) {
         if (!active[k]) continue;
         long i = pix[k];
-        fv_pt_first_hit first;
+        fv_path_first_hit first;
         memset(&first, 0, sizeof first);
-        fv_vec3 L = fv_pt_trace_from(j->scene, &j->pt, j->cam.pos, dir[k], &hits[k], ok[k], &rng[k], &first, &rays);
-        if (!fv_is_finite3(L)) { /* the NaN/Inf guard of every technique: counted, kept off the film */
-            bad++;
-            L = fv_v3s(0.0f);
-        }
+        fv_vec3 L = fv_kit_guard(fv_path_trace_from(j->scene, &j->pt, j->cam.pos, dir[k], &hits[k], ok[k], &rng[k], &first, &rays), &bad);
         g->color[3 * i] = L.x, g->color[3 * i + 1] = L.y, g->color[3 * i + 2] = L.z;
         if (first.hit) {
             g->albedo[3 * i] = first.albedo.x, g->albedo[3 * i + 1] = first.albedo.y, g->albedo[3 * i + 2] = first.albedo.z;
@@ -100,9 +91,9 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
             g->color[3 * i] = keep.x, g->color[3 * i + 1] = keep.y, g->color[3 * i + 2] = keep.z;
         }
     }
-    c->counters[thread].rays += rays;
-    c->counters[thread].paths += (uint64_t)nactive;
-    c->counters[thread].bad += bad;
+    fv_kit_count(c->counters, thread, FV_KIT_RAYS, rays);
+    fv_kit_count(c->counters, thread, FV_KIT_USER0, (uint64_t)nactive);
+    fv_kit_count(c->counters, thread, FV_KIT_NAN, bad);
 }
 
 static void grid_tile(void *ctx, const fv_tile *t)
@@ -130,25 +121,26 @@ static void random_range(void *ctx, int64_t b, int64_t e, int thread)
     }
 }
 
-void fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_result *res)
+bool fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_result *res)
 {
-    trace_ctx *c = calloc(1, sizeof *c);
+    trace_ctx ctx, *c = &ctx;
     memset(res, 0, sizeof *res);
-    if (!c) return; /* the caller checks res->paths against the grid */
+    memset(c, 0, sizeof *c);
+    if (!(c->counters = fv_kit_counters_create())) return true; /* the caller checks res->paths against the grid */
     c->job = job;
     c->g = g;
     c->grid = fv_space_grid(job->view.space);
     const fv_grid *grid = c->grid;
+    bool done = true;
     if (job->order == FV_VP_ORDER_RANDOM && job->perm)
-        fv_parallel_for(job->nperm, 4096, job->threads, random_range, c);
+        fv_parallel_for(job->nperm, 4096, job->frame->threads, random_range, c);
     else
-        fv_parallel_tiles(grid->w, grid->h, job->threads, grid_tile, c, job->progress, job->progress_user);
-    for (int i = 0; i < FV_MAX_THREADS; i++) {
-        res->rays += c->counters[i].rays;
-        res->paths += c->counters[i].paths;
-        res->nan_paths += c->counters[i].bad;
-    }
-    free(c);
+        done = fv_parallel_tiles(grid->w, grid->h, job->frame->threads, grid_tile, c, fv_kit_progress_fn, job->progress);
+    res->rays = fv_kit_sum(c->counters, FV_KIT_RAYS);
+    res->paths = fv_kit_sum(c->counters, FV_KIT_USER0);
+    res->nan_paths = fv_kit_sum(c->counters, FV_KIT_NAN);
+    fv_kit_counters_destroy(c->counters);
+    return done;
 }
 
 uint32_t *fv_vp_random_order(const fv_grid *g, uint64_t seed, long *n)
@@ -162,7 +154,7 @@ uint32_t *fv_vp_random_order(const fv_grid *g, uint64_t seed, long *n)
         for (int x = 0; x < g->w; x++)
             if (fv_grid_valid(g, x, y)) p[k++] = (uint32_t)((long)y * g->w + x);
     /* Fisher-Yates with the counter-based generator. */
-    fv_rng r = fv_rng_make(seed, 0x7065726dULL, 0, 0);
+    fv_rng r = fv_rng_stream(seed, FV_STREAM_ORDER, 0, 0, 0);
     for (long i = count - 1; i > 0; i--) {
         uint64_t hi = fv_rng_u32(&r);
         uint64_t lo = fv_rng_u32(&r);

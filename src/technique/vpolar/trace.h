@@ -1,7 +1,7 @@
 /* fovea — the trace stage shared by Visual-Polar path tracing and its baselines: one path per
  * sample of a sample space (Foveated Real-Time Path Tracing in Visual-Polar Space, Sec. 3.1: a
- * primary ray, one indirect bounce, a shadow ray from each hit), with the path tracing kernel of
- * `pt` (technique/pt/pt.h) and its first-hit features for the denoiser.
+ * primary ray, one indirect bounce, a shadow ray from each hit), with the shared path tracing
+ * kernel (transport/path.h) and its first-hit features for the denoiser.
  *
  * Launch orders (Sec. 6):
  *  - grid order: samples are taken in tiles of the grid, camera rays eight neighbours at a time as
@@ -9,15 +9,16 @@
  *  - random order: the same samples in a random permutation, eight at a time (incoherent packets);
  *  - kill: every pixel of a full-resolution screen grid is launched and a path survives with the
  *    linear fall-off probability (Weier et al. 2016); killed lanes idle in their packet.
- * Every sample draws its random numbers from (seed, sample index, frame), so the image does not
- * depend on the order, the packing or the thread count.
+ * Every sample draws its random numbers from the frame's camera stream at its grid index (kit.h),
+ * so the image does not depend on the order, the packing or the thread count.
  */
 #ifndef FV_TECHNIQUE_VPOLAR_TRACE_H
 #define FV_TECHNIQUE_VPOLAR_TRACE_H
 
 #include <stdint.h>
 #include "fovea/camera.h"
-#include "technique/pt/pt.h"
+#include "technique/kit.h"
+#include "transport/path.h"
 #include "technique/vpolar/space.h"
 
 typedef enum fv_vp_order { FV_VP_ORDER_GRID = 0, FV_VP_ORDER_RANDOM } fv_vp_order;
@@ -31,7 +32,7 @@ typedef struct fv_vp_gbuf {
 
 typedef struct fv_vp_trace_job {
     const fv_scene *scene;
-    fv_pt_options pt;
+    fv_path_opts pt;
     fv_camera_basis cam;
     fv_space_view view;
     int screen_w, screen_h;
@@ -41,10 +42,8 @@ typedef struct fv_vp_trace_job {
     bool skip_offscreen;   /* samples whose screen position is more than a pixel off screen are not traced */
     bool kill;             /* linear fall-off: survival 1 up to kill_e0, kill_p from kill_e1 on */
     double kill_e0, kill_e1, kill_p, px_per_deg;
-    uint64_t seed;
-    int frame, eye, threads;
-    fv_progress_fn progress;
-    void *progress_user;
+    const fv_frame *frame;     /* seed, index, eye, threads */
+    fv_kit_progress *progress; /* the trace's phase of the frame */
 } fv_vp_trace_job;
 
 typedef struct fv_vp_trace_result {
@@ -57,10 +56,11 @@ typedef struct fv_vp_trace_result {
 double fv_vp_survival(const fv_space_view *v, float px, float py, double px_per_deg, double e0, double e1, double p);
 
 /* Traces every valid sample of job->view's grid into g (every valid cell is written, traced or not;
- * rows beyond a column's height are left as they are). */
-void fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_result *res);
+ * rows beyond a column's height are left as they are). False when cancelled through the progress
+ * callback (g is then partly written). */
+bool fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_result *res);
 
-/* A permutation of the grid's valid pixel indices drawn from seed (for FV_VP_ORDER_RANDOM);
+/* A permutation of the grid's valid pixel indices drawn from seed's order stream (for FV_VP_ORDER_RANDOM);
  * *n receives the count. NULL when out of memory. */
 uint32_t *fv_vp_random_order(const fv_grid *g, uint64_t seed, long *n);
 

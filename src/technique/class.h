@@ -1,0 +1,36 @@
+/* fovea — the technique class: what a rendering method implements to be driven like every other.
+ *
+ * Private to the library (docs/architecture.md, "The boundary"): a class is defined in its family's
+ * folder and listed in registry.c; drivers only see fovea/technique.h. The registry wraps create
+ * and render with what every method shares: parameters are validated on a private copy of the
+ * caller's bag and unknown keys refused once, after create; films are checked against the frame.
+ */
+#ifndef FV_TECHNIQUE_CLASS_H
+#define FV_TECHNIQUE_CLASS_H
+
+#include "core/params_read.h"
+#include "fovea/technique.h"
+
+typedef struct fv_technique_class {
+    const char *name;        /* "pt", "fpm", ... */
+    const char *summary;     /* one line */
+    const char *params_help; /* lines "key=type (default): meaning" */
+    /* Reads its parameters with the fv_params_* readers (keys it never reads are refused after
+     * create returns) and prepares its state. The scene is committed and outlives the state. */
+    fv_status (*create)(const fv_scene *scene, fv_params *params, const fv_log *log, void **state, fv_error *err);
+    /* Renders one eye of one frame (frame->eye) into film, whose size matches frame->camera.
+     * Adds stage timings and counters to stats. */
+    fv_status (*render)(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);
+    void (*destroy)(void *state);
+    /* For the conformance suite (tests/conformance): parameters that make a small render cheap,
+     * and the radiance the method should see inside the built-in furnace with them, with the
+     * relative tolerance its estimator and filters deserve. */
+    const char *test_params;
+    double furnace_radiance, furnace_tolerance;
+} fv_technique_class;
+
+/* The class of a registered method by index or name (NULL when unknown). */
+const fv_technique_class *fv_technique_class_at(int i);
+const fv_technique_class *fv_technique_class_find(const char *name);
+
+#endif
