@@ -7,6 +7,7 @@
 #ifndef FOVEA_BENCH_H
 #define FOVEA_BENCH_H
 
+#include "fovea/export.h"
 #include "fovea/status.h"
 
 #ifdef __cplusplus
@@ -34,10 +35,10 @@ typedef struct fv_bench_options {
 /* Runs the scenario file at `path`. Bad scenario -> FV_ERR_INVALID naming file and field. Writes
  * <out_dir>/<name>.json, <name>.md, <name>/ images and, with a sweep, <name>-sweep.csv and .png.
  * Every file is written whole or not at all. */
-fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *err);
+FV_API fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *err);
 
 /* Only parses and validates the scenario (for `fovea bench --check`). */
-fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err);
+FV_API fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err);
 
 #ifdef __cplusplus
 }

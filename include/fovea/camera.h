@@ -6,6 +6,7 @@
 #ifndef FOVEA_CAMERA_H
 #define FOVEA_CAMERA_H
 
+#include "fovea/export.h"
 #include "fovea/math.h"
 #include "fovea/status.h"
 
@@ -30,7 +31,7 @@ typedef struct fv_camera_basis {
 
 /* Checks fields (finite vectors, look != pos, up not parallel to view, fov in (0,180), sizes > 0)
  * and builds the basis. */
-fv_status fv_camera_basis_make(const fv_camera *cam, fv_camera_basis *out, fv_error *err);
+FV_API fv_status fv_camera_basis_make(const fv_camera *cam, fv_camera_basis *out, fv_error *err);
 
 /* Direction (unit) of the ray through film position (px, py) in pixels, e.g. (x + 0.5, y + 0.5). */
 static inline fv_vec3 fv_camera_dir(const fv_camera_basis *b, float px, float py)
@@ -42,11 +43,11 @@ static inline fv_vec3 fv_camera_dir(const fv_camera_basis *b, float px, float py
 
 /* Projects a world point to film coordinates in pixels; false when behind the camera.
  * Inverse of fv_camera_dir: used by reprojection between two cameras. */
-bool fv_camera_project(const fv_camera_basis *b, fv_vec3 p, float *px, float *py);
+FV_API bool fv_camera_project(const fv_camera_basis *b, fv_vec3 p, float *px, float *py);
 
 /* Left and right eye cameras of a stereo pair: each offset by half of eye_sep along the camera's
  * right vector, looking in parallel (look point offset by the same amount). */
-void fv_camera_stereo(const fv_camera *center, float eye_sep, fv_camera *left, fv_camera *right);
+FV_API void fv_camera_stereo(const fv_camera *center, float eye_sep, fv_camera *left, fv_camera *right);
 
 /* A keyframed camera path: position, look-at point and fov interpolated linearly in time;
  * times strictly increasing. Before the first / after the last key the end key holds. */
@@ -64,10 +65,10 @@ typedef struct fv_camera_path {
 /* Reads a camera path from a CSV trace (docs/gaze.md): lines "time,px,py,pz,lx,ly,lz", optionally
  * followed by "ux,uy,uz" and then "fov"; missing up and fov come from base. *keys is the
  * caller's to free. Errors name the file and line. */
-fv_status fv_camera_path_load_csv(const char *path, const fv_camera *base, fv_camera_key **keys, int *count, fv_error *err);
+FV_API fv_status fv_camera_path_load_csv(const char *path, const fv_camera *base, fv_camera_key **keys, int *count, fv_error *err);
 
 /* Camera at time t along path (count >= 1); width/height are taken from base. */
-void fv_camera_path_eval(const fv_camera_path *path, double t, const fv_camera *base, fv_camera *out);
+FV_API void fv_camera_path_eval(const fv_camera_path *path, double t, const fv_camera *base, fv_camera *out);
 
 #ifdef __cplusplus
 }

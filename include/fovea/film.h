@@ -8,6 +8,7 @@
 #ifndef FOVEA_FILM_H
 #define FOVEA_FILM_H
 
+#include "fovea/export.h"
 #include <stdbool.h>
 #include <stdint.h>
 #include "fovea/math.h"
@@ -33,32 +34,32 @@ typedef enum fv_film_aux {
 typedef struct fv_film fv_film;
 
 /* Checks the size (1..FV_FILM_MAX_DIM each, at most FV_FILM_MAX_PIXELS) before allocating. */
-fv_status fv_film_check_size(int width, int height, fv_error *err);
-fv_status fv_film_create(int width, int height, unsigned aux, fv_film **out, fv_error *err);
-void fv_film_destroy(fv_film *film);
+FV_API fv_status fv_film_check_size(int width, int height, fv_error *err);
+FV_API fv_status fv_film_create(int width, int height, unsigned aux, fv_film **out, fv_error *err);
+FV_API void fv_film_destroy(fv_film *film);
 /* Zeroes colour, sets depth to +inf, ids to 0. */
-void fv_film_clear(fv_film *film);
+FV_API void fv_film_clear(fv_film *film);
 
-int fv_film_width(const fv_film *film);
-int fv_film_height(const fv_film *film);
-unsigned fv_film_aux_flags(const fv_film *film);
-float *fv_film_color(fv_film *film);          /* 3 floats per pixel */
-const float *fv_film_color_const(const fv_film *film);
-float *fv_film_depth(fv_film *film);          /* NULL when not requested */
-float *fv_film_normal(fv_film *film);
-float *fv_film_albedo(fv_film *film);
-float *fv_film_position(fv_film *film);
-uint32_t *fv_film_id(fv_film *film);
+FV_API int fv_film_width(const fv_film *film);
+FV_API int fv_film_height(const fv_film *film);
+FV_API unsigned fv_film_aux_flags(const fv_film *film);
+FV_API float *fv_film_color(fv_film *film);          /* 3 floats per pixel */
+FV_API const float *fv_film_color_const(const fv_film *film);
+FV_API float *fv_film_depth(fv_film *film);          /* NULL when not requested */
+FV_API float *fv_film_normal(fv_film *film);
+FV_API float *fv_film_albedo(fv_film *film);
+FV_API float *fv_film_position(fv_film *film);
+FV_API uint32_t *fv_film_id(fv_film *film);
 /* Read-only views: depth/normal/albedo/position by flag (NULL when absent), and the ids. */
-const float *fv_film_aux_const(const fv_film *film, fv_film_aux which);
-const uint32_t *fv_film_id_const(const fv_film *film);
+FV_API const float *fv_film_aux_const(const fv_film *film, fv_film_aux which);
+FV_API const uint32_t *fv_film_id_const(const fv_film *film);
 
 /* All buffers at once (absent ones NULL), for a technique's inner loop. */
 typedef struct fv_film_views {
     float *color, *depth, *normal, *albedo, *position;
     uint32_t *id;
 } fv_film_views;
-fv_film_views fv_film_views_of(fv_film *film);
+FV_API fv_film_views fv_film_views_of(fv_film *film);
 
 /* Writes pixel pix's auxiliary buffers (those the film has) from the first surface its camera ray
  * met; with hit false, the "nothing" values: depth +inf, zero vectors, id 0. */
@@ -79,15 +80,15 @@ static inline void fv_film_store_first_hit(const fv_film_views *v, size_t pix, b
 typedef enum fv_image_format { FV_IMG_UNKNOWN = 0, FV_IMG_PNG, FV_IMG_PFM, FV_IMG_EXR } fv_image_format;
 
 /* Format from the path's extension (case-insensitive); FV_IMG_UNKNOWN when not recognised. */
-fv_image_format fv_image_format_from_path(const char *path);
+FV_API fv_image_format fv_image_format_from_path(const char *path);
 
 /* Writes linear RGB (3 floats per pixel). PNG: multiplied by `exposure`, clamped to [0,1],
  * sRGB-encoded, 8 bits. PFM: exact floats. EXR: half-free 32-bit float R,G,B. */
-fv_status fv_image_write(const char *path, const float *rgb, int width, int height, float exposure,
+FV_API fv_status fv_image_write(const char *path, const float *rgb, int width, int height, float exposure,
                          fv_error *err);
 /* Writes the film: PNG/PFM get the colour; EXR gets colour plus every auxiliary buffer as named
  * channels (depth Z, normal N.x/N.y/N.z, albedo albedo.R/G/B, position P.x/P.y/P.z, id). */
-fv_status fv_film_write(const fv_film *film, const char *path, float exposure, fv_error *err);
+FV_API fv_status fv_film_write(const fv_film *film, const char *path, float exposure, fv_error *err);
 
 /* A loaded image: linear RGB floats (PNG is decoded from sRGB). Free with fv_image_free. */
 typedef struct fv_image {
@@ -96,12 +97,12 @@ typedef struct fv_image {
 } fv_image;
 
 /* Reads PNG, PFM or EXR (RGB channels). Errors name the file and what is wrong with it. */
-fv_status fv_image_read(const char *path, fv_image *out, fv_error *err);
-void fv_image_free(fv_image *img);
+FV_API fv_status fv_image_read(const char *path, fv_image *out, fv_error *err);
+FV_API void fv_image_free(fv_image *img);
 
 /* The sRGB transfer function and its inverse, on one channel. */
-float fv_srgb_encode(float linear);
-float fv_srgb_decode(float encoded);
+FV_API float fv_srgb_encode(float linear);
+FV_API float fv_srgb_decode(float encoded);
 
 #ifdef __cplusplus
 }

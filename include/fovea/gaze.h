@@ -14,6 +14,7 @@
 #ifndef FOVEA_GAZE_H
 #define FOVEA_GAZE_H
 
+#include "fovea/export.h"
 #include <stdint.h>
 #include "fovea/math.h"
 #include "fovea/status.h"
@@ -51,22 +52,22 @@ typedef struct fv_eye_model {
 
 /* The defaults above for a display of the given size: the Vive's panel, its ppi scaled by
  * width / 1080 so that the regions cover the same part of the view at any resolution. */
-void fv_eye_model_default(int width, int height, fv_eye_model *out);
+FV_API void fv_eye_model_default(int width, int height, fv_eye_model *out);
 /* Checks every field (positive sizes and densities, 0 < e_f <= e_t < 90, 0 < frac_f <= frac_t). */
-fv_status fv_eye_model_validate(const fv_eye_model *m, fv_error *err);
+FV_API fv_status fv_eye_model_validate(const fv_eye_model *m, fv_error *err);
 
 /* Viewing distance D in pixels. */
-double fv_eye_view_dist_px(const fv_eye_model *m);
+FV_API double fv_eye_view_dist_px(const fv_eye_model *m);
 /* Pixels per degree at the gaze point, D pi / 180: the scale of the "planar degrees" (a screen
  * distance over this) that Visual-Polar Eq. 2 and the linear fall-off are written in. */
-double fv_eye_px_per_deg(const fv_eye_model *m);
+FV_API double fv_eye_px_per_deg(const fv_eye_model *m);
 /* Foveal and transition radii r_f <= r_t in pixels (Eq. 7 in angle mode). */
-double fv_eye_fovea_radius_px(const fv_eye_model *m);
-double fv_eye_transition_radius_px(const fv_eye_model *m);
+FV_API double fv_eye_fovea_radius_px(const fv_eye_model *m);
+FV_API double fv_eye_transition_radius_px(const fv_eye_model *m);
 /* Eccentricity in degrees of pixel centre (x + 0.5, y + 0.5) for a gaze point. */
-double fv_eye_eccentricity_deg(const fv_eye_model *m, fv_gaze g, double px, double py);
+FV_API double fv_eye_eccentricity_deg(const fv_eye_model *m, fv_gaze g, double px, double py);
 /* Distance of film position (px, py) from the gaze point, in pixels. */
-double fv_eye_gaze_dist_px(const fv_eye_model *m, fv_gaze g, double px, double py);
+FV_API double fv_eye_gaze_dist_px(const fv_eye_model *m, fv_gaze g, double px, double py);
 
 typedef enum fv_region {
     FV_REGION_FOVEA = 0,
@@ -75,29 +76,29 @@ typedef enum fv_region {
     FV_REGION_ALL,         /* for reports: the whole image */
     FV_REGION_COUNT
 } fv_region;
-const char *fv_region_name(fv_region r); /* "fovea", "transition", "periphery", "all" */
+FV_API const char *fv_region_name(fv_region r); /* "fovea", "transition", "periphery", "all" */
 
 /* Region of the pixel (x, y) (its centre) for a gaze. */
-fv_region fv_eye_region(const fv_eye_model *m, fv_gaze g, int x, int y);
+FV_API fv_region fv_eye_region(const fv_eye_model *m, fv_gaze g, int x, int y);
 /* Fills labels[y * width + x] with the fv_region of every pixel. */
-void fv_eye_region_labels(const fv_eye_model *m, fv_gaze g, uint8_t *labels);
+FV_API void fv_eye_region_labels(const fv_eye_model *m, fv_gaze g, uint8_t *labels);
 /* Transition blend weight b(x) of Foveated Photon Mapping Eq. 6, clamped to [0,1]: 0 in the
  * fovea, 1 in the periphery, linear in the pixel distance in between. */
-double fv_eye_blend(const fv_eye_model *m, fv_gaze g, double px, double py);
+FV_API double fv_eye_blend(const fv_eye_model *m, fv_gaze g, double px, double py);
 
 /* ---- acuity models ---- */
 
 /* Visual acuity in cycles per degree at eccentricity e (Visual-Polar, Eq. 1). */
-double fv_acuity_v(double e_deg);
+FV_API double fv_acuity_v(double e_deg);
 /* The cumulative distribution of Visual-Polar Eq. 2 at distance d (degrees) from the gaze. */
-double fv_acuity_cdf(double d_deg);
+FV_API double fv_acuity_cdf(double d_deg);
 /* Eq. 3: the fitted polynomial inverse of the cumulative distribution, for p in [0,1]. */
-double fv_acuity_cdf_inv_fit(double p);
+FV_API double fv_acuity_cdf_inv_fit(double p);
 /* Sphere-tracing probability (Inverted pyramid, Eq. 1, exponent negative) with its three zones:
  * 1 inside fovea_deg, 0 beyond outer_deg (<= 0: no outer zone), the fitted fall-off between. */
-double fv_acuity_hyperbolic(double w_deg, double fovea_deg, double outer_deg);
+FV_API double fv_acuity_hyperbolic(double w_deg, double fovea_deg, double outer_deg);
 /* Linear fall-off: 1 up to e0, min_value from e1 on, linear between (Visual-Polar's baseline). */
-double fv_acuity_linear(double e_deg, double e0, double e1, double min_value);
+FV_API double fv_acuity_linear(double e_deg, double e0, double e1, double min_value);
 
 /* ---- gaze over time ---- */
 
@@ -109,16 +110,16 @@ typedef struct fv_gaze_key {
 typedef struct fv_gaze_path fv_gaze_path;
 
 /* A fixed gaze (both eyes). Coordinates must be in [0,1]. */
-fv_status fv_gaze_path_create_fixed(fv_gaze g, fv_gaze_path **out, fv_error *err);
+FV_API fv_status fv_gaze_path_create_fixed(fv_gaze g, fv_gaze_path **out, fv_error *err);
 /* Keys with strictly increasing times, linear interpolation, end keys held. */
-fv_status fv_gaze_path_create_keys(const fv_gaze_key *keys, int count, fv_gaze_path **out, fv_error *err);
+FV_API fv_status fv_gaze_path_create_keys(const fv_gaze_key *keys, int count, fv_gaze_path **out, fv_error *err);
 /* A recorded trace: CSV lines "time,x,y" or "time,xl,yl,xr,yr" (docs/gaze.md); '#' comments
  * and a header line are allowed. Errors name the file and line. */
-fv_status fv_gaze_path_load_csv(const char *path, fv_gaze_path **out, fv_error *err);
-void fv_gaze_path_destroy(fv_gaze_path *p);
+FV_API fv_status fv_gaze_path_load_csv(const char *path, fv_gaze_path **out, fv_error *err);
+FV_API void fv_gaze_path_destroy(fv_gaze_path *p);
 /* Gaze of each eye at time t. */
-void fv_gaze_path_eval(const fv_gaze_path *p, double t, fv_gaze *left, fv_gaze *right);
-int fv_gaze_path_key_count(const fv_gaze_path *p);
+FV_API void fv_gaze_path_eval(const fv_gaze_path *p, double t, fv_gaze *left, fv_gaze *right);
+FV_API int fv_gaze_path_key_count(const fv_gaze_path *p);
 
 #ifdef __cplusplus
 }

@@ -9,6 +9,7 @@
 #ifndef FOVEA_METRICS_H
 #define FOVEA_METRICS_H
 
+#include "fovea/export.h"
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -25,7 +26,7 @@ typedef struct fv_metric_opts {
     float ppd;       /* pixels per degree for FLIP (default 67: 0.7 m from a 0.7 m wide 3840 px screen) */
 } fv_metric_opts;
 
-void fv_metric_opts_default(fv_metric_opts *o);
+FV_API void fv_metric_opts_default(fv_metric_opts *o);
 
 typedef struct fv_metric_values {
     double mse, psnr, e, ssim, flip;  /* psnr is +inf when mse is 0 */
@@ -38,34 +39,34 @@ typedef struct fv_metric_report {
 
 /* Compares test against ref (w x h linear RGB). labels (w*h fv_region values) may be NULL: then
  * only FV_REGION_ALL is filled. flip_map (w*h floats) receives the per-pixel FLIP when not NULL. */
-fv_status fv_metrics_compare(const float *ref, const float *test, int w, int h, const uint8_t *labels,
+FV_API fv_status fv_metrics_compare(const float *ref, const float *test, int w, int h, const uint8_t *labels,
                              const fv_metric_opts *opts, fv_metric_report *out, float *flip_map, fv_error *err);
 
 /* Per-pixel maps (w*h floats) of values already in display space (3 floats per pixel, [0,1]). */
-fv_status fv_metrics_ssim_map(const float *a, const float *b, int w, int h, float *map, fv_error *err);
-fv_status fv_metrics_flip_map(const float *ref, const float *test, int w, int h, float ppd, float *map, fv_error *err);
+FV_API fv_status fv_metrics_ssim_map(const float *a, const float *b, int w, int h, float *map, fv_error *err);
+FV_API fv_status fv_metrics_flip_map(const float *ref, const float *test, int w, int h, float ppd, float *map, fv_error *err);
 
 /* Linear RGB -> the values metrics compare (display or linear, per opts), into out (3 per pixel). */
-void fv_metrics_prepare(const float *rgb, size_t pixels, const fv_metric_opts *opts, float *out);
+FV_API void fv_metrics_prepare(const float *rgb, size_t pixels, const fv_metric_opts *opts, float *out);
 
 /* ---- temporal error over a sequence ---- */
 
 typedef struct fv_temporal fv_temporal;
-fv_status fv_temporal_create(int w, int h, const fv_metric_opts *opts, fv_temporal **out, fv_error *err);
+FV_API fv_status fv_temporal_create(int w, int h, const fv_metric_opts *opts, fv_temporal **out, fv_error *err);
 /* Adds the next frame; each pair (previous, this) is judged with this frame's labels (may be NULL). */
-fv_status fv_temporal_push(fv_temporal *t, const float *rgb, const uint8_t *labels, fv_error *err);
+FV_API fv_status fv_temporal_push(fv_temporal *t, const float *rgb, const uint8_t *labels, fv_error *err);
 /* MSE' and E' of a region: the mean over the consecutive pairs in which the region has pixels;
  * 0 with fewer than two frames, NaN when the region was empty in every pair. */
-void fv_temporal_result(const fv_temporal *t, fv_region region, double *mse, double *e);
-int fv_temporal_frames(const fv_temporal *t);
-void fv_temporal_destroy(fv_temporal *t);
+FV_API void fv_temporal_result(const fv_temporal *t, fv_region region, double *mse, double *e);
+FV_API int fv_temporal_frames(const fv_temporal *t);
+FV_API void fv_temporal_destroy(fv_temporal *t);
 
 /* ---- heat maps ---- */
 
 /* Writes map (w*h values, 0..vmax) as a PNG through a perceptual colour ramp (dark purple for 0,
  * through red and orange, to pale yellow for vmax). With eye non-NULL, the fovea and transition
  * circles around gaze are drawn as thin grey rings. */
-fv_status fv_heatmap_write(const char *path, const float *map, int w, int h, float vmax, const fv_eye_model *eye,
+FV_API fv_status fv_heatmap_write(const char *path, const float *map, int w, int h, float vmax, const fv_eye_model *eye,
                            fv_gaze gaze, fv_error *err);
 
 #ifdef __cplusplus

@@ -8,6 +8,7 @@
 #ifndef FOVEA_STATUS_H
 #define FOVEA_STATUS_H
 
+#include "fovea/export.h"
 #include <stddef.h>
 
 #ifdef __cplusplus
@@ -32,24 +33,24 @@ typedef struct fv_error {
 
 /* Records status and a printf-style message in err (err may be NULL) and returns status, so a
  * failure path reads `return fv_error_set(err, FV_ERR_INVALID, "...", ...);`. */
-fv_status fv_error_set(fv_error *err, fv_status status, const char *fmt, ...)
+FV_API fv_status fv_error_set(fv_error *err, fv_status status, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
 
 /* Clears err to FV_OK with an empty message. */
-void fv_error_clear(fv_error *err);
+FV_API void fv_error_clear(fv_error *err);
 
 /* Prefixes the existing message with a context string ("scene.json: "), keeping the status. */
-void fv_error_prefix(fv_error *err, const char *fmt, ...)
+FV_API void fv_error_prefix(fv_error *err, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
 
 /* Short stable name of a status ("invalid input", "i/o error", ...). */
-const char *fv_status_name(fv_status status);
+FV_API const char *fv_status_name(fv_status status);
 
 /* Warnings (dropped NaN triangles, default light added, ...) go through a sink the caller sets;
  * the default sink of the tools prints "fovea: warning: ..." on stderr. */
@@ -59,7 +60,7 @@ typedef struct fv_log {
     void *user;
 } fv_log;
 
-void fv_log_warn(const fv_log *log, const char *fmt, ...)
+FV_API void fv_log_warn(const fv_log *log, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
 #endif

@@ -287,14 +287,16 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
     if (is_file && scene[0] != '/') snprintf(s->scene, need, "%s/%s", dir, scene);
     else snprintf(s->scene, need, "%s", scene);
 
+    /* Without "eye" or "gaze" blocks the sequence driver takes the scene file's display and gaze
+     * path, as `fovea render` does (fovea/drive.h). */
     fv_eye_model_default(s->width, s->height, &s->eye);
     const cJSON *o;
-    if ((o = cJSON_GetObjectItemCaseSensitive(root, "eye")) && (st = fv_gaze_json_eye(o, file, "eye", &s->eye, err))) return st;
-    if ((o = cJSON_GetObjectItemCaseSensitive(root, "gaze"))) {
-        if ((st = fv_gaze_json_path(o, file, "gaze", dir, &s->gaze, err)) != FV_OK) return st;
-    } else if ((st = fv_gaze_path_create_fixed((fv_gaze){0.5f, 0.5f}, &s->gaze, err)) != FV_OK) {
-        return st;
+    if ((o = cJSON_GetObjectItemCaseSensitive(root, "eye"))) {
+        if ((st = fv_gaze_json_eye(o, file, "eye", &s->eye, err))) return st;
+        s->has_eye = true;
     }
+    if ((o = cJSON_GetObjectItemCaseSensitive(root, "gaze")) && (st = fv_gaze_json_path(o, file, "gaze", dir, &s->gaze, err)) != FV_OK)
+        return st;
     if ((o = cJSON_GetObjectItemCaseSensitive(root, "camera_path")) && cJSON_IsString(o)) {
         char full[8192];
         snprintf(full, sizeof full, "%s%s%s", o->valuestring[0] == '/' ? "" : dir, o->valuestring[0] == '/' ? "" : "/", o->valuestring);

@@ -44,8 +44,9 @@ typedef struct fv_scenario {
     int repeats;
     float exposure;
     unsigned long long seed;
-    fv_eye_model eye;
-    fv_gaze_path *gaze;
+    fv_eye_model eye;        /* the scenario's "eye" block (has_eye), then the one the driver used */
+    bool has_eye;
+    fv_gaze_path *gaze;      /* NULL: the scene's gaze path, else the centre */
     fv_camera_key *cam_keys; /* optional camera path overriding the scene's */
     int ncam_keys;
     fv_bench_method reference;

@@ -53,6 +53,14 @@ printf '{"scene": "cornell", "size": [16, 16], "repeats": 1, "reference": {"meth
 expect 0 "" -- $B "$TMP/extra.json" --out "$OUT" --quiet
 python3 -c 'import json,sys; r=json.load(open(sys.argv[1]))["results"][0]; e=r["error_vs"]["pt-hi"]; assert e["all"]["mse"] > 0 and e["fovea"]["pixels"] if "pixels" in e["fovea"] else True' "$OUT/extra.json" \
   || fail "no error_vs block in extra.json"
+# References are drawn from their own random stream: a method identical to the reference (pt at
+# 1 spp) is not measured against its own samples, so its error is that of two independent 1-spp
+# images, not zero.
+printf '{"scene": "cornell", "size": [16, 16], "repeats": 1, "reference": {"method": "pt", "params": {"spp": 1}},
+ "methods": [{"method": "pt", "params": {"spp": 1}}]}' > "$TMP/same.json"
+expect 0 "" -- $B "$TMP/same.json" --out "$OUT" --quiet
+python3 -c 'import json,sys; r=json.load(open(sys.argv[1]))["results"][0]; assert r["error"]["all"]["mse"] > 1e-4, r["error"]["all"]' "$OUT/same.json" \
+  || fail "a method identical to the reference measured zero error: the reference shares its random stream"
 printf '{"scene": "cornell", "reference": {"method": "pt"}, "extra_references": [{"label": "reference", "method": "pt"}], "methods": [{"method": "pt"}]}' > "$TMP/bad7.json"
 expect 2 "'reference' is taken" -- $B "$TMP/bad7.json" --out "$OUT"
 finish

@@ -1,0 +1,134 @@
+/* fovea — the sequence driver (see include/fovea/drive.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "fovea/drive.h"
+
+struct fv_driver {
+    fv_scene *scene;
+    const fv_view *view;
+    fv_drive_opts o;
+    fv_eye_model eye;
+};
+
+void fv_drive_opts_init(fv_drive_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->width = o->height = 512;
+    o->fps = 30.0;
+    o->seed = 1;
+}
+
+fv_status fv_driver_create(fv_scene *scene, const fv_view *view, const fv_drive_opts *opts, fv_driver **out, fv_error *err)
+{
+    *out = NULL;
+    if (!scene) return fv_error_set(err, FV_ERR_INVALID, "driver: no scene");
+    fv_status s = fv_film_check_size(opts->width, opts->height, err);
+    if (s != FV_OK) return s;
+    if (!(opts->fps > 0.0) || !isfinite(opts->fps)) return fv_error_set(err, FV_ERR_INVALID, "driver: fps %g must be positive", opts->fps);
+    if (!isfinite(opts->time0)) return fv_error_set(err, FV_ERR_INVALID, "driver: start time must be finite");
+    if (!(opts->eye_separation >= 0.0f) || !isfinite(opts->eye_separation))
+        return fv_error_set(err, FV_ERR_INVALID, "driver: eye separation %g must be >= 0", opts->eye_separation);
+    if (opts->threads < 0) return fv_error_set(err, FV_ERR_INVALID, "driver: thread count %d must be >= 0", opts->threads);
+    fv_driver *d = calloc(1, sizeof *d);
+    if (!d) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    d->scene = scene;
+    d->view = view;
+    d->o = *opts;
+    /* The eye model: the caller's, else the view's display rescaled to this width, else the
+     * default. A display's density is per display pixel; rendering it at another width must keep
+     * the regions on the same part of the view, so pixels per inch scale with the width. */
+    if (opts->eye_model) {
+        d->eye = *opts->eye_model;
+    } else {
+        fv_eye_model_default(opts->width, opts->height, &d->eye);
+        if (view && fv_view_display(view, &d->eye)) {
+            d->eye.ppi *= (float)opts->width / (float)d->eye.width;
+            d->eye.width = opts->width;
+            d->eye.height = opts->height;
+        }
+    }
+    d->o.eye_model = &d->eye;
+    *out = d;
+    return FV_OK;
+}
+
+void fv_driver_destroy(fv_driver *d) { free(d); }
+
+const fv_eye_model *fv_driver_eye_model(const fv_driver *d) { return &d->eye; }
+int fv_driver_eye_count(const fv_driver *d) { return d->o.eye_separation > 0.0f ? 2 : 1; }
+
+void fv_driver_set_gaze(fv_driver *d, fv_gaze g)
+{
+    d->o.fixed_gaze = true;
+    d->o.gaze = g;
+}
+
+void fv_driver_views(const fv_driver *d, int index, fv_frame_views *out)
+{
+    const fv_drive_opts *o = &d->o;
+    memset(out, 0, sizeof *out);
+    double t = o->time0 + index / o->fps;
+    out->time = t;
+    out->eye_count = fv_driver_eye_count(d);
+    fv_camera c;
+    fv_view_camera(d->view, d->scene, t, o->width, o->height, &c);
+    if (o->camera_path && o->camera_path->count > 0) fv_camera_path_eval(o->camera_path, t, &c, &c);
+    if (o->camera_set & FV_DRIVE_POS) c.pos = o->pos;
+    if (o->camera_set & FV_DRIVE_LOOK) c.look = o->look;
+    if (o->camera_set & FV_DRIVE_UP) c.up = o->up;
+    if (o->camera_set & FV_DRIVE_FOV) c.fov_y = o->fov_y;
+    if (out->eye_count == 2) fv_camera_stereo(&c, o->eye_separation, &out->camera[0], &out->camera[1]);
+    else out->camera[0] = out->camera[1] = c;
+    const fv_gaze_path *gp = o->gaze_path ? o->gaze_path : d->view ? fv_view_gaze_path(d->view) : NULL;
+    fv_gaze g = o->fixed_gaze ? o->gaze : (fv_gaze){0.5f, 0.5f};
+    out->gaze[0] = out->gaze[1] = g;
+    if (!o->fixed_gaze && gp) fv_gaze_path_eval(gp, t, &out->gaze[0], &out->gaze[1]);
+}
+
+/* Progress of one eye -> progress of the whole frame. */
+typedef struct eye_progress {
+    fv_progress_fn fn;
+    void *user;
+    int eye, eyes;
+} eye_progress;
+
+static bool on_eye_progress(void *user, double f)
+{
+    eye_progress *p = user;
+    return p->fn(p->user, (p->eye + f) / p->eyes);
+}
+
+fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool continues, fv_film *const *films, fv_stats *stats,
+                           fv_progress_fn progress, void *progress_user, fv_error *err)
+{
+    if (index < 0) return fv_error_set(err, FV_ERR_INVALID, "driver: frame index %d must be >= 0", index);
+    fv_frame_views v, pv;
+    fv_driver_views(d, index, &v);
+    bool has_prev = continues && index > 0;
+    if (has_prev) fv_driver_views(d, index - 1, &pv);
+    fv_status s = fv_scene_set_time(d->scene, v.time, err);
+    eye_progress ep = {progress, progress_user, 0, v.eye_count};
+    for (int e = 0; e < v.eye_count && s == FV_OK; e++) {
+        if (!films[e]) return fv_error_set(err, FV_ERR_INVALID, "driver: no film for eye %d", e);
+        fv_frame fr;
+        fv_frame_init(&fr, &v.camera[e]);
+        fr.time = v.time;
+        fr.index = index;
+        fr.seed = d->o.seed;
+        fr.threads = d->o.threads;
+        fr.eye = e;
+        fr.eye_count = v.eye_count;
+        fr.prev_camera = has_prev ? &pv.camera[e] : NULL;
+        fr.left_camera = e == 1 ? &v.camera[0] : NULL;
+        fr.gaze = v.gaze[e];
+        fr.eye_model = &d->eye;
+        if (progress) {
+            ep.eye = e;
+            fr.progress = on_eye_progress;
+            fr.progress_user = &ep;
+        }
+        s = fv_technique_render(t, &fr, films[e], stats, err);
+    }
+    return s;
+}
