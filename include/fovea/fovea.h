@@ -12,6 +12,7 @@
 #include "fovea/camera.h"
 #include "fovea/gaze.h"
 #include "fovea/scene.h"
+#include "fovea/view.h"
 #include "fovea/film.h"
 #include "fovea/technique.h"
 #include "fovea/metrics.h"
