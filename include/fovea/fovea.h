@@ -13,6 +13,7 @@
 #include "fovea/camera.h"
 #include "fovea/gaze.h"
 #include "fovea/scene.h"
+#include "fovea/view.h"
 #include "fovea/film.h"
 #include "fovea/params.h"
 #include "fovea/stats.h"

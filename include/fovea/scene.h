@@ -1,5 +1,6 @@
-/* fovea — the scene: triangle meshes (static or rigidly animated), materials, lights, and the
- * camera/view data a scene file may carry.
+/* fovea — the scene: triangle meshes (static or rigidly animated), materials and lights. How the
+ * scene is looked at (camera, camera path, display, gaze) is an fv_view (fovea/view.h); the
+ * loaders return both.
  *
  * Ownership: fv_scene_create returns a scene the caller destroys with fv_scene_destroy. Every
  * fv_scene_add_* call copies what it is given. After fv_scene_commit the geometry is frozen; only
@@ -10,8 +11,6 @@
 #define FOVEA_SCENE_H
 
 #include <stdint.h>
-#include "fovea/camera.h"
-#include "fovea/gaze.h"
 #include "fovea/math.h"
 #include "fovea/status.h"
 
@@ -20,6 +19,7 @@ extern "C" {
 #endif
 
 typedef struct fv_scene fv_scene;
+typedef struct fv_view fv_view; /* fovea/view.h */
 
 typedef enum fv_material_type {
     FV_MAT_DIFFUSE = 0, /* Lambert: albedo */
@@ -101,14 +101,8 @@ fv_status fv_scene_animate_object(fv_scene *scene, int object_id, const fv_anim_
 
 fv_status fv_scene_add_light(fv_scene *scene, const fv_light_desc *light, fv_error *err);
 
-/* Optional data a scene file carries for the view. */
-void fv_scene_set_camera(fv_scene *scene, const fv_camera *camera);
-/* Copies path (count >= 1). */
-fv_status fv_scene_set_camera_path(fv_scene *scene, const fv_camera_key *keys, int count, fv_error *err);
-
 /* Validates the scene and builds the acceleration structures. A scene without any triangle is
- * refused; a scene without any light gets a default point light (a warning says so); a scene
- * without camera gets one framing its bounds. */
+ * refused; a scene without any light gets a default point light (a warning says so). */
 fv_status fv_scene_commit(fv_scene *scene, const fv_log *log, fv_error *err);
 
 /* Moves dynamic objects to time t (seconds) and refits only what moved. */
@@ -123,36 +117,27 @@ int fv_scene_dynamic_object_count(const fv_scene *scene);
 int fv_scene_light_count(const fv_scene *scene);       /* delta lights + emissive triangles */
 int fv_scene_material_count(const fv_scene *scene);
 const fv_material *fv_scene_material(const fv_scene *scene, int id);
-/* The scene's camera (set, or framed at commit) with the given size. At time t along the
- * camera path when the scene has one. */
-void fv_scene_camera(const fv_scene *scene, double t, int width, int height, fv_camera *out);
-bool fv_scene_has_camera_path(const fv_scene *scene);
-
-/* The display/eye model and the gaze path a scene file may carry ("display" and "gaze" blocks).
- * fv_scene_eye returns false (and leaves *out alone) when the scene has none. The scene takes
- * ownership of the gaze path. */
-void fv_scene_set_eye(fv_scene *scene, const fv_eye_model *eye);
-bool fv_scene_eye(const fv_scene *scene, fv_eye_model *out);
-void fv_scene_set_gaze_path(fv_scene *scene, fv_gaze_path *path);
-const fv_gaze_path *fv_scene_gaze_path(const fv_scene *scene);
 
 /* ---- loading ---- */
 
 /* Loads SCENE, a built-in name (see fv_builtin_*) or a file path: .json (fovea scene format,
  * docs/scene-format.md) or any mesh file assimp reads (.obj, .gltf, .glb, .ply, ...). The scene
- * is committed. Errors name the file (and line or field) at fault. */
-fv_status fv_scene_load(const char *name_or_path, const fv_log *log, fv_scene **out, fv_error *err);
+ * is committed. The view data (camera, camera path, display, gaze) goes to a new *view, or is
+ * checked and dropped when view is NULL; the caller destroys both. On failure neither is returned.
+ * Errors name the file (and line or field) at fault. */
+fv_status fv_scene_load(const char *name_or_path, const fv_log *log, fv_scene **out, fv_view **view, fv_error *err);
 
 /* Like fv_scene_load but leaves the scene uncommitted, so the caller can still add lights,
  * materials or meshes (the CLI's --point-light) before fv_scene_commit. */
-fv_status fv_scene_open(const char *name_or_path, const fv_log *log, fv_scene **out, fv_error *err);
+fv_status fv_scene_open(const char *name_or_path, const fv_log *log, fv_scene **out, fv_view **view, fv_error *err);
 
 /* Built-in scenes: they need no file. */
 int fv_builtin_count(void);
 const char *fv_builtin_name(int i);
 const char *fv_builtin_summary(int i);
-/* Builds (uncommitted) built-in scene `name` into an empty scene; FV_ERR_INVALID if unknown. */
-fv_status fv_builtin_build(const char *name, fv_scene *scene, const fv_log *log, fv_error *err);
+/* Builds (uncommitted) built-in scene `name` into an empty scene, and its camera (and camera
+ * path) into view (NULL: dropped); FV_ERR_INVALID if unknown. */
+fv_status fv_builtin_build(const char *name, fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 
 #ifdef __cplusplus
 }

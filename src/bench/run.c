@@ -435,6 +435,7 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
 {
     fv_scenario *sc = NULL;
     fv_scene *scene = NULL;
+    fv_view *view = NULL;
     frame_setup *frames = NULL;
     fv_bench_result *res = NULL;
     fv_bench_method *match_methods = NULL;
@@ -455,7 +456,7 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
 
     say(opt, "scenario %s: scene %s, %dx%d, %d frame(s), %d method(s)", sc->name, sc->scene, sc->width, sc->height, sc->frames,
         sc->nmethods);
-    if ((st = fv_scene_load(sc->scene, opt->log, &scene, err)) != FV_OK) goto done;
+    if ((st = fv_scene_load(sc->scene, opt->log, &scene, &view, err)) != FV_OK) goto done;
     /* Every method's parameters are checked before anything is rendered. */
     for (int i = -1 - sc->nextra; i < sc->nmethods && st == FV_OK; i++) {
         const fv_bench_method *m = i >= 0 ? &sc->methods[i] : i == -1 ? &sc->reference : &sc->extra[-2 - i];
@@ -476,7 +477,7 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
     for (int i = 0; i < sc->frames; i++) {
         frame_setup *f = &frames[i];
         f->time = sc->start_time + i / sc->fps;
-        fv_scene_camera(scene, f->time, sc->width, sc->height, &f->cam);
+        fv_view_camera(view, scene, f->time, sc->width, sc->height, &f->cam);
         if (sc->ncam_keys) fv_camera_path_eval(&cpath, f->time, &f->cam, &f->cam);
         fv_gaze_path_eval(sc->gaze, f->time, &f->gaze, NULL);
         f->labels = fv_alloc_array(npix, 1);
@@ -530,6 +531,7 @@ done:
     if (match_methods)
         for (int k = 0; k < sc->nmatches; k++) fv_params_destroy(match_methods[k].params);
     free(match_methods);
+    fv_view_destroy(view);
     fv_scene_destroy(scene);
     fv_scenario_destroy(sc);
     return st;

@@ -8,7 +8,7 @@
 typedef struct builtin {
     const char *name;
     const char *summary;
-    fv_status (*build)(fv_scene *scene, const fv_log *log, fv_error *err);
+    fv_status (*build)(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 } builtin;
 
 static const builtin k_builtins[] = {
@@ -29,11 +29,18 @@ int fv_builtin_count(void) { return N_BUILTINS; }
 const char *fv_builtin_name(int i) { return i >= 0 && i < N_BUILTINS ? k_builtins[i].name : NULL; }
 const char *fv_builtin_summary(int i) { return i >= 0 && i < N_BUILTINS ? k_builtins[i].summary : NULL; }
 
-fv_status fv_builtin_build(const char *name, fv_scene *scene, const fv_log *log, fv_error *err)
+fv_status fv_builtin_build(const char *name, fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err)
 {
     if (!name) name = "";
-    for (int i = 0; i < N_BUILTINS; i++)
-        if (strcmp(name, k_builtins[i].name) == 0) return k_builtins[i].build(scene, log, err);
+    for (int i = 0; i < N_BUILTINS; i++) {
+        if (strcmp(name, k_builtins[i].name) != 0) continue;
+        /* Without a view the builder fills a scratch one, so builders never test for NULL. */
+        fv_view *scratch = NULL;
+        fv_status st = view ? FV_OK : fv_view_create(&scratch, err);
+        if (st == FV_OK) st = k_builtins[i].build(scene, view ? view : scratch, log, err);
+        fv_view_destroy(scratch);
+        return st;
+    }
     char known[256] = "";
     size_t len = 0;
     for (int i = 0; i < N_BUILTINS; i++) {

@@ -109,7 +109,7 @@ static void add_blocks(const city_mats *cm, fv_meshbuf *towers, fv_meshbuf *sphe
         }
 }
 
-fv_status fv_builtin_city(fv_scene *s, const fv_log *log, fv_error *err)
+fv_status fv_builtin_city(fv_scene *s, fv_view *view, const fv_log *log, fv_error *err)
 {
     city_mats cm;
     fv_status st = add_materials(s, &cm, err);
@@ -148,6 +148,6 @@ fv_status fv_builtin_city(fv_scene *s, const fv_log *log, fv_error *err)
         if ((st = fv_scene_add_light(s, &p, err)) != FV_OK) return st;
     }
     const fv_camera cam = {{-25.0f, 55.0f, -25.0f}, {110.0f, 0.0f, 110.0f}, {0, 1, 0}, 55.0f, 640, 480};
-    fv_scene_set_camera(s, &cam);
+    fv_view_set_camera(view, &cam);
     return FV_OK;
 }

@@ -86,7 +86,7 @@ static fv_status add_blocks(fv_scene *s, int short_mat, int tall_mat, const fv_l
     return st;
 }
 
-fv_status fv_builtin_cornell(fv_scene *s, const fv_log *log, fv_error *err)
+fv_status fv_builtin_cornell(fv_scene *s, fv_view *view, const fv_log *log, fv_error *err)
 {
     fv_cornell_mats cm;
     fv_status st;
@@ -94,11 +94,11 @@ fv_status fv_builtin_cornell(fv_scene *s, const fv_log *log, fv_error *err)
         (st = add_blocks(s, cm.white, cm.white, log, err)) != FV_OK)
         return st;
     fv_camera cam = fv_cornell_camera();
-    fv_scene_set_camera(s, &cam);
+    fv_view_set_camera(view, &cam);
     return FV_OK;
 }
 
-fv_status fv_builtin_cornell_glossy(fv_scene *s, const fv_log *log, fv_error *err)
+fv_status fv_builtin_cornell_glossy(fv_scene *s, fv_view *view, const fv_log *log, fv_error *err)
 {
     fv_cornell_mats cm;
     fv_status st = fv_cornell_materials(s, &cm, err);
@@ -117,6 +117,6 @@ fv_status fv_builtin_cornell_glossy(fv_scene *s, const fv_log *log, fv_error *er
         (st = fv_cornell_room(s, &cm, log, err)) != FV_OK || (st = add_blocks(s, ip, im, log, err)) != FV_OK)
         return st;
     fv_camera cam = fv_cornell_camera();
-    fv_scene_set_camera(s, &cam);
+    fv_view_set_camera(view, &cam);
     return FV_OK;
 }

@@ -19,7 +19,7 @@
 /* Mirror cube of side 150 built around the origin and placed by its animation. */
 #define CUBE_HALF 75.0f
 
-fv_status fv_builtin_cornell_fpm(fv_scene *s, const fv_log *log, fv_error *err)
+fv_status fv_builtin_cornell_fpm(fv_scene *s, fv_view *view, const fv_log *log, fv_error *err)
 {
     fv_cornell_mats cm;
     fv_status st = fv_cornell_materials(s, &cm, err);
@@ -65,6 +65,6 @@ fv_status fv_builtin_cornell_fpm(fv_scene *s, const fv_log *log, fv_error *err)
         {2.0, P(320, 290, -740), P(290, 260, 0), up, cam.fov_y},
         {4.0, P(240, 265, -780), P(270, 273, 0), up, cam.fov_y},
     };
-    fv_scene_set_camera(s, &cam);
-    return fv_scene_set_camera_path(s, path, 3, err);
+    fv_view_set_camera(view, &cam);
+    return fv_view_set_camera_path(view, path, 3, err);
 }

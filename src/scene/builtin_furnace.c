@@ -9,7 +9,7 @@
  */
 #include "scene/builtin_impl.h"
 
-fv_status fv_builtin_furnace(fv_scene *s, const fv_log *log, fv_error *err)
+fv_status fv_builtin_furnace(fv_scene *s, fv_view *view, const fv_log *log, fv_error *err)
 {
     fv_material m = fv_material_default(FV_MAT_DIFFUSE);
     m.albedo = fv_v3s(0.5f);
@@ -25,6 +25,6 @@ fv_status fv_builtin_furnace(fv_scene *s, const fv_log *log, fv_error *err)
     fv_meshbuf_free(&mb);
     if (st != FV_OK) return st;
     const fv_camera cam = {{0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 60.0f, 256, 256};
-    fv_scene_set_camera(s, &cam);
+    fv_view_set_camera(view, &cam);
     return FV_OK;
 }

@@ -1,18 +1,20 @@
 /* fovea — internal interface of the built-in scenes: one builder per scene (builtin_*.c), all
  * registered in the table of builtin.c, plus helpers the Cornell-box family shares. Each builder
- * fills an empty, uncommitted scene through the public scene API only.
+ * fills an empty, uncommitted scene and its view (never NULL) through the public scene and view
+ * APIs only.
  */
 #ifndef FV_SCENE_BUILTIN_IMPL_H
 #define FV_SCENE_BUILTIN_IMPL_H
 
 #include "fovea/scene.h"
+#include "fovea/view.h"
 #include "scene/mesh_gen.h"
 
-fv_status fv_builtin_cornell(fv_scene *scene, const fv_log *log, fv_error *err);
-fv_status fv_builtin_cornell_glossy(fv_scene *scene, const fv_log *log, fv_error *err);
-fv_status fv_builtin_cornell_fpm(fv_scene *scene, const fv_log *log, fv_error *err);
-fv_status fv_builtin_city(fv_scene *scene, const fv_log *log, fv_error *err);
-fv_status fv_builtin_furnace(fv_scene *scene, const fv_log *log, fv_error *err);
+fv_status fv_builtin_cornell(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
+fv_status fv_builtin_cornell_glossy(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
+fv_status fv_builtin_cornell_fpm(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
+fv_status fv_builtin_city(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
+fv_status fv_builtin_furnace(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 
 /* Adds material m under `name`; its id goes to *id. */
 fv_status fv_builtin_material(fv_scene *scene, const char *name, fv_material m, int *id, fv_error *err);

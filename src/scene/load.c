@@ -1,5 +1,6 @@
 /* fovea — opening a scene by name: a built-in scene, a fovea JSON scene file, or any mesh file
- * assimp imports. On failure nothing is returned: the partly built scene is destroyed. */
+ * assimp imports, with the view data it carries. On failure nothing is returned: the partly built
+ * scene and view are destroyed. */
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
@@ -20,14 +21,24 @@ static bool has_ext(const char *path, const char *ext)
     return dot && (!slash || dot > slash) && strcasecmp(dot, ext) == 0;
 }
 
-fv_status fv_scene_open(const char *name, const fv_log *log, fv_scene **out, fv_error *err)
+/* Creates the scene and the view the loaders fill; the view is made even when the caller wants
+ * none, so every loader checks the view blocks the same way. */
+static fv_status create_pair(fv_scene **s, fv_view **v, fv_error *err)
+{
+    fv_status st = fv_scene_create(s, err);
+    if (st == FV_OK && (st = fv_view_create(v, err)) != FV_OK) fv_scene_destroy(*s);
+    return st;
+}
+
+fv_status fv_scene_open(const char *name, const fv_log *log, fv_scene **out, fv_view **view, fv_error *err)
 {
     if (!name || !name[0]) return fv_error_set(err, FV_ERR_INVALID, "no scene given");
     fv_scene *s;
+    fv_view *v;
     fv_status st;
     if (is_builtin(name)) {
-        if ((st = fv_scene_create(&s, err)) != FV_OK) return st;
-        st = fv_builtin_build(name, s, log, err);
+        if ((st = create_pair(&s, &v, err)) != FV_OK) return st;
+        st = fv_builtin_build(name, s, v, log, err);
     } else {
         struct stat sb;
         if (stat(name, &sb) != 0) {
@@ -51,32 +62,38 @@ fv_status fv_scene_open(const char *name, const fv_log *log, fv_scene **out, fv_
         if (!has_ext(name, ".json") && !fv_load_assimp_supports(name))
             return fv_error_set(err, FV_ERR_INVALID,
                                 "scene '%s': unknown file type (use .json, or a mesh format assimp reads: .obj, .gltf, .glb, .ply, ...)", name);
-        if ((st = fv_scene_create(&s, err)) != FV_OK) return st;
+        if ((st = create_pair(&s, &v, err)) != FV_OK) return st;
         if (has_ext(name, ".json")) {
-            st = fv_load_json(name, s, log, err);
+            st = fv_load_json(name, s, v, log, err);
         } else {
             fv_import_opts o = {-1, NULL, true, true, ""};
-            st = fv_load_assimp(name, s, &o, log, NULL, NULL, err);
+            st = fv_load_assimp(name, s, v, &o, log, NULL, NULL, err);
         }
     }
     if (st != FV_OK) {
+        fv_view_destroy(v);
         fv_scene_destroy(s);
         return st;
     }
     *out = s;
+    if (view) *view = v;
+    else fv_view_destroy(v);
     return FV_OK;
 }
 
-fv_status fv_scene_load(const char *name, const fv_log *log, fv_scene **out, fv_error *err)
+fv_status fv_scene_load(const char *name, const fv_log *log, fv_scene **out, fv_view **view, fv_error *err)
 {
     fv_scene *s;
-    fv_status st = fv_scene_open(name, log, &s, err);
+    fv_view *v = NULL;
+    fv_status st = fv_scene_open(name, log, &s, view ? &v : NULL, err);
     if (st != FV_OK) return st;
     if ((st = fv_scene_commit(s, log, err)) != FV_OK) {
         if (err && strncmp(err->msg, name, strlen(name)) != 0) fv_error_prefix(err, "%s: ", name);
+        fv_view_destroy(v);
         fv_scene_destroy(s);
         return st;
     }
     *out = s;
+    if (view) *view = v;
     return FV_OK;
 }

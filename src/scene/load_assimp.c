@@ -115,6 +115,7 @@ static fv_material map_material(const struct aiMaterial *am, int index)
 typedef struct import_ctx {
     const struct aiScene *ai;
     fv_scene *scene;
+    fv_view *view;
     const fv_import_opts *opts;
     const fv_log *log;
     const char *path;
@@ -265,7 +266,7 @@ static void import_camera_and_lights(import_ctx *c, const fv_xform *base, fv_err
         fv_camera fc = {p, fv_add(p, fv_normalize(dir)), up, fv_degrees(fov_y), 512, (int)lroundf(512 / aspect)};
         fv_camera_basis b;
         fv_error e2;
-        if (fv_is_finite3(fc.look) && fv_camera_basis_make(&fc, &b, &e2) == FV_OK) fv_scene_set_camera(c->scene, &fc);
+        if (fv_is_finite3(fc.look) && fv_camera_basis_make(&fc, &b, &e2) == FV_OK) fv_view_set_camera(c->view, &fc);
         else fv_log_warn(c->log, "%s: ignoring camera '%s' (%s)", c->path, cam->mName.data, e2.msg);
     }
     if (!c->opts->import_lights) return;
@@ -291,8 +292,8 @@ static void import_camera_and_lights(import_ctx *c, const fv_xform *base, fv_err
     (void)err;
 }
 
-fv_status fv_load_assimp(const char *path, fv_scene *scene, const fv_import_opts *opts, const fv_log *log, int *first_object,
-                         int *object_count, fv_error *err)
+fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const fv_import_opts *opts, const fv_log *log,
+                         int *first_object, int *object_count, fv_error *err)
 {
     struct aiPropertyStore *props = aiCreatePropertyStore();
     /* Points and lines would only be dropped later; ask assimp not to produce them. */
@@ -314,6 +315,7 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, const fv_import_opts
     memset(&c, 0, sizeof c);
     c.ai = ai;
     c.scene = scene;
+    c.view = view;
     c.opts = opts;
     c.log = log;
     c.path = path;

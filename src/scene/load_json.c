@@ -1,7 +1,8 @@
 /* fovea — the fovea JSON scene format (docs/scene-format.md): materials, objects (mesh files or
- * inline quads, boxes, spheres), rigid animation of objects, lights, camera, camera path, display
- * (eye model) and gaze path. Strict: unknown fields, wrong types, non-finite or out-of-range
- * numbers and unknown material names are errors naming the file and the field.
+ * inline quads, boxes, spheres), rigid animation of objects and lights into the scene; camera,
+ * camera path, display (eye model) and gaze path into the view. Strict: unknown fields, wrong
+ * types, non-finite or out-of-range numbers and unknown material names are errors naming the file
+ * and the field.
  */
 #include <libgen.h>
 #include <math.h>
@@ -218,7 +219,7 @@ static fv_status parse_object(const cJSON *o, const json_ctx *c, int index, fv_e
         char prefix[FV_NAME_MAX];
         snprintf(prefix, sizeof prefix, "%.30s/", oname);
         fv_import_opts io = {mat, &x, false, false, prefix};
-        if ((st = fv_load_assimp(path, c->scene, &io, c->log, &first, &count, err)) != FV_OK) {
+        if ((st = fv_load_assimp(path, c->scene, NULL, &io, c->log, &first, &count, err)) != FV_OK) {
             fv_error_prefix(err, "%s: %s: ", c->file, where);
             return st;
         }
@@ -293,7 +294,7 @@ static fv_status parse_camera_key(const cJSON *o, const json_ctx *c, const char 
     return st;
 }
 
-fv_status fv_load_json(const char *path, fv_scene *scene, const fv_log *log, fv_error *err)
+fv_status fv_load_json(const char *path, fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err)
 {
     static const char *const keys[] = {"materials", "objects", "lights", "camera", "camera_path", "display", "gaze", "description", NULL};
     cJSON *root = NULL;
@@ -334,17 +335,17 @@ fv_status fv_load_json(const char *path, fv_scene *scene, const fv_log *log, fv_
         fv_camera_key k;
         if ((st = parse_camera_key(it, &c, "camera", false, &k, err)) != FV_OK) goto done;
         fv_camera cam = {k.pos, k.look, k.up, k.fov_y, 512, 512};
-        fv_scene_set_camera(scene, &cam);
+        fv_view_set_camera(view, &cam);
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(root, "camera_path")) && cJSON_IsString(it)) {
         /* A recorded trace next to the scene file. */
         char full[8192];
         snprintf(full, sizeof full, "%s%s%s", it->valuestring[0] == '/' ? "" : c.dir, it->valuestring[0] == '/' ? "" : "/", it->valuestring);
         fv_camera base;
-        fv_scene_camera(scene, 0.0, 512, 512, &base);
+        fv_view_camera(view, scene, 0.0, 512, 512, &base);
         fv_camera_key *k = NULL;
         int n = 0;
-        if ((st = fv_camera_path_load_csv(full, &base, &k, &n, err)) == FV_OK && (st = fv_scene_set_camera_path(scene, k, n, err)) != FV_OK)
+        if ((st = fv_camera_path_load_csv(full, &base, &k, &n, err)) == FV_OK && (st = fv_view_set_camera_path(view, k, n, err)) != FV_OK)
             fv_error_prefix(err, "%s: ", path);
         free(k);
         if (st != FV_OK) goto done;
@@ -365,7 +366,7 @@ fv_status fv_load_json(const char *path, fv_scene *scene, const fv_log *log, fv_
             snprintf(w, sizeof w, "camera_path[%d]", i);
             st = parse_camera_key(e, &c, w, true, &k[i], err);
         }
-        if (st == FV_OK && (st = fv_scene_set_camera_path(scene, k, n, err)) != FV_OK) fv_error_prefix(err, "%s: ", path);
+        if (st == FV_OK && (st = fv_view_set_camera_path(view, k, n, err)) != FV_OK) fv_error_prefix(err, "%s: ", path);
         free(k);
         if (st != FV_OK) goto done;
     }
@@ -388,12 +389,12 @@ fv_status fv_load_json(const char *path, fv_scene *scene, const fv_log *log, fv_
         }
         cJSON_Delete(copy);
         if (st != FV_OK) goto done;
-        fv_scene_set_eye(scene, &eye);
+        fv_view_set_display(view, &eye);
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(root, "gaze"))) {
         fv_gaze_path *g;
         if ((st = fv_gaze_json_path(it, path, "gaze", c.dir, &g, err)) != FV_OK) goto done;
-        fv_scene_set_gaze_path(scene, g);
+        fv_view_set_gaze_path(view, g);
     }
 done:
     cJSON_Delete(root);

@@ -53,8 +53,6 @@ void fv_scene_destroy(fv_scene *s)
     free(s->delta);
     free(s->lights);
     free(s->light_cdf);
-    free(s->cam_keys);
-    fv_gaze_path_destroy(s->gaze);
     free(s);
 }
 
@@ -239,51 +237,6 @@ fv_status fv_scene_add_light(fv_scene *s, const fv_light_desc *l, fv_error *err)
     return FV_OK;
 }
 
-void fv_scene_set_camera(fv_scene *s, const fv_camera *c)
-{
-    s->camera = *c;
-    s->has_camera = true;
-}
-
-void fv_scene_set_eye(fv_scene *s, const fv_eye_model *eye)
-{
-    s->eye = *eye;
-    s->has_eye = true;
-}
-
-bool fv_scene_eye(const fv_scene *s, fv_eye_model *out)
-{
-    if (s->has_eye) *out = s->eye;
-    return s->has_eye;
-}
-
-void fv_scene_set_gaze_path(fv_scene *s, fv_gaze_path *path)
-{
-    fv_gaze_path_destroy(s->gaze);
-    s->gaze = path;
-}
-
-const fv_gaze_path *fv_scene_gaze_path(const fv_scene *s) { return s->gaze; }
-
-fv_status fv_scene_set_camera_path(fv_scene *s, const fv_camera_key *keys, int count, fv_error *err)
-{
-    if (count < 1) return fv_error_set(err, FV_ERR_INVALID, "camera path: no keys");
-    for (int i = 0; i < count; i++) {
-        if (!isfinite(keys[i].time) || !fv_is_finite3(keys[i].pos) || !fv_is_finite3(keys[i].look) || !fv_is_finite3(keys[i].up) ||
-            !(keys[i].fov_y > 0.0f && keys[i].fov_y < 180.0f))
-            return fv_error_set(err, FV_ERR_INVALID, "camera path: key %d has non-finite values or a fov outside (0,180)", i);
-        if (i > 0 && !(keys[i].time > keys[i - 1].time))
-            return fv_error_set(err, FV_ERR_INVALID, "camera path: key times must increase (key %d)", i);
-    }
-    fv_camera_key *copy = fv_alloc_array((size_t)count, sizeof *copy);
-    if (!copy) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    memcpy(copy, keys, (size_t)count * sizeof *copy);
-    free(s->cam_keys);
-    s->cam_keys = copy;
-    s->ncam_keys = count;
-    return FV_OK;
-}
-
 /* ---- animation ---- */
 
 static fv_xform anim_eval(const fv_object *o, double t)
@@ -445,15 +398,6 @@ fv_status fv_scene_commit(fv_scene *s, const fv_log *log, fv_error *err)
         s->light_cdf = NULL;
         s->tri_light = NULL;
         if ((st = build_lights(s, err)) != FV_OK) return st;
-    }
-    if (!s->has_camera) {
-        /* Frame the bounding sphere from the +z side with a 45 degree view. */
-        fv_vec3 c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
-        float r = 0.5f * diag, fov = 45.0f;
-        float dist = 1.05f * r / sinf(fv_radians(fov) * 0.5f);
-        fv_camera cam = {fv_add(c, fv_v3(0, 0, dist)), c, fv_v3(0, 1, 0), fov, 512, 512};
-        s->camera = cam;
-        s->has_camera = true;
     }
 
     s->rtc_static = rtcNewScene(s->dev);
@@ -736,17 +680,3 @@ int fv_scene_dynamic_object_count(const fv_scene *s)
 int fv_scene_light_count(const fv_scene *s) { return s->committed ? s->nlights : s->ndelta; }
 int fv_scene_material_count(const fv_scene *s) { return s->nmat; }
 const fv_material *fv_scene_material(const fv_scene *s, int id) { return id >= 0 && id < s->nmat ? &s->mats[id] : NULL; }
-bool fv_scene_has_camera_path(const fv_scene *s) { return s->ncam_keys > 0; }
-
-void fv_scene_camera(const fv_scene *s, double t, int width, int height, fv_camera *out)
-{
-    fv_camera base = s->camera;
-    base.width = width;
-    base.height = height;
-    if (s->ncam_keys > 0) {
-        fv_camera_path p = {s->cam_keys, s->ncam_keys};
-        fv_camera_path_eval(&p, t, &base, out);
-    } else {
-        *out = base;
-    }
-}

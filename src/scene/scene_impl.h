@@ -64,15 +64,6 @@ struct fv_scene {
     float eps;                 /* ray offset scaled to the scene's size */
     double time;
     char embree_msg[256];      /* last message from Embree's error callback */
-
-    bool has_camera;
-    fv_camera camera;
-    fv_camera_key *cam_keys;
-    int ncam_keys;
-
-    bool has_eye;
-    fv_eye_model eye;
-    fv_gaze_path *gaze;        /* owned */
 };
 
 #endif

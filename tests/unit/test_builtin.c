@@ -13,6 +13,7 @@
 #include <time.h>
 #include <cmocka.h>
 #include "scene/mesh_gen.h"
+#include "fovea/view.h"
 #include "scene/scene_impl.h"
 
 typedef struct capture {
@@ -34,16 +35,18 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* Builds and commits built-in `name`; fails the test on any error or warning. */
-static fv_scene *build(const char *name, double *build_seconds)
+/* Builds and commits built-in `name`, its view into a new *view when view is not NULL (else
+ * dropped); fails the test on any error or warning. */
+static fv_scene *build(const char *name, fv_view **view, double *build_seconds)
 {
     fv_scene *s;
     fv_error err;
     capture cap = {0, ""};
     fv_log log = {capture_warn, &cap};
     assert_int_equal(fv_scene_create(&s, &err), FV_OK);
+    if (view) assert_int_equal(fv_view_create(view, &err), FV_OK);
     double t0 = now_s();
-    fv_status st = fv_builtin_build(name, s, &log, &err);
+    fv_status st = fv_builtin_build(name, s, view ? *view : NULL, &log, &err);
     if (build_seconds) *build_seconds = now_s() - t0;
     if (st != FV_OK) fail_msg("%s: %s", name, err.msg);
     if (fv_scene_commit(s, &log, &err) != FV_OK) fail_msg("%s: commit: %s", name, err.msg);
@@ -96,7 +99,7 @@ static void test_unknown_name(void **st)
     fv_scene *s;
     fv_error err;
     assert_int_equal(fv_scene_create(&s, &err), FV_OK);
-    assert_int_equal(fv_builtin_build("cornel", s, NULL, &err), FV_ERR_INVALID);
+    assert_int_equal(fv_builtin_build("cornel", s, NULL, NULL, &err), FV_ERR_INVALID);
     assert_non_null(strstr(err.msg, "'cornel'"));
     assert_non_null(strstr(err.msg, "cornell-fpm"));
     assert_null(strchr(err.msg, '\n'));
@@ -123,7 +126,7 @@ static void test_counts(void **st)
         {"furnace", 2 * 48 * 23, 2 * 48 * 23},
     };
     for (size_t i = 0; i < sizeof k / sizeof k[0]; i++) {
-        fv_scene *s = build(k[i].name, NULL);
+        fv_scene *s = build(k[i].name, NULL, NULL);
         assert_int_equal(fv_scene_triangle_count(s), k[i].tris);
         assert_int_equal(fv_scene_light_count(s), k[i].lights);
         fv_scene_destroy(s);
@@ -135,7 +138,8 @@ static void test_counts(void **st)
 static void test_cornell_geometry(void **st)
 {
     (void)st;
-    fv_scene *s = build("cornell", NULL);
+    fv_view *v;
+    fv_scene *s = build("cornell", &v, NULL);
     fv_vec3 lo, hi;
     fv_scene_bounds(s, &lo, &hi);
     assert_float_equal(lo.x, 0.0, 0.5);
@@ -148,7 +152,7 @@ static void test_cornell_geometry(void **st)
     assert_int_equal(fv_scene_material_count(s), 4);
 
     fv_camera cam;
-    fv_scene_camera(s, 0.0, 512, 512, &cam);
+    fv_view_camera(v, s, 0.0, 512, 512, &cam);
     assert_float_equal(cam.pos.x, 278.0, 1e-3);
     assert_float_equal(cam.pos.y, 273.0, 1e-3);
     assert_float_equal(cam.pos.z, -800.0, 1e-3);
@@ -204,13 +208,14 @@ static void test_cornell_geometry(void **st)
     assert_true(h.ng.y > 0.99f);
     assert_true(fv_scene_intersect(s, FV_TRACE_ALL, fv_v3(368, 500, 351), fv_v3(0, -1, 0), 1e30f, &h));
     assert_float_equal(h.p.y, 330.0, 0.01);
+    fv_view_destroy(v);
     fv_scene_destroy(s);
 }
 
 static void test_cornell_glossy(void **st)
 {
     (void)st;
-    fv_scene *s = build("cornell-glossy", NULL);
+    fv_scene *s = build("cornell-glossy", NULL, NULL);
     fv_hit h;
     /* The tall block's top is the copper (glossy) one. */
     assert_true(fv_scene_intersect(s, FV_TRACE_ALL, fv_v3(368, 500, 351), fv_v3(0, -1, 0), 1e30f, &h));
@@ -225,9 +230,10 @@ static void test_cornell_glossy(void **st)
 static void test_fpm(void **st)
 {
     (void)st;
-    fv_scene *s = build("cornell-fpm", NULL);
+    fv_view *v;
+    fv_scene *s = build("cornell-fpm", &v, NULL);
     assert_int_equal(fv_scene_dynamic_object_count(s), 1);
-    assert_true(fv_scene_has_camera_path(s));
+    assert_true(fv_view_has_camera_path(v));
     int glass = fv_scene_find_material(s, "glass"), mirror = fv_scene_find_material(s, "mirror");
     assert_true(glass >= 0 && mirror >= 0);
     assert_int_equal(fv_scene_material(s, glass)->type, FV_MAT_DIELECTRIC);
@@ -270,13 +276,14 @@ static void test_fpm(void **st)
 
     /* The camera path: the measured camera at 0 s, the second key at 2 s. */
     fv_camera cam;
-    fv_scene_camera(s, 0.0, 64, 64, &cam);
+    fv_view_camera(v, s, 0.0, 64, 64, &cam);
     assert_float_equal(cam.pos.x, 278.0, 1e-3);
     assert_float_equal(cam.pos.z, -800.0, 1e-3);
-    fv_scene_camera(s, 2.0, 64, 64, &cam);
+    fv_view_camera(v, s, 2.0, 64, 64, &cam);
     assert_float_equal(cam.pos.x, 320.0, 1e-2);
     assert_float_equal(cam.pos.z, -740.0, 1e-2);
     assert_int_equal(cam.width, 64);
+    fv_view_destroy(v);
     fv_scene_destroy(s);
 }
 
@@ -285,9 +292,10 @@ static void test_fpm(void **st)
 static void test_furnace(void **st)
 {
     (void)st;
-    fv_scene *s = build("furnace", NULL);
+    fv_view *v;
+    fv_scene *s = build("furnace", &v, NULL);
     fv_camera cam;
-    fv_scene_camera(s, 0.0, 32, 32, &cam);
+    fv_view_camera(v, s, 0.0, 32, 32, &cam);
     assert_float_equal(fv_length(cam.pos), 0.0, 1e-6);
     /* Closed: rays from the centre in 26 directions all hit the unit sphere (inscribed polygon
      * of 48 x 24 segments: distance between cos(pi/24) = 0.9914 and 1). */
@@ -305,6 +313,7 @@ static void test_furnace(void **st)
                 assert_true(m->two_sided_emission);
                 assert_true(fv_dot(h.ng, d) < 0.0f); /* wound to face the centre */
             }
+    fv_view_destroy(v);
     fv_scene_destroy(s);
 }
 
@@ -314,8 +323,9 @@ static void test_city(void **st)
 {
     (void)st;
     double secs;
-    fv_scene *a = build("city", &secs);
-    fv_scene *b = build("city", NULL);
+    fv_view *v;
+    fv_scene *a = build("city", &v, &secs);
+    fv_scene *b = build("city", NULL, NULL);
     int n = fv_scene_triangle_count(a);
     assert_true(n >= 100000);
     assert_int_equal(fv_scene_triangle_count(b), n); /* deterministic */
@@ -353,11 +363,12 @@ static void test_city(void **st)
     fv_camera cam;
     fv_camera_basis bs;
     fv_error err;
-    fv_scene_camera(a, 0.0, 64, 48, &cam);
+    fv_view_camera(v, a, 0.0, 64, 48, &cam);
     assert_int_equal(fv_camera_basis_make(&cam, &bs, &err), FV_OK);
     fv_hit h;
     assert_true(fv_scene_intersect(a, FV_TRACE_ALL, cam.pos, fv_camera_dir(&bs, 32, 24), 1e30f, &h));
     assert_true(h.p.x > 0.0f && h.p.x < 240.0f && h.p.z > 0.0f && h.p.z < 240.0f);
+    fv_view_destroy(v);
     fv_scene_destroy(a);
     fv_scene_destroy(b);
 }

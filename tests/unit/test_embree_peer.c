@@ -58,7 +58,7 @@ static void test_embree_pathtracer_peer(void **st)
 
     fv_scene *s;
     fv_error err;
-    assert_int_equal(fv_scene_open(MODELS "/cornell_box.obj", NULL, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_open(MODELS "/cornell_box.obj", NULL, &s, NULL, &err), FV_OK);
     fv_light_desc l = {FV_LIGHT_POINT, {213, 300, 227}, {0, -1, 0}, {100000, 100000, 100000}, 0, 0};
     assert_int_equal(fv_scene_add_light(s, &l, &err), FV_OK);
     assert_int_equal(fv_scene_commit(s, NULL, &err), FV_OK);

@@ -51,11 +51,12 @@ static void assert_vec3(fv_vec3 v, float x, float y, float z, float tol)
         fail_msg("(%g, %g, %g) != (%g, %g, %g)", v.x, v.y, v.z, x, y, z);
 }
 
-static fv_scene *load_ok(const char *path, const fv_log *log)
+/* Loads path, failing the test on error; its view goes to *view (NULL: dropped). */
+static fv_scene *load_ok(const char *path, const fv_log *log, fv_view **view)
 {
     fv_scene *s = NULL;
     fv_error err;
-    if (fv_scene_load(path, log, &s, &err) != FV_OK) fail_msg("%s: %s", path, err.msg);
+    if (fv_scene_load(path, log, &s, view, &err) != FV_OK) fail_msg("%s: %s", path, err.msg);
     return s;
 }
 
@@ -68,7 +69,7 @@ static void test_mtl_rules(void **state)
     (void)state;
     warnings w = {0, ""};
     fv_log log = {on_warn, &w};
-    fv_scene *s = load_ok(DATA("mtl_rules.obj"), &log);
+    fv_scene *s = load_ok(DATA("mtl_rules.obj"), &log, NULL);
     assert_int_equal(fv_scene_triangle_count(s), 10);
     assert_int_equal(fv_scene_object_count(s), 5);
     const fv_material *m = mat_named(s, "polished");
@@ -102,7 +103,8 @@ static void test_mtl_rules(void **state)
 static void test_gltf_pbr(void **state)
 {
     (void)state;
-    fv_scene *s = load_ok(DATA("pbr.gltf"), NULL);
+    fv_view *v;
+    fv_scene *s = load_ok(DATA("pbr.gltf"), NULL, &v);
     assert_int_equal(fv_scene_triangle_count(s), 10);
     fv_vec3 lo, hi;
     fv_scene_bounds(s, &lo, &hi);
@@ -148,11 +150,12 @@ static void test_gltf_pbr(void **state)
     assert_float_equal(l->outer_deg, 22.9183f, 1e-3f); /* 0.4 rad */
 
     fv_camera cam;
-    fv_scene_camera(s, 0.0, 300, 200, &cam);
+    fv_view_camera(v, s, 0.0, 300, 200, &cam);
     assert_vec3(cam.pos, 0, 5, 30, 1e-5f);
     assert_float_equal(cam.look.y, 5.0f, 1e-5f);
     assert_true(cam.look.z < 30.0f); /* glTF cameras look down -z */
     assert_float_equal(cam.fov_y, 28.6479f, 0.01f); /* 0.5 rad */
+    fv_view_destroy(v);
     fv_scene_destroy(s);
 }
 
@@ -166,7 +169,8 @@ static void test_json_transforms(void **state)
     (void)state;
     warnings w = {0, ""};
     fv_log log = {on_warn, &w};
-    fv_scene *s = load_ok(DATA("xform.json"), &log);
+    fv_view *v;
+    fv_scene *s = load_ok(DATA("xform.json"), &log, &v);
     assert_int_equal(fv_scene_triangle_count(s), 12);
     assert_int_equal(fv_scene_object_count(s), 6);
     assert_int_equal(fv_scene_dynamic_object_count(s), 5);
@@ -193,11 +197,12 @@ static void test_json_transforms(void **state)
     assert_true(fv_scene_intersect(s, FV_TRACE_ALL, fv_v3(-0.5f, 10, -5.5f), down, 100, &h));
     assert_float_equal(h.t, 7.0f, 1e-4f);
     fv_camera cam;
-    fv_scene_camera(s, 0.0, 64, 64, &cam);
+    fv_view_camera(v, s, 0.0, 64, 64, &cam);
     assert_vec3(cam.pos, 4, 6, 12, 0);
     assert_float_equal(cam.fov_y, 30.0f, 0);
     assert_int_equal(fv_scene_light_count(s), 1); /* the default light */
     assert_int_equal(w.count, 1);
+    fv_view_destroy(v);
     fv_scene_destroy(s);
 }
 
@@ -209,7 +214,7 @@ static void test_open_uncommitted(void **state)
     fv_log log = {on_warn, &w};
     fv_scene *s = NULL;
     fv_error err;
-    assert_int_equal(fv_scene_open(DATA("mtl_rules.obj"), &log, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_open(DATA("mtl_rules.obj"), &log, &s, NULL, &err), FV_OK);
     fv_light_desc d;
     memset(&d, 0, sizeof d);
     d.type = FV_LIGHT_POINT;
@@ -234,7 +239,7 @@ static void test_example_scenes(void **state)
         if (len < 5 || strcmp(e->d_name + len - 5, ".json") != 0) continue;
         char path[1024];
         snprintf(path, sizeof path, "%s/scenes/%s", FOVEA_SOURCE_DIR, e->d_name);
-        fv_scene *s = load_ok(path, NULL);
+        fv_scene *s = load_ok(path, NULL, NULL);
         assert_true(fv_scene_triangle_count(s) > 0);
         fv_scene_destroy(s);
         n++;
@@ -249,7 +254,7 @@ static void test_embree_cornell(void **state)
 {
     (void)state;
     if (access(EMBREE_CORNELL, R_OK) != 0) skip();
-    fv_scene *s = load_ok(EMBREE_CORNELL, NULL);
+    fv_scene *s = load_ok(EMBREE_CORNELL, NULL, NULL);
     assert_int_equal(fv_scene_triangle_count(s), 34);
     assert_int_equal(mat_named(s, "red")->type, FV_MAT_DIFFUSE);
     assert_vec3(mat_named(s, "red")->albedo, 1, 0, 0, 0);
@@ -259,15 +264,20 @@ static void test_embree_cornell(void **state)
 static void expect_bad(const char *path, fv_status status, const char *needle)
 {
     fv_scene *s = NULL;
+    fv_view *v = NULL;
     fv_error err;
-    fv_status rc = fv_scene_load(path, NULL, &s, &err);
+    fv_status rc = fv_scene_load(path, NULL, &s, &v, &err);
     if (rc != status) fail_msg("%s: status %d, expected %d (%s)", path, rc, status, err.msg);
     assert_null(s);
+    assert_null(v);
     if (!strstr(err.msg, needle)) fail_msg("%s: message '%s' lacks '%s'", path, err.msg, needle);
     assert_null(strchr(err.msg, '\n'));
-    /* The uncommitted entry point fails the same way. */
+    /* The uncommitted entry point fails the same way, and without a view too. */
     fv_scene *o = NULL;
-    assert_int_equal(fv_scene_open(path, NULL, &o, &err), status);
+    assert_int_equal(fv_scene_open(path, NULL, &o, &v, &err), status);
+    assert_null(o);
+    assert_null(v);
+    assert_int_equal(fv_scene_open(path, NULL, &o, NULL, &err), status);
     assert_null(o);
 }
 

@@ -36,17 +36,22 @@ static void test_builtin_and_unknown(void **st)
 {
     (void)st;
     fv_scene *s = NULL;
+    fv_view *v = NULL;
     fv_error err;
-    assert_int_equal(fv_scene_load("cornell", NULL, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load("cornell", NULL, &s, &v, &err), FV_OK);
     assert_true(fv_scene_triangle_count(s) > 0);
+    assert_true(fv_view_has_camera(v)); /* the built-in's camera is in the view */
+    fv_view_destroy(v);
     fv_scene_destroy(s);
     s = NULL;
-    assert_int_equal(fv_scene_load("cornel", NULL, &s, &err), FV_ERR_INVALID);
+    v = NULL;
+    assert_int_equal(fv_scene_load("cornel", NULL, &s, &v, &err), FV_ERR_INVALID);
     assert_null(s);
+    assert_null(v);
     assert_non_null(strstr(err.msg, "cornel"));
-    assert_int_equal(fv_scene_load("/no/such/scene.obj", NULL, &s, &err), FV_ERR_IO);
+    assert_int_equal(fv_scene_load("/no/such/scene.obj", NULL, &s, NULL, &err), FV_ERR_IO);
     assert_non_null(strstr(err.msg, "/no/such/scene.obj"));
-    assert_int_equal(fv_scene_load(DATA("materials.mtl"), NULL, &s, &err), FV_ERR_INVALID); /* not a scene type */
+    assert_int_equal(fv_scene_load(DATA("materials.mtl"), NULL, &s, NULL, &err), FV_ERR_INVALID); /* not a scene type */
     assert_null(s);
 }
 
@@ -59,7 +64,7 @@ static void test_obj_materials(void **st)
     fv_error err;
     warnings w = {0, ""};
     fv_log log = {on_warn, &w};
-    assert_int_equal(fv_scene_load(DATA("materials.obj"), &log, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load(DATA("materials.obj"), &log, &s, NULL, &err), FV_OK);
     assert_int_equal(fv_scene_triangle_count(s), 10);
     const fv_material *m = mat_named(s, "red");
     assert_non_null(m);
@@ -88,7 +93,7 @@ static void test_gltf_and_ply(void **st)
     fv_error err;
     warnings w = {0, ""};
     fv_log log = {on_warn, &w};
-    assert_int_equal(fv_scene_load(DATA("quad.gltf"), &log, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load(DATA("quad.gltf"), &log, &s, NULL, &err), FV_OK);
     assert_int_equal(fv_scene_triangle_count(s), 2);
     const fv_material *m = mat_named(s, "chrome");
     assert_non_null(m);
@@ -103,7 +108,7 @@ static void test_gltf_and_ply(void **st)
     assert_int_equal(w.count, 1);
     assert_non_null(strstr(w.last, "no lights"));
     fv_scene_destroy(s);
-    assert_int_equal(fv_scene_load(DATA("quad.ply"), NULL, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load(DATA("quad.ply"), NULL, &s, NULL, &err), FV_OK);
     assert_int_equal(fv_scene_triangle_count(s), 2);
     fv_scene_destroy(s);
 }
@@ -115,12 +120,12 @@ static void test_nan_and_empty(void **st)
     fv_error err;
     warnings w = {0, ""};
     fv_log log = {on_warn, &w};
-    assert_int_equal(fv_scene_load(DATA("nan.obj"), &log, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load(DATA("nan.obj"), &log, &s, NULL, &err), FV_OK);
     assert_int_equal(fv_scene_triangle_count(s), 1); /* the NaN and the degenerate one are dropped */
     assert_true(w.count >= 1);
     fv_scene_destroy(s);
     s = NULL;
-    assert_int_equal(fv_scene_load(DATA("empty.obj"), NULL, &s, &err), FV_ERR_INVALID);
+    assert_int_equal(fv_scene_load(DATA("empty.obj"), NULL, &s, NULL, &err), FV_ERR_INVALID);
     assert_null(s);
     assert_non_null(strstr(err.msg, "empty.obj"));
 }
@@ -129,39 +134,43 @@ static void test_json_scene(void **st)
 {
     (void)st;
     fv_scene *s;
+    fv_view *v;
     fv_error err;
-    fv_status rc = fv_scene_load(DATA("scene.json"), NULL, &s, &err);
+    fv_status rc = fv_scene_load(DATA("scene.json"), NULL, &s, &v, &err);
     if (rc != FV_OK) fail_msg("%s", err.msg);
     /* floor 2 + light 2 + box 12 + sphere 2*16*7 = 224 + ply quad 2 = 242 triangles. */
     assert_int_equal(fv_scene_triangle_count(s), 242);
     assert_int_equal(fv_scene_object_count(s), 5);
     assert_int_equal(fv_scene_dynamic_object_count(s), 1);
     assert_int_equal(fv_scene_light_count(s), 2 + 2); /* point, spot, two emissive triangles */
-    assert_true(fv_scene_has_camera_path(s));
+    assert_true(fv_view_has_camera_path(v));
     fv_camera cam;
-    fv_scene_camera(s, 1.0, 64, 48, &cam);
+    fv_view_camera(v, s, 1.0, 64, 48, &cam);
     assert_float_equal(cam.pos.x, 1.0f, 1e-5f); /* halfway along the path */
     assert_int_equal(cam.width, 64);
     fv_eye_model eye;
-    assert_true(fv_scene_eye(s, &eye));
+    assert_true(fv_view_display(v, &eye));
     assert_int_equal(eye.width, 1080);
     assert_float_equal(eye.fovea_deg, 5.0f, 0.0f);
-    const fv_gaze_path *g = fv_scene_gaze_path(s);
+    const fv_gaze_path *g = fv_view_gaze_path(v);
     assert_non_null(g);
     fv_gaze l;
     fv_gaze_path_eval(g, 1.0, &l, NULL);
     assert_float_equal(l.x, 0.4f, 1e-6f);
     assert_int_equal(fv_scene_material(s, fv_scene_find_material(s, "gold"))->type, FV_MAT_GLOSSY);
+    fv_view_destroy(v);
     fv_scene_destroy(s);
 }
 
 static void expect_bad(const char *path, fv_status status, const char *needle)
 {
     fv_scene *s = NULL;
+    fv_view *v = NULL;
     fv_error err;
-    fv_status rc = fv_scene_load(path, NULL, &s, &err);
+    fv_status rc = fv_scene_load(path, NULL, &s, &v, &err);
     if (rc != status) fail_msg("%s: status %d, expected %d (%s)", path, rc, status, err.msg);
     assert_null(s);
+    assert_null(v);
     if (!strstr(err.msg, needle)) fail_msg("%s: message '%s' lacks '%s'", path, err.msg, needle);
     assert_null(strchr(err.msg, '\n'));
 }
@@ -202,10 +211,12 @@ static void test_camera_trace(void **st)
     assert_null(k);
     assert_int_equal(fv_camera_path_load_csv(DATA("nope.csv"), &base, &k, &n, &err), FV_ERR_IO);
     fv_scene *s;
-    assert_int_equal(fv_scene_load(DATA("scene_trace.json"), NULL, &s, &err), FV_OK);
-    assert_true(fv_scene_has_camera_path(s));
-    fv_scene_camera(s, 2.0, 32, 32, &c);
+    fv_view *v;
+    assert_int_equal(fv_scene_load(DATA("scene_trace.json"), NULL, &s, &v, &err), FV_OK);
+    assert_true(fv_view_has_camera_path(v));
+    fv_view_camera(v, s, 2.0, 32, 32, &c);
     assert_float_equal(c.pos.x, 2.0f, 1e-6f);
+    fv_view_destroy(v);
     fv_scene_destroy(s);
 }
 

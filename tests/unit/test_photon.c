@@ -106,8 +106,6 @@ static fv_scene *occluder_scene(void)
     assert_int_equal(fv_scene_add_mesh(s, &box, NULL, &obj, &err), FV_OK);
     fv_anim_key keys[2] = {{0.0, {0, 50, 0}, {0, 0, 0, 1}, {1, 1, 1}}, {1.0, {0, 50, 0}, {0, 0, 0, 1}, {1, 1, 1}}};
     assert_int_equal(fv_scene_animate_object(s, obj, keys, 2, &err), FV_OK);
-    fv_camera cam = {{0, 150, 150}, {0, 0, 0}, {0, 1, 0}, 60.0f, 32, 32};
-    fv_scene_set_camera(s, &cam);
     assert_int_equal(fv_scene_commit(s, NULL, &err), FV_OK);
     assert_int_equal(fv_scene_set_time(s, 0.0, &err), FV_OK);
     return s;
@@ -209,12 +207,13 @@ static void test_tpm_reuse(void **st)
 {
     (void)st;
     fv_scene *s;
+    fv_view *v;
     fv_error err;
-    assert_int_equal(fv_scene_load("cornell", NULL, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load("cornell", NULL, &s, &v, &err), FV_OK);
     const char *kv[] = {"photons=40000", "filter=false", "paths_per_pixel=2", NULL};
     fv_technique *t = make(s, "fpm", kv);
     fv_camera cam;
-    fv_scene_camera(s, 0.0, 48, 48, &cam);
+    fv_view_camera(v, s, 0.0, 48, 48, &cam);
     fv_film *f;
     assert_int_equal(fv_film_create(48, 48, 0, &f, &err), FV_OK);
     fv_stats a, b, c;
@@ -240,6 +239,7 @@ static void test_tpm_reuse(void **st)
     fv_technique_destroy(t);
     fv_technique_destroy(t2);
     fv_film_destroy(f);
+    fv_view_destroy(v);
     fv_scene_destroy(s);
 }
 
@@ -249,8 +249,9 @@ static void test_memory_flat(void **st)
 {
     (void)st;
     fv_scene *s;
+    fv_view *v;
     fv_error err;
-    assert_int_equal(fv_scene_load("cornell-fpm", NULL, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load("cornell-fpm", NULL, &s, &v, &err), FV_OK);
     const char *kv[] = {"photons=6000", "filter=false", "paths_per_pixel=2", NULL};
     fv_technique *t = make(s, "fpm", kv);
     fv_film *f;
@@ -262,7 +263,7 @@ static void test_memory_flat(void **st)
     for (int i = 0; i < frames; i++) {
         double time = 4.0 * i / frames;
         assert_int_equal(fv_scene_set_time(s, time, &err), FV_OK);
-        fv_scene_camera(s, time, 24, 24, &cam);
+        fv_view_camera(v, s, time, 24, 24, &cam);
         fv_gaze g = {0.5f + 0.3f * sinf(0.05f * i), 0.5f + 0.2f * cosf(0.03f * i)};
         frame_stats(t, s, f, &cam, i ? &prev : NULL, g, i, &stats);
         prev = cam;
@@ -275,6 +276,7 @@ static void test_memory_flat(void **st)
     assert_true(cap_late <= 2 * cap_early || cap_late <= 4 * 24 * 24);
     fv_technique_destroy(t);
     fv_film_destroy(f);
+    fv_view_destroy(v);
     fv_scene_destroy(s);
 }
 
@@ -285,12 +287,13 @@ static void test_stereo_reprojection(void **st)
 {
     (void)st;
     fv_scene *s;
+    fv_view *v;
     fv_error err;
-    assert_int_equal(fv_scene_load("cornell", NULL, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load("cornell", NULL, &s, &v, &err), FV_OK);
     const char *kv[] = {"photons=20000", "filter=false", NULL};
     fv_technique *t = make(s, "fpm", kv);
     fv_camera c, l, r;
-    fv_scene_camera(s, 0.0, 40, 40, &c);
+    fv_view_camera(v, s, 0.0, 40, 40, &c);
     fv_film *fl, *fr;
     assert_int_equal(fv_film_create(40, 40, 0, &fl, &err), FV_OK);
     assert_int_equal(fv_film_create(40, 40, 0, &fr, &err), FV_OK);
@@ -320,6 +323,7 @@ static void test_stereo_reprojection(void **st)
     fv_technique_destroy(t);
     fv_film_destroy(fl);
     fv_film_destroy(fr);
+    fv_view_destroy(v);
     fv_scene_destroy(s);
 }
 
@@ -328,7 +332,7 @@ static void test_bad_params(void **st)
     (void)st;
     fv_scene *s;
     fv_error err;
-    assert_int_equal(fv_scene_load("cornell", NULL, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load("cornell", NULL, &s, NULL, &err), FV_OK);
     const char *cases[][2] = {{"fpm", "photons=-5"},       {"fpm", "fov_fraction=1.5"}, {"fpm", "fov_fraction=-0.1"},
                               {"pm", "radius=0"},           {"pm-t", "radius=-2"},       {"fpm", "paths_per_pixel=100"},
                               {"pm", "max_depth=0"},        {"pm-t", "dyn_fraction=2"},  {"pm", "fov_fraction=0.4"},

@@ -55,10 +55,12 @@ static void test_furnace(void **st)
 {
     (void)st;
     fv_scene *s;
+    fv_view *v;
     fv_error err;
-    assert_int_equal(fv_scene_load("furnace", NULL, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load("furnace", NULL, &s, &v, &err), FV_OK);
     fv_camera cam;
-    fv_scene_camera(s, 0.0, 32, 32, &cam);
+    fv_view_camera(v, s, 0.0, 32, 32, &cam);
+    fv_view_destroy(v);
     const char *kv[] = {"spp=64", "max_depth=64", NULL};
     fv_film *f = render(s, &cam, kv, 0, 1);
     /* L = Le + a L  =>  L = 0.5 / (1 - 0.5) = 1 in every pixel and channel. */
@@ -155,10 +157,12 @@ static void test_deterministic_threads(void **st)
 {
     (void)st;
     fv_scene *s;
+    fv_view *v;
     fv_error err;
-    assert_int_equal(fv_scene_load("cornell", NULL, &s, &err), FV_OK);
+    assert_int_equal(fv_scene_load("cornell", NULL, &s, &v, &err), FV_OK);
     fv_camera cam;
-    fv_scene_camera(s, 0.0, 48, 40, &cam);
+    fv_view_camera(v, s, 0.0, 48, 40, &cam);
+    fv_view_destroy(v);
     const char *kv[] = {"spp=4", NULL};
     fv_film *a = render(s, &cam, kv, 1, 42);
     fv_film *b = render(s, &cam, kv, 2, 42);

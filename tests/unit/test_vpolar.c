@@ -12,23 +12,26 @@
 #include <cmocka.h>
 #include "fovea/metrics.h"
 #include "fovea/technique.h"
+#include "fovea/view.h"
 #include "technique/vpolar/space.h"
 
 #define W 128
 #define H 144
 
 static fv_scene *g_scene;
+static fv_view *g_view;
 
 static int setup(void **st)
 {
     (void)st;
     fv_error err;
-    return fv_scene_load("cornell", NULL, &g_scene, &err) == FV_OK ? 0 : -1;
+    return fv_scene_load("cornell", NULL, &g_scene, &g_view, &err) == FV_OK ? 0 : -1;
 }
 
 static int teardown(void **st)
 {
     (void)st;
+    fv_view_destroy(g_view);
     fv_scene_destroy(g_scene);
     return 0;
 }
@@ -46,7 +49,7 @@ static float *render(const char *method, const char *const *kv, int frames, int 
     fv_film *film;
     assert_int_equal(fv_film_create(W, H, FV_AUX_ALL, &film, &err), FV_OK);
     fv_camera cam;
-    fv_scene_camera(g_scene, 0.0, W, H, &cam);
+    fv_view_camera(g_view, g_scene, 0.0, W, H, &cam);
     fv_stats stats;
     for (int i = 0; i < frames; i++) {
         fv_frame fr;
@@ -218,7 +221,7 @@ static void test_stereo(void **st)
     assert_int_equal(fv_film_create(W, H, 0, &fl, &err), FV_OK);
     assert_int_equal(fv_film_create(W, H, 0, &fr_, &err), FV_OK);
     fv_camera c, l, r;
-    fv_scene_camera(g_scene, 0.0, W, H, &c);
+    fv_view_camera(g_view, g_scene, 0.0, W, H, &c);
     fv_camera_stereo(&c, 60.0f, &l, &r);
     fv_frame fr;
     fv_frame_init(&fr, NULL);

@@ -190,6 +190,7 @@ int fv_cmd_render(int argc, char **argv)
     fv_error_clear(&err);
     fv_params *params = NULL;
     fv_scene *scene = NULL;
+    fv_view *view = NULL;
     fv_technique *tech = NULL;
     fv_film *film[2] = {NULL, NULL};
     fv_gaze_path *trace = NULL;
@@ -230,7 +231,7 @@ int fv_cmd_render(int argc, char **argv)
 
     bool quiet = o.quiet;
     fv_log log = fv_cli_log(&quiet);
-    if ((s = fv_scene_open(o.scene, &log, &scene, &err)) != FV_OK) {
+    if ((s = fv_scene_open(o.scene, &log, &scene, &view, &err)) != FV_OK) {
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
     }
@@ -251,8 +252,9 @@ int fv_cmd_render(int argc, char **argv)
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
     }
-    /* Gaze: --gaze, else --gaze-trace, else the scene's gaze path, else the centre. The eye model
-     * is the scene's display (its density rescaled to this image width) or the default. */
+    /* Gaze: --gaze, else --gaze-trace, else the view's gaze path (the scene file's), else the
+     * centre. The eye model is the view's display (its density rescaled to this image width) or
+     * the default. */
     if (o.has_gaze && o.gaze_trace) {
         rc = fv_cli_usage_error(cmd, "--gaze and --gaze-trace exclude each other");
         goto done;
@@ -263,16 +265,16 @@ int fv_cmd_render(int argc, char **argv)
     }
     if (o.camera_trace) {
         fv_camera base;
-        fv_scene_camera(scene, o.time0, o.width, o.height, &base);
+        fv_view_camera(view, scene, o.time0, o.width, o.height, &base);
         if ((s = fv_camera_path_load_csv(o.camera_trace, &base, &ctrace.keys, &ctrace.count, &err)) != FV_OK) {
             rc = fv_cli_fail(cmd, s, err.msg);
             goto done;
         }
     }
-    const fv_gaze_path *gpath = trace ? trace : o.has_gaze ? NULL : fv_scene_gaze_path(scene);
+    const fv_gaze_path *gpath = trace ? trace : o.has_gaze ? NULL : fv_view_gaze_path(view);
     fv_eye_model eye;
     fv_eye_model_default(o.width, o.height, &eye);
-    if (fv_scene_eye(scene, &eye)) {
+    if (fv_view_display(view, &eye)) {
         eye.ppi *= (float)o.width / (float)eye.width;
         eye.width = o.width;
         eye.height = o.height;
@@ -292,7 +294,7 @@ int fv_cmd_render(int argc, char **argv)
         double t = o.time0 + f / o.fps;
         if ((s = fv_scene_set_time(scene, t, &err)) != FV_OK) break;
         fv_camera c;
-        fv_scene_camera(scene, t, o.width, o.height, &c);
+        fv_view_camera(view, scene, t, o.width, o.height, &c);
         if (ctrace.keys) fv_camera_path_eval(&ctrace, t, &c, &c);
         if (o.has_pos) c.pos = fv_v3(o.pos[0], o.pos[1], o.pos[2]);
         if (o.has_look) c.look = fv_v3(o.look[0], o.look[1], o.look[2]);
@@ -364,6 +366,7 @@ done:
     fv_film_destroy(film[1]);
     fv_technique_destroy(tech);
     fv_scene_destroy(scene);
+    fv_view_destroy(view);
     fv_params_destroy(params);
     return rc;
 }

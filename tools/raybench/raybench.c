@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/rng.h"
+#include "fovea/view.h"
 #include "scene/scene_impl.h"
 
 static double run(const fv_scene *s, const fv_camera_basis *cam, int coherent, long nrays, int threads, long *hits_out)
@@ -69,12 +70,14 @@ int main(int argc, char **argv)
     }
     fv_error err;
     fv_scene *s;
-    if (fv_scene_load(argv[1], NULL, &s, &err) != FV_OK) {
+    fv_view *v;
+    if (fv_scene_load(argv[1], NULL, &s, &v, &err) != FV_OK) {
         fprintf(stderr, "fovea-raybench: %s\n", err.msg);
         return err.status == FV_ERR_INVALID || err.status == FV_ERR_IO ? 2 : 1;
     }
     fv_camera c;
-    fv_scene_camera(s, 0.0, w, h, &c);
+    fv_view_camera(v, s, 0.0, w, h, &c);
+    fv_view_destroy(v);
     fv_camera_basis cam;
     if (fv_camera_basis_make(&c, &cam, &err) != FV_OK) {
         fprintf(stderr, "fovea-raybench: %s\n", err.msg);
