@@ -14,6 +14,7 @@
 #include "fovea/gaze.h"
 #include "fovea/scene.h"
 #include "fovea/view.h"
+#include "fovea/drive.h"
 #include "fovea/film.h"
 #include "fovea/params.h"
 #include "fovea/stats.h"

@@ -10,6 +10,7 @@
 #ifndef FOVEA_SCENE_H
 #define FOVEA_SCENE_H
 
+#include "fovea/export.h"
 #include <stdint.h>
 #include "fovea/math.h"
 #include "fovea/status.h"
@@ -42,12 +43,12 @@ typedef struct fv_material {
 } fv_material;
 
 /* A default material of the given type (grey diffuse, white mirror, ...), to be adjusted. */
-fv_material fv_material_default(fv_material_type type);
+FV_API fv_material fv_material_default(fv_material_type type);
 /* Checks ranges and finiteness; the message names the material and field. */
-fv_status fv_material_validate(const fv_material *m, fv_error *err);
+FV_API fv_status fv_material_validate(const fv_material *m, fv_error *err);
 /* "diffuse" | "mirror" | "glossy" | "dielectric" <-> type; false when unknown. */
-bool fv_material_type_from_name(const char *name, fv_material_type *out);
-const char *fv_material_type_name(fv_material_type type);
+FV_API bool fv_material_type_from_name(const char *name, fv_material_type *out);
+FV_API const char *fv_material_type_name(fv_material_type type);
 
 typedef enum fv_light_type { FV_LIGHT_POINT = 0, FV_LIGHT_SPOT } fv_light_type;
 
@@ -80,43 +81,43 @@ typedef struct fv_anim_key {
     fv_vec3 scale;
 } fv_anim_key;
 
-fv_status fv_scene_create(fv_scene **out, fv_error *err);
-void fv_scene_destroy(fv_scene *scene);
+FV_API fv_status fv_scene_create(fv_scene **out, fv_error *err);
+FV_API void fv_scene_destroy(fv_scene *scene);
 
 /* Returns the new material's id in *id. */
-fv_status fv_scene_add_material(fv_scene *scene, const fv_material *m, int *id, fv_error *err);
+FV_API fv_status fv_scene_add_material(fv_scene *scene, const fv_material *m, int *id, fv_error *err);
 /* Looks a material up by name; -1 when absent. */
-int fv_scene_find_material(const fv_scene *scene, const char *name);
+FV_API int fv_scene_find_material(const fv_scene *scene, const char *name);
 
 /* Adds a triangle mesh as one object (static until fv_scene_animate_object makes it dynamic).
  * Triangles with a non-finite vertex, an index out of range or zero area are dropped, with one
  * warning per mesh through log; a mesh left empty is refused. *object_id may be NULL. */
-fv_status fv_scene_add_mesh(fv_scene *scene, const fv_mesh_desc *mesh, const fv_log *log,
+FV_API fv_status fv_scene_add_mesh(fv_scene *scene, const fv_mesh_desc *mesh, const fv_log *log,
                             int *object_id, fv_error *err);
 
 /* Makes an object dynamic, moved rigidly along keys (times strictly increasing; translation lerp,
  * rotation slerp, scale lerp). A dynamic object may not be emissive. */
-fv_status fv_scene_animate_object(fv_scene *scene, int object_id, const fv_anim_key *keys, int count,
+FV_API fv_status fv_scene_animate_object(fv_scene *scene, int object_id, const fv_anim_key *keys, int count,
                                   fv_error *err);
 
-fv_status fv_scene_add_light(fv_scene *scene, const fv_light_desc *light, fv_error *err);
+FV_API fv_status fv_scene_add_light(fv_scene *scene, const fv_light_desc *light, fv_error *err);
 
 /* Validates the scene and builds the acceleration structures. A scene without any triangle is
  * refused; a scene without any light gets a default point light (a warning says so). */
-fv_status fv_scene_commit(fv_scene *scene, const fv_log *log, fv_error *err);
+FV_API fv_status fv_scene_commit(fv_scene *scene, const fv_log *log, fv_error *err);
 
 /* Moves dynamic objects to time t (seconds) and refits only what moved. */
-fv_status fv_scene_set_time(fv_scene *scene, double t, fv_error *err);
-double fv_scene_time(const fv_scene *scene);
+FV_API fv_status fv_scene_set_time(fv_scene *scene, double t, fv_error *err);
+FV_API double fv_scene_time(const fv_scene *scene);
 
 /* Queries. */
-void fv_scene_bounds(const fv_scene *scene, fv_vec3 *lo, fv_vec3 *hi);
-int fv_scene_triangle_count(const fv_scene *scene);
-int fv_scene_object_count(const fv_scene *scene);
-int fv_scene_dynamic_object_count(const fv_scene *scene);
-int fv_scene_light_count(const fv_scene *scene);       /* delta lights + emissive triangles */
-int fv_scene_material_count(const fv_scene *scene);
-const fv_material *fv_scene_material(const fv_scene *scene, int id);
+FV_API void fv_scene_bounds(const fv_scene *scene, fv_vec3 *lo, fv_vec3 *hi);
+FV_API int fv_scene_triangle_count(const fv_scene *scene);
+FV_API int fv_scene_object_count(const fv_scene *scene);
+FV_API int fv_scene_dynamic_object_count(const fv_scene *scene);
+FV_API int fv_scene_light_count(const fv_scene *scene);       /* delta lights + emissive triangles */
+FV_API int fv_scene_material_count(const fv_scene *scene);
+FV_API const fv_material *fv_scene_material(const fv_scene *scene, int id);
 
 /* ---- loading ---- */
 
@@ -125,19 +126,19 @@ const fv_material *fv_scene_material(const fv_scene *scene, int id);
  * is committed. The view data (camera, camera path, display, gaze) goes to a new *view, or is
  * checked and dropped when view is NULL; the caller destroys both. On failure neither is returned.
  * Errors name the file (and line or field) at fault. */
-fv_status fv_scene_load(const char *name_or_path, const fv_log *log, fv_scene **out, fv_view **view, fv_error *err);
+FV_API fv_status fv_scene_load(const char *name_or_path, const fv_log *log, fv_scene **out, fv_view **view, fv_error *err);
 
 /* Like fv_scene_load but leaves the scene uncommitted, so the caller can still add lights,
  * materials or meshes (the CLI's --point-light) before fv_scene_commit. */
-fv_status fv_scene_open(const char *name_or_path, const fv_log *log, fv_scene **out, fv_view **view, fv_error *err);
+FV_API fv_status fv_scene_open(const char *name_or_path, const fv_log *log, fv_scene **out, fv_view **view, fv_error *err);
 
 /* Built-in scenes: they need no file. */
-int fv_builtin_count(void);
-const char *fv_builtin_name(int i);
-const char *fv_builtin_summary(int i);
+FV_API int fv_builtin_count(void);
+FV_API const char *fv_builtin_name(int i);
+FV_API const char *fv_builtin_summary(int i);
 /* Builds (uncommitted) built-in scene `name` into an empty scene, and its camera (and camera
  * path) into view (NULL: dropped); FV_ERR_INVALID if unknown. */
-fv_status fv_builtin_build(const char *name, fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
+FV_API fv_status fv_builtin_build(const char *name, fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 
 #ifdef __cplusplus
 }

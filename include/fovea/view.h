@@ -10,6 +10,7 @@
 #ifndef FOVEA_VIEW_H
 #define FOVEA_VIEW_H
 
+#include "fovea/export.h"
 #include "fovea/camera.h"
 #include "fovea/gaze.h"
 #include "fovea/scene.h"
@@ -22,31 +23,31 @@ extern "C" {
 typedef struct fv_view fv_view;
 
 /* A view with nothing set; destroy it with fv_view_destroy. */
-fv_status fv_view_create(fv_view **out, fv_error *err);
+FV_API fv_status fv_view_create(fv_view **out, fv_error *err);
 /* Frees the view and the gaze path it owns; NULL is a no-op. */
-void fv_view_destroy(fv_view *v);
+FV_API void fv_view_destroy(fv_view *v);
 
 /* Sets the base camera (copied); its width/height are replaced by fv_view_camera's. */
-void fv_view_set_camera(fv_view *v, const fv_camera *camera);
-bool fv_view_has_camera(const fv_view *v);
+FV_API void fv_view_set_camera(fv_view *v, const fv_camera *camera);
+FV_API bool fv_view_has_camera(const fv_view *v);
 /* Copies keys (count >= 1, times strictly increasing, finite, fov in (0,180)); on error the view
  * keeps its earlier path. */
-fv_status fv_view_set_camera_path(fv_view *v, const fv_camera_key *keys, int count, fv_error *err);
-bool fv_view_has_camera_path(const fv_view *v);
+FV_API fv_status fv_view_set_camera_path(fv_view *v, const fv_camera_key *keys, int count, fv_error *err);
+FV_API bool fv_view_has_camera_path(const fv_view *v);
 /* The camera at time t with the given size: the view's camera (when it has none and scene is a
  * committed scene: one framing the scene's bounds from +z, 45 degrees; else all zero but the
  * size), moved along the camera path when there is one. v and scene may each be NULL; v == NULL
  * gives the scene's framing camera. Reads only: safe from several threads at once. */
-void fv_view_camera(const fv_view *v, const fv_scene *scene, double t, int width, int height, fv_camera *out);
+FV_API void fv_view_camera(const fv_view *v, const fv_scene *scene, double t, int width, int height, fv_camera *out);
 
 /* Sets the display/eye model (copied). */
-void fv_view_set_display(fv_view *v, const fv_eye_model *eye);
+FV_API void fv_view_set_display(fv_view *v, const fv_eye_model *eye);
 /* Copies the display into *out; false (and *out untouched) when the view has none. */
-bool fv_view_display(const fv_view *v, fv_eye_model *out);
+FV_API bool fv_view_display(const fv_view *v, fv_eye_model *out);
 /* Takes ownership of path (NULL allowed); an earlier path is destroyed. */
-void fv_view_set_gaze_path(fv_view *v, fv_gaze_path *path);
+FV_API void fv_view_set_gaze_path(fv_view *v, fv_gaze_path *path);
 /* The view's gaze path or NULL; it lives until the view is destroyed or gets another path. */
-const fv_gaze_path *fv_view_gaze_path(const fv_view *v);
+FV_API const fv_gaze_path *fv_view_gaze_path(const fv_view *v);
 
 #ifdef __cplusplus
 }

@@ -3,6 +3,7 @@
 #define FV_BENCH_IMPL_H
 
 #include "bench/scenario.h"
+#include "fovea/drive.h"
 #include "fovea/metrics.h"
 
 /* What one method measured over all frames and repeats. */
@@ -25,6 +26,8 @@ typedef struct fv_bench_run_info {
     const fv_bench_options *opt;
     int threads;
     const char *out_dir;
+    fv_driver *driver;          /* the frames of every measured method */
+    fv_driver *ref_driver;      /* the same frames on the reference stream */
     double ref_ms;              /* reference render time per frame (0 when cached) */
     int ref_cached;             /* how many reference frames came from the cache */
     double extra_ms[FV_BENCH_MAX_EXTRA];

@@ -14,6 +14,7 @@
 #include "bench/bench_impl.h"
 #include "core/alloc.h"
 #include "core/fileio.h"
+#include "core/rng.h"
 #include "fovea/fovea.h"
 
 typedef struct frame_setup {
@@ -77,7 +78,7 @@ static void reference_key(const fv_scenario *sc, const fv_bench_method *m, const
     KEY("fovea %s|scene=%s", FOVEA_VERSION_STRING, sc->scene);
     struct stat sb;
     if (stat(sc->scene, &sb) == 0) KEY("|bytes=%lld|mtime=%lld", (long long)sb.st_size, (long long)sb.st_mtime);
-    KEY("|%dx%d|frame=%d|t=%.9g|seed=%llu|method=%s", sc->width, sc->height, index, f->time, sc->seed, m->method);
+    KEY("|%dx%d|frame=%d|t=%.9g|seed=%llu|stream=reference|method=%s", sc->width, sc->height, index, f->time, sc->seed, m->method);
     for (int i = 0; i < fv_params_count(m->params); i++) KEY("|%s=%s", fv_params_key(m->params, i), fv_params_value(m->params, i));
     const fv_camera *c = &f->cam;
     KEY("|cam=%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", c->pos.x, c->pos.y, c->pos.z, c->look.x, c->look.y, c->look.z,
@@ -85,12 +86,12 @@ static void reference_key(const fv_scenario *sc, const fv_bench_method *m, const
 #undef KEY
 }
 
-/* Renders frames [first, nframes) of one method with a fresh technique; calls back per frame. */
+/* Renders frames [first, nframes) of one method with a fresh technique; calls back per frame.
+ * The frames come from the sequence driver, as `fovea render` makes them. */
 typedef struct render_job {
     const fv_scenario *sc;
     fv_scene *scene;
-    frame_setup *frames;
-    int threads;
+    fv_driver *driver;
     const fv_bench_method *m;
     const fv_log *log;
 } render_job;
@@ -99,30 +100,17 @@ typedef fv_status (*frame_fn)(void *user, int index, fv_film *film, double ms, c
 
 static fv_status render_sequence(const render_job *j, int first, int nframes, frame_fn on_frame, void *user, fv_error *err)
 {
-    fv_params *params = NULL;
     fv_technique *t = NULL;
     fv_film *film = NULL;
-    fv_status st = fv_params_clone(j->m->params, &params, err);
-    if (st == FV_OK && (st = fv_technique_create(j->m->method, j->scene, params, j->log, &t, err)) != FV_OK)
-        fv_error_prefix(err, "%s: ", j->m->label);
+    fv_status st = fv_technique_create(j->m->method, j->scene, j->m->params, j->log, &t, err);
+    if (st != FV_OK) fv_error_prefix(err, "%s: ", j->m->label);
     if (st == FV_OK) st = fv_film_create(j->sc->width, j->sc->height, 0, &film, err);
     for (int i = first; i < nframes && st == FV_OK; i++) {
-        const frame_setup *f = &j->frames[i];
-        if ((st = fv_scene_set_time(j->scene, f->time, err)) != FV_OK) break;
-        fv_frame fr;
-        fv_frame_init(&fr, &f->cam);
-        fr.time = f->time;
-        fr.index = i;
-        fr.seed = j->sc->seed;
-        fr.threads = j->threads;
-        fr.prev_camera = i > first ? &j->frames[i - 1].cam : NULL;
-        fr.gaze = f->gaze;
-        fr.eye_model = &j->sc->eye;
         fv_stats stats;
         fv_stats_clear(&stats);
         fv_film_clear(film);
         double t0 = fv_time_ms();
-        st = fv_technique_render(t, &fr, film, &stats, err);
+        st = fv_driver_render(j->driver, t, i, i > first, &film, &stats, NULL, NULL, err);
         double ms = fv_time_ms() - t0;
         if (st != FV_OK) {
             fv_error_prefix(err, "%s, frame %d: ", j->m->label, i);
@@ -132,7 +120,6 @@ static fv_status render_sequence(const render_job *j, int first, int nframes, fr
     }
     fv_film_destroy(film);
     fv_technique_destroy(t);
-    fv_params_destroy(params);
     return st;
 }
 
@@ -192,7 +179,8 @@ static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene,
          * already cached are simply not written again. Frames before measure_from are never
          * compared, so they need no reference. */
         say(info->opt, "%s: rendering %d frame(s) with %s (%d cached)", m->label, n - first, m->method, *cached);
-        render_job j = {sc, scene, frames, info->threads, m, info->opt->log};
+        /* References are rendered on their own random stream (core/rng.h). */
+        render_job j = {sc, scene, info->ref_driver, m, info->opt->log};
         ref_ctx c = {frames, (const char *const *)paths, slot, 0.0};
         st = render_sequence(&j, first, n, on_reference_frame, &c, err);
         *ms = c.ms / (n - first);
@@ -314,7 +302,7 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
     if (!res->ms || !stage_per_rep || !c.flip_map || !c.last) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_stats stage_names;
     fv_stats_clear(&stage_names);
-    render_job j = {sc, scene, frames, info->threads, m, info->opt->log};
+    render_job j = {sc, scene, info->driver, m, info->opt->log};
     /* One untimed frame first: thread start-up and cold caches would otherwise land in the
      * first repeat of whichever method runs first. */
     if (st == FV_OK) st = render_sequence(&j, 0, 1, on_warmup_frame, NULL, err);
@@ -460,26 +448,41 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
     /* Every method's parameters are checked before anything is rendered. */
     for (int i = -1 - sc->nextra; i < sc->nmethods && st == FV_OK; i++) {
         const fv_bench_method *m = i >= 0 ? &sc->methods[i] : i == -1 ? &sc->reference : &sc->extra[-2 - i];
-        fv_params *p = NULL;
         fv_technique *t = NULL;
-        if ((st = fv_params_clone(m->params, &p, err)) == FV_OK && (st = fv_technique_create(m->method, scene, p, opt->log, &t, err)) != FV_OK)
-            fv_error_prefix(err, "%s: %s: ", path, m->label);
+        if ((st = fv_technique_create(m->method, scene, m->params, opt->log, &t, err)) != FV_OK) fv_error_prefix(err, "%s: %s: ", path, m->label);
         fv_technique_destroy(t);
-        fv_params_destroy(p);
     }
     if (st != FV_OK) goto done;
+    /* The frames: the same driver policy as `fovea render`; the scenario's camera path, gaze and
+     * eye model when it has them, else the scene file's. */
+    fv_camera_path cpath = {sc->cam_keys, sc->ncam_keys};
+    fv_drive_opts dopt;
+    fv_drive_opts_init(&dopt);
+    dopt.width = sc->width;
+    dopt.height = sc->height;
+    dopt.time0 = sc->start_time;
+    dopt.fps = sc->fps;
+    dopt.seed = sc->seed;
+    dopt.threads = opt->threads;
+    dopt.camera_path = sc->ncam_keys ? &cpath : NULL;
+    dopt.gaze_path = sc->gaze;
+    dopt.eye_model = sc->has_eye ? &sc->eye : NULL;
+    if ((st = fv_driver_create(scene, view, &dopt, &info.driver, err)) != FV_OK) goto done;
+    dopt.seed = fv_seed_reference(sc->seed);
+    if ((st = fv_driver_create(scene, view, &dopt, &info.ref_driver, err)) != FV_OK) goto done;
+    sc->eye = *fv_driver_eye_model(info.driver); /* what the reports and heat maps draw */
     size_t npix = (size_t)sc->width * sc->height;
     if (!(frames = fv_calloc_array((size_t)sc->frames, sizeof *frames))) {
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
         goto done;
     }
-    fv_camera_path cpath = {sc->cam_keys, sc->ncam_keys};
     for (int i = 0; i < sc->frames; i++) {
         frame_setup *f = &frames[i];
-        f->time = sc->start_time + i / sc->fps;
-        fv_view_camera(view, scene, f->time, sc->width, sc->height, &f->cam);
-        if (sc->ncam_keys) fv_camera_path_eval(&cpath, f->time, &f->cam, &f->cam);
-        fv_gaze_path_eval(sc->gaze, f->time, &f->gaze, NULL);
+        fv_frame_views v;
+        fv_driver_views(info.driver, i, &v);
+        f->time = v.time;
+        f->cam = v.camera[0];
+        f->gaze = v.gaze[0];
         f->labels = fv_alloc_array(npix, 1);
         bool ok = f->labels != NULL;
         for (int k = 0; k <= sc->nextra; k++) ok = ok && (f->ref[k] = fv_alloc_array(npix, 3 * sizeof(float))) != NULL;
@@ -531,6 +534,8 @@ done:
     if (match_methods)
         for (int k = 0; k < sc->nmatches; k++) fv_params_destroy(match_methods[k].params);
     free(match_methods);
+    fv_driver_destroy(info.driver);
+    fv_driver_destroy(info.ref_driver);
     fv_view_destroy(view);
     fv_scene_destroy(scene);
     fv_scenario_destroy(sc);

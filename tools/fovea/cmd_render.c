@@ -192,6 +192,7 @@ int fv_cmd_render(int argc, char **argv)
     fv_scene *scene = NULL;
     fv_view *view = NULL;
     fv_technique *tech = NULL;
+    fv_driver *driver = NULL;
     fv_film *film[2] = {NULL, NULL};
     fv_gaze_path *trace = NULL;
     fv_camera_path ctrace = {NULL, 0};
@@ -252,9 +253,6 @@ int fv_cmd_render(int argc, char **argv)
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
     }
-    /* Gaze: --gaze, else --gaze-trace, else the view's gaze path (the scene file's), else the
-     * centre. The eye model is the view's display (its density rescaled to this image width) or
-     * the default. */
     if (o.has_gaze && o.gaze_trace) {
         rc = fv_cli_usage_error(cmd, "--gaze and --gaze-trace exclude each other");
         goto done;
@@ -271,16 +269,31 @@ int fv_cmd_render(int argc, char **argv)
             goto done;
         }
     }
-    const fv_gaze_path *gpath = trace ? trace : o.has_gaze ? NULL : fv_view_gaze_path(view);
-    fv_eye_model eye;
-    fv_eye_model_default(o.width, o.height, &eye);
-    if (fv_view_display(view, &eye)) {
-        eye.ppi *= (float)o.width / (float)eye.width;
-        eye.width = o.width;
-        eye.height = o.height;
+    /* Everything else (which camera, gaze and eye model each frame gets) is the sequence
+     * driver's policy, shared with the bench and the viewer (fovea/drive.h). */
+    fv_drive_opts dopt;
+    fv_drive_opts_init(&dopt);
+    dopt.width = o.width;
+    dopt.height = o.height;
+    dopt.time0 = o.time0;
+    dopt.fps = o.fps;
+    dopt.seed = o.seed;
+    dopt.threads = o.threads;
+    dopt.eye_separation = (float)o.stereo;
+    dopt.camera_path = ctrace.keys ? &ctrace : NULL;
+    if (o.has_pos) dopt.camera_set |= FV_DRIVE_POS, dopt.pos = fv_v3(o.pos[0], o.pos[1], o.pos[2]);
+    if (o.has_look) dopt.camera_set |= FV_DRIVE_LOOK, dopt.look = fv_v3(o.look[0], o.look[1], o.look[2]);
+    if (o.has_up) dopt.camera_set |= FV_DRIVE_UP, dopt.up = fv_v3(o.up[0], o.up[1], o.up[2]);
+    if (o.has_fov) dopt.camera_set |= FV_DRIVE_FOV, dopt.fov_y = o.fov;
+    dopt.fixed_gaze = o.has_gaze;
+    dopt.gaze = (fv_gaze){o.gaze[0], o.gaze[1]};
+    dopt.gaze_path = trace;
+    if ((s = fv_driver_create(scene, view, &dopt, &driver, &err)) != FV_OK) {
+        rc = fv_cli_fail(cmd, s, err.msg);
+        goto done;
     }
     unsigned aux = fmt == FV_IMG_EXR ? FV_AUX_ALL : 0;
-    int neyes = o.stereo > 0 ? 2 : 1;
+    int neyes = fv_driver_eye_count(driver);
     for (int e = 0; e < neyes; e++)
         if ((s = fv_film_create(o.width, o.height, aux, &film[e], &err)) != FV_OK) {
             rc = fv_cli_fail(cmd, s, err.msg);
@@ -289,45 +302,12 @@ int fv_cmd_render(int argc, char **argv)
 
     fv_cli_progress prog;
     fv_cli_progress_init(&prog, o.quiet, o.frames);
-    fv_camera cam[2], prev[2];
     for (int f = 0; f < o.frames; f++) {
-        double t = o.time0 + f / o.fps;
-        if ((s = fv_scene_set_time(scene, t, &err)) != FV_OK) break;
-        fv_camera c;
-        fv_view_camera(view, scene, t, o.width, o.height, &c);
-        if (ctrace.keys) fv_camera_path_eval(&ctrace, t, &c, &c);
-        if (o.has_pos) c.pos = fv_v3(o.pos[0], o.pos[1], o.pos[2]);
-        if (o.has_look) c.look = fv_v3(o.look[0], o.look[1], o.look[2]);
-        if (o.has_up) c.up = fv_v3(o.up[0], o.up[1], o.up[2]);
-        if (o.has_fov) c.fov_y = o.fov;
-        if (neyes == 2) fv_camera_stereo(&c, (float)o.stereo, &cam[0], &cam[1]);
-        else cam[0] = c;
         fv_stats stats;
         fv_stats_clear(&stats);
-        double t0 = fv_time_ms();
-        fv_gaze gz[2];
-        gz[0].x = gz[1].x = o.gaze[0];
-        gz[0].y = gz[1].y = o.gaze[1];
-        if (gpath) fv_gaze_path_eval(gpath, t, &gz[0], &gz[1]);
         prog.frame = f;
-        for (int e = 0; e < neyes && s == FV_OK; e++) {
-            fv_frame fr;
-            fv_frame_init(&fr, &cam[e]);
-            fr.time = t;
-            fr.index = f;
-            fr.seed = o.seed;
-            fr.threads = o.threads;
-            fr.eye = e;
-            fr.eye_count = neyes;
-            fr.prev_camera = f > 0 ? &prev[e] : NULL;
-            fr.left_camera = e == 1 ? &cam[0] : NULL;
-            fr.gaze = gz[e];
-            fr.eye_model = &eye;
-            fr.progress = fv_cli_progress_frame;
-            fr.progress_user = &prog;
-            s = fv_technique_render(tech, &fr, film[e], &stats, &err);
-        }
-        if (s != FV_OK) break;
+        double t0 = fv_time_ms();
+        if ((s = fv_driver_render(driver, tech, f, f > 0, film, &stats, fv_cli_progress_frame, &prog, &err)) != FV_OK) break;
         double ms = fv_time_ms() - t0;
         for (int e = 0; e < neyes && s == FV_OK; e++) {
             char path[4096], tmp[4096];
@@ -345,8 +325,6 @@ int fv_cmd_render(int argc, char **argv)
             s = fv_film_write(film[e], path, (float)o.exposure, &err);
         }
         if (s != FV_OK) break;
-        prev[0] = cam[0];
-        prev[1] = cam[1];
         if (!o.quiet) {
             fv_cli_progress_done(&prog);
             double rays = fv_stats_get_count(&stats, "rays"), bad = fv_stats_get_count(&stats, "nan_samples");
@@ -360,6 +338,7 @@ int fv_cmd_render(int argc, char **argv)
     fv_cli_progress_done(&prog);
     if (s != FV_OK) rc = fv_cli_fail(cmd, s, err.msg);
 done:
+    fv_driver_destroy(driver);
     fv_gaze_path_destroy(trace);
     free(ctrace.keys);
     fv_film_destroy(film[0]);
