@@ -270,10 +270,15 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
     snprintf(gp, sizeof gp, "%s/%s-sweep.gp", info->out_dir, sc->name);
     fv_status st = text_write(&t, csv, err);
     if (st != FV_OK) return st;
-    /* MSE per region against the swept value; log axes when the values span a decade. */
+    /* MSE per region against the swept value; log axes when the values span a decade. gnuplot
+     * writes the plot by name, into the temporary file of an fv_atomic_file. */
     bool logx = lo > 0 && hi / lo >= 10.0;
-    char tmp_png[4096 + 160];
-    snprintf(tmp_png, sizeof tmp_png, "%s.tmp.png", png);
+    fv_atomic_file plot;
+    fv_error perr;
+    if (fv_atomic_file_begin(png, &plot, &perr) != FV_OK) {
+        fv_log_warn(info->opt->log, "could not plot: %s; the CSV %s is complete", perr.msg, csv);
+        return FV_OK;
+    }
     tprintf(&t,
             "set terminal png size 800,500\nset output '%s'\nset datafile separator ','\nset key top right\n"
             "set title \"%s: error per region vs %s\" noenhanced\nset xlabel '%s' noenhanced\nset ylabel 'MSE'\n"
@@ -281,14 +286,15 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
             "plot '%s' every ::1 using 1:4 with linespoints lw 2 title 'fovea', "
             "'' every ::1 using 1:5 with linespoints lw 2 title 'transition', "
             "'' every ::1 using 1:6 with linespoints lw 2 title 'periphery'\n",
-            tmp_png, sc->name, sc->sweep_param, sc->sweep_param, logx ? "set logscale x 2" : "", csv);
-    if ((st = text_write(&t, gp, err)) != FV_OK) return st;
-    if (run_gnuplot(gp) && rename(tmp_png, png) == 0) {
-        unlink(gp);
-        return FV_OK;
+            fv_atomic_file_path(&plot), sc->name, sc->sweep_param, sc->sweep_param, logx ? "set logscale x 2" : "", csv);
+    if ((st = text_write(&t, gp, err)) != FV_OK) {
+        fv_atomic_file_abort(&plot);
+        return st;
     }
-    unlink(tmp_png);
+    bool plotted = run_gnuplot(gp) && fv_atomic_file_commit(&plot, &perr) == FV_OK;
+    fv_atomic_file_abort(&plot);
     unlink(gp);
+    if (plotted) return FV_OK;
     fv_log_warn(info->opt->log, "could not plot %s with gnuplot (is gnuplot installed?); the CSV %s is complete", png, csv);
     return FV_OK;
 }

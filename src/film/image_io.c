@@ -2,9 +2,8 @@
  * either byte order on read), OpenEXR (linear 32-bit float, plus the film's auxiliary buffers as
  * extra channels so a denoiser or a metric script can read them back).
  *
- * Every write goes to a temporary file next to the target (same directory, so the final rename
- * is atomic on POSIX) and is renamed into place only when complete: a failed or interrupted write
- * never leaves a truncated image under the requested name.
+ * Every write goes through an fv_atomic_file (core/fileio.h): a failed or interrupted write never
+ * leaves a truncated image under the requested name.
  * Limits: PNG read is 8 bits per channel (16-bit files are reduced); EXR read takes the first
  * part, scanline or tiled images decoded by scanline chunks only (tiled files are refused).
  */
@@ -17,9 +16,9 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
-#include <unistd.h>
 #include <OpenEXR/openexr.h>
 #include "core/alloc.h"
+#include "core/fileio.h"
 #include "fovea/film.h"
 
 fv_image_format fv_image_format_from_path(const char *path)
@@ -33,61 +32,6 @@ fv_image_format fv_image_format_from_path(const char *path)
     return FV_IMG_UNKNOWN;
 }
 
-/* ---- atomic writes ---- */
-
-typedef struct tmpfile_t {
-    char path[4096];
-    int fd;
-} tmpfile_t;
-
-static fv_status tmp_create(const char *target, tmpfile_t *t, fv_error *err)
-{
-    if (snprintf(t->path, sizeof t->path, "%s.tmp.XXXXXX", target) >= (int)sizeof t->path)
-        return fv_error_set(err, FV_ERR_IO, "cannot write '%s': path too long", target);
-    t->fd = mkstemp(t->path);
-    if (t->fd < 0) return fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", target, strerror(errno));
-    /* mkstemp makes the file 0600; an image should get the usual permissions. */
-    mode_t mask = umask(0);
-    umask(mask);
-    fchmod(t->fd, 0666 & ~mask);
-    return FV_OK;
-}
-
-static fv_status tmp_commit(tmpfile_t *t, const char *target, fv_error *err)
-{
-    if (rename(t->path, target) != 0) {
-        int e = errno;
-        unlink(t->path);
-        return fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", target, strerror(e));
-    }
-    return FV_OK;
-}
-
-/* Opens the temporary file as a stdio stream (taking over its descriptor). */
-static FILE *tmp_stream(tmpfile_t *t)
-{
-    FILE *f = fdopen(t->fd, "wb");
-    if (!f) {
-        close(t->fd);
-        unlink(t->path);
-    }
-    return f;
-}
-
-/* Closes the stream and renames into place, or removes the temporary file on any error. */
-static fv_status tmp_finish_stream(tmpfile_t *t, FILE *f, bool ok, const char *target, fv_error *err)
-{
-    int e = 0;
-    if (ferror(f)) ok = false, e = errno;
-    if (fclose(f) != 0 && ok) ok = false, e = errno;
-    if (!ok) {
-        unlink(t->path);
-        if (err && err->status != FV_OK) return err->status;
-        return fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", target, e ? strerror(e) : "write failed");
-    }
-    return tmp_commit(t, target, err);
-}
-
 /* ---- PNG (libpng's simplified API) ---- */
 
 static fv_status png_write(const char *path, const float *rgb, int w, int h, float exposure, fv_error *err)
@@ -96,16 +40,14 @@ static fv_status png_write(const char *path, const float *rgb, int w, int h, flo
     unsigned char *px = fv_alloc_array(n, 1);
     if (!px) return fv_error_set(err, FV_ERR_NOMEM, "out of memory writing '%s'", path);
     for (size_t i = 0; i < n; i++) px[i] = (unsigned char)lrintf(255.0f * fv_srgb_encode(rgb[i] * exposure));
-    tmpfile_t t;
-    fv_status s = tmp_create(path, &t, err);
+    fv_atomic_file af;
+    FILE *f = NULL;
+    fv_status s = fv_atomic_file_begin(path, &af, err);
+    if (s == FV_OK) s = fv_atomic_file_stream(&af, &f, err);
     if (s != FV_OK) {
+        fv_atomic_file_abort(&af);
         free(px);
         return s;
-    }
-    FILE *f = tmp_stream(&t);
-    if (!f) {
-        free(px);
-        return fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, strerror(errno));
     }
     png_image img;
     memset(&img, 0, sizeof img);
@@ -114,10 +56,12 @@ static fv_status png_write(const char *path, const float *rgb, int w, int h, flo
     img.height = (png_uint_32)h;
     img.format = PNG_FORMAT_RGB;
     bool ok = png_image_write_to_stdio(&img, f, 0, px, 0, NULL) != 0;
-    if (!ok) fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, img.message[0] ? img.message : "libpng failed");
+    if (ok) s = fv_atomic_file_commit(&af, err);
+    else s = fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, img.message[0] ? img.message : "libpng failed");
+    fv_atomic_file_abort(&af);
     png_image_free(&img);
     free(px);
-    return tmp_finish_stream(&t, f, ok, path, err);
+    return s;
 }
 
 static fv_status png_read(const char *path, fv_image *out, fv_error *err)
@@ -165,15 +109,19 @@ static bool host_little_endian(void)
 
 static fv_status pfm_write(const char *path, const float *rgb, int w, int h, fv_error *err)
 {
-    tmpfile_t t;
-    fv_status s = tmp_create(path, &t, err);
-    if (s != FV_OK) return s;
-    FILE *f = tmp_stream(&t);
-    if (!f) return fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, strerror(errno));
+    fv_atomic_file af;
+    FILE *f = NULL;
+    fv_status s = fv_atomic_file_begin(path, &af, err);
+    if (s == FV_OK) s = fv_atomic_file_stream(&af, &f, err);
+    if (s != FV_OK) {
+        fv_atomic_file_abort(&af);
+        return s;
+    }
+    /* A failed fprintf or fwrite leaves the stream's error flag set, which the commit reports. */
     bool ok = fprintf(f, "PF\n%d %d\n%s\n", w, h, host_little_endian() ? "-1.0" : "1.0") > 0;
     for (int y = h - 1; ok && y >= 0; y--)
         ok = fwrite(rgb + (size_t)y * w * 3, sizeof(float) * 3, (size_t)w, f) == (size_t)w;
-    return tmp_finish_stream(&t, f, ok, path, err);
+    return fv_atomic_file_commit(&af, err);
 }
 
 /* Reads one whitespace-delimited token of the PFM header. */
@@ -288,17 +236,16 @@ typedef struct exr_plane {
 
 static fv_status exr_write_planes(const char *path, int w, int h, const exr_plane *planes, int np, fv_error *err)
 {
-    tmpfile_t t;
-    fv_status s = tmp_create(path, &t, err);
+    fv_atomic_file af;
+    fv_status s = fv_atomic_file_begin(path, &af, err);
     if (s != FV_OK) return s;
-    close(t.fd);
     exr_msg m;
     exr_context_initializer_t init = exr_init(&m);
     exr_context_t ctxt = NULL;
     exr_encode_pipeline_t enc;
     bool enc_init = false;
     int part = 0;
-    exr_result_t r = exr_start_write(&ctxt, t.path, EXR_WRITE_FILE_DIRECTLY, &init);
+    exr_result_t r = exr_start_write(&ctxt, fv_atomic_file_path(&af), EXR_WRITE_FILE_DIRECTLY, &init);
     if (r == EXR_ERR_SUCCESS) r = exr_add_part(ctxt, "fovea", EXR_STORAGE_SCANLINE, &part);
     if (r == EXR_ERR_SUCCESS) r = exr_initialize_required_attr_simple(ctxt, part, w, h, EXR_COMPRESSION_ZIP);
     for (int i = 0; i < np && r == EXR_ERR_SUCCESS; i++)
@@ -341,10 +288,10 @@ static fv_status exr_write_planes(const char *path, int w, int h, const exr_plan
     exr_result_t rf = ctxt ? exr_finish(&ctxt) : EXR_ERR_SUCCESS;
     if (r == EXR_ERR_SUCCESS) r = rf;
     if (r != EXR_ERR_SUCCESS) {
-        unlink(t.path);
+        fv_atomic_file_abort(&af);
         return fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, exr_why(&m, r));
     }
-    return tmp_commit(&t, path, err);
+    return fv_atomic_file_commit(&af, err);
 }
 
 /* Splits interleaved 3-channel data into planes. */

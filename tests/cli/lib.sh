@@ -1,4 +1,4 @@
-# Shared helpers of the CLI tests: each test script is run as `bash test_x.sh FOVEA SRCDIR`.
+# Shared helpers of the CLI tests: each test script is run as `bash test_x.sh FOVEA SRCDIR BUILDDIR`.
 set -u
 FOVEA=$1
 SRC=$2

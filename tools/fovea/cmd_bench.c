@@ -1,10 +1,14 @@
 /* fovea CLI — `fovea bench SCENARIO`: run a benchmark scenario (bench/<name>.json, docs/bench.md)
- * and write its report. A bare name is looked up in $FOVEA_BENCH_DIR, ./bench and the source
- * tree's bench/ folder, so `fovea bench pt-cornell` works from a fresh clone. */
+ * and write its report. A bare name is looked up in $FOVEA_BENCH_DIR, ./bench, the installed
+ * share/fovea/bench next to this executable and, for an uninstalled build, the source tree's
+ * bench/ folder, so `fovea bench pt-cornell` works both installed and from a fresh clone. */
+#include <dirent.h>
 #include <getopt.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include "cli.h"
 
 static void usage(FILE *f)
@@ -30,15 +34,43 @@ static bool is_file(const char *p)
     return stat(p, &sb) == 0 && S_ISREG(sb.st_mode);
 }
 
-/* The folders searched for scenario names, in order. */
-static int bench_dirs(const char **dirs)
+static bool is_dir(const char *p)
+{
+    struct stat sb;
+    return stat(p, &sb) == 0 && S_ISDIR(sb.st_mode);
+}
+
+/* The installed scenarios: FOVEA_BENCH_FROM_BIN (e.g. ../share/fovea/bench) from the folder of the
+ * running executable, so a moved or relocated install still finds its own. PATH_MAX bytes. */
+static bool installed_dir(char *out)
+{
+#ifdef FOVEA_BENCH_FROM_BIN
+    char exe[PATH_MAX], joined[PATH_MAX + 64];
+    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (len <= 0) return false;
+    exe[len] = '\0';
+    char *slash = strrchr(exe, '/');
+    if (!slash) return false;
+    *slash = '\0';
+    snprintf(joined, sizeof joined, "%s/%s", exe, FOVEA_BENCH_FROM_BIN);
+    return realpath(joined, out) && is_dir(out);
+#else
+    (void)out;
+    return false;
+#endif
+}
+
+/* The folders searched for scenario names, in order. The source tree comes last and only when no
+ * installed folder exists, so an installed tool never picks up a stale clone's scenarios. */
+static int bench_dirs(const char **dirs, char *installed)
 {
     int n = 0;
     const char *env = getenv("FOVEA_BENCH_DIR");
     if (env && env[0]) dirs[n++] = env;
     dirs[n++] = "bench";
+    if (installed_dir(installed)) dirs[n++] = installed;
 #ifdef FOVEA_SOURCE_DIR
-    dirs[n++] = FOVEA_SOURCE_DIR "/bench";
+    else dirs[n++] = FOVEA_SOURCE_DIR "/bench";
 #endif
     return n;
 }
@@ -50,7 +82,8 @@ static bool resolve(const char *arg, char *out, size_t n)
         return true;
     }
     const char *dirs[4];
-    int nd = bench_dirs(dirs);
+    char installed[PATH_MAX];
+    int nd = bench_dirs(dirs, installed);
     for (int i = 0; i < nd; i++) {
         snprintf(out, n, "%s/%s.json", dirs[i], arg);
         if (is_file(out)) return true;
@@ -58,28 +91,38 @@ static bool resolve(const char *arg, char *out, size_t n)
     return false;
 }
 
+static int is_json(const struct dirent *e)
+{
+    size_t n = strlen(e->d_name);
+    return n > 5 && strcmp(e->d_name + n - 5, ".json") == 0;
+}
+
 static void list_scenarios(void)
 {
     const char *dirs[4];
-    int nd = bench_dirs(dirs);
-    char cmd[8192] = "";
-    /* Listing through ls keeps this simple and the order stable. */
-    char seen[4][4096];
+    char installed[PATH_MAX];
+    int nd = bench_dirs(dirs, installed);
+    char seen[4][PATH_MAX];
     int nseen = 0;
     for (int i = 0; i < nd; i++) {
-        struct stat sb;
-        if (stat(dirs[i], &sb) != 0 || !S_ISDIR(sb.st_mode)) continue;
-        /* ./bench and the source tree's bench/ are often the same folder: list it once. */
-        char real[4096];
+        if (!is_dir(dirs[i])) continue;
+        /* ./bench and the source tree's (or the installed) bench/ are often the same folder: list
+         * it once. */
+        char real[PATH_MAX];
         if (!realpath(dirs[i], real)) continue;
         bool dup = false;
         for (int k = 0; k < nseen && !dup; k++) dup = strcmp(seen[k], real) == 0;
         if (dup) continue;
         snprintf(seen[nseen++], sizeof seen[0], "%s", real);
+        struct dirent **names;
+        int nn = scandir(dirs[i], &names, is_json, alphasort);
+        if (nn < 0) continue;
         printf("%s:\n", dirs[i]);
-        snprintf(cmd, sizeof cmd, "ls -1 '%s' | sed -n 's/\\.json$//p' | sed 's/^/  /'", dirs[i]);
-        fflush(stdout);
-        if (system(cmd) != 0) continue;
+        for (int k = 0; k < nn; k++) {
+            printf("  %.*s\n", (int)(strlen(names[k]->d_name) - 5), names[k]->d_name);
+            free(names[k]);
+        }
+        free(names);
     }
 }
 
