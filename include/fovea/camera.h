@@ -6,6 +6,7 @@
 #ifndef FOVEA_CAMERA_H
 #define FOVEA_CAMERA_H
 
+#include <stdbool.h>
 #include "fovea/export.h"
 #include "fovea/math.h"
 #include "fovea/status.h"
@@ -63,9 +64,11 @@ typedef struct fv_camera_path {
 } fv_camera_path;
 
 /* Reads a camera path from a CSV trace (docs/gaze.md): lines "time,px,py,pz,lx,ly,lz", optionally
- * followed by "ux,uy,uz" and then "fov"; missing up and fov come from base. *keys is the
- * caller's to free. Errors name the file and line. */
+ * followed by "ux,uy,uz" and then "fov"; missing up and fov come from base. Release *keys with
+ * fv_camera_keys_free. Errors name the file and line; on error *keys is NULL. */
 FV_API fv_status fv_camera_path_load_csv(const char *path, const fv_camera *base, fv_camera_key **keys, int *count, fv_error *err);
+/* Releases keys from fv_camera_path_load_csv (NULL is ignored). */
+FV_API void fv_camera_keys_free(fv_camera_key *keys);
 
 /* Camera at time t along path (count >= 1); width/height are taken from base. */
 FV_API void fv_camera_path_eval(const fv_camera_path *path, double t, const fv_camera *base, fv_camera *out);

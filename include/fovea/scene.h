@@ -10,6 +10,7 @@
 #ifndef FOVEA_SCENE_H
 #define FOVEA_SCENE_H
 
+#include <stdbool.h>
 #include "fovea/export.h"
 #include <stdint.h>
 #include "fovea/math.h"

@@ -10,6 +10,7 @@
 #ifndef FOVEA_VIEW_H
 #define FOVEA_VIEW_H
 
+#include <stdbool.h>
 #include "fovea/export.h"
 #include "fovea/camera.h"
 #include "fovea/gaze.h"

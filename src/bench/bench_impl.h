@@ -2,6 +2,7 @@
 #ifndef FV_BENCH_IMPL_H
 #define FV_BENCH_IMPL_H
 
+#include <stdbool.h>
 #include "bench/scenario.h"
 #include "fovea/drive.h"
 #include "fovea/metrics.h"

@@ -2,6 +2,7 @@
 #ifndef FV_BENCH_SCENARIO_H
 #define FV_BENCH_SCENARIO_H
 
+#include <stdbool.h>
 #include "fovea/bench.h"
 #include "fovea/camera.h"
 #include "fovea/gaze.h"

@@ -8,6 +8,7 @@
 #ifndef FV_SCENE_BSDF_H
 #define FV_SCENE_BSDF_H
 
+#include <stdbool.h>
 #include "fovea/scene.h"
 
 /* Which quantity a path carries: camera paths carry radiance, light (photon) paths importance.

@@ -46,3 +46,5 @@ fv_status fv_camera_path_load_csv(const char *path, const fv_camera *base, fv_ca
     *count = r.n;
     return FV_OK;
 }
+
+void fv_camera_keys_free(fv_camera_key *keys) { free(keys); }

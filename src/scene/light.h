@@ -7,6 +7,7 @@
 #ifndef FV_SCENE_LIGHT_H
 #define FV_SCENE_LIGHT_H
 
+#include <stdbool.h>
 #include "core/rng.h"
 #include "scene/query.h"
 

@@ -2,6 +2,7 @@
 #ifndef FV_SCENE_LOAD_IMPL_H
 #define FV_SCENE_LOAD_IMPL_H
 
+#include <stdbool.h>
 #include "fovea/scene.h"
 #include "fovea/view.h"
 

@@ -347,7 +347,7 @@ fv_status fv_load_json(const char *path, fv_scene *scene, fv_view *view, const f
         int n = 0;
         if ((st = fv_camera_path_load_csv(full, &base, &k, &n, err)) == FV_OK && (st = fv_view_set_camera_path(view, k, n, err)) != FV_OK)
             fv_error_prefix(err, "%s: ", path);
-        free(k);
+        fv_camera_keys_free(k);
         if (st != FV_OK) goto done;
     } else if (it) {
         int n = cJSON_GetArraySize(it);
@@ -367,7 +367,7 @@ fv_status fv_load_json(const char *path, fv_scene *scene, fv_view *view, const f
             st = parse_camera_key(e, &c, w, true, &k[i], err);
         }
         if (st == FV_OK && (st = fv_view_set_camera_path(view, k, n, err)) != FV_OK) fv_error_prefix(err, "%s: ", path);
-        free(k);
+        fv_camera_keys_free(k);
         if (st != FV_OK) goto done;
     }
     if ((it = cJSON_GetObjectItemCaseSensitive(root, "display"))) {

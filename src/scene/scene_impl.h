@@ -11,6 +11,7 @@
 #ifndef FV_SCENE_IMPL_H
 #define FV_SCENE_IMPL_H
 
+#include <stdbool.h>
 #include <embree3/rtcore.h>
 #include "fovea/scene.h"
 #include "scene/query.h"

@@ -204,7 +204,7 @@ static void test_camera_trace(void **st)
     assert_float_equal(c.pos.x, 1.0f, 1e-6f);
     assert_float_equal(c.fov_y, 47.5f, 1e-5f);
     assert_int_equal(c.width, 64);
-    free(k);
+    fv_camera_keys_free(k);
     k = NULL;
     assert_int_equal(fv_camera_path_load_csv(DATA("camera_bad.csv"), &base, &k, &n, &err), FV_ERR_INVALID);
     assert_non_null(strstr(err.msg, "camera_bad.csv:2:"));

@@ -340,7 +340,7 @@ int fv_cmd_render(int argc, char **argv)
 done:
     fv_driver_destroy(driver);
     fv_gaze_path_destroy(trace);
-    free(ctrace.keys);
+    fv_camera_keys_free(ctrace.keys);
     fv_film_destroy(film[0]);
     fv_film_destroy(film[1]);
     fv_technique_destroy(tech);

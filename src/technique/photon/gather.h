@@ -9,6 +9,7 @@
 #ifndef FV_PHOTON_GATHER_H
 #define FV_PHOTON_GATHER_H
 
+#include <stdbool.h>
 #include "core/rng.h"
 #include "scene/query.h"
 #include "technique/photon/photon_map.h"

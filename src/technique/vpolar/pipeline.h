@@ -12,6 +12,7 @@
 #ifndef FV_TECHNIQUE_VPOLAR_PIPELINE_H
 #define FV_TECHNIQUE_VPOLAR_PIPELINE_H
 
+#include <stdbool.h>
 #include "filter/svgf.h"
 #include "fovea/film.h"
 #include "fovea/frame.h"

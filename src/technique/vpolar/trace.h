@@ -15,6 +15,7 @@
 #ifndef FV_TECHNIQUE_VPOLAR_TRACE_H
 #define FV_TECHNIQUE_VPOLAR_TRACE_H
 
+#include <stdbool.h>
 #include <stdint.h>
 #include "fovea/camera.h"
 #include "technique/kit.h"
