@@ -1,0 +1,278 @@
+/* The sequence driver (fovea/drive.h): every tool builds frames through it, so its policy is
+ * checked here field by field with hand-worked values:
+ *  - time of frame i is time0 + i / fps;
+ *  - camera: the view's, then the options' path, then the overrides;
+ *  - stereo: two cameras eye_separation apart;
+ *  - gaze: fixed > options' path > view's path > centre;
+ *  - eye model: options' > view's display rescaled to the width (615 ppi at 1080 px -> 307.5 at
+ *    540 px) > default;
+ *  - rendering: both eyes, progress over the whole frame, cancel, bad options refused. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <string.h>
+#include <cmocka.h>
+#include "fovea/fovea.h"
+
+static fv_scene *g_scene;
+static fv_view *g_view; /* cornell's camera: the framing camera looks at the box from behind */
+
+static int setup(void **st)
+{
+    (void)st;
+    fv_error err;
+    return fv_scene_load("cornell", NULL, &g_scene, &g_view, &err) == FV_OK ? 0 : -1;
+}
+
+static int teardown(void **st)
+{
+    (void)st;
+    fv_view_destroy(g_view);
+    fv_scene_destroy(g_scene);
+    return 0;
+}
+
+static fv_driver *make(const fv_view *v, const fv_drive_opts *o)
+{
+    fv_error err;
+    fv_driver *d = NULL;
+    if (fv_driver_create(g_scene, v, o, &d, &err) != FV_OK) fail_msg("%s", err.msg);
+    return d;
+}
+
+static fv_gaze_path *fixed_path(float x, float y)
+{
+    fv_error err;
+    fv_gaze_path *p = NULL;
+    assert_int_equal(fv_gaze_path_create_fixed((fv_gaze){x, y}, &p, &err), FV_OK);
+    return p;
+}
+
+static void test_time_and_camera(void **st)
+{
+    (void)st;
+    fv_error err;
+    fv_view *v;
+    assert_int_equal(fv_view_create(&v, &err), FV_OK);
+    fv_camera c = {{1, 2, 3}, {1, 2, 0}, {0, 1, 0}, 40.0f, 10, 10};
+    fv_view_set_camera(v, &c);
+    fv_drive_opts o;
+    fv_drive_opts_init(&o);
+    o.width = 64, o.height = 32, o.time0 = 2.0, o.fps = 4.0;
+    fv_driver *d = make(v, &o);
+    fv_frame_views fv;
+    fv_driver_views(d, 3, &fv);
+    assert_float_equal(fv.time, 2.75, 1e-12); /* 2 + 3 / 4 */
+    assert_int_equal(fv.eye_count, 1);
+    assert_float_equal(fv.camera[0].pos.z, 3.0f, 0.0f);
+    assert_int_equal(fv.camera[0].width, 64);
+    assert_int_equal(fv.camera[0].height, 32);
+    fv_driver_destroy(d);
+
+    /* an options path moves the camera; then the overrides replace single fields */
+    fv_camera_key keys[2] = {{0.0, {0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 40.0f}, {1.0, {0, 0, 20}, {0, 0, 0}, {0, 1, 0}, 60.0f}};
+    fv_camera_path path = {keys, 2};
+    o.time0 = 0.0, o.fps = 2.0;
+    o.camera_path = &path;
+    d = make(v, &o);
+    fv_driver_views(d, 1, &fv); /* t = 0.5: halfway */
+    assert_float_equal(fv.camera[0].pos.z, 15.0f, 1e-5f);
+    assert_float_equal(fv.camera[0].fov_y, 50.0f, 1e-4f);
+    fv_driver_destroy(d);
+    o.camera_set = FV_DRIVE_POS | FV_DRIVE_FOV;
+    o.pos = fv_v3(7, 8, 9);
+    o.fov_y = 30.0f;
+    d = make(v, &o);
+    fv_driver_views(d, 1, &fv);
+    assert_float_equal(fv.camera[0].pos.x, 7.0f, 0.0f);
+    assert_float_equal(fv.camera[0].pos.z, 9.0f, 0.0f);
+    assert_float_equal(fv.camera[0].fov_y, 30.0f, 0.0f);
+    assert_float_equal(fv.camera[0].look.z, 0.0f, 0.0f); /* not overridden: from the path */
+    fv_driver_destroy(d);
+    fv_view_destroy(v);
+}
+
+static void test_stereo(void **st)
+{
+    (void)st;
+    fv_drive_opts o;
+    fv_drive_opts_init(&o);
+    o.width = o.height = 16;
+    o.eye_separation = 0.5f;
+    fv_driver *d = make(NULL, &o);
+    assert_int_equal(fv_driver_eye_count(d), 2);
+    fv_frame_views fv;
+    fv_driver_views(d, 0, &fv);
+    assert_int_equal(fv.eye_count, 2);
+    assert_float_equal(fv_length(fv_sub(fv.camera[0].pos, fv.camera[1].pos)), 0.5f, 1e-5f);
+    fv_driver_destroy(d);
+}
+
+static void test_gaze_precedence(void **st)
+{
+    (void)st;
+    fv_error err;
+    fv_view *v;
+    assert_int_equal(fv_view_create(&v, &err), FV_OK);
+    fv_drive_opts o;
+    fv_drive_opts_init(&o);
+    o.width = o.height = 16;
+    fv_frame_views fv;
+    /* nothing: the centre */
+    fv_driver *d = make(v, &o);
+    fv_driver_views(d, 0, &fv);
+    assert_float_equal(fv.gaze[0].x, 0.5f, 0.0f);
+    fv_driver_destroy(d);
+    /* the view's path */
+    fv_view_set_gaze_path(v, fixed_path(0.1f, 0.2f));
+    d = make(v, &o);
+    fv_driver_views(d, 0, &fv);
+    assert_float_equal(fv.gaze[0].x, 0.1f, 1e-6f);
+    assert_float_equal(fv.gaze[1].y, 0.2f, 1e-6f);
+    fv_driver_destroy(d);
+    /* the options' path beats the view's */
+    fv_gaze_path *mine = fixed_path(0.3f, 0.4f);
+    o.gaze_path = mine;
+    d = make(v, &o);
+    fv_driver_views(d, 0, &fv);
+    assert_float_equal(fv.gaze[0].x, 0.3f, 1e-6f);
+    fv_driver_destroy(d);
+    /* a fixed gaze beats both, and the viewer's live gaze beats that */
+    o.fixed_gaze = true;
+    o.gaze = (fv_gaze){0.9f, 0.8f};
+    d = make(v, &o);
+    fv_driver_views(d, 0, &fv);
+    assert_float_equal(fv.gaze[0].x, 0.9f, 0.0f);
+    fv_driver_set_gaze(d, (fv_gaze){0.6f, 0.7f});
+    fv_driver_views(d, 5, &fv);
+    assert_float_equal(fv.gaze[0].y, 0.7f, 0.0f);
+    fv_driver_destroy(d);
+    fv_gaze_path_destroy(mine);
+    fv_view_destroy(v);
+}
+
+static void test_eye_model(void **st)
+{
+    (void)st;
+    fv_error err;
+    fv_view *v;
+    assert_int_equal(fv_view_create(&v, &err), FV_OK);
+    fv_drive_opts o;
+    fv_drive_opts_init(&o);
+    o.width = 540, o.height = 600;
+    /* no display anywhere: the default for the size */
+    fv_driver *d = make(v, &o);
+    fv_eye_model def;
+    fv_eye_model_default(540, 600, &def);
+    assert_float_equal(fv_driver_eye_model(d)->ppi, def.ppi, 0.0f);
+    fv_driver_destroy(d);
+    /* the view's display, its density rescaled from 1080 to 540 pixels wide */
+    fv_eye_model disp;
+    fv_eye_model_default(1080, 1200, &disp);
+    disp.ppi = 615.0f;
+    disp.fovea_deg = 5.0f;
+    fv_view_set_display(v, &disp);
+    d = make(v, &o);
+    const fv_eye_model *e = fv_driver_eye_model(d);
+    assert_float_equal(e->ppi, 307.5f, 1e-4f);
+    assert_int_equal(e->width, 540);
+    assert_int_equal(e->height, 600);
+    assert_float_equal(e->fovea_deg, 5.0f, 0.0f);
+    fv_driver_destroy(d);
+    /* the options' model is taken as given */
+    fv_eye_model mine = disp;
+    mine.ppi = 100.0f;
+    o.eye_model = &mine;
+    d = make(v, &o);
+    assert_float_equal(fv_driver_eye_model(d)->ppi, 100.0f, 0.0f);
+    fv_driver_destroy(d);
+    fv_view_destroy(v);
+}
+
+static void test_bad_options(void **st)
+{
+    (void)st;
+    fv_error err;
+    fv_driver *d = NULL;
+    fv_drive_opts o;
+    fv_drive_opts_init(&o);
+    o.fps = 0.0;
+    assert_int_equal(fv_driver_create(g_scene, NULL, &o, &d, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "fps"));
+    fv_drive_opts_init(&o);
+    o.width = 0;
+    assert_int_equal(fv_driver_create(g_scene, NULL, &o, &d, &err), FV_ERR_INVALID);
+    fv_drive_opts_init(&o);
+    o.eye_separation = NAN;
+    assert_int_equal(fv_driver_create(g_scene, NULL, &o, &d, &err), FV_ERR_INVALID);
+    assert_null(d);
+}
+
+typedef struct progress_log {
+    double f[4096];
+    int n;
+    int cancel_after; /* calls; < 0: never */
+} progress_log;
+
+static bool on_progress(void *user, double f)
+{
+    progress_log *p = user;
+    if (p->n < 4096) p->f[p->n++] = f;
+    return p->cancel_after < 0 || p->n < p->cancel_after;
+}
+
+static void test_render_progress_and_cancel(void **st)
+{
+    (void)st;
+    fv_error err;
+    fv_params *p;
+    assert_int_equal(fv_params_create(&p, &err), FV_OK);
+    assert_int_equal(fv_params_set(p, "spp", "2", &err), FV_OK);
+    fv_technique *t;
+    assert_int_equal(fv_technique_create("pt", g_scene, p, NULL, &t, &err), FV_OK);
+    fv_drive_opts o;
+    fv_drive_opts_init(&o);
+    o.width = 64, o.height = 64, o.eye_separation = 50.0f, o.threads = 1;
+    fv_driver *d = make(g_view, &o);
+    fv_film *films[2];
+    assert_int_equal(fv_film_create(64, 64, 0, &films[0], &err), FV_OK);
+    assert_int_equal(fv_film_create(64, 64, 0, &films[1], &err), FV_OK);
+    fv_stats stats;
+    fv_stats_clear(&stats);
+    progress_log log = {{0}, 0, -1};
+    assert_int_equal(fv_driver_render(d, t, 0, false, films, &stats, on_progress, &log, &err), FV_OK);
+    /* both eyes: the first half of the reports from the left eye, ending at 1 */
+    assert_true(log.n >= 4);
+    bool left = false, right = false;
+    for (int i = 0; i < log.n; i++) {
+        if (i) assert_true(log.f[i] >= log.f[i - 1]);
+        left |= log.f[i] > 0.0 && log.f[i] < 0.5;
+        right |= log.f[i] > 0.5 && log.f[i] < 1.0;
+    }
+    assert_true(left && right);
+    assert_float_equal(log.f[log.n - 1], 1.0, 1e-12);
+    double sum0 = 0, sum1 = 0;
+    for (int i = 0; i < 3 * 64 * 64; i++) sum0 += fv_film_color(films[0])[i], sum1 += fv_film_color(films[1])[i];
+    assert_true(sum0 > 0.0 && sum1 > 0.0 && sum0 != sum1);
+    /* cancel in the left eye: the frame stops with FV_ERR_CANCELLED; the next frame renders */
+    progress_log stop = {{0}, 0, 2};
+    assert_int_equal(fv_driver_render(d, t, 1, true, films, &stats, on_progress, &stop, &err), FV_ERR_CANCELLED);
+    assert_true(stop.n <= 3);
+    assert_int_equal(fv_driver_render(d, t, 2, false, films, &stats, NULL, NULL, &err), FV_OK);
+    fv_film_destroy(films[0]);
+    fv_film_destroy(films[1]);
+    fv_driver_destroy(d);
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_time_and_camera), cmocka_unit_test(test_stereo),
+        cmocka_unit_test(test_gaze_precedence), cmocka_unit_test(test_eye_model),
+        cmocka_unit_test(test_bad_options),     cmocka_unit_test(test_render_progress_and_cancel),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
