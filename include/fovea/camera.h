@@ -2,6 +2,8 @@
  *
  * Screen convention used everywhere in fovea: pixel (0,0) is the top-left corner, x grows right,
  * y grows down; normalised screen coordinates are (x + 0.5)/width, (y + 0.5)/height in [0,1].
+ * Cameras and keys are plain structs; the functions are pure (thread-safe) except the CSV reader,
+ * whose keys the caller releases with fv_camera_keys_free.
  */
 #ifndef FOVEA_CAMERA_H
 #define FOVEA_CAMERA_H

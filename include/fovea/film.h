@@ -4,6 +4,10 @@
  * A film is created with the auxiliary buffers asked for; the colour buffer always exists.
  * Buffers are row-major from the top-left pixel. Writes go to a temporary file in the target's
  * directory and are renamed into place, so a failed or interrupted write leaves nothing behind.
+ *
+ * Ownership: the caller creates and destroys films; the buffer pointers a film hands out live as
+ * long as it. Threads: a film is plain memory; techniques write disjoint pixels from their
+ * threads, callers must not use a film that is being rendered into.
  */
 #ifndef FOVEA_FILM_H
 #define FOVEA_FILM_H

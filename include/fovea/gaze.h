@@ -10,6 +10,10 @@
  *   - Inverted-pyramid sphere tracing, Eq. 1: p(w) = 0.90964 e^(-w/2.9661) + 0.00792 (the sign of
  *     the exponent is negative: the printed positive sign is a typo, acuity falls with w).
  * Gaze over time is fixed, keyframed, or a recorded trace (docs/gaze.md gives the CSV format).
+ *
+ * Ownership: gaze paths are created and destroyed by the caller (a view takes over the one it is
+ * given). The eye model is a plain struct. Every function here only reads its inputs: safe from
+ * any number of threads.
  */
 #ifndef FOVEA_GAZE_H
 #define FOVEA_GAZE_H

@@ -5,6 +5,10 @@
  * and the temporal errors MSE' (Foveated Photon Mapping Eq. 9) and E' (Foveated Instant
  * Radiosity Eq. 4) over a frame sequence. Every metric is a per-pixel map averaged over the
  * pixels of a region; by default on display values (exposure, clamp to [0,1], sRGB encoding).
+ *
+ * Ownership: images and label maps are the caller's, only read; the temporal accumulator
+ * (fv_temporal) is created and destroyed by the caller and used by one thread at a time. The
+ * one-shot comparisons are safe from several threads at once.
  */
 #ifndef FOVEA_METRICS_H
 #define FOVEA_METRICS_H

@@ -6,6 +6,9 @@
  * fv_scene_add_* call copies what it is given. After fv_scene_commit the geometry is frozen; only
  * the time (fv_scene_set_time, which moves dynamic objects) changes. Area lights are emissive
  * triangles: any triangle whose material has non-zero emission.
+ * Lifetime and threads: techniques and drivers keep a pointer to the scene, which must outlive
+ * them. Building (add_*, commit) and fv_scene_set_time must not overlap any other call on the
+ * scene; the queries of a committed scene are safe from any number of threads.
  */
 #ifndef FOVEA_SCENE_H
 #define FOVEA_SCENE_H
