@@ -44,14 +44,36 @@ bool fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *
     return !progress || progress(progress_user, 1.0);
 }
 
-void fv_parallel_for(int64_t n, int64_t chunk, int threads, fv_range_fn fn, void *ctx)
+bool fv_parallel_for_progress(int64_t n, int64_t chunk, int threads, fv_range_fn fn, void *ctx, fv_progress_fn progress,
+                              void *progress_user)
 {
     if (chunk < 1) chunk = 1;
     const int64_t nchunks = (n + chunk - 1) / chunk;
     const int nthreads = fv_thread_count(threads);
+    int64_t done = 0;
+    int stop = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
     for (int64_t c = 0; c < nchunks; c++) {
+        int halt;
+#pragma omp atomic read
+        halt = stop;
+        if (halt) continue;
         int64_t b = c * chunk, e = b + chunk < n ? b + chunk : n;
-        fn(ctx, b, e, omp_get_thread_num());
+        int thread = omp_get_thread_num();
+        fn(ctx, b, e, thread);
+        int64_t d;
+#pragma omp atomic capture
+        d = ++done;
+        if (progress && thread == 0 && !progress(progress_user, (double)d / (double)nchunks)) {
+#pragma omp atomic write
+            stop = 1;
+        }
     }
+    if (stop) return false;
+    return !progress || progress(progress_user, 1.0);
+}
+
+void fv_parallel_for(int64_t n, int64_t chunk, int threads, fv_range_fn fn, void *ctx)
+{
+    fv_parallel_for_progress(n, chunk, threads, fn, ctx, NULL, NULL);
 }

@@ -33,5 +33,8 @@ bool fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *
 /* Runs fn(ctx, begin, end, thread) over [0, n) in chunks of `chunk`. */
 typedef void (*fv_range_fn)(void *ctx, int64_t begin, int64_t end, int thread);
 void fv_parallel_for(int64_t n, int64_t chunk, int threads, fv_range_fn fn, void *ctx);
+/* The same with progress and cancel as in fv_parallel_tiles; false when cancelled. */
+bool fv_parallel_for_progress(int64_t n, int64_t chunk, int threads, fv_range_fn fn, void *ctx, fv_progress_fn progress,
+                              void *progress_user);
 
 #endif

@@ -319,6 +319,9 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
             float ci = cosf(fv_radians(l->desc.inner_deg)), co = cosf(fv_radians(l->desc.outer_deg));
             l->power = 2.0f * FV_PI * (1.0f - 0.5f * (ci + co)) * lum;
         }
+        /* An emitted power beyond the float range would turn the whole pick table into NaN and
+         * silently switch every light off. */
+        if (!isfinite(l->power)) return fv_error_set(err, FV_ERR_INVALID, "light %d: intensity %g emits more power than a float holds", i, lum);
         if (l->power > 0.0f) k++;
     }
     for (int i = 0; i < s->nobj; i++) {
@@ -340,6 +343,9 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
             l->emission = m->emission;
             l->two_sided = m->two_sided_emission;
             l->power = FV_PI * fv_luminance(m->emission) * area * (l->two_sided ? 2.0f : 1.0f);
+            if (!isfinite(l->power))
+                return fv_error_set(err, FV_ERR_INVALID, "object '%s', triangle %d: material '%s' emits more power than a float holds (emission too large)",
+                                    o->name, t, m->name);
             if (l->power > 0.0f) s->tri_light[i][t] = k++;
         }
     }

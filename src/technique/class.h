@@ -22,10 +22,10 @@ typedef struct fv_technique_class {
      * Adds stage timings and counters to stats. */
     fv_status (*render)(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);
     void (*destroy)(void *state);
-    /* For the conformance suite (tests/conformance): parameters that make a small render cheap,
-     * and the radiance the method should see inside the built-in furnace with them, with the
-     * relative tolerance its estimator and filters deserve. */
-    const char *test_params;
+    /* For the conformance suite (tests/conformance): parameters that make a small render cheap
+     * in any scene; what the furnace (a unit sphere) adds to them; and the radiance the method
+     * should see there, with the relative tolerance its estimator and filters deserve. */
+    const char *test_params, *furnace_params;
     double furnace_radiance, furnace_tolerance;
 } fv_technique_class;
 

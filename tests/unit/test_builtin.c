@@ -15,18 +15,7 @@
 #include "scene/mesh_gen.h"
 #include "fovea/view.h"
 #include "scene/scene_impl.h"
-
-typedef struct capture {
-    int count;
-    char last[512];
-} capture;
-
-static void capture_warn(void *user, const char *msg)
-{
-    capture *c = user;
-    c->count++;
-    snprintf(c->last, sizeof c->last, "%s", msg);
-}
+#include "testkit.h"
 
 static double now_s(void)
 {
@@ -41,8 +30,8 @@ static fv_scene *build(const char *name, fv_view **view, double *build_seconds)
 {
     fv_scene *s;
     fv_error err;
-    capture cap = {0, ""};
-    fv_log log = {capture_warn, &cap};
+    fv_test_warnings cap = {0};
+    fv_log log = {fv_test_warn, &cap};
     assert_int_equal(fv_scene_create(&s, &err), FV_OK);
     if (view) assert_int_equal(fv_view_create(view, &err), FV_OK);
     double t0 = now_s();

@@ -21,22 +21,10 @@
 #include <cmocka.h>
 #include "fovea/fovea.h"
 #include "scene/scene_impl.h"
+#include "testkit.h"
 
 #define DATA(f) FOVEA_TEST_DATA "/" f
 #define EMBREE_CORNELL "/usr/share/doc/embree3/models/cornell_box.obj"
-
-typedef struct warnings {
-    int count;
-    char all[2048];
-} warnings;
-
-static void on_warn(void *user, const char *msg)
-{
-    warnings *w = user;
-    w->count++;
-    size_t n = strlen(w->all);
-    snprintf(w->all + n, sizeof w->all - n, "%s|", msg);
-}
 
 static const fv_material *mat_named(const fv_scene *s, const char *name)
 {
@@ -67,8 +55,8 @@ static fv_scene *load_ok(const char *path, const fv_log *log, fv_view **view)
 static void test_mtl_rules(void **state)
 {
     (void)state;
-    warnings w = {0, ""};
-    fv_log log = {on_warn, &w};
+    fv_test_warnings w = {0};
+    fv_log log = {fv_test_warn, &w};
     fv_scene *s = load_ok(DATA("mtl_rules.obj"), &log, NULL);
     assert_int_equal(fv_scene_triangle_count(s), 10);
     assert_int_equal(fv_scene_object_count(s), 5);
@@ -167,8 +155,8 @@ static void test_gltf_pbr(void **state)
 static void test_json_transforms(void **state)
 {
     (void)state;
-    warnings w = {0, ""};
-    fv_log log = {on_warn, &w};
+    fv_test_warnings w = {0};
+    fv_log log = {fv_test_warn, &w};
     fv_view *v;
     fv_scene *s = load_ok(DATA("xform.json"), &log, &v);
     assert_int_equal(fv_scene_triangle_count(s), 12);
@@ -210,8 +198,8 @@ static void test_json_transforms(void **state)
 static void test_open_uncommitted(void **state)
 {
     (void)state;
-    warnings w = {0, ""};
-    fv_log log = {on_warn, &w};
+    fv_test_warnings w = {0};
+    fv_log log = {fv_test_warn, &w};
     fv_scene *s = NULL;
     fv_error err;
     assert_int_equal(fv_scene_open(DATA("mtl_rules.obj"), &log, &s, NULL, &err), FV_OK);
@@ -267,11 +255,9 @@ static void expect_bad(const char *path, fv_status status, const char *needle)
     fv_view *v = NULL;
     fv_error err;
     fv_status rc = fv_scene_load(path, NULL, &s, &v, &err);
-    if (rc != status) fail_msg("%s: status %d, expected %d (%s)", path, rc, status, err.msg);
+    fv_test_expect_fail(rc, &err, status, needle, path);
     assert_null(s);
     assert_null(v);
-    if (!strstr(err.msg, needle)) fail_msg("%s: message '%s' lacks '%s'", path, err.msg, needle);
-    assert_null(strchr(err.msg, '\n'));
     /* The uncommitted entry point fails the same way, and without a view too. */
     fv_scene *o = NULL;
     assert_int_equal(fv_scene_open(path, NULL, &o, &v, &err), status);

@@ -11,20 +11,9 @@
 #include <string.h>
 #include <cmocka.h>
 #include "fovea/fovea.h"
+#include "testkit.h"
 
 #define DATA(f) FOVEA_TEST_DATA "/" f
-
-typedef struct warnings {
-    int count;
-    char last[512];
-} warnings;
-
-static void on_warn(void *user, const char *msg)
-{
-    warnings *w = user;
-    w->count++;
-    snprintf(w->last, sizeof w->last, "%s", msg);
-}
 
 static const fv_material *mat_named(const fv_scene *s, const char *name)
 {
@@ -62,8 +51,8 @@ static void test_obj_materials(void **st)
     (void)st;
     fv_scene *s;
     fv_error err;
-    warnings w = {0, ""};
-    fv_log log = {on_warn, &w};
+    fv_test_warnings w = {0};
+    fv_log log = {fv_test_warn, &w};
     assert_int_equal(fv_scene_load(DATA("materials.obj"), &log, &s, NULL, &err), FV_OK);
     assert_int_equal(fv_scene_triangle_count(s), 10);
     const fv_material *m = mat_named(s, "red");
@@ -91,8 +80,8 @@ static void test_gltf_and_ply(void **st)
     (void)st;
     fv_scene *s;
     fv_error err;
-    warnings w = {0, ""};
-    fv_log log = {on_warn, &w};
+    fv_test_warnings w = {0};
+    fv_log log = {fv_test_warn, &w};
     assert_int_equal(fv_scene_load(DATA("quad.gltf"), &log, &s, NULL, &err), FV_OK);
     assert_int_equal(fv_scene_triangle_count(s), 2);
     const fv_material *m = mat_named(s, "chrome");
@@ -118,8 +107,8 @@ static void test_nan_and_empty(void **st)
     (void)st;
     fv_scene *s = NULL;
     fv_error err;
-    warnings w = {0, ""};
-    fv_log log = {on_warn, &w};
+    fv_test_warnings w = {0};
+    fv_log log = {fv_test_warn, &w};
     assert_int_equal(fv_scene_load(DATA("nan.obj"), &log, &s, NULL, &err), FV_OK);
     assert_int_equal(fv_scene_triangle_count(s), 1); /* the NaN and the degenerate one are dropped */
     assert_true(w.count >= 1);
@@ -168,11 +157,9 @@ static void expect_bad(const char *path, fv_status status, const char *needle)
     fv_view *v = NULL;
     fv_error err;
     fv_status rc = fv_scene_load(path, NULL, &s, &v, &err);
-    if (rc != status) fail_msg("%s: status %d, expected %d (%s)", path, rc, status, err.msg);
+    fv_test_expect_fail(rc, &err, status, needle, path);
     assert_null(s);
     assert_null(v);
-    if (!strstr(err.msg, needle)) fail_msg("%s: message '%s' lacks '%s'", path, err.msg, needle);
-    assert_null(strchr(err.msg, '\n'));
 }
 
 static void test_json_errors(void **st)

@@ -13,6 +13,7 @@
 #include "fovea/fovea.h"
 #include "technique/photon/foveated.h"
 #include "technique/photon/photon_trace.h"
+#include "testkit.h"
 
 /* Eq. 8 for the Cornell box (0..556, 0..548.8, 0..559.2) at 1080x1200: mean extent
  * (556 + 548.8 + 559.2) / 3 = 554.667, over (1080 + 1200) / 2 = 1140, times 20 = 9.73099. */
@@ -173,9 +174,7 @@ static void test_negative_photons(void **st)
 static fv_technique *make(const fv_scene *s, const char *method, const char *const *kv)
 {
     fv_error err;
-    fv_params *p;
-    assert_int_equal(fv_params_create(&p, &err), FV_OK);
-    for (int i = 0; kv && kv[i]; i++) assert_int_equal(fv_params_parse(p, kv[i], &err), FV_OK);
+    fv_params *p = fv_test_params(kv);
     fv_technique *t = NULL;
     fv_status rc = fv_technique_create(method, s, p, NULL, &t, &err);
     if (rc != FV_OK) fail_msg("%s", err.msg);
@@ -338,15 +337,13 @@ static void test_bad_params(void **st)
                               {"pm", "max_depth=0"},        {"pm-t", "dyn_fraction=2"},  {"pm", "fov_fraction=0.4"},
                               {"fpm", "tpm=maybe"}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        fv_params *p;
-        assert_int_equal(fv_params_create(&p, &err), FV_OK);
-        assert_int_equal(fv_params_parse(p, cases[i][1], &err), FV_OK);
+        const char *kv[] = {cases[i][1], NULL};
+        fv_params *p = fv_test_params(kv);
         fv_technique *t = NULL;
-        fv_status rc = fv_technique_create(cases[i][0], s, p, NULL, &t, &err);
-        if (rc != FV_ERR_INVALID) fail_msg("%s %s: status %d", cases[i][0], cases[i][1], rc);
-        char key[32];
+        char key[32], what[64];
         snprintf(key, sizeof key, "%.*s", (int)strcspn(cases[i][1], "="), cases[i][1]);
-        if (!strstr(err.msg, key)) fail_msg("%s %s: message '%s' does not name %s", cases[i][0], cases[i][1], err.msg, key);
+        snprintf(what, sizeof what, "%s %s", cases[i][0], cases[i][1]);
+        fv_test_expect_fail(fv_technique_create(cases[i][0], s, p, NULL, &t, &err), &err, FV_ERR_INVALID, key, what);
         assert_null(t);
         fv_params_destroy(p);
     }

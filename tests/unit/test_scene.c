@@ -10,18 +10,7 @@
 #include "core/rng.h"
 #include "scene/light.h"
 #include "scene/scene_impl.h"
-
-typedef struct capture {
-    int count;
-    char last[512];
-} capture;
-
-static void capture_warn(void *user, const char *msg)
-{
-    capture *c = user;
-    c->count++;
-    snprintf(c->last, sizeof c->last, "%s", msg);
-}
+#include "testkit.h"
 
 /* Unit square in the y=0 plane, [0,1]x[0,1] in x,z, normal +y (wound counter-clockwise from above). */
 static const fv_vec3 k_quad[4] = {{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}};
@@ -54,8 +43,8 @@ static void test_intersect_quad(void **st)
     (void)st;
     fv_scene *s = quad_scene(NULL);
     fv_error err;
-    capture cap = {0};
-    fv_log log = {capture_warn, &cap};
+    fv_test_warnings cap = {0};
+    fv_log log = {fv_test_warn, &cap};
     assert_int_equal(fv_scene_commit(s, &log, &err), FV_OK);
     assert_int_equal(cap.count, 1); /* no light -> a default light, and a warning saying so */
     assert_non_null(strstr(cap.last, "no lights"));
@@ -136,8 +125,8 @@ static void test_bad_geometry_dropped(void **st)
     (void)st;
     fv_scene *s;
     fv_error err;
-    capture cap = {0};
-    fv_log log = {capture_warn, &cap};
+    fv_test_warnings cap = {0};
+    fv_log log = {fv_test_warn, &cap};
     assert_int_equal(fv_scene_create(&s, &err), FV_OK);
     fv_material m = fv_material_default(FV_MAT_DIFFUSE);
     int mat;
@@ -186,6 +175,21 @@ static void test_refusals(void **st)
     fv_light_desc l2 = {FV_LIGHT_POINT, {NAN, 1, 0}, {0, -1, 0}, {1, 1, 1}, 0, 0};
     assert_int_equal(fv_scene_add_light(s, &l2, &err), FV_ERR_INVALID);
     fv_scene_destroy(s);
+
+    /* An emission that is finite but whose power (pi L A) is not: refused at commit, naming the
+     * material, instead of a NaN light table that switches every light off. A unit quad at
+     * 3e38: pi * 3e38 overflows a float. */
+    assert_int_equal(fv_scene_create(&s, &err), FV_OK);
+    m = fv_material_default(FV_MAT_DIFFUSE);
+    snprintf(m.name, sizeof m.name, "sun");
+    m.emission = fv_v3s(3e38f);
+    int id;
+    assert_int_equal(fv_scene_add_material(s, &m, &id, &err), FV_OK);
+    add_quad(s, id, "lamp");
+    assert_int_equal(fv_scene_commit(s, NULL, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "'sun'"));
+    assert_null(strchr(err.msg, '\n'));
+    fv_scene_destroy(s);
 }
 
 /* Light sampling of a unit-area emissive quad at height 1 above the origin, facing down, with
@@ -206,8 +210,8 @@ static void test_area_light_sampling(void **st)
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
     fv_mesh_desc d = {"light", v, 4, NULL, idx, 2, NULL, mat};
     assert_int_equal(fv_scene_add_mesh(s, &d, NULL, NULL, &err), FV_OK);
-    capture cap = {0};
-    fv_log log = {capture_warn, &cap};
+    fv_test_warnings cap = {0};
+    fv_log log = {fv_test_warn, &cap};
     assert_int_equal(fv_scene_commit(s, &log, &err), FV_OK);
     assert_int_equal(cap.count, 0); /* emissive triangles are lights: no default light */
     assert_int_equal(fv_scene_light_count(s), 2);

@@ -14,6 +14,7 @@
 #include "fovea/technique.h"
 #include "fovea/view.h"
 #include "technique/vpolar/space.h"
+#include "testkit.h"
 
 #define W 128
 #define H 144
@@ -41,9 +42,7 @@ static int teardown(void **st)
 static float *render(const char *method, const char *const *kv, int frames, int threads, fv_gaze gaze, fv_stats *stats_out)
 {
     fv_error err;
-    fv_params *p;
-    assert_int_equal(fv_params_create(&p, &err), FV_OK);
-    for (int i = 0; kv && kv[i]; i++) assert_int_equal(fv_params_parse(p, kv[i], &err), FV_OK);
+    fv_params *p = fv_test_params(kv);
     fv_technique *t;
     if (fv_technique_create(method, g_scene, p, NULL, &t, &err) != FV_OK) fail_msg("%s", err.msg);
     fv_film *film;
@@ -51,19 +50,12 @@ static float *render(const char *method, const char *const *kv, int frames, int 
     fv_camera cam;
     fv_view_camera(g_view, g_scene, 0.0, W, H, &cam);
     fv_stats stats;
-    for (int i = 0; i < frames; i++) {
-        fv_frame fr;
-        fv_frame_init(&fr, NULL);
-        fr.index = i;
-        fr.seed = 5;
-        fr.threads = threads;
-        fr.camera = &cam;
-        fr.prev_camera = i ? &cam : NULL;
-        fr.gaze = gaze;
-        fv_stats_clear(&stats);
-        fv_film_clear(film);
-        if (fv_technique_render(t, &fr, film, &stats, &err) != FV_OK) fail_msg("%s", err.msg);
-    }
+    fv_frame fr;
+    fv_frame_init(&fr, &cam);
+    fr.seed = 5;
+    fr.threads = threads;
+    fr.gaze = gaze;
+    fv_test_render_frames(t, &fr, frames, film, &stats);
     float *img = malloc(sizeof(float) * 3 * W * H);
     memcpy(img, fv_film_color_const(film), sizeof(float) * 3 * W * H);
     if (stats_out) *stats_out = stats;
@@ -248,13 +240,12 @@ static void test_stereo(void **st)
 static void expect_refused(const char *method, const char *kv, const char *needle)
 {
     fv_error err;
-    fv_params *p;
-    assert_int_equal(fv_params_create(&p, &err), FV_OK);
-    assert_int_equal(fv_params_parse(p, kv, &err), FV_OK);
+    const char *list[] = {kv, NULL};
+    fv_params *p = fv_test_params(list);
     fv_technique *t = NULL;
-    fv_status s = fv_technique_create(method, g_scene, p, NULL, &t, &err);
-    if (s != FV_ERR_INVALID) fail_msg("%s %s: expected a refusal, got %d", method, kv, (int)s);
-    if (!strstr(err.msg, needle)) fail_msg("%s %s: '%s' does not name '%s'", method, kv, err.msg, needle);
+    char what[128];
+    snprintf(what, sizeof what, "%s %s", method, kv);
+    fv_test_expect_fail(fv_technique_create(method, g_scene, p, NULL, &t, &err), &err, FV_ERR_INVALID, needle, what);
     assert_null(t);
     fv_params_destroy(p);
 }

@@ -410,7 +410,7 @@ static fv_status finish_fpm(render_ctx *c, fv_film *film, fv_stats *stats, fv_er
     free(l), free(f), free(mask);
     float *col = fv_film_color(film);
     uint64_t bad = 0;
-    #pragma omp parallel for schedule(static) reduction(+ : bad)
+    #pragma omp parallel for schedule(static) reduction(+ : bad) num_threads(fv_thread_count(c->frame->threads))
     for (long long i = 0; i < (long long)n; i++) {
         fv_vec3 L = fv_kit_guard(estimate_sums(c, &c->sums[i]), &bad);
         col[3 * i] = L.x, col[3 * i + 1] = L.y, col[3 * i + 2] = L.z;
@@ -589,9 +589,18 @@ static fv_status fpm_create(const fv_scene *s, fv_params *p, const fv_log *log, 
     "eye_depth=int (8): mirror/glass bounces of eye rays\n"                                         \
     "filter=bool (true): edge-avoiding A-Trous filter afterwards\n"
 
-/* The furnace: emission 0.5 seen directly plus photons of up to 8 bounces, 1 - 0.5^9; the
- * density estimate and the filter add noise but no bias inside a sphere. */
-#define FURNACE_TEST .test_params = "photons=40000", .furnace_radiance = 0.998046875, .furnace_tolerance = 0.06
+/* The furnace, with a gather radius fixed at r = 0.25: emission 0.5 seen directly, plus what the
+ * photons of up to 8 bounces bring, 0.5 (1 - 0.5^8) = 0.498047, as far as the density estimate
+ * on the unit sphere keeps it. The photons within chord r lie on a cap of area pi r^2 (Archimedes),
+ * so the pi r^2 of the estimate is right; but their flux arrives cosine-distributed about their
+ * own normal, at angle theta from the pixel's, and only the share (1 + cos theta) / 2 arriving
+ * from above the pixel's surface is gathered: over the cap, 1 - r^2 / 8 = 0.992188 (for r >= 1,
+ * where the gather's 60-degree normal test bounds the cap, 0.875 / r^2). So 0.5 + 0.498047 *
+ * 0.992188 = 0.994156. Eq. 8 would give a 40x32 film r = 1.11 here (0.5 + 0.498 * 0.709 = 0.853,
+ * as measured), hence the fixed radius in the furnace (the other checks keep Eq. 8's). Six seeds: means 0.976-1.004, sigma 0.9%. */
+#define FURNACE_TEST                                                                                \
+    .test_params = "photons=40000", .furnace_params = "radius=0.25", .furnace_radiance = 0.994155884, \
+    .furnace_tolerance = 0.04
 
 const fv_technique_class fv_technique_pm = {
     .name = "pm",

@@ -70,7 +70,8 @@ static void pt_tile(void *ctx, const fv_tile *tile)
             }
             for (int k = 0; k < n; k++) {
                 size_t pix = (size_t)y * (size_t)w + (size_t)(x0 + k);
-                fv_vec3 v = fv_scale(sum[k], 1.0f / (float)opt->spp);
+                /* finite samples can still sum past the float range */
+                fv_vec3 v = fv_kit_guard(fv_scale(sum[k], 1.0f / (float)opt->spp), &bad);
                 const fv_path_first_hit *f = &first[k];
                 j->out.color[3 * pix] = v.x;
                 j->out.color[3 * pix + 1] = v.y;

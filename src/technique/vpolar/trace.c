@@ -133,7 +133,7 @@ bool fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_re
     const fv_grid *grid = c->grid;
     bool done = true;
     if (job->order == FV_VP_ORDER_RANDOM && job->perm)
-        fv_parallel_for(job->nperm, 4096, job->frame->threads, random_range, c);
+        done = fv_parallel_for_progress(job->nperm, 4096, job->frame->threads, random_range, c, fv_kit_progress_fn, job->progress);
     else
         done = fv_parallel_tiles(grid->w, grid->h, job->frame->threads, grid_tile, c, fv_kit_progress_fn, job->progress);
     res->rays = fv_kit_sum(c->counters, FV_KIT_RAYS);

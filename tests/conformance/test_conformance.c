@@ -1,0 +1,532 @@
+/* Conformance of every registered technique: each check below runs once per class in the registry
+ * (src/technique/registry.c), with the class's own test_params, so a new method gets all of them
+ * by registering. Per technique:
+ *   furnace     inside the built-in furnace the image's mean radiance is the class's declared
+ *               furnace_radiance within its relative furnace_tolerance; every pixel written and
+ *               finite; "nan_samples" reported (zero here);
+ *   params      an unknown key is refused naming the key and the method; create leaves the
+ *               caller's bag as it was, whether it succeeds or not;
+ *   threads     1 and 2 threads give bit-identical colour over two frames (cornell);
+ *   stereo      eye 0 then eye 1 of two stereo frames: both films finite and lit, the eyes differ;
+ *   refusals    a film of another size than the camera, an eye out of range, no camera: each
+ *               refused with FV_ERR_INVALID, and a correct render afterwards still works;
+ *   overflow    a light whose radiance overflows float: no pixel non-finite, "nan_samples" > 0
+ *               in every frame;
+ *   progress    the callback sees fractions in (0, 1) and last 1, never decreasing, never from two
+ *               threads at once; a callback returning false (at its first call, or half-way)
+ *               cancels with FV_ERR_CANCELLED and hears nothing more, and the cancelled frame,
+ *               asked again, comes out bit-identical to an uninterrupted sequence's.
+ * Once, for all: films of no size cannot be created, and the overflow scene overflows.
+ * Renders are 40x32 and a few frames: about 3 s in all, small enough under sanitizers too.
+ */
+#include <math.h>
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+#include "testkit.h"
+#include "scene/light.h"
+#include "technique/class.h"
+
+#define W 40
+#define H 32
+#define NPIX ((size_t)W * H)
+#define FURNACE_FRAMES 3
+
+/* ---- scenes, shared by every test ---- */
+
+static fv_scene *g_furnace, *g_cornell, *g_overflow;
+static fv_camera g_furnace_cam, g_cornell_cam, g_overflow_cam;
+
+/* A built-in scene and its camera at W x H (the one place that knows how a scene's view is read). */
+static fv_scene *load_builtin(const char *name, fv_camera *cam)
+{
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    fv_error err;
+    if (fv_scene_load(name, NULL, &s, &v, &err) != FV_OK) fail_msg("%s: %s", name, err.msg);
+    fv_view_camera(v, s, 0.0, W, H, cam);
+    fv_view_destroy(v);
+    return s;
+}
+
+/* A diffuse floor (albedo 0.5, 4 x 4 at y = 0) lit by a 1 x 1 lamp (emission 5) at y = 2, and a
+ * spot light at (0, 0.5, 0) pointing down with intensity 3e38 and a hard 10-degree cone (inner =
+ * outer). Everything passes validation, but the spot's numbers overflow float:
+ *  - a floor point in its cone is at d <= 0.5 / cos 10deg = 0.508, so the light it receives is
+ *    I / d^2 >= 3e38 / 0.258 = 1.16e39 > FLT_MAX = 3.40e38: +inf (next-event estimation);
+ *  - a photon leaving it inside the cone carries I 4 pi / pmf >= 3.77e39: +inf (photon mapping).
+ * The spot's power, 2 pi (1 - cos 10deg) I = 2 pi 0.0152 3e38 = 2.9e37, stays finite, so the light
+ * table is sound and the lamp's light still reaches the floor (by BSDF sampling: next to the spot
+ * its pick probability rounds to 0). The cone's footprint, radius 0.5 tan 10deg = 0.088, is at the
+ * image centre, where every technique samples. */
+static fv_scene *overflow_scene(fv_camera *cam)
+{
+    fv_scene *s;
+    fv_error err;
+    assert_int_equal(fv_scene_create(&s, &err), FV_OK);
+    fv_material floor = fv_material_default(FV_MAT_DIFFUSE), lamp = fv_material_default(FV_MAT_DIFFUSE);
+    floor.albedo = fv_v3s(0.5f);
+    lamp.albedo = fv_v3s(0.0f);
+    lamp.emission = fv_v3s(5.0f);
+    int fm, lm;
+    assert_int_equal(fv_scene_add_material(s, &floor, &fm, &err), FV_OK);
+    assert_int_equal(fv_scene_add_material(s, &lamp, &lm, &err), FV_OK);
+    const uint32_t quad[6] = {0, 1, 2, 0, 2, 3};
+    const fv_vec3 fv[4] = {{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}};
+    const fv_vec3 lv[4] = {{-0.5f, 2, -0.5f}, {0.5f, 2, -0.5f}, {0.5f, 2, 0.5f}, {-0.5f, 2, 0.5f}}; /* faces down */
+    fv_mesh_desc fd = {"floor", fv, 4, NULL, quad, 2, NULL, fm}, ld = {"lamp", lv, 4, NULL, quad, 2, NULL, lm};
+    assert_int_equal(fv_scene_add_mesh(s, &fd, NULL, NULL, &err), FV_OK);
+    assert_int_equal(fv_scene_add_mesh(s, &ld, NULL, NULL, &err), FV_OK);
+    fv_light_desc spot = {FV_LIGHT_SPOT, {0, 0.5f, 0}, {0, -1, 0}, {3e38f, 3e38f, 3e38f}, 10.0f, 10.0f};
+    assert_int_equal(fv_scene_add_light(s, &spot, &err), FV_OK);
+    assert_int_equal(fv_scene_commit(s, NULL, &err), FV_OK);
+    /* Below the lamp, looking down at the footprint from 1.7 away: the view is 2 tan 15deg 1.7 =
+     * 0.91 high, so the footprint spans about 6 of the 32 rows. */
+    *cam = (fv_camera){{0, 1.2f, 1.2f}, {0, 0, 0}, {0, 1, 0}, 30.0f, W, H};
+    return s;
+}
+
+static int group_setup(void **st)
+{
+    (void)st;
+    g_furnace = load_builtin("furnace", &g_furnace_cam);
+    g_cornell = load_builtin("cornell", &g_cornell_cam);
+    g_overflow = overflow_scene(&g_overflow_cam);
+    return 0;
+}
+
+static int group_teardown(void **st)
+{
+    (void)st;
+    fv_scene_destroy(g_furnace);
+    fv_scene_destroy(g_cornell);
+    fv_scene_destroy(g_overflow);
+    return 0;
+}
+
+/* ---- helpers ---- */
+
+static const fv_technique_class *cls_of(void **st) { return *st; }
+
+/* The class's test_params plus the NULL-terminated extra entries. */
+static fv_params *params_of(const fv_technique_class *c, const char *const *extra)
+{
+    fv_params *p = fv_test_params_str(c->test_params);
+    fv_error err;
+    for (int i = 0; extra && extra[i]; i++)
+        if (fv_params_parse(p, extra[i], &err) != FV_OK) fail_msg("%s", err.msg);
+    return p;
+}
+
+static fv_technique *create_with(const fv_technique_class *c, const fv_scene *s, const char *more)
+{
+    fv_params *p = params_of(c, NULL);
+    fv_params *q = fv_test_params_str(more);
+    fv_error err0;
+    for (int i = 0; i < fv_params_count(q); i++)
+        if (fv_params_set(p, fv_params_key(q, i), fv_params_value(q, i), &err0) != FV_OK) fail_msg("%s", err0.msg);
+    fv_params_destroy(q);
+    fv_technique *t = NULL;
+    fv_error err;
+    if (fv_technique_create(c->name, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s: %s", c->name, err.msg);
+    fv_params_destroy(p);
+    return t;
+}
+
+static fv_technique *create(const fv_technique_class *c, const fv_scene *s) { return create_with(c, s, NULL); }
+
+static fv_film *film_new(int w, int h)
+{
+    fv_film *f = NULL;
+    fv_error err;
+    if (fv_film_create(w, h, 0, &f, &err) != FV_OK) fail_msg("%s", err.msg);
+    return f;
+}
+
+/* Fails unless every colour value is finite; returns the mean over pixels and channels. */
+static double finite_mean(const fv_film *f, const char *what)
+{
+    const float *c = fv_film_color_const(f);
+    size_t n = (size_t)3 * fv_film_width(f) * fv_film_height(f);
+    double sum = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        if (!isfinite(c[i])) fail_msg("%s: pixel %zu channel %zu is %g", what, i / 3, i % 3, c[i]);
+        sum += c[i];
+    }
+    return sum / (double)n;
+}
+
+static bool has_counter(const fv_stats *s, const char *name)
+{
+    for (int i = 0; i < s->n_counters; i++)
+        if (strcmp(s->counter[i].name, name) == 0) return true;
+    return false;
+}
+
+static fv_frame frame_at(const fv_camera *cam, int index, int threads)
+{
+    fv_frame f;
+    fv_frame_init(&f, cam);
+    f.index = index;
+    f.threads = threads;
+    f.prev_camera = index > 0 ? cam : NULL;
+    return f;
+}
+
+/* ---- 1. the furnace ---- */
+
+static void test_furnace(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    fv_technique *t = create_with(c, g_furnace, c->furnace_params);
+    fv_film *f = film_new(W, H);
+    fv_frame fr = frame_at(&g_furnace_cam, 0, 0);
+    fv_stats s;
+    fv_test_render_frames(t, &fr, FURNACE_FRAMES, f, &s);
+    double mean = finite_mean(f, c->name);
+    print_message("%-15s furnace mean %.5f (declared %.5f +- %.0f%%)\n", c->name, mean, c->furnace_radiance, 100.0 * c->furnace_tolerance);
+    if (!(fabs(mean / c->furnace_radiance - 1.0) <= c->furnace_tolerance))
+        fail_msg("%s: furnace mean %.5f, declared %.5f within %g", c->name, mean, c->furnace_radiance, c->furnace_tolerance);
+    if (!has_counter(&s, "nan_samples")) fail_msg("%s: no \"nan_samples\" counter in its stats", c->name);
+    assert_float_equal(fv_stats_get_count(&s, "nan_samples"), 0.0, 0.0);
+    fv_film_destroy(f);
+    fv_technique_destroy(t);
+}
+
+/* ---- 2. parameters ---- */
+
+typedef struct bag_copy {
+    int n;
+    char kv[32][2][128];
+} bag_copy;
+
+static void bag_snapshot(const fv_params *p, bag_copy *b)
+{
+    b->n = fv_params_count(p);
+    assert_true(b->n <= 32);
+    for (int i = 0; i < b->n; i++) {
+        snprintf(b->kv[i][0], sizeof b->kv[i][0], "%s", fv_params_key(p, i));
+        snprintf(b->kv[i][1], sizeof b->kv[i][1], "%s", fv_params_value(p, i));
+    }
+}
+
+static void bag_unchanged(const fv_params *p, const bag_copy *b, const char *what)
+{
+    if (fv_params_count(p) != b->n) fail_msg("%s: the bag had %d entries, now %d", what, b->n, fv_params_count(p));
+    for (int i = 0; i < b->n; i++)
+        if (strcmp(fv_params_key(p, i), b->kv[i][0]) || strcmp(fv_params_value(p, i), b->kv[i][1]))
+            fail_msg("%s: entry %d was %s=%s, now %s=%s", what, i, b->kv[i][0], b->kv[i][1], fv_params_key(p, i), fv_params_value(p, i));
+}
+
+static void test_params(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    fv_error err;
+    bag_copy before;
+    /* Its own test parameters are accepted and left as they were. */
+    fv_params *p = params_of(c, NULL);
+    bag_snapshot(p, &before);
+    fv_technique *t = NULL;
+    if (fv_technique_create(c->name, g_cornell, p, NULL, &t, &err) != FV_OK) fail_msg("%s: %s", c->name, err.msg);
+    bag_unchanged(p, &before, c->name);
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+    /* One unknown key more: refused, naming the key and the method; nothing returned. */
+    const char *extra[] = {"no_such_key=1", NULL};
+    p = params_of(c, extra);
+    bag_snapshot(p, &before);
+    t = NULL;
+    fv_status rc = fv_technique_create(c->name, g_cornell, p, NULL, &t, &err);
+    fv_test_expect_fail(rc, &err, FV_ERR_INVALID, "no_such_key", c->name);
+    fv_test_expect_msg(&err, c->name, c->name);
+    assert_null(t);
+    bag_unchanged(p, &before, c->name);
+    fv_params_destroy(p);
+}
+
+/* ---- 3. threads ---- */
+
+static void test_threads(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    fv_technique *t1 = create(c, g_cornell), *t2 = create(c, g_cornell);
+    fv_film *a = film_new(W, H), *b = film_new(W, H);
+    for (int i = 0; i < 2; i++) {
+        fv_frame f1 = frame_at(&g_cornell_cam, i, 1), f2 = frame_at(&g_cornell_cam, i, 2);
+        fv_test_render_frames(t1, &f1, 1, a, NULL);
+        fv_test_render_frames(t2, &f2, 1, b, NULL);
+        finite_mean(a, c->name);
+        if (memcmp(fv_film_color_const(a), fv_film_color_const(b), NPIX * 3 * sizeof(float)) != 0)
+            fail_msg("%s: frame %d differs between 1 and 2 threads", c->name, i);
+    }
+    fv_film_destroy(a);
+    fv_film_destroy(b);
+    fv_technique_destroy(t1);
+    fv_technique_destroy(t2);
+}
+
+/* ---- 4. stereo ---- */
+
+static void test_stereo(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    fv_technique *t = create(c, g_cornell);
+    fv_film *fl = film_new(W, H), *fr = film_new(W, H);
+    fv_camera l, r;
+    fv_camera_stereo(&g_cornell_cam, 60.0f, &l, &r); /* the box is 556 wide: a clear disparity */
+    for (int i = 0; i < 2; i++) {
+        fv_frame e0 = frame_at(&l, i, 0);
+        e0.eye_count = 2;
+        fv_frame e1 = frame_at(&r, i, 0);
+        e1.eye = 1;
+        e1.eye_count = 2;
+        e1.left_camera = &l;
+        fv_test_render_frames(t, &e0, 1, fl, NULL);
+        fv_test_render_frames(t, &e1, 1, fr, NULL);
+        assert_int_equal(fv_film_width(fl), l.width);
+        assert_int_equal(fv_film_height(fr), r.height);
+        double ml = finite_mean(fl, c->name), mr = finite_mean(fr, c->name);
+        if (!(ml > 0.0 && mr > 0.0)) fail_msg("%s: frame %d: left mean %g, right mean %g", c->name, i, ml, mr);
+        if (memcmp(fv_film_color_const(fl), fv_film_color_const(fr), NPIX * 3 * sizeof(float)) == 0)
+            fail_msg("%s: frame %d: both eyes got the same image", c->name, i);
+    }
+    fv_film_destroy(fl);
+    fv_film_destroy(fr);
+    fv_technique_destroy(t);
+}
+
+/* ---- 5. refusals ---- */
+
+static void expect_refused(fv_technique *t, const fv_frame *f, fv_film *film, const char *needle, const char *what)
+{
+    fv_stats s;
+    fv_stats_clear(&s);
+    fv_error err;
+    fv_test_expect_fail(fv_technique_render(t, f, film, &s, &err), &err, FV_ERR_INVALID, needle, what);
+}
+
+static void test_refusals(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    fv_technique *t = create(c, g_cornell);
+    fv_film *good = film_new(W, H), *half = film_new(W / 2, H / 2);
+    fv_frame f = frame_at(&g_cornell_cam, 0, 0);
+    /* registry.c: "camera size 40x32 differs from the film's 20x16" */
+    expect_refused(t, &f, half, "20x16", "film of half the camera's size");
+    const struct {
+        int eye, count;
+    } eyes[] = {{1, 1}, {2, 2}, {-1, 1}, {0, 0}, {0, 3}};
+    for (size_t i = 0; i < sizeof eyes / sizeof eyes[0]; i++) {
+        fv_frame e = f;
+        e.eye = eyes[i].eye;
+        e.eye_count = eyes[i].count;
+        e.left_camera = &g_cornell_cam;
+        char what[64];
+        snprintf(what, sizeof what, "eye %d of %d", e.eye, e.eye_count);
+        expect_refused(t, &e, good, what, what);
+    }
+    fv_frame none = f;
+    none.camera = NULL;
+    expect_refused(t, &none, good, "camera", "no camera");
+    /* Nothing of that reached the method: a correct frame renders. */
+    fv_test_render_frames(t, &f, 2, good, NULL);
+    assert_true(finite_mean(good, c->name) > 0.0);
+    fv_film_destroy(good);
+    fv_film_destroy(half);
+    fv_technique_destroy(t);
+}
+
+/* Films of no size cannot exist (technique-independent, run once). */
+static void test_film_sizes(void **st)
+{
+    (void)st;
+    const int sizes[][2] = {{0, 10}, {10, 0}, {-4, 10}, {FV_FILM_MAX_DIM + 1, 1}};
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
+        fv_film *f = NULL;
+        fv_error err;
+        char what[64];
+        snprintf(what, sizeof what, "%dx%d", sizes[i][0], sizes[i][1]);
+        fv_test_expect_fail(fv_film_create(sizes[i][0], sizes[i][1], 0, &f, &err), &err, FV_ERR_INVALID, what, what);
+        assert_null(f);
+    }
+}
+
+/* ---- 6. overflow ---- */
+
+/* The scene does what its comment says: the spot's light at the footprint's centre and a photon
+ * straight down are +inf (u = {0, 0.5, 0.75, ..} picks the spot, whose pick probability rounds to
+ * 1, and the uniform sphere direction z = 1 - 2 u1 = 0, phi = 2 pi u2 = 3 pi / 2: (0, -1, 0)). */
+static void test_overflow_scene(void **st)
+{
+    (void)st;
+    fv_light_sample ls;
+    assert_true(fv_light_sample_li(g_overflow, fv_v3(0, 0, 0), 0.0f, 0.5f, 0.5f, &ls));
+    assert_true(ls.delta);
+    assert_false(isfinite(ls.li.y));
+    const float u[5] = {0.0f, 0.5f, 0.75f, 0.5f, 0.5f};
+    fv_vec3 o, d, power, n;
+    assert_true(fv_light_sample_emission(g_overflow, u, &o, &d, &power, &n));
+    assert_float_equal(d.y, -1.0f, 1e-6f);
+    assert_false(isfinite(power.y));
+}
+
+static void test_overflow(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    fv_technique *t = create(c, g_overflow);
+    fv_film *f = film_new(W, H);
+    for (int i = 0; i < 2; i++) {
+        fv_frame fr = frame_at(&g_overflow_cam, i, 0);
+        fv_stats s;
+        fv_test_render_frames(t, &fr, 1, f, &s);
+        finite_mean(f, c->name);
+        double dropped = fv_stats_get_count(&s, "nan_samples");
+        print_message("%-15s overflow frame %d: nan_samples %g\n", c->name, i, dropped);
+        if (!(dropped > 0.0)) fail_msg("%s: frame %d: non-finite radiance was not counted in \"nan_samples\"", c->name, i);
+    }
+    fv_film_destroy(f);
+    fv_technique_destroy(t);
+}
+
+/* ---- 7. progress and cancel ---- */
+
+#define MAX_CALLS 4096
+
+typedef struct progress_log {
+    int calls, cancel_at; /* cancel_at: return false on that call (1-based), 0 never */
+    int after_cancel;     /* calls after returning false */
+    double f[MAX_CALLS];
+    atomic_int inside, overlap;
+} progress_log;
+
+static bool on_progress(void *user, double fraction)
+{
+    progress_log *p = user;
+    if (atomic_fetch_add(&p->inside, 1) != 0) atomic_store(&p->overlap, 1);
+    int call = ++p->calls;
+    if (call <= MAX_CALLS) p->f[call - 1] = fraction;
+    bool go = !(p->cancel_at && call >= p->cancel_at);
+    if (p->cancel_at && call > p->cancel_at) p->after_cancel++;
+    atomic_fetch_sub(&p->inside, 1);
+    return go;
+}
+
+static void progress_init(progress_log *p, int cancel_at)
+{
+    memset(p, 0, sizeof *p);
+    atomic_init(&p->inside, 0);
+    atomic_init(&p->overlap, 0);
+    p->cancel_at = cancel_at;
+}
+
+/* Renders frame `index` of cornell with progress into f; returns the status. */
+static fv_status render_progress(fv_technique *t, int index, int threads, progress_log *p, fv_film *f)
+{
+    fv_frame fr = frame_at(&g_cornell_cam, index, threads);
+    fr.progress = on_progress;
+    fr.progress_user = p;
+    fv_stats s;
+    fv_stats_clear(&s);
+    fv_error err;
+    fv_status rc = fv_technique_render(t, &fr, f, &s, &err);
+    if (rc != FV_OK && rc != FV_ERR_CANCELLED) fail_msg("%s", err.msg);
+    return rc;
+}
+
+static void check_fractions(const progress_log *p, bool need_inner, const char *what)
+{
+    int n = p->calls < MAX_CALLS ? p->calls : MAX_CALLS;
+    if (n < 1) fail_msg("%s: progress never reported", what);
+    bool inner = false;
+    for (int i = 0; i < n; i++) {
+        if (!(p->f[i] >= 0.0 && p->f[i] <= 1.0)) fail_msg("%s: fraction %g", what, p->f[i]);
+        if (i > 0 && p->f[i] < p->f[i - 1]) fail_msg("%s: fraction went back from %g to %g (call %d)", what, p->f[i - 1], p->f[i], i);
+        inner |= p->f[i] > 0.0 && p->f[i] < 1.0;
+    }
+    if (need_inner && !inner) fail_msg("%s: no fraction strictly between 0 and 1 in %d calls", what, n);
+    if (!(p->f[n - 1] >= 1.0 - 1e-9)) fail_msg("%s: last fraction %g", what, p->f[n - 1]);
+    if (atomic_load(&p->overlap)) fail_msg("%s: the callback ran on two threads at once", what);
+}
+
+static void test_progress(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    fv_film *f = film_new(W, H), *ref = film_new(W, H);
+    progress_log *p = calloc(1, sizeof *p);
+    assert_non_null(p);
+    /* One thread reports every step; two threads at least the end, in order. */
+    fv_technique *t = create(c, g_cornell);
+    progress_init(p, 0);
+    assert_int_equal(render_progress(t, 0, 1, p, f), FV_OK);
+    check_fractions(p, true, c->name);
+    progress_init(p, 0);
+    assert_int_equal(render_progress(t, 1, 1, p, f), FV_OK);
+    check_fractions(p, true, c->name);
+    int calls = p->calls; /* of a second frame, which the cancels below interrupt */
+    progress_init(p, 0);
+    assert_int_equal(render_progress(t, 2, 2, p, f), FV_OK);
+    check_fractions(p, false, c->name);
+    fv_technique_destroy(t);
+    print_message("%-15s progress: %d calls in frame 1 with one thread\n", c->name, calls);
+
+    /* The reference: frames 0 and 1 uninterrupted. */
+    fv_technique *r = create(c, g_cornell);
+    fv_frame f0 = frame_at(&g_cornell_cam, 0, 1), f1 = frame_at(&g_cornell_cam, 1, 1);
+    fv_test_render_frames(r, &f0, 1, ref, NULL);
+    fv_test_render_frames(r, &f1, 1, ref, NULL);
+    fv_technique_destroy(r);
+    /* Frame 1 cancelled at the first call, then half-way; asked again, it is the reference's. */
+    const int at[2] = {1, calls / 2 + 1};
+    for (int k = 0; k < 2; k++) {
+        t = create(c, g_cornell);
+        fv_test_render_frames(t, &f0, 1, f, NULL);
+        progress_init(p, at[k]);
+        if (render_progress(t, 1, 1, p, f) != FV_ERR_CANCELLED) fail_msg("%s: cancel at call %d was not reported", c->name, at[k]);
+        if (p->after_cancel) fail_msg("%s: %d progress calls after the cancel", c->name, p->after_cancel);
+        fv_test_render_frames(t, &f1, 1, f, NULL);
+        finite_mean(f, c->name);
+        if (memcmp(fv_film_color_const(f), fv_film_color_const(ref), NPIX * 3 * sizeof(float)) != 0)
+            fail_msg("%s: frame 1 after a cancel at progress call %d of %d differs from an uninterrupted frame 1", c->name, at[k], calls);
+        fv_technique_destroy(t);
+    }
+    free(p);
+    fv_film_destroy(f);
+    fv_film_destroy(ref);
+}
+
+/* ---- the table: every check for every registered technique ---- */
+
+typedef struct check {
+    const char *name;
+    void (*fn)(void **);
+} check;
+
+static const check k_checks[] = {
+    {"furnace", test_furnace}, {"params", test_params},     {"threads", test_threads},   {"stereo", test_stereo},
+    {"refusals", test_refusals}, {"overflow", test_overflow}, {"progress", test_progress},
+};
+#define N_CHECKS (sizeof k_checks / sizeof k_checks[0])
+
+int main(void)
+{
+    const int n = fv_technique_count();
+    struct CMUnitTest *tests = calloc((size_t)n * N_CHECKS + 2, sizeof *tests);
+    char(*names)[64] = calloc((size_t)n * N_CHECKS, sizeof *names);
+    if (!tests || !names) return 1;
+    int k = 0;
+    tests[k++] = (struct CMUnitTest)cmocka_unit_test(test_film_sizes);
+    tests[k++] = (struct CMUnitTest)cmocka_unit_test(test_overflow_scene);
+    for (int i = 0; i < n; i++) {
+        const fv_technique_class *c = fv_technique_class_at(i);
+        for (size_t j = 0; j < N_CHECKS; j++) {
+            char *name = names[(size_t)i * N_CHECKS + j];
+            snprintf(name, 64, "%s: %s", c->name, k_checks[j].name);
+            tests[k++] = (struct CMUnitTest){name, k_checks[j].fn, NULL, NULL, (void *)c};
+        }
+    }
+    int failed = _cmocka_run_group_tests("conformance", tests, (size_t)k, group_setup, group_teardown);
+    free(tests);
+    free(names);
+    return failed;
+}

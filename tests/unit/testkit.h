@@ -1,0 +1,116 @@
+/* Helpers shared by the cmocka tests (tests/unit and tests/conformance): a warning sink that
+ * records what it was told, a check of a refusal (status, a needle in its one-line message), a
+ * parameter bag from a list of "key=value" strings, and rendering a few frames of a technique by
+ * hand. Header-only (static inline): include it after <cmocka.h>'s prerequisites, or on its own.
+ */
+#ifndef FV_TESTKIT_H
+#define FV_TESTKIT_H
+
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+#include <cmocka.h>
+#include "fovea/fovea.h"
+
+/* ---- warnings ---- */
+
+/* What an fv_log sink was told: how many warnings, the last one, and all of them, each followed
+ * by '|' (truncated when long). Start from {0}. */
+typedef struct fv_test_warnings {
+    int count;
+    char last[512];
+    char all[2048];
+} fv_test_warnings;
+
+/* The sink: fv_log log = {fv_test_warn, &warnings}. */
+static inline void fv_test_warn(void *user, const char *msg)
+{
+    fv_test_warnings *w = user;
+    w->count++;
+    snprintf(w->last, sizeof w->last, "%s", msg);
+    size_t n = strlen(w->all);
+    snprintf(w->all + n, sizeof w->all - n, "%s|", msg);
+}
+
+/* ---- refusals ---- */
+
+/* A refusal's message: it names `needle` and is one line. `what` (the input at fault) heads the
+ * failure report. */
+static inline void fv_test_expect_msg(const fv_error *err, const char *needle, const char *what)
+{
+    if (!strstr(err->msg, needle)) fail_msg("%s: message '%s' lacks '%s'", what, err->msg, needle);
+    if (strchr(err->msg, '\n')) fail_msg("%s: message '%s' is more than one line", what, err->msg);
+}
+
+/* A call that had to fail: it returned `want` and its message names `needle` in one line. */
+static inline void fv_test_expect_fail(fv_status got, const fv_error *err, fv_status want, const char *needle, const char *what)
+{
+    if (got != want) fail_msg("%s: status %d, expected %d (%s)", what, (int)got, (int)want, got == FV_OK ? "" : err->msg);
+    fv_test_expect_msg(err, needle, what);
+}
+
+/* ---- parameters ---- */
+
+/* A new bag from a NULL-terminated list of "key=value" strings (kv may be NULL: an empty bag);
+ * fails the test on a malformed entry. Release with fv_params_destroy. */
+static inline fv_params *fv_test_params(const char *const *kv)
+{
+    fv_params *p = NULL;
+    fv_error err;
+    if (fv_params_create(&p, &err) != FV_OK) fail_msg("%s", err.msg);
+    for (int i = 0; kv && kv[i]; i++)
+        if (fv_params_parse(p, kv[i], &err) != FV_OK) fail_msg("'%s': %s", kv[i], err.msg);
+    return p;
+}
+
+/* The same from one string of entries separated by spaces or commas ("spp=4 max_depth=2"; ""
+ * or NULL: an empty bag), as a technique class's test_params. */
+static inline fv_params *fv_test_params_str(const char *list)
+{
+    fv_params *p = fv_test_params(NULL);
+    fv_error err;
+    for (const char *c = list ? list : ""; *c;) {
+        size_t n = strcspn(c, " ,");
+        if (n > 0) {
+            char kv[256];
+            if (n >= sizeof kv) fail_msg("parameter '%.40s...' too long", c);
+            memcpy(kv, c, n);
+            kv[n] = '\0';
+            if (fv_params_parse(p, kv, &err) != FV_OK) fail_msg("'%s': %s", kv, err.msg);
+        }
+        c += n + (c[n] != '\0');
+    }
+    return p;
+}
+
+/* ---- rendering by hand ---- */
+
+/* Renders frames 0 .. n-1 of t into film from the template `first` (camera, seed, threads, gaze,
+ * eye, ...): frame i gets index i and, from frame 1 on, prev_camera = camera (a still view). Before
+ * each frame the film is cleared and its colour set to NaN, so a pixel the technique leaves
+ * unwritten cannot pass for a result. stats (may be NULL) receives the last frame's stats.
+ * Fails the test when a render fails. */
+static inline void fv_test_render_frames(fv_technique *t, const fv_frame *first, int n, fv_film *film, fv_stats *stats)
+{
+    fv_stats s;
+    fv_stats_clear(&s);
+    for (int i = 0; i < n; i++) {
+        fv_frame fr = *first;
+        fr.index = first->index + i;
+        if (i > 0) fr.prev_camera = first->camera;
+        fv_film_clear(film);
+        float *col = fv_film_color(film);
+        for (size_t k = 0, m = (size_t)3 * fv_film_width(film) * fv_film_height(film); k < m; k++) col[k] = NAN;
+        fv_error err;
+        fv_stats_clear(&s);
+        if (fv_technique_render(t, &fr, film, &s, &err) != FV_OK)
+            fail_msg("%s: frame %d of %d: %s", fv_technique_name_of(t), i, n, err.msg);
+    }
+    if (stats) *stats = s;
+}
+
+#endif
