@@ -1,8 +1,9 @@
 /* Conformance of every registered technique: each check below runs once per class in the registry
  * (src/technique/registry.c), with the class's own test_params, so a new method gets all of them
  * by registering. Per technique:
- *   furnace     inside the built-in furnace the image's mean radiance is the class's declared
- *               furnace_radiance within its relative furnace_tolerance; every pixel written and
+ *   furnace     inside the built-in furnace (with the class's furnace_params added) the image's
+ *               mean radiance is the class's declared furnace_radiance within its relative
+ *               furnace_tolerance; every pixel written and
  *               finite; "nan_samples" reported (zero here);
  *   params      an unknown key is refused naming the key and the method; create leaves the
  *               caller's bag as it was, whether it succeeds or not;
