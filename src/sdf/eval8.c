@@ -1,0 +1,18 @@
+/* fovea — the eight-lane SDF evaluator (sdf_eval.h): kernel.h with GCC vector extensions, for the
+ * packet sphere tracer of issue 11 (eight rays of a tile step together). */
+#include <string.h>
+#define FV_K_WIDE 1
+#include "sdf/kernel.h"
+#include "sdf/sdf_eval.h"
+
+void fv_sdf_distance8(const fv_sdf *sdf, const float x[8], const float y[8], const float z[8], float d[8], int mat[8])
+{
+    kf vx, vy, vz, vd;
+    ki vm;
+    memcpy(&vx, x, sizeof vx);
+    memcpy(&vy, y, sizeof vy);
+    memcpy(&vz, z, sizeof vz);
+    k_eval(sdf, vx, vy, vz, &vd, &vm);
+    memcpy(d, &vd, sizeof vd);
+    if (mat) memcpy(mat, &vm, sizeof vm);
+}
