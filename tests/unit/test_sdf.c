@@ -534,6 +534,15 @@ static void test_lipschitz_and_bound(void **st)
 
 /* ---- eight lanes == scalar ---- */
 
+static int have_avx2(void)
+{
+#if defined(__x86_64__) && defined(__GNUC__)
+    return __builtin_cpu_supports("avx2");
+#else
+    return 0;
+#endif
+}
+
 static void test_wide_equals_scalar(void **st)
 {
     (void)st;
@@ -557,13 +566,19 @@ static void test_wide_equals_scalar(void **st)
                 y[l] = lo.y + (hi.y - lo.y) * u[1];
                 z[l] = lo.z + (hi.z - lo.z) * u[2];
             }
-            fv_sdf_distance8(s, x, y, z, d, m);
-            for (int l = 0; l < 8; l++) {
-                int ms = -1;
-                float ds = fv_sdf_distance1(s, x[l], y[l], z[l], &ms);
-                if (memcmp(&ds, &d[l], sizeof ds) != 0 || ms != m[l])
-                    fail_msg("%s: lane %d at (%g %g %g): 8-wide %.9g/%d, scalar %.9g/%d", t[ti].name, l, x[l], y[l], z[l],
-                             d[l], m[l], ds, ms);
+            /* The dispatching entry, then each build directly (AVX2 only where the CPU has it). */
+            for (int path = 0; path < 3; path++) {
+                if (path == 0) fv_sdf_distance8(s, x, y, z, d, m);
+                else if (path == 1) fv_sdf_distance8_base(s, x, y, z, d, m);
+                else if (have_avx2()) fv_sdf_distance8_avx2(s, x, y, z, d, m);
+                else continue;
+                for (int l = 0; l < 8; l++) {
+                    int ms = -1;
+                    float ds = fv_sdf_distance1(s, x[l], y[l], z[l], &ms);
+                    if (memcmp(&ds, &d[l], sizeof ds) != 0 || ms != m[l])
+                        fail_msg("%s: path %d lane %d at (%g %g %g): 8-wide %.9g/%d, scalar %.9g/%d", t[ti].name, path, l, x[l],
+                                 y[l], z[l], d[l], m[l], ds, ms);
+                }
             }
         }
         fv_sdf_destroy(s);
@@ -747,10 +762,15 @@ static void test_speed_report(void **st)
         for (int i = 0; i < N; i += 8) fv_sdf_distance8(s, x + i, y + i, z + i, d + i, NULL);
     double t2 = now_s();
     for (int i = 0; i < N; i++) sink += d[i];
+    for (int rep = 0; rep < reps; rep++)
+        for (int i = 0; i < N; i += 8) fv_sdf_distance8_base(s, x + i, y + i, z + i, d + i, NULL);
+    double t3 = now_s();
+    for (int i = 0; i < N; i++) sink += d[i];
     double ev = (double)N * reps;
-    printf("sdf speed: %d nodes (20 primitives + clipped plane under unions): scalar %.2f M eval/s, 8-wide %.2f M eval/s "
-           "(x%.2f) [checksum %.3f]\n",
-           count, ev / (t1 - t0) * 1e-6, ev / (t2 - t1) * 1e-6, (t1 - t0) / (t2 - t1), sink);
+    printf("sdf speed: %d nodes (20 primitives + clipped plane under unions), 1 thread: scalar %.2f M eval/s, 8-wide %.2f "
+           "M eval/s (x%.2f; %s), 8-wide baseline build %.2f M eval/s (x%.2f) [checksum %.3f]\n",
+           count, ev / (t1 - t0) * 1e-6, ev / (t2 - t1) * 1e-6, (t1 - t0) / (t2 - t1), have_avx2() ? "AVX2" : "baseline",
+           ev / (t3 - t2) * 1e-6, (t1 - t0) / (t3 - t2), sink);
     fv_sdf_destroy(s);
 }
 
