@@ -22,5 +22,6 @@
 #include "fovea/technique.h"
 #include "fovea/metrics.h"
 #include "fovea/bench.h"
+#include "fovea/sdf.h"
 
 #endif

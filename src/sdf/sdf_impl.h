@@ -1,0 +1,49 @@
+/* fovea — the compiled form of a signed distance field (include/fovea/sdf.h), shared by the
+ * compiler (compile.c) and the two evaluators (eval1.c scalar, eval8.c eight lanes).
+ *
+ * The node tree becomes a post-order program for a small stack machine, so evaluation is a flat
+ * loop without recursion or pointer chasing: leaves push a distance and a material, operators pop
+ * two and push one, TRANSFORM and REPEAT push a new evaluation point before their child and pop
+ * it (fixing the child's distance) after. Every constant an instruction needs is precomputed
+ * (inverse rotation, 1/period, the height field's Lipschitz divisor).
+ */
+#ifndef FV_SDF_IMPL_H
+#define FV_SDF_IMPL_H
+
+#include "fovea/sdf.h"
+
+typedef enum fv_sdf_opcode {
+    FV_OP_SPHERE,      /* f0 r */
+    FV_OP_BOX,         /* f0..2 half extents */
+    FV_OP_ROUND_BOX,   /* f0..2 inner half extents (b - r), f3 r */
+    FV_OP_TORUS,       /* f0 R, f1 r */
+    FV_OP_CAPSULE,     /* f0..2 a, f3..5 b - a, f6 1/|b - a|^2 (0 when a = b), f7 r */
+    FV_OP_CYLINDER,    /* f0 r, f1 h */
+    FV_OP_CONE,        /* f0 r1, f1 r2, f2 h, f3 r2 - r1, f4 2h, f5 1/((r2-r1)^2 + 4h^2) */
+    FV_OP_PLANE,       /* f0..2 n, f3 h */
+    FV_OP_HEIGHTFIELD, /* f0 base, f1 amplitude, f2 frequency, f3 1/Lipschitz, ia octaves, ib seed */
+    FV_OP_UNION,
+    FV_OP_SUBTRACT,
+    FV_OP_INTERSECT,
+    FV_OP_SMOOTH_UNION, /* f0 k, f1 1/k */
+    FV_OP_XFORM_PUSH,   /* f0..8 R^T row-major, f9..11 t, f12 1/s */
+    FV_OP_XFORM_POP,    /* f0 s */
+    FV_OP_REPEAT_PUSH,  /* f0..2 period (0: none), f3..5 1/period, f6..8 cell limit n (0: none) */
+    FV_OP_REPEAT_POP    /* f0 margin m between the child's bounds and its cell */
+} fv_sdf_opcode;
+
+typedef struct fv_sdf_op {
+    int code;     /* fv_sdf_opcode */
+    int material; /* leaves */
+    int ia, ib;   /* integer parameters */
+    float f[13];
+} fv_sdf_op;
+
+struct fv_sdf {
+    fv_sdf_op *ops;
+    int count;
+    fv_vec3 lo, hi;   /* the root's bounds */
+    float normal_h;   /* default step of fv_sdf_normal */
+};
+
+#endif
