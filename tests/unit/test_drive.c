@@ -14,6 +14,7 @@
 #include <string.h>
 #include <cmocka.h>
 #include "fovea/fovea.h"
+#include "testkit.h"
 
 static fv_scene *g_scene;
 static fv_view *g_view; /* cornell's camera: the framing camera looks at the box from behind */
@@ -21,8 +22,7 @@ static fv_view *g_view; /* cornell's camera: the framing camera looks at the box
 static int setup(void **st)
 {
     (void)st;
-    fv_error err;
-    return fv_scene_load("cornell", NULL, &g_scene, &g_view, &err) == FV_OK ? 0 : -1;
+    return fv_test_load("cornell", &g_scene, &g_view);
 }
 
 static int teardown(void **st)

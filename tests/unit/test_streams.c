@@ -16,6 +16,7 @@
 #include <cmocka.h>
 #include "core/rng.h"
 #include "fovea/fovea.h"
+#include "testkit.h"
 
 #define W 96
 #define H 96
@@ -26,8 +27,7 @@ static fv_view *g_view;
 static int setup(void **st)
 {
     (void)st;
-    fv_error err;
-    return fv_scene_load("cornell", NULL, &g_scene, &g_view, &err) == FV_OK ? 0 : -1;
+    return fv_test_load("cornell", &g_scene, &g_view);
 }
 
 static int teardown(void **st)

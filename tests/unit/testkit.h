@@ -87,6 +87,18 @@ static inline fv_params *fv_test_params_str(const char *list)
     return p;
 }
 
+/* ---- scenes ---- */
+
+/* Loads a built-in scene or file with its view (the camera a built-in comes with), for a group
+ * setup: 0 on success, -1 (and the message on stderr) otherwise. */
+static inline int fv_test_load(const char *name, fv_scene **scene, fv_view **view)
+{
+    fv_error err;
+    if (fv_scene_load(name, NULL, scene, view, &err) == FV_OK) return 0;
+    fprintf(stderr, "%s: %s\n", name, err.msg);
+    return -1;
+}
+
 /* ---- rendering by hand ---- */
 
 /* Renders frames 0 .. n-1 of t into film from the template `first` (camera, seed, threads, gaze,
