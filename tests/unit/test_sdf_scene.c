@@ -1,14 +1,16 @@
 /* Tests of signed distance fields as scene objects (src/scene/scene_sdf.c, issue 11 "SDF scenes
  * are scenes"): Embree user geometry that sphere-traces the field. Hand-worked hits (t, normal,
  * material) on spheres and a union, 8-ray packets and occlusion against single rays, a mesh and
- * an SDF in one scene (the nearer wins), a moving SDF, SDF-only scenes, refusals of bad input, and
- * `pt` on an SDF sphere against `pt` on a finely tessellated sphere. */
+ * an SDF in one scene (the nearer wins), a moving SDF, SDF-only scenes, refusals of bad input,
+ * `pt` on an SDF sphere against `pt` on a finely tessellated sphere, and the JSON "sdf" block: a
+ * tree that loads, and bad trees refused with the JSON path of the fault. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <cmocka.h>
 #include "core/rng.h"
 #include "scene/mesh_gen.h"
@@ -385,12 +387,76 @@ static void test_pt_sdf_matches_mesh(void **st)
     fv_scene_destroy(ss);
 }
 
+/* ---- the JSON "sdf" block ---- */
+
+static const char *const k_json_head =
+    "{\"materials\": {\"red\": {\"albedo\": [0.8, 0.2, 0.2]}, \"lamp\": {\"emission\": [4, 4, 4]}},\n"
+    " \"objects\": [{\"name\": \"floor\", \"quad\": [[-5,0,-5],[-5,0,5],[5,0,5],[5,0,-5]], \"material\": \"red\"},\n"
+    "  {\"material\": \"red\", \"sdf\": ";
+
+/* Loads a scene whose second object's sdf block is `sdf`; returns the status, the error in err. */
+static fv_status load_sdf_text(const char *sdf, fv_scene **out, fv_error *err)
+{
+    char path[] = "/tmp/fovea_test_sdf_XXXXXX.json";
+    int fd = mkstemps(path, 5);
+    assert_true(fd >= 0);
+    FILE *f = fdopen(fd, "w");
+    assert_non_null(f);
+    fprintf(f, "%s%s}]}\n", k_json_head, sdf);
+    fclose(f);
+    fv_scene *s = NULL;
+    fv_status st = fv_scene_load(path, NULL, &s, NULL, err);
+    unlink(path);
+    if (out) *out = s;
+    else fv_scene_destroy(s);
+    return st;
+}
+
+static void test_json_sdf(void **st)
+{
+    (void)st;
+    fv_scene *s;
+    fv_error err;
+    const char *good = "{\"union\": [{\"transform\": {\"translate\": [0, 1, 0], \"child\": {\"sphere\": {\"radius\": 1}}}},"
+                       " {\"transform\": {\"translate\": [3, 1, 0], \"rotate_deg\": [0, 45, 0], \"scale\": 2, \"child\":"
+                       " {\"box\": {\"half\": [0.5, 0.5, 0.5]}}}}]}";
+    fv_status r = load_sdf_text(good, &s, &err);
+    if (r != FV_OK) fail_msg("%s", err.msg);
+    assert_int_equal(fv_scene_sdf_object_count(s), 1);
+    assert_int_equal(fv_scene_object_kind(s, 1), FV_OBJECT_SDF);
+    fv_hit h;
+    assert_true(fv_scene_intersect(s, FV_TRACE_ALL, fv_v3(0, 5, 0), fv_v3(0, -1, 0), INFINITY, &h));
+    assert_float_equal(h.t, 3.0f, 1e-4);
+    assert_int_equal(h.obj, 1);
+    /* The box scaled by 2: half 1 around (3, 1, 0); its top at y = 2. */
+    assert_true(fv_scene_intersect(s, FV_TRACE_ALL, fv_v3(3, 5, 0), fv_v3(0, -1, 0), INFINITY, &h));
+    assert_float_equal(h.t, 3.0f, 1e-3);
+    fv_scene_destroy(s);
+
+    static const char *const bad[][2] = {
+        {"{\"union\": [{\"sphere\": {\"radius\": 1}}, {\"sphear\": {\"radius\": 1}}]}", "objects[1].sdf.union[1]: unknown field 'sphear'"},
+        {"{\"union\": [{\"sphere\": {\"radius\": 1}}, {\"sphere\": {\"radius\": -1}}]}", "objects[1].sdf.union[1].sphere.radius: must be > 0"},
+        {"{\"sphere\": {\"radius\": 1e999}}", "objects[1].sdf.sphere.radius: expected a finite number"},
+        {"{\"sphere\": {\"radius\": \"NaN\"}}", "objects[1].sdf.sphere.radius: expected a finite number"},
+        {"{\"transform\": {\"scale\": [1, 2, 1], \"child\": {\"sphere\": {\"radius\": 1}}}}", "objects[1].sdf.transform.scale: must be one number"},
+        {"{\"smooth_union\": {\"k\": 0, \"children\": [{\"sphere\": {\"radius\": 1}}, {\"sphere\": {\"radius\": 1}}]}}", "objects[1].sdf.smooth_union.k: must be > 0"},
+        {"{\"union\": [{\"sphere\": {\"radius\": 1}}]}", "objects[1].sdf.union: expected an array of at least 2 nodes"},
+        {"{\"sphere\": {\"radius\": 1}, \"material\": \"lamp\"}", "emissive"},
+        {"{\"sphere\": {\"radius\": 1}, \"material\": \"nope\"}", "objects[1].sdf.material: unknown material 'nope'"},
+        {"{\"plane\": {\"normal\": [0, 1, 0]}}", "unbounded"},
+        {"{\"repeat\": {\"period\": [1, 0, 0], \"count\": [2, 0, 0], \"child\": {\"sphere\": {\"radius\": 0.8}}}}", "objects[1].sdf.repeat"},
+        {"{\"box\": {\"half\": [1, 1, 1]}, \"sphere\": {\"radius\": 1}}", "objects[1].sdf: give exactly one of"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+        fv_test_expect_fail(load_sdf_text(bad[i][0], NULL, &err), &err, FV_ERR_INVALID, bad[i][1], bad[i][0]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sphere_hit),         cmocka_unit_test(test_union_materials), cmocka_unit_test(test_packets_and_occlusion),
         cmocka_unit_test(test_mesh_and_sdf),       cmocka_unit_test(test_dynamic_sdf),     cmocka_unit_test(test_refusals),
-        cmocka_unit_test(test_pt_sdf_matches_mesh),
+        cmocka_unit_test(test_pt_sdf_matches_mesh), cmocka_unit_test(test_json_sdf),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
