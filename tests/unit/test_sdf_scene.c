@@ -451,12 +451,47 @@ static void test_json_sdf(void **st)
         fv_test_expect_fail(load_sdf_text(bad[i][0], NULL, &err), &err, FV_ERR_INVALID, bad[i][1], bad[i][0]);
 }
 
+/* The built-in SDF scenes load (SDF objects only, lights, a camera path) and `pt` renders them
+ * to a lit image (8 spp at 48 x 48 from their own camera). */
+static void test_builtin_sdf_scenes(void **st)
+{
+    (void)st;
+    const char *names[] = {"sdf-primitives", "sdf-columns", "sdf-temple"};
+    for (int i = 0; i < 3; i++) {
+        fv_scene *s;
+        fv_view *v;
+        fv_error err;
+        fv_status r = fv_scene_load(names[i], NULL, &s, &v, &err);
+        if (r != FV_OK) fail_msg("%s: %s", names[i], err.msg);
+        assert_true(fv_scene_sdf_object_count(s) >= 1);
+        assert_int_equal(fv_scene_triangle_count(s), 0);
+        assert_true(fv_scene_light_count(s) >= 2);
+        fv_camera cam;
+        fv_view_camera(v, s, 1.0, 48, 48, &cam);
+        fv_film *f = render_pt(s, &cam, 5);
+        const float *c = fv_film_color(f);
+        double sum = 0;
+        int lit = 0;
+        for (int p = 0; p < 48 * 48; p++) {
+            double y = c[3 * p] + c[3 * p + 1] + c[3 * p + 2];
+            sum += y;
+            lit += y > 0.01;
+        }
+        print_message("%s: mean %.4f, %d of %d pixels lit\n", names[i], sum / (3.0 * 48 * 48), lit, 48 * 48);
+        assert_true(lit > 48 * 48 / 3);
+        fv_film_destroy(f);
+        fv_view_destroy(v);
+        fv_scene_destroy(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sphere_hit),         cmocka_unit_test(test_union_materials), cmocka_unit_test(test_packets_and_occlusion),
         cmocka_unit_test(test_mesh_and_sdf),       cmocka_unit_test(test_dynamic_sdf),     cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_pt_sdf_matches_mesh), cmocka_unit_test(test_json_sdf),
+        cmocka_unit_test(test_builtin_sdf_scenes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
