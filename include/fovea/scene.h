@@ -1,4 +1,5 @@
-/* fovea — the scene: triangle meshes (static or rigidly animated), materials and lights. How the
+/* fovea — the scene: triangle meshes and signed distance fields (static or rigidly animated),
+ * materials and lights. How the
  * scene is looked at (camera, camera path, display, gaze) is an fv_view (fovea/view.h); the
  * loaders return both.
  *
@@ -18,6 +19,7 @@
 #include <stdint.h>
 #include "fovea/math.h"
 #include "fovea/status.h"
+#include "fovea/sdf.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -99,6 +101,16 @@ FV_API int fv_scene_find_material(const fv_scene *scene, const char *name);
 FV_API fv_status fv_scene_add_mesh(fv_scene *scene, const fv_mesh_desc *mesh, const fv_log *log,
                             int *object_id, fv_error *err);
 
+/* Adds a signed distance field (fovea/sdf.h) as one object, in world space: nodes[root] is its
+ * root and each leaf's `material` is a material id of this scene. It is rendered by every
+ * technique (an Embree user geometry sphere-traced on demand, docs/scene-format.md) and may be
+ * made dynamic with fv_scene_animate_object like a mesh. Refused (FV_ERR_INVALID, naming the node):
+ * what fv_sdf_create refuses, a material id that does not exist, an emissive material (lights are
+ * emissive triangles or delta lights). log is unused today (warnings to come). *object_id may be
+ * NULL. */
+FV_API fv_status fv_scene_add_sdf(fv_scene *scene, const char *name, const fv_sdf_node *nodes, int count, int root,
+                                  const fv_log *log, int *object_id, fv_error *err);
+
 /* Makes an object dynamic, moved rigidly along keys (times strictly increasing; translation lerp,
  * rotation slerp, scale lerp). A dynamic object may not be emissive. */
 FV_API fv_status fv_scene_animate_object(fv_scene *scene, int object_id, const fv_anim_key *keys, int count,
@@ -106,8 +118,8 @@ FV_API fv_status fv_scene_animate_object(fv_scene *scene, int object_id, const f
 
 FV_API fv_status fv_scene_add_light(fv_scene *scene, const fv_light_desc *light, fv_error *err);
 
-/* Validates the scene and builds the acceleration structures. A scene without any triangle is
- * refused; a scene without any light gets a default point light (a warning says so). */
+/* Validates the scene and builds the acceleration structures. A scene without any object (mesh
+ * or SDF) is refused; a scene without any light gets a default point light (a warning says so). */
 FV_API fv_status fv_scene_commit(fv_scene *scene, const fv_log *log, fv_error *err);
 
 /* Moves dynamic objects to time t (seconds) and refits only what moved. */

@@ -1,5 +1,5 @@
-/* fovea — the fovea JSON scene format (docs/scene-format.md): materials, objects (mesh files or
- * inline quads, boxes, spheres), rigid animation of objects and lights into the scene; camera,
+/* fovea — the fovea JSON scene format (docs/scene-format.md): materials, objects (mesh files,
+ * inline quads, boxes, spheres, or signed distance field trees), rigid animation of objects and lights into the scene; camera,
  * camera path, display (eye model) and gaze path into the view. Strict: unknown fields, wrong
  * types, non-finite or out-of-range numbers and unknown material names are errors naming the file
  * and the field.
@@ -181,17 +181,314 @@ static fv_status parse_animation(const cJSON *arr, const json_ctx *c, const char
     return st;
 }
 
+/* ---- "sdf": a signed distance field as a nested tree (docs/scene-format.md) ----
+ *
+ * Each JSON node becomes one fv_sdf_node, children before their parent, so the root is the last
+ * node. The JSON path of every node is kept, so an error fv_sdf_create finds ("sdf node 7 ...")
+ * is reported at the JSON path the user wrote, like the errors found here. */
+
+typedef struct sdf_build {
+    const json_ctx *c;
+    fv_sdf_node *n;
+    char **path;
+    int count, cap_n, cap_path;
+} sdf_build;
+
+#define SDF_WHERE 512
+
+static fv_status sdf_num(const cJSON *o, const char *key, bool required, int cond, const sdf_build *b, const char *where, float *out,
+                         fv_error *err)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(o, key);
+    if (!it) return required ? fv_error_set(err, FV_ERR_INVALID, "%s: %s: missing '%s'", b->c->file, where, key) : FV_OK;
+    if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble) || fabs(it->valuedouble) > BIG)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: expected a finite number", b->c->file, where, key);
+    double v = it->valuedouble;
+    if (cond > 0 && !(v > 0)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: must be > 0", b->c->file, where, key);
+    if (cond == 0 && !(v >= 0)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: must be >= 0", b->c->file, where, key);
+    *out = (float)v;
+    return FV_OK;
+}
+
+/* cond as sdf_num: > 0 (1), >= 0 (0), any finite (-1), per component. */
+static fv_status sdf_vec(const cJSON *o, const char *key, bool required, int cond, const sdf_build *b, const char *where, fv_vec3 *out,
+                         fv_error *err)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(o, key);
+    if (!it) return required ? fv_error_set(err, FV_ERR_INVALID, "%s: %s: missing '%s'", b->c->file, where, key) : FV_OK;
+    float v[3];
+    int k = 0;
+    if (cJSON_IsArray(it) && cJSON_GetArraySize(it) == 3)
+        for (const cJSON *e = it->child; e; e = e->next, k++) {
+            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > BIG) break;
+            v[k] = (float)e->valuedouble;
+        }
+    if (k != 3) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: expected 3 finite numbers", b->c->file, where, key);
+    for (k = 0; k < 3; k++) {
+        if (cond > 0 && !(v[k] > 0)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: each must be > 0", b->c->file, where, key);
+        if (cond == 0 && !(v[k] >= 0)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: each must be >= 0", b->c->file, where, key);
+    }
+    *out = fv_v3(v[0], v[1], v[2]);
+    return FV_OK;
+}
+
+static fv_status sdf_push(sdf_build *b, const fv_sdf_node *n, const char *where, int *id, fv_error *err)
+{
+    if (b->count >= FV_SDF_MAX_NODES)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s: more than %d sdf nodes", b->c->file, where, FV_SDF_MAX_NODES);
+    if (fv_grow((void **)&b->n, &b->cap_n, b->count + 1, sizeof *b->n) ||
+        fv_grow((void **)&b->path, &b->cap_path, b->count + 1, sizeof *b->path))
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    char *p = malloc(strlen(where) + 1);
+    if (!p) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    strcpy(p, where);
+    b->n[b->count] = *n;
+    b->path[b->count] = p;
+    *id = b->count++;
+    return FV_OK;
+}
+
+static fv_sdf_node sdf_blank(fv_sdf_kind k)
+{
+    fv_sdf_node n;
+    memset(&n, 0, sizeof n);
+    n.kind = k;
+    n.q = (fv_quat){0, 0, 0, 1};
+    n.a = n.b = -1;
+    return n;
+}
+
+static fv_status sdf_node(sdf_build *b, const cJSON *o, const char *where, int mat, int depth, int *id, fv_error *err);
+
+/* The children of an n-ary operator (>= 2), folded left: op(op(c0, c1), c2) ... */
+static fv_status sdf_children(sdf_build *b, const cJSON *arr, const char *where, fv_sdf_node proto, int mat, int depth, int *id,
+                              fv_error *err)
+{
+    if (!cJSON_IsArray(arr) || cJSON_GetArraySize(arr) < 2)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an array of at least 2 nodes", b->c->file, where);
+    int acc = -1, i = 0;
+    fv_status st = FV_OK;
+    for (const cJSON *e = arr->child; e; e = e->next, i++) {
+        char w[SDF_WHERE + 16];
+        snprintf(w, sizeof w, "%s[%d]", where, i);
+        int child;
+        if ((st = sdf_node(b, e, w, mat, depth + 1, &child, err))) return st;
+        if (acc < 0) {
+            acc = child;
+            continue;
+        }
+        fv_sdf_node n = proto;
+        n.a = acc;
+        n.b = child;
+        if ((st = sdf_push(b, &n, where, &acc, err))) return st;
+    }
+    *id = acc;
+    return FV_OK;
+}
+
+static fv_status sdf_node(sdf_build *b, const cJSON *o, const char *where, int mat, int depth, int *id, fv_error *err)
+{
+    static const char *const kinds[] = {"sphere", "box", "round_box", "torus", "capsule", "cylinder", "cone", "plane", "heightfield",
+                                        "union", "subtract", "intersect", "smooth_union", "transform", "repeat", NULL};
+    static const char *const keys[] = {"sphere", "box", "round_box", "torus", "capsule", "cylinder", "cone", "plane", "heightfield",
+                                       "union", "subtract", "intersect", "smooth_union", "transform", "repeat", "material", NULL};
+    const json_ctx *c = b->c;
+    if (depth > FV_SDF_MAX_DEPTH)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s: sdf nested deeper than %d levels", c->file, where, FV_SDF_MAX_DEPTH);
+    if (!cJSON_IsObject(o)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an sdf node object", c->file, where);
+    fv_status st = fv_json_check_keys(o, keys, c->file, where, err);
+    if (st) return st;
+    if (cJSON_GetObjectItemCaseSensitive(o, "material") && (st = find_material(o, c, where, &mat, err))) return st;
+    int kind = -1, nk = 0;
+    for (int k = 0; kinds[k]; k++)
+        if (cJSON_GetObjectItemCaseSensitive(o, kinds[k])) kind = k, nk++;
+    if (nk != 1)
+        return fv_error_set(err, FV_ERR_INVALID,
+                            "%s: %s: give exactly one of sphere, box, round_box, torus, capsule, cylinder, cone, plane, heightfield, "
+                            "union, subtract, intersect, smooth_union, transform, repeat",
+                            c->file, where);
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(o, kinds[kind]);
+    char w[SDF_WHERE + 16];
+    snprintf(w, sizeof w, "%s.%s", where, kinds[kind]);
+    fv_sdf_node n = sdf_blank((fv_sdf_kind)kind);
+    if (kind <= FV_SDF_HEIGHTFIELD) {
+        if (mat < 0) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: a leaf needs a 'material' (here or on an enclosing node)", c->file, where);
+        n.material = mat;
+        if (!cJSON_IsObject(it)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an object", c->file, w);
+    }
+    switch (kind) {
+    case FV_SDF_SPHERE: {
+        static const char *const k[] = {"radius", NULL};
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_num(it, "radius", true, 1, b, w, &n.p[0], err))) return st;
+        break;
+    }
+    case FV_SDF_BOX: {
+        static const char *const k[] = {"half", NULL};
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_vec(it, "half", true, 1, b, w, &n.v[0], err))) return st;
+        break;
+    }
+    case FV_SDF_ROUND_BOX: {
+        static const char *const k[] = {"half", "radius", NULL};
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_vec(it, "half", true, 1, b, w, &n.v[0], err)) ||
+            (st = sdf_num(it, "radius", true, 1, b, w, &n.p[0], err)))
+            return st;
+        if (n.p[0] > fv_min3(n.v[0]))
+            return fv_error_set(err, FV_ERR_INVALID, "%s: %s.radius: must be <= the smallest half extent (%g)", c->file, w, fv_min3(n.v[0]));
+        break;
+    }
+    case FV_SDF_TORUS: {
+        static const char *const k[] = {"major", "minor", NULL};
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_num(it, "major", true, 1, b, w, &n.p[0], err)) ||
+            (st = sdf_num(it, "minor", true, 1, b, w, &n.p[1], err)))
+            return st;
+        break;
+    }
+    case FV_SDF_CAPSULE: {
+        static const char *const k[] = {"a", "b", "radius", NULL};
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_vec(it, "a", true, -1, b, w, &n.v[0], err)) ||
+            (st = sdf_vec(it, "b", true, -1, b, w, &n.v[1], err)) || (st = sdf_num(it, "radius", true, 1, b, w, &n.p[0], err)))
+            return st;
+        break;
+    }
+    case FV_SDF_CYLINDER: {
+        static const char *const k[] = {"radius", "half_height", NULL};
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_num(it, "radius", true, 1, b, w, &n.p[0], err)) ||
+            (st = sdf_num(it, "half_height", true, 1, b, w, &n.p[1], err)))
+            return st;
+        break;
+    }
+    case FV_SDF_CONE: {
+        static const char *const k[] = {"radius_bottom", "radius_top", "half_height", NULL};
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_num(it, "radius_bottom", true, 1, b, w, &n.p[0], err)) ||
+            (st = sdf_num(it, "radius_top", false, 0, b, w, &n.p[1], err)) ||
+            (st = sdf_num(it, "half_height", true, 1, b, w, &n.p[2], err)))
+            return st;
+        break;
+    }
+    case FV_SDF_PLANE: {
+        static const char *const k[] = {"normal", "offset", NULL};
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_vec(it, "normal", true, -1, b, w, &n.v[0], err)) ||
+            (st = sdf_num(it, "offset", false, -1, b, w, &n.p[0], err)))
+            return st;
+        float len = fv_length(n.v[0]);
+        if (!(len > 1e-6f) || !isfinite(len)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.normal: must not be zero", c->file, w);
+        n.v[0] = fv_scale(n.v[0], 1.0f / len);
+        break;
+    }
+    case FV_SDF_HEIGHTFIELD: {
+        static const char *const k[] = {"base", "amplitude", "frequency", "octaves", "seed", NULL};
+        int oct = 4, seed = 0;
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_num(it, "base", false, -1, b, w, &n.p[0], err)) ||
+            (st = sdf_num(it, "amplitude", true, 0, b, w, &n.p[1], err)) || (st = sdf_num(it, "frequency", true, 1, b, w, &n.p[2], err)) ||
+            (st = fv_json_int(it, "octaves", 1, 8, c->file, w, &oct, err)) || (st = fv_json_int(it, "seed", 0, 1 << 24, c->file, w, &seed, err)))
+            return st;
+        n.p[3] = (float)oct;
+        n.p[4] = (float)seed;
+        break;
+    }
+    case FV_SDF_UNION:
+    case FV_SDF_SUBTRACT:
+    case FV_SDF_INTERSECT: return sdf_children(b, it, w, n, mat, depth, id, err);
+    case FV_SDF_SMOOTH_UNION: {
+        static const char *const k[] = {"k", "children", NULL};
+        if (!cJSON_IsObject(it)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected {\"k\": ..., \"children\": [...]}", c->file, w);
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_num(it, "k", true, 1, b, w, &n.p[0], err))) return st;
+        char w2[SDF_WHERE + 32];
+        snprintf(w2, sizeof w2, "%s.children", w);
+        return sdf_children(b, cJSON_GetObjectItemCaseSensitive(it, "children"), w2, n, mat, depth, id, err);
+    }
+    case FV_SDF_TRANSFORM: {
+        static const char *const k[] = {"translate", "rotate_deg", "rotate_quat", "scale", "child", NULL};
+        if (!cJSON_IsObject(it)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an object", c->file, w);
+        fv_vec3 sc;
+        if ((st = parse_trs(it, c, w, k, &n.v[0], &n.q, &sc, err))) return st;
+        if (sc.x != sc.y || sc.y != sc.z)
+            return fv_error_set(err, FV_ERR_INVALID, "%s: %s.scale: must be one number (a non-uniform scale breaks the distance bound)", c->file, w);
+        n.p[0] = sc.x;
+        char w2[SDF_WHERE + 32];
+        snprintf(w2, sizeof w2, "%s.child", w);
+        const cJSON *ch = cJSON_GetObjectItemCaseSensitive(it, "child");
+        if (!ch) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: missing 'child'", c->file, w);
+        if ((st = sdf_node(b, ch, w2, mat, depth + 1, &n.a, err))) return st;
+        break;
+    }
+    case FV_SDF_REPEAT: {
+        static const char *const k[] = {"period", "count", "child", NULL};
+        if (!cJSON_IsObject(it)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an object", c->file, w);
+        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_vec(it, "period", true, 0, b, w, &n.v[0], err)) ||
+            (st = sdf_vec(it, "count", false, 0, b, w, &n.v[1], err)))
+            return st;
+        const float *cn = &n.v[1].x;
+        for (int a = 0; a < 3; a++)
+            if (cn[a] != floorf(cn[a]))
+                return fv_error_set(err, FV_ERR_INVALID, "%s: %s.count: each must be an integer (0: unlimited)", c->file, w);
+        char w2[SDF_WHERE + 32];
+        snprintf(w2, sizeof w2, "%s.child", w);
+        const cJSON *ch = cJSON_GetObjectItemCaseSensitive(it, "child");
+        if (!ch) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: missing 'child'", c->file, w);
+        if ((st = sdf_node(b, ch, w2, mat, depth + 1, &n.a, err))) return st;
+        break;
+    }
+    default: break;
+    }
+    return sdf_push(b, &n, w, id, err);
+}
+
+static void sdf_build_free(sdf_build *b)
+{
+    for (int i = 0; i < b->count; i++) free(b->path[i]);
+    free(b->path);
+    free(b->n);
+}
+
+/* objects[i] with "sdf": the tree, the object's "material" as the leaves' default, its
+ * "transform" as a TRANSFORM node around the root. */
+static fv_status parse_sdf_object(const cJSON *o, const json_ctx *c, const char *where, const char *oname, int mat, int *first,
+                                  fv_error *err)
+{
+    static const char *const tkeys[] = {"translate", "rotate_deg", "rotate_quat", "scale", NULL};
+    sdf_build b = {c, NULL, NULL, 0, 0, 0};
+    char w[SDF_WHERE];
+    snprintf(w, sizeof w, "%s.sdf", where);
+    int root = -1;
+    fv_status st = sdf_node(&b, cJSON_GetObjectItemCaseSensitive(o, "sdf"), w, mat, 0, &root, err);
+    const cJSON *tr = cJSON_GetObjectItemCaseSensitive(o, "transform");
+    if (st == FV_OK && tr) {
+        char w2[SDF_WHERE + 32];
+        snprintf(w2, sizeof w2, "%s.transform", where);
+        fv_sdf_node n = sdf_blank(FV_SDF_TRANSFORM);
+        fv_vec3 sc;
+        if ((st = parse_trs(tr, c, w2, tkeys, &n.v[0], &n.q, &sc, err)) == FV_OK) {
+            if (sc.x != sc.y || sc.y != sc.z)
+                st = fv_error_set(err, FV_ERR_INVALID, "%s: %s.scale: an sdf object takes one number (uniform scale)", c->file, w2);
+            n.p[0] = sc.x;
+            n.a = root;
+            if (st == FV_OK) st = sdf_push(&b, &n, w2, &root, err);
+        }
+    }
+    if (st == FV_OK && (st = fv_scene_add_sdf(c->scene, oname, b.n, b.count, root, c->log, first, err)) != FV_OK) {
+        /* Name the JSON node behind "node K" of the library's message. */
+        const char *k = strstr(err->msg, "node ");
+        int idx = -1;
+        if (k && sscanf(k + 5, "%d", &idx) == 1 && idx >= 0 && idx < b.count) fv_error_prefix(err, "%s: %s: ", c->file, b.path[idx]);
+        else fv_error_prefix(err, "%s: %s: ", c->file, w);
+    }
+    sdf_build_free(&b);
+    return st;
+}
+
 static fv_status parse_object(const cJSON *o, const json_ctx *c, int index, fv_error *err)
 {
-    static const char *const keys[] = {"name", "mesh", "quad", "box", "sphere", "material", "transform", "animation", NULL};
+    static const char *const keys[] = {"name", "mesh", "quad", "box", "sphere", "sdf", "material", "transform", "animation", NULL};
     static const char *const tkeys[] = {"translate", "rotate_deg", "rotate_quat", "scale", NULL};
     char where[64];
     snprintf(where, sizeof where, "objects[%d]", index);
     fv_status st = fv_json_check_keys(o, keys, c->file, where, err);
     if (st != FV_OK) return st;
     int kinds = !!cJSON_GetObjectItemCaseSensitive(o, "mesh") + !!cJSON_GetObjectItemCaseSensitive(o, "quad") +
-                !!cJSON_GetObjectItemCaseSensitive(o, "box") + !!cJSON_GetObjectItemCaseSensitive(o, "sphere");
-    if (kinds != 1) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: give exactly one of mesh, quad, box, sphere", c->file, where);
+                !!cJSON_GetObjectItemCaseSensitive(o, "box") + !!cJSON_GetObjectItemCaseSensitive(o, "sphere") +
+                !!cJSON_GetObjectItemCaseSensitive(o, "sdf");
+    if (kinds != 1) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: give exactly one of mesh, quad, box, sphere, sdf", c->file, where);
     const char *name = NULL, *mesh = NULL;
     int mat = -1;
     if ((st = fv_json_string(o, "name", c->file, where, &name, err)) || (st = fv_json_string(o, "mesh", c->file, where, &mesh, err)) ||
@@ -199,6 +496,12 @@ static fv_status parse_object(const cJSON *o, const json_ctx *c, int index, fv_e
         return st;
     char oname[FV_NAME_MAX];
     snprintf(oname, sizeof oname, "%s", name ? name : where);
+    int first = -1, count = 0;
+    const cJSON *an = cJSON_GetObjectItemCaseSensitive(o, "animation");
+    if (cJSON_GetObjectItemCaseSensitive(o, "sdf")) {
+        if ((st = parse_sdf_object(o, c, where, oname, mat, &first, err)) != FV_OK) return st;
+        return an ? parse_animation(an, c, where, first, 1, err) : FV_OK;
+    }
     fv_xform x = fv_xform_identity();
     const cJSON *tr = cJSON_GetObjectItemCaseSensitive(o, "transform");
     if (tr) {
@@ -209,7 +512,6 @@ static fv_status parse_object(const cJSON *o, const json_ctx *c, int index, fv_e
         if ((st = parse_trs(tr, c, w2, tkeys, &t, &q, &s, err))) return st;
         x = fv_xform_trs(t, q, s);
     }
-    int first = -1, count = 0;
     if (mesh) {
         char path[8192];
         snprintf(path, sizeof path, "%s%s%s", mesh[0] == '/' ? "" : c->dir, mesh[0] == '/' ? "" : "/", mesh);
@@ -242,7 +544,6 @@ static fv_status parse_object(const cJSON *o, const json_ctx *c, int index, fv_e
         if (st != FV_OK) return st;
         count = 1;
     }
-    const cJSON *an = cJSON_GetObjectItemCaseSensitive(o, "animation");
     return an ? parse_animation(an, c, where, first, count, err) : FV_OK;
 }
 

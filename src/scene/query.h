@@ -3,7 +3,7 @@
  *
  * This is the seam between light transport and geometry: techniques include this header (and
  * scene/light.h for lights), never the scene's representation (scene_impl.h), so any kind of object
- * that answers these queries (triangle meshes today, signed distance fields next) is rendered by
+ * that answers these queries (triangle meshes and signed distance fields) is rendered by
  * every technique. All queries are thread-safe on a committed scene whose time is not being set.
  */
 #ifndef FV_SCENE_QUERY_H
@@ -11,6 +11,7 @@
 
 #include <stdbool.h>
 #include "fovea/scene.h"
+#include "fovea/sdf.h"
 
 /* ---- ray queries (scene.c) ---- */
 
@@ -61,10 +62,16 @@ void fv_scene_triangle(const fv_scene *s, int obj, int prim, fv_vec3 *a, fv_vec3
 /* ---- objects ---- */
 
 typedef enum fv_object_kind {
-    FV_OBJECT_MESH = 0 /* a triangle mesh */
+    FV_OBJECT_MESH = 0, /* a triangle mesh */
+    FV_OBJECT_SDF       /* a signed distance field (fv_scene_add_sdf) */
 } fv_object_kind;
 
 fv_object_kind fv_scene_object_kind(const fv_scene *s, int obj);
+/* The compiled field of an SDF object, in object space (world space unless the object moves: then
+ * evaluate at the point moved back by the object's inverse transform); NULL for a mesh. */
+const fv_sdf *fv_scene_object_sdf(const fv_scene *s, int obj);
+/* How many objects are signed distance fields. */
+int fv_scene_sdf_object_count(const fv_scene *s);
 /* True when the object moves (fv_scene_animate_object). */
 bool fv_scene_object_dynamic(const fv_scene *s, int obj);
 /* World-space box around the object at the scene's current time. */

@@ -1,7 +1,7 @@
 /* fovea — scene model and its Embree acceleration structures (see scene_impl.h for the layout).
  *
- * Limits: triangles only; rigid animation only; emissive objects must be static (area lights are
- * sampled from a table built once at commit).
+ * Limits: triangle meshes and signed distance fields (scene_sdf.c) only; rigid animation only;
+ * emissive objects must be static (area lights are sampled from a table built once at commit).
  */
 #include <float.h>
 #include <stdio.h>
@@ -40,6 +40,7 @@ void fv_scene_destroy(fv_scene *s)
         free(o->idx);
         free(o->mat);
         free(o->keys);
+        fv_sdf_destroy(o->sdf);
         if (o->rtc_child) rtcReleaseScene(o->rtc_child);
         if (s->tri_light) free(s->tri_light[i]);
     }
@@ -365,7 +366,7 @@ fv_status fv_scene_commit(fv_scene *s, const fv_log *log, fv_error *err)
 {
     fv_status st = check_open(s, err);
     if (st != FV_OK) return st;
-    if (s->nobj == 0) return fv_error_set(err, FV_ERR_INVALID, "scene is empty: it has no triangles");
+    if (s->nobj == 0) return fv_error_set(err, FV_ERR_INVALID, "scene is empty: it has no objects (no triangles, no SDF)");
     for (int i = 0; i < s->nobj; i++)
         if (s->objs[i].dynamic) s->ndynamic++;
 
@@ -410,7 +411,7 @@ fv_status fv_scene_commit(fv_scene *s, const fv_log *log, fv_error *err)
     rtcSetSceneBuildQuality(s->rtc_static, RTC_BUILD_QUALITY_HIGH);
     for (int i = 0; i < s->nobj; i++) {
         fv_object *o = &s->objs[i];
-        RTCGeometry g = make_triangles(s, o);
+        RTCGeometry g = o->sdf ? fv_scene_sdf_geometry(s, o) : make_triangles(s, o);
         if (o->dynamic) {
             o->rtc_child = rtcNewScene(s->dev);
             rtcAttachGeometryByID(o->rtc_child, g, 0);
@@ -494,6 +495,20 @@ static void fill_hit(const fv_scene *s, unsigned geom, unsigned prim_id, unsigne
     int obj = (inst == RTC_INVALID_GEOMETRY_ID || inst == s->static_inst_id) ? (int)geom : (int)inst;
     const fv_object *ob = &s->objs[obj];
     int prim = (int)prim_id;
+    if (ob->sdf) {
+        /* The field's gradient is the normal (the callback put it in Ng); the material is the
+         * leaf's nearest the hit, found again here because Embree's hit has no field for it. */
+        if (ob->dynamic) ng = fv_xform_normal(&ob->inv, ng);
+        hit->ng = fv_normalize(ng);
+        hit->ns = hit->ng;
+        hit->t = t;
+        hit->p = fv_madd(o, d, t);
+        hit->obj = obj;
+        hit->prim = 0;
+        hit->mat = fv_scene_sdf_material(ob, ob->dynamic ? fv_xform_point(&ob->inv, hit->p) : hit->p);
+        hit->u = hit->v = 0.0f;
+        return;
+    }
     const uint32_t *ix = &ob->idx[3 * prim];
     /* Embree's geometric normal (object space, as wound: (v1 - v0) x (v2 - v0)) saves reading the
      * vertices back. */
@@ -650,8 +665,16 @@ float fv_scene_ray_eps(const fv_scene *s) { return s->eps; }
 
 fv_object_kind fv_scene_object_kind(const fv_scene *s, int obj)
 {
-    (void)s, (void)obj;
-    return FV_OBJECT_MESH;
+    return obj >= 0 && obj < s->nobj && s->objs[obj].sdf ? FV_OBJECT_SDF : FV_OBJECT_MESH;
+}
+
+const fv_sdf *fv_scene_object_sdf(const fv_scene *s, int obj) { return obj >= 0 && obj < s->nobj ? s->objs[obj].sdf : NULL; }
+
+int fv_scene_sdf_object_count(const fv_scene *s)
+{
+    int n = 0;
+    for (int i = 0; i < s->nobj; i++) n += s->objs[i].sdf != NULL;
+    return n;
 }
 
 bool fv_scene_object_dynamic(const fv_scene *s, int obj) { return obj >= 0 && obj < s->nobj && s->objs[obj].dynamic; }

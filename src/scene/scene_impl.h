@@ -1,7 +1,8 @@
 /* fovea — the scene's internal representation, shared by the library's modules (loaders,
  * lights, techniques). Not part of the public API.
  *
- * Geometry: every object is a triangle mesh in object space. Static objects live in one Embree
+ * Geometry: every object is a triangle mesh or a signed distance field (an Embree user geometry
+ * that sphere-traces it, scene_sdf.c) in object space. Static objects live in one Embree
  * scene (`rtc_static`). Each dynamic object gets its own Embree scene instanced into the top-level
  * scene (`rtc_all`) with a per-frame transform; when the scene has dynamic objects, the static
  * scene is instanced into `rtc_all` too (identity), so moving an object rebuilds only the tiny
@@ -14,10 +15,14 @@
 #include <stdbool.h>
 #include <embree3/rtcore.h>
 #include "fovea/scene.h"
+#include "fovea/sdf.h"
 #include "scene/query.h"
 
 typedef struct fv_object {
     char name[FV_NAME_MAX];
+    fv_sdf *sdf;         /* a signed distance field (Embree user geometry, scene_sdf.c); NULL: a mesh,
+                            and for an SDF the triangle arrays below are NULL and nt = 0 */
+    float sdf_eps;       /* sphere tracing's hit distance, scaled to the field's bounds */
     fv_vec3 *pos;        /* object-space vertices */
     fv_vec3 *nrm;        /* optional per-vertex normals */
     uint32_t *idx;       /* 3 per triangle */
@@ -66,5 +71,10 @@ struct fv_scene {
     double time;
     char embree_msg[256];      /* last message from Embree's error callback */
 };
+
+/* The Embree user geometry of SDF object o (scene_sdf.c), ready to attach. */
+RTCGeometry fv_scene_sdf_geometry(fv_scene *s, fv_object *o);
+/* The material of SDF object o at object-space point p (on its surface). */
+int fv_scene_sdf_material(const fv_object *o, fv_vec3 p);
 
 #endif

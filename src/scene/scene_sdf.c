@@ -1,0 +1,239 @@
+/* fovea — signed distance fields as scene objects: fv_scene_add_sdf and the Embree user geometry
+ * that sphere-traces a field (issue 11: Polychronakis, Koulieris and Mania, "An Inverted Pyramid
+ * Acceleration Structure Guiding Foveated Sphere Tracing for Implicit Surfaces in VR", EG 2023,
+ * Sec. 2.1: march along the ray by the distance the field returns, which never overshoots).
+ *
+ * Each SDF object is one user primitive. Embree asks its box (fv_sdf_bounds) when building the
+ * BVH and calls intersect/occluded for rays that reach the box; those clip the ray to the box and
+ * sphere-trace inside it, so an SDF sits in the same BVH as the meshes and every query of
+ * scene/query.h (single rays, 8-ray packets, occlusion, the static/dynamic sets) sees it. A
+ * dynamic SDF is instanced like a dynamic mesh: Embree hands the callbacks the ray in object
+ * space, where the field lives.
+ *
+ * Limits: the hit is where |distance| falls below 1e-4 of the field's bounds diagonal (then
+ * refined), so a ray grazing a surface closer than that counts as a hit, as in any sphere tracer;
+ * a ray that needs more than FV_SDF_TRACE_STEPS steps is reported as a miss. SDF objects never
+ * emit: lights stay emissive triangles and delta lights.
+ */
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "scene/scene_impl.h"
+
+#define FV_SDF_TRACE_STEPS 512
+/* Hit distance relative to the field's bounds diagonal; the scene's ray offset (1e-4 of the
+ * whole scene's diagonal) is never smaller, so a ray leaving a surface starts outside the band. */
+#define FV_SDF_HIT_REL 1e-4f
+/* Newton-like steps along the ray after the hit, which put the point on the surface to float
+ * precision for rays that are not grazing. */
+#define FV_SDF_REFINE 3
+
+static bool is_leaf(fv_sdf_kind k) { return k >= FV_SDF_SPHERE && k <= FV_SDF_HEIGHTFIELD; }
+
+fv_status fv_scene_add_sdf(fv_scene *s, const char *name, const fv_sdf_node *nodes, int count, int root, const fv_log *log,
+                           int *object_id, fv_error *err)
+{
+    (void)log;
+    if (s->committed) return fv_error_set(err, FV_ERR_INTERNAL, "scene already committed: it cannot be changed");
+    if (!name) name = "sdf";
+    if (!nodes || count < 1) return fv_error_set(err, FV_ERR_INVALID, "sdf '%s': no nodes", name);
+    fv_sdf *sdf = NULL;
+    fv_status st = fv_sdf_create(nodes, count, root, &sdf, err);
+    if (st != FV_OK) {
+        fv_error_prefix(err, "sdf '%s': ", name);
+        return st;
+    }
+    for (int i = 0; i < count; i++) {
+        if (!is_leaf(nodes[i].kind)) continue;
+        int m = nodes[i].material;
+        const char *kind = fv_sdf_kind_name(nodes[i].kind);
+        if (m < 0 || m >= s->nmat) {
+            fv_sdf_destroy(sdf);
+            return fv_error_set(err, FV_ERR_INVALID, "sdf '%s': node %d (%s): material id %d does not exist", name, i, kind, m);
+        }
+        if (fv_max3(s->mats[m].emission) > 0.0f) {
+            fv_sdf_destroy(sdf);
+            return fv_error_set(err, FV_ERR_INVALID,
+                                "sdf '%s': node %d (%s): material '%s' is emissive; SDF objects cannot emit (lights are emissive "
+                                "triangles or point/spot lights)",
+                                name, i, kind, s->mats[m].name);
+        }
+    }
+    fv_object o;
+    memset(&o, 0, sizeof o);
+    snprintf(o.name, sizeof o.name, "%s", name);
+    o.sdf = sdf;
+    o.xf = o.inv = fv_xform_identity();
+    fv_sdf_bounds(sdf, &o.lo, &o.hi);
+    o.sdf_eps = FV_SDF_HIT_REL * fv_length(fv_sub(o.hi, o.lo));
+    if (fv_grow((void **)&s->objs, &s->capobj, s->nobj + 1, sizeof *s->objs)) {
+        fv_sdf_destroy(sdf);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory adding sdf '%s'", name);
+    }
+    s->objs[s->nobj] = o;
+    if (object_id) *object_id = s->nobj;
+    s->nobj++;
+    return FV_OK;
+}
+
+int fv_scene_sdf_material(const fv_object *o, fv_vec3 p)
+{
+    int m = 0;
+    fv_sdf_distance(o->sdf, p, &m);
+    return m;
+}
+
+/* The box the tracer clips to: the field's bounds grown by a few hit distances, so a surface on
+ * the box's face (a plane clipped by its own bounding box) is still reached from outside. */
+static void padded_box(const fv_object *o, fv_vec3 *lo, fv_vec3 *hi)
+{
+    fv_vec3 pad = fv_v3s(4.0f * o->sdf_eps);
+    *lo = fv_sub(o->lo, pad);
+    *hi = fv_add(o->hi, pad);
+}
+
+/* Sphere-traces o + t d for t in [tnear, tfar] (d need not be unit); the hit's t in *thit. */
+static bool sdf_trace(const fv_object *ob, fv_vec3 o, fv_vec3 d, float tnear, float tfar, float *thit)
+{
+    fv_vec3 lo, hi;
+    padded_box(ob, &lo, &hi);
+    float t0 = tnear, t1 = tfar;
+    const float oa[3] = {o.x, o.y, o.z}, da[3] = {d.x, d.y, d.z}, la[3] = {lo.x, lo.y, lo.z}, ha[3] = {hi.x, hi.y, hi.z};
+    for (int a = 0; a < 3; a++) {
+        if (da[a] == 0.0f) {
+            if (oa[a] < la[a] || oa[a] > ha[a]) return false;
+            continue;
+        }
+        float inv = 1.0f / da[a];
+        float ta = (la[a] - oa[a]) * inv, tb = (ha[a] - oa[a]) * inv;
+        if (ta > tb) {
+            float x = ta;
+            ta = tb;
+            tb = x;
+        }
+        if (ta > t0) t0 = ta;
+        if (tb < t1) t1 = tb;
+    }
+    if (!(t0 <= t1)) return false;
+    float dl = fv_length(d);
+    if (!(dl > 0.0f) || !isfinite(dl)) return false;
+    const float eps = ob->sdf_eps, inv_dl = 1.0f / dl;
+
+    float t = t0;
+    float dist = fv_sdf_distance(ob->sdf, fv_madd(o, d, t), NULL);
+    /* A ray that starts on a surface (inside the hit band at its own origin, not where it enters
+     * the box) is leaving that surface: walk out of the band before looking for hits, or it would
+     * hit itself at t = tnear. Fields whose bound is loose (height fields, smooth unions) can
+     * leave a ray offset by the scene's epsilon still inside the band. */
+    int step = 0;
+    if (t0 == tnear && fabsf(dist) < eps) {
+        while (fabsf(dist) < eps) {
+            t += fmaxf(fabsf(dist), eps) * inv_dl;
+            if (t > t1 || ++step >= FV_SDF_TRACE_STEPS) return false;
+            dist = fv_sdf_distance(ob->sdf, fv_madd(o, d, t), NULL);
+        }
+    }
+    /* side: +1 when marching outside the solid, -1 inside (a refracted ray), so side * dist is
+     * the distance to the surface ahead either way, and < eps once the surface is reached or
+     * crossed. */
+    float side = dist >= 0.0f ? 1.0f : -1.0f;
+    for (; step < FV_SDF_TRACE_STEPS; step++) {
+        float ds = side * dist;
+        if (ds < eps) {
+            for (int k = 0; k < FV_SDF_REFINE; k++) {
+                t += ds * inv_dl;
+                ds = side * fv_sdf_distance(ob->sdf, fv_madd(o, d, t), NULL);
+            }
+            if (!(t >= tnear && t <= tfar)) return false;
+            *thit = t;
+            return true;
+        }
+        t += ds * inv_dl;
+        if (t > t1) return false;
+        dist = fv_sdf_distance(ob->sdf, fv_madd(o, d, t), NULL);
+    }
+    return false;
+}
+
+/* Embree's SOA packets of runtime size N (rtcore_ray.h gives accessors only to C++): ray fields
+ * org_x, org_y, org_z, tnear, dir_x, dir_y, dir_z, time, tfar, mask, id, flags, then the hit
+ * Ng_x, Ng_y, Ng_z, u, v, primID, geomID, instID[levels], each N wide. */
+#define RAYF(base, N, field, i) (((float *)(base))[(field) * (N) + (i)])
+#define RAYU(base, N, field, i) (((unsigned *)(base))[(field) * (N) + (i)])
+enum { R_OX, R_OY, R_OZ, R_TNEAR, R_DX, R_DY, R_DZ, R_TIME, R_TFAR };
+enum { H_NGX, H_NGY, H_NGZ, H_U, H_V, H_PRIM, H_GEOM, H_INST };
+
+static void sdf_bounds_cb(const struct RTCBoundsFunctionArguments *args)
+{
+    const fv_object *o = args->geometryUserPtr;
+    fv_vec3 lo, hi;
+    padded_box(o, &lo, &hi);
+    struct RTCBounds *b = args->bounds_o;
+    b->lower_x = lo.x;
+    b->lower_y = lo.y;
+    b->lower_z = lo.z;
+    b->upper_x = hi.x;
+    b->upper_y = hi.y;
+    b->upper_z = hi.z;
+}
+
+static void ray_of(const void *ray, unsigned N, unsigned i, fv_vec3 *o, fv_vec3 *d)
+{
+    *o = fv_v3(RAYF(ray, N, R_OX, i), RAYF(ray, N, R_OY, i), RAYF(ray, N, R_OZ, i));
+    *d = fv_v3(RAYF(ray, N, R_DX, i), RAYF(ray, N, R_DY, i), RAYF(ray, N, R_DZ, i));
+}
+
+static void sdf_intersect_cb(const struct RTCIntersectFunctionNArguments *args)
+{
+    const fv_object *ob = args->geometryUserPtr;
+    const unsigned N = args->N;
+    void *ray = args->rayhit;
+    void *hit = (float *)args->rayhit + 12 * N;
+    for (unsigned i = 0; i < N; i++) {
+        if (args->valid[i] != -1) continue;
+        fv_vec3 o, d;
+        ray_of(ray, N, i, &o, &d);
+        float t;
+        if (!sdf_trace(ob, o, d, RAYF(ray, N, R_TNEAR, i), RAYF(ray, N, R_TFAR, i), &t)) continue;
+        fv_vec3 n = fv_sdf_normal(ob->sdf, fv_madd(o, d, t), 0.0f);
+        /* Where the differences cancel (a crease's exact middle), face the ray. */
+        if (!(fv_dot(n, n) > 0.0f)) n = fv_neg(d);
+        RAYF(ray, N, R_TFAR, i) = t;
+        RAYF(hit, N, H_NGX, i) = n.x;
+        RAYF(hit, N, H_NGY, i) = n.y;
+        RAYF(hit, N, H_NGZ, i) = n.z;
+        RAYF(hit, N, H_U, i) = 0.0f;
+        RAYF(hit, N, H_V, i) = 0.0f;
+        RAYU(hit, N, H_PRIM, i) = args->primID;
+        RAYU(hit, N, H_GEOM, i) = args->geomID;
+        for (unsigned l = 0; l < RTC_MAX_INSTANCE_LEVEL_COUNT; l++) RAYU(hit, N, H_INST + l, i) = args->context->instID[l];
+    }
+}
+
+static void sdf_occluded_cb(const struct RTCOccludedFunctionNArguments *args)
+{
+    const fv_object *ob = args->geometryUserPtr;
+    const unsigned N = args->N;
+    void *ray = args->ray;
+    for (unsigned i = 0; i < N; i++) {
+        if (args->valid[i] != -1) continue;
+        fv_vec3 o, d;
+        ray_of(ray, N, i, &o, &d);
+        float t;
+        if (sdf_trace(ob, o, d, RAYF(ray, N, R_TNEAR, i), RAYF(ray, N, R_TFAR, i), &t)) RAYF(ray, N, R_TFAR, i) = -INFINITY;
+    }
+}
+
+RTCGeometry fv_scene_sdf_geometry(fv_scene *s, fv_object *o)
+{
+    RTCGeometry g = rtcNewGeometry(s->dev, RTC_GEOMETRY_TYPE_USER);
+    rtcSetGeometryUserPrimitiveCount(g, 1);
+    rtcSetGeometryUserData(g, o);
+    rtcSetGeometryBoundsFunction(g, sdf_bounds_cb, NULL);
+    rtcSetGeometryIntersectFunction(g, sdf_intersect_cb);
+    rtcSetGeometryOccludedFunction(g, sdf_occluded_cb);
+    rtcCommitGeometry(g);
+    return g;
+}
