@@ -260,11 +260,9 @@ fv_status fv_builtin_sdf_temple(fv_scene *s, fv_view *view, const fv_log *log, f
     int side = repeat(&t, col, P(0, 0, 1.3), P(0, 0, 1));
     int sides = op(&t, FV_SDF_UNION, at(&t, side, P(3.15, 5.4, 0)), at(&t, side, P(-3.15, 5.4, 0)));
     int lintel = at(&t, box(&t, P(3.5, 0.2, 2.5), marble), P(0, 7.2, 0));
-    int gable = place(&t, box(&t, P(3.6, 0.9, 0.9), roof), P(0, 7.4, 0), fv_quat_axis_angle(P(1, 0, 0), fv_radians(45)), 1.0f);
     int roof_cut = op(&t, FV_SDF_INTERSECT, at(&t, place(&t, box(&t, P(3.6, 1.0, 1.0), roof), P(0, 0, 0),
                                                          fv_quat_axis_angle(P(1, 0, 0), fv_radians(45)), 2.1f), P(0, 7.4, 0)),
                      at(&t, box(&t, P(3.7, 1.0, 2.7), roof), P(0, 8.4, 0)));
-    (void)gable;
     int temple = op(&t, FV_SDF_UNION, op(&t, FV_SDF_UNION, op(&t, FV_SDF_UNION, platform, rows), op(&t, FV_SDF_UNION, sides, lintel)), roof_cut);
     int root = op(&t, FV_SDF_UNION, terrain, temple);
     if ((st = fv_scene_add_sdf(s, "temple", t.n, t.count, root, log, NULL, err))) return st;
