@@ -494,41 +494,35 @@ static void fill_hit(const fv_scene *s, unsigned geom, unsigned prim_id, unsigne
      * their own instance, whose id is the object index. */
     int obj = (inst == RTC_INVALID_GEOMETRY_ID || inst == s->static_inst_id) ? (int)geom : (int)inst;
     const fv_object *ob = &s->objs[obj];
-    int prim = (int)prim_id;
-    if (ob->sdf) {
-        /* The field's gradient is the normal (the callback put it in Ng); the material is the
-         * leaf's nearest the hit, found again here because Embree's hit has no field for it. */
-        if (ob->dynamic) ng = fv_xform_normal(&ob->inv, ng);
-        hit->ng = fv_normalize(ng);
-        hit->ns = hit->ng;
-        hit->t = t;
-        hit->p = fv_madd(o, d, t);
-        hit->obj = obj;
-        hit->prim = 0;
-        hit->mat = fv_scene_sdf_material(ob, ob->dynamic ? fv_xform_point(&ob->inv, hit->p) : hit->p);
-        hit->u = hit->v = 0.0f;
-        return;
-    }
-    const uint32_t *ix = &ob->idx[3 * prim];
-    /* Embree's geometric normal (object space, as wound: (v1 - v0) x (v2 - v0)) saves reading the
-     * vertices back. */
+    /* Embree's geometric normal (object space; for triangles as wound, (v1 - v0) x (v2 - v0); for
+     * a field its gradient, which the callback put there) saves reading the geometry back. */
     if (ob->dynamic) ng = fv_xform_normal(&ob->inv, ng);
     hit->ng = fv_normalize(ng);
     hit->ns = hit->ng; /* flat shading unless the mesh has vertex normals */
+    hit->t = t;
+    hit->p = fv_madd(o, d, t);
+    hit->obj = obj;
+    hit->u = u;
+    hit->v = v;
+    if (ob->sdf) {
+        /* The material is the leaf's nearest the hit, found again here because Embree's hit has
+         * no field for it. */
+        hit->prim = 0;
+        hit->u = hit->v = 0.0f;
+        hit->mat = fv_scene_sdf_material(ob, ob->dynamic ? fv_xform_point(&ob->inv, hit->p) : hit->p);
+        return;
+    }
+    int prim = (int)prim_id;
+    hit->prim = prim;
+    hit->mat = ob->mat[prim];
     if (ob->nrm) {
+        const uint32_t *ix = &ob->idx[3 * prim];
         fv_vec3 n = fv_add(fv_add(fv_scale(ob->nrm[ix[0]], 1.0f - u - v), fv_scale(ob->nrm[ix[1]], u)), fv_scale(ob->nrm[ix[2]], v));
         if (ob->dynamic) n = fv_xform_normal(&ob->inv, n);
         float len = fv_length(n);
         if (len > 1e-6f) hit->ns = fv_scale(n, 1.0f / len);
         if (fv_dot(hit->ns, hit->ng) < 0.0f) hit->ns = fv_neg(hit->ns);
     }
-    hit->t = t;
-    hit->p = fv_madd(o, d, t);
-    hit->obj = obj;
-    hit->prim = prim;
-    hit->mat = ob->mat[prim];
-    hit->u = u;
-    hit->v = v;
 }
 
 bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax, fv_hit *hit)
