@@ -22,12 +22,5 @@ void fv_sdf_distance8(const fv_sdf *sdf, const float x[8], const float y[8], con
 
 void fv_sdf_distance8_base(const fv_sdf *sdf, const float x[8], const float y[8], const float z[8], float d[8], int mat[8])
 {
-    kf vx, vy, vz, vd;
-    ki vm;
-    memcpy(&vx, x, sizeof vx);
-    memcpy(&vy, y, sizeof vy);
-    memcpy(&vz, z, sizeof vz);
-    k_eval(sdf, vx, vy, vz, &vd, &vm);
-    memcpy(d, &vd, sizeof vd);
-    if (mat) memcpy(mat, &vm, sizeof vm);
+    k_eval_arrays(sdf, x, y, z, d, mat);
 }

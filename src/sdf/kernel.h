@@ -16,6 +16,7 @@
  */
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 #include "sdf/sdf_impl.h"
 
 #ifndef FV_K_WIDE
@@ -286,3 +287,18 @@ static inline void k_eval(const fv_sdf *s, kf x0, kf y0, kf z0, kf *dout, ki *mo
     *dout = DS[0];
     *mout = MS[0];
 }
+
+#if FV_K_WIDE
+/* Eight points from plain arrays through the kernel, for the entry points of each vector build. */
+static inline void k_eval_arrays(const fv_sdf *s, const float x[8], const float y[8], const float z[8], float d[8], int mat[8])
+{
+    kf vx, vy, vz, vd;
+    ki vm;
+    memcpy(&vx, x, sizeof vx);
+    memcpy(&vy, y, sizeof vy);
+    memcpy(&vz, z, sizeof vz);
+    k_eval(s, vx, vy, vz, &vd, &vm);
+    memcpy(d, &vd, sizeof vd);
+    if (mat) memcpy(mat, &vm, sizeof vm);
+}
+#endif
