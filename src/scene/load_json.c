@@ -316,55 +316,41 @@ static fv_status sdf_node(sdf_build *b, const cJSON *o, const char *where, int m
         n.material = mat;
         if (!cJSON_IsObject(it)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an object", c->file, w);
     }
-    switch (kind) {
-    case FV_SDF_SPHERE: {
-        static const char *const k[] = {"radius", NULL};
-        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_num(it, "radius", true, 1, b, w, &n.p[0], err))) return st;
-        break;
-    }
-    case FV_SDF_BOX: {
-        static const char *const k[] = {"half", NULL};
-        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_vec(it, "half", true, 1, b, w, &n.v[0], err))) return st;
-        break;
-    }
-    case FV_SDF_ROUND_BOX: {
-        static const char *const k[] = {"half", "radius", NULL};
-        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_vec(it, "half", true, 1, b, w, &n.v[0], err)) ||
-            (st = sdf_num(it, "radius", true, 1, b, w, &n.p[0], err)))
-            return st;
-        if (n.p[0] > fv_min3(n.v[0]))
+    /* The primitives whose fields are plain numbers and vectors: one table, read in order after
+     * the key check (cond: 1 positive, 0 non-negative, -1 any finite value; slot: p[] or v[]). */
+    typedef struct sdf_field {
+        const char *key;
+        bool vec, required;
+        int cond, slot;
+    } sdf_field;
+    static const struct {
+        int kind;
+        sdf_field f[4];
+    } k_prims[] = {
+        {FV_SDF_SPHERE, {{"radius", false, true, 1, 0}}},
+        {FV_SDF_BOX, {{"half", true, true, 1, 0}}},
+        {FV_SDF_ROUND_BOX, {{"half", true, true, 1, 0}, {"radius", false, true, 1, 0}}},
+        {FV_SDF_TORUS, {{"major", false, true, 1, 0}, {"minor", false, true, 1, 1}}},
+        {FV_SDF_CAPSULE, {{"a", true, true, -1, 0}, {"b", true, true, -1, 1}, {"radius", false, true, 1, 0}}},
+        {FV_SDF_CYLINDER, {{"radius", false, true, 1, 0}, {"half_height", false, true, 1, 1}}},
+        {FV_SDF_CONE, {{"radius_bottom", false, true, 1, 0}, {"radius_top", false, false, 0, 1}, {"half_height", false, true, 1, 2}}},
+    };
+    for (size_t i = 0; i < sizeof k_prims / sizeof k_prims[0]; i++) {
+        if (k_prims[i].kind != kind) continue;
+        const char *names[5] = {NULL};
+        for (int f = 0; f < 4 && k_prims[i].f[f].key; f++) names[f] = k_prims[i].f[f].key;
+        if ((st = fv_json_check_keys(it, names, c->file, w, err))) return st;
+        for (int f = 0; f < 4 && k_prims[i].f[f].key; f++) {
+            const sdf_field *fd = &k_prims[i].f[f];
+            st = fd->vec ? sdf_vec(it, fd->key, fd->required, fd->cond, b, w, &n.v[fd->slot], err)
+                         : sdf_num(it, fd->key, fd->required, fd->cond, b, w, &n.p[fd->slot], err);
+            if (st) return st;
+        }
+        if (kind == FV_SDF_ROUND_BOX && n.p[0] > fv_min3(n.v[0]))
             return fv_error_set(err, FV_ERR_INVALID, "%s: %s.radius: must be <= the smallest half extent (%g)", c->file, w, fv_min3(n.v[0]));
         break;
     }
-    case FV_SDF_TORUS: {
-        static const char *const k[] = {"major", "minor", NULL};
-        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_num(it, "major", true, 1, b, w, &n.p[0], err)) ||
-            (st = sdf_num(it, "minor", true, 1, b, w, &n.p[1], err)))
-            return st;
-        break;
-    }
-    case FV_SDF_CAPSULE: {
-        static const char *const k[] = {"a", "b", "radius", NULL};
-        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_vec(it, "a", true, -1, b, w, &n.v[0], err)) ||
-            (st = sdf_vec(it, "b", true, -1, b, w, &n.v[1], err)) || (st = sdf_num(it, "radius", true, 1, b, w, &n.p[0], err)))
-            return st;
-        break;
-    }
-    case FV_SDF_CYLINDER: {
-        static const char *const k[] = {"radius", "half_height", NULL};
-        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_num(it, "radius", true, 1, b, w, &n.p[0], err)) ||
-            (st = sdf_num(it, "half_height", true, 1, b, w, &n.p[1], err)))
-            return st;
-        break;
-    }
-    case FV_SDF_CONE: {
-        static const char *const k[] = {"radius_bottom", "radius_top", "half_height", NULL};
-        if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_num(it, "radius_bottom", true, 1, b, w, &n.p[0], err)) ||
-            (st = sdf_num(it, "radius_top", false, 0, b, w, &n.p[1], err)) ||
-            (st = sdf_num(it, "half_height", true, 1, b, w, &n.p[2], err)))
-            return st;
-        break;
-    }
+    switch (kind) {
     case FV_SDF_PLANE: {
         static const char *const k[] = {"normal", "offset", NULL};
         if ((st = fv_json_check_keys(it, k, c->file, w, err)) || (st = sdf_vec(it, "normal", true, -1, b, w, &n.v[0], err)) ||
