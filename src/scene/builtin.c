@@ -26,6 +26,8 @@ static const builtin k_builtins[] = {
      fv_builtin_sdf_columns},
     {"sdf-temple", "signed distance fields (IPR paper Sec. 4.1): noise cliff terrain with a temple of columns and steps",
      fv_builtin_sdf_temple},
+    {"sdf-furnace", "hollow SDF sphere lit from its centre: sphere tracers see radiance exactly 1 (albedo 0.5, I = 2 pi)",
+     fv_builtin_sdf_furnace},
     {"furnace", "white furnace test: inside a sphere of albedo 0.5 emitting 0.5, radiance is exactly 1",
      fv_builtin_furnace},
 };

@@ -17,6 +17,7 @@ fv_status fv_builtin_city(fv_scene *scene, fv_view *view, const fv_log *log, fv_
 fv_status fv_builtin_sdf_primitives(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 fv_status fv_builtin_sdf_columns(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 fv_status fv_builtin_sdf_temple(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
+fv_status fv_builtin_sdf_furnace(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 fv_status fv_builtin_furnace(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 
 /* Adds material m under `name`; its id goes to *id. */

@@ -278,3 +278,22 @@ fv_status fv_builtin_sdf_temple(fv_scene *s, fv_view *view, const fv_log *log, f
     fv_view_set_camera(view, &cam);
     return fv_view_set_camera_path(view, path, 3, err);
 }
+
+/* `sdf-furnace`: the sphere tracers' analogue of the white furnace. The camera and a point light
+ * of intensity 2 pi sit at the centre of a hollow sphere of radius 1 (a box minus the ball) whose
+ * inside is diffuse with albedo 0.5: every camera ray meets the wall head-on at distance 1, where
+ * direct light alone gives albedo / pi x I / r^2 x cos 0 = 0.5 / pi x 2 pi = 1 exactly, in every
+ * pixel and channel. (Path tracing adds the interreflections: 1 / (1 - 0.5) = 2.) */
+fv_status fv_builtin_sdf_furnace(fv_scene *s, fv_view *view, const fv_log *log, fv_error *err)
+{
+    int wall;
+    fv_status st;
+    if ((st = diffuse(s, "wall", fv_v3s(0.5f), &wall, err))) return st;
+    tree t = {.count = 0};
+    int root = op(&t, FV_SDF_SUBTRACT, box(&t, P(1.5, 1.5, 1.5), wall), sphere(&t, 1.0f, wall));
+    if ((st = fv_scene_add_sdf(s, "furnace", t.n, t.count, root, log, NULL, err))) return st;
+    if ((st = point(s, P(0, 0, 0), fv_v3s(2.0f * FV_PI), err))) return st;
+    const fv_camera cam = {P(0, 0, 0), P(0, 0, 1), P(0, 1, 0), 60.0f, 256, 256};
+    fv_view_set_camera(view, &cam);
+    return FV_OK;
+}

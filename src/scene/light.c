@@ -177,3 +177,19 @@ fv_vec3 fv_light_total_power(const fv_scene *s)
     }
     return p;
 }
+
+int fv_light_delta_count(const fv_scene *s)
+{
+    int n = 0;
+    for (int i = 0; i < s->nlights; i++) n += s->lights[i].kind == 0;
+    return n;
+}
+
+const fv_light *fv_light_delta_at(const fv_scene *s, int i)
+{
+    for (int k = 0; k < s->nlights; k++)
+        if (s->lights[k].kind == 0 && i-- == 0) return &s->lights[k];
+    return NULL;
+}
+
+fv_vec3 fv_light_delta_pos(const fv_light *l) { return l->desc.pos; }

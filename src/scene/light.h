@@ -54,6 +54,11 @@ bool fv_light_pick_point(const fv_scene *s, fv_rng *rng, fv_light_point *out);
  * area / pdf for an area light. False when an area light does not emit towards dir. */
 bool fv_light_point_power(const fv_scene *s, const fv_light_point *lp, fv_vec3 dir, float pdf, fv_vec3 *power);
 
+/* The delta (point and spot) lights, for techniques that shade them directly (the SDF sphere
+ * tracers): how many, the i-th in the order they were added, and its position now. */
+int fv_light_delta_count(const fv_scene *s);
+const fv_light *fv_light_delta_at(const fv_scene *s, int i);
+fv_vec3 fv_light_delta_pos(const fv_light *l);
 /* Radiant intensity of delta light l towards unit direction w (spot fall-off applied). */
 fv_vec3 fv_light_delta_intensity(const fv_light *l, fv_vec3 w);
 

@@ -74,6 +74,9 @@ const fv_sdf *fv_scene_object_sdf(const fv_scene *s, int obj);
 int fv_scene_sdf_object_count(const fv_scene *s);
 /* True when the object moves (fv_scene_animate_object). */
 bool fv_scene_object_dynamic(const fv_scene *s, int obj);
+/* The map from world space to the object's own space at the scene's current time (identity for a
+ * static object): where an SDF object's field is evaluated. */
+void fv_scene_object_world_to_local(const fv_scene *s, int obj, fv_xform *out);
 /* World-space box around the object at the scene's current time. */
 void fv_scene_object_bounds(const fv_scene *s, int obj, fv_vec3 *lo, fv_vec3 *hi);
 /* The material of a hit (the hit's mat id). */

@@ -673,6 +673,8 @@ int fv_scene_sdf_object_count(const fv_scene *s)
 
 bool fv_scene_object_dynamic(const fv_scene *s, int obj) { return obj >= 0 && obj < s->nobj && s->objs[obj].dynamic; }
 
+void fv_scene_object_world_to_local(const fv_scene *s, int obj, fv_xform *out) { *out = s->objs[obj].inv; }
+
 void fv_scene_object_bounds(const fv_scene *s, int obj, fv_vec3 *lo, fv_vec3 *hi)
 {
     const fv_object *o = &s->objs[obj];

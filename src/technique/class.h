@@ -22,6 +22,9 @@ typedef struct fv_technique_class {
      * Adds stage timings and counters to stats. */
     fv_status (*render)(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);
     void (*destroy)(void *state);
+    /* The method sphere-traces signed distance fields only: the registry refuses a scene without
+     * an SDF object, and the conformance suite runs it in the SDF twins of its scenes. */
+    bool sdf_only;
     /* For the conformance suite (tests/conformance): parameters that make a small render cheap
      * in any scene; what the furnace (a unit sphere) adds to them; and the radiance the method
      * should see there, with the relative tolerance its estimator and filters deserve. */

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "scene/query.h"
 #include "technique/class.h"
 
 extern const fv_technique_class fv_technique_pt;
@@ -23,11 +24,16 @@ extern const fv_technique_class fv_technique_cartesian;
 extern const fv_technique_class fv_technique_cartesian_full;
 extern const fv_technique_class fv_technique_linear_falloff;
 extern const fv_technique_class fv_technique_logpolar;
+extern const fv_technique_class fv_technique_sdf_gt;
+extern const fv_technique_class fv_technique_sdf_relaxed;
+extern const fv_technique_class fv_technique_ipr;
+extern const fv_technique_class fv_technique_fipr;
 
 static const fv_technique_class *const k_classes[] = {
     &fv_technique_pt,       &fv_technique_pm,        &fv_technique_pm_t,           &fv_technique_fpm,
     &fv_technique_vpolar,   &fv_technique_cartesian, &fv_technique_cartesian_full, &fv_technique_linear_falloff,
-    &fv_technique_logpolar,
+    &fv_technique_logpolar, &fv_technique_sdf_gt,   &fv_technique_sdf_relaxed,    &fv_technique_ipr,
+    &fv_technique_fipr,
 };
 
 #define N_CLASSES ((int)(sizeof k_classes / sizeof k_classes[0]))
@@ -68,6 +74,11 @@ fv_status fv_technique_create(const char *name, const fv_scene *scene, const fv_
         return fv_error_set(err, FV_ERR_INVALID, "unknown method '%s' (known: %s)", name ? name : "(null)", list);
     }
     if (!scene) return fv_error_set(err, FV_ERR_INVALID, "method '%s': no scene", name);
+    if (cls->sdf_only && fv_scene_sdf_object_count(scene) == 0)
+        return fv_error_set(err, FV_ERR_INVALID,
+                            "method '%s' sphere-traces signed distance fields and the scene has none (try sdf-primitives, "
+                            "sdf-columns, sdf-temple, or a JSON scene with an \"sdf\" object)",
+                            name);
     fv_params *own = NULL;
     fv_status s = fv_params_clone(params, &own, err);
     if (s != FV_OK) return s;

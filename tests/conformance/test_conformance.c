@@ -36,8 +36,18 @@
 
 /* ---- scenes, shared by every test ---- */
 
-static fv_scene *g_furnace, *g_cornell, *g_overflow;
-static fv_camera g_furnace_cam, g_cornell_cam, g_overflow_cam;
+/* Each check's scenes: the mesh ones, or for a method that only sphere-traces signed distance
+ * fields (class.h, sdf_only) their SDF twins: sdf-furnace, sdf-primitives, and the overflowing
+ * spot over an SDF floor. */
+typedef struct suite {
+    fv_scene *furnace, *cornell, *overflow;
+    fv_camera furnace_cam, cornell_cam, overflow_cam;
+    float stereo_sep; /* a clear disparity at the scene's scale */
+} suite;
+
+static suite g_mesh, g_sdf;
+
+static const suite *suite_of(const fv_technique_class *c) { return c->sdf_only ? &g_sdf : &g_mesh; }
 
 /* A built-in scene and its camera at W x H (the one place that knows how a scene's view is read). */
 static fv_scene *load_builtin(const char *name, fv_camera *cam)
@@ -61,7 +71,7 @@ static fv_scene *load_builtin(const char *name, fv_camera *cam)
  * table is sound and the lamp's light still reaches the floor (by BSDF sampling: next to the spot
  * its pick probability rounds to 0). The cone's footprint, radius 0.5 tan 10deg = 0.088, is at the
  * image centre, where every technique samples. */
-static fv_scene *overflow_scene(fv_camera *cam)
+static fv_scene *overflow_scene(bool sdf_floor, fv_camera *cam)
 {
     fv_scene *s;
     fv_error err;
@@ -77,7 +87,23 @@ static fv_scene *overflow_scene(fv_camera *cam)
     const fv_vec3 fv[4] = {{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}};
     const fv_vec3 lv[4] = {{-0.5f, 2, -0.5f}, {0.5f, 2, -0.5f}, {0.5f, 2, 0.5f}, {-0.5f, 2, 0.5f}}; /* faces down */
     fv_mesh_desc fd = {"floor", fv, 4, NULL, quad, 2, NULL, fm}, ld = {"lamp", lv, 4, NULL, quad, 2, NULL, lm};
-    assert_int_equal(fv_scene_add_mesh(s, &fd, NULL, NULL, &err), FV_OK);
+    if (sdf_floor) {
+        /* the same floor as a field: a 4 x 4 slab whose top is y = 0 */
+        fv_sdf_node n[2];
+        memset(n, 0, sizeof n);
+        n[0].kind = FV_SDF_BOX;
+        n[0].v[0] = fv_v3(2.0f, 0.1f, 2.0f);
+        n[0].material = fm;
+        n[0].q = (fv_quat){0, 0, 0, 1};
+        n[1].kind = FV_SDF_TRANSFORM;
+        n[1].a = 0;
+        n[1].v[0] = fv_v3(0, -0.1f, 0);
+        n[1].q = (fv_quat){0, 0, 0, 1};
+        n[1].p[0] = 1.0f;
+        assert_int_equal(fv_scene_add_sdf(s, "floor", n, 2, 1, NULL, NULL, &err), FV_OK);
+    } else {
+        assert_int_equal(fv_scene_add_mesh(s, &fd, NULL, NULL, &err), FV_OK);
+    }
     assert_int_equal(fv_scene_add_mesh(s, &ld, NULL, NULL, &err), FV_OK);
     fv_light_desc spot = {FV_LIGHT_SPOT, {0, 0.5f, 0}, {0, -1, 0}, {3e38f, 3e38f, 3e38f}, 10.0f, 10.0f};
     assert_int_equal(fv_scene_add_light(s, &spot, &err), FV_OK);
@@ -91,18 +117,26 @@ static fv_scene *overflow_scene(fv_camera *cam)
 static int group_setup(void **st)
 {
     (void)st;
-    g_furnace = load_builtin("furnace", &g_furnace_cam);
-    g_cornell = load_builtin("cornell", &g_cornell_cam);
-    g_overflow = overflow_scene(&g_overflow_cam);
+    g_mesh.furnace = load_builtin("furnace", &g_mesh.furnace_cam);
+    g_mesh.cornell = load_builtin("cornell", &g_mesh.cornell_cam);
+    g_mesh.overflow = overflow_scene(false, &g_mesh.overflow_cam);
+    g_mesh.stereo_sep = 60.0f; /* the box is 556 wide */
+    g_sdf.furnace = load_builtin("sdf-furnace", &g_sdf.furnace_cam);
+    g_sdf.cornell = load_builtin("sdf-primitives", &g_sdf.cornell_cam);
+    g_sdf.overflow = overflow_scene(true, &g_sdf.overflow_cam);
+    g_sdf.stereo_sep = 0.5f; /* the shapes stand about 1 apart */
     return 0;
 }
 
 static int group_teardown(void **st)
 {
     (void)st;
-    fv_scene_destroy(g_furnace);
-    fv_scene_destroy(g_cornell);
-    fv_scene_destroy(g_overflow);
+    const suite *all[2] = {&g_mesh, &g_sdf};
+    for (int i = 0; i < 2; i++) {
+        fv_scene_destroy(all[i]->furnace);
+        fv_scene_destroy(all[i]->cornell);
+        fv_scene_destroy(all[i]->overflow);
+    }
     return 0;
 }
 
@@ -180,9 +214,9 @@ static fv_frame frame_at(const fv_camera *cam, int index, int threads)
 static void test_furnace(void **st)
 {
     const fv_technique_class *c = cls_of(st);
-    fv_technique *t = create_with(c, g_furnace, c->furnace_params);
+    fv_technique *t = create_with(c, suite_of(c)->furnace, c->furnace_params);
     fv_film *f = film_new(W, H);
-    fv_frame fr = frame_at(&g_furnace_cam, 0, 0);
+    fv_frame fr = frame_at(&suite_of(c)->furnace_cam, 0, 0);
     fv_stats s;
     fv_test_render_frames(t, &fr, FURNACE_FRAMES, f, &s);
     double mean = finite_mean(f, c->name);
@@ -229,7 +263,7 @@ static void test_params(void **st)
     fv_params *p = params_of(c, NULL);
     bag_snapshot(p, &before);
     fv_technique *t = NULL;
-    if (fv_technique_create(c->name, g_cornell, p, NULL, &t, &err) != FV_OK) fail_msg("%s: %s", c->name, err.msg);
+    if (fv_technique_create(c->name, suite_of(c)->cornell, p, NULL, &t, &err) != FV_OK) fail_msg("%s: %s", c->name, err.msg);
     bag_unchanged(p, &before, c->name);
     fv_technique_destroy(t);
     fv_params_destroy(p);
@@ -238,7 +272,7 @@ static void test_params(void **st)
     p = params_of(c, extra);
     bag_snapshot(p, &before);
     t = NULL;
-    fv_status rc = fv_technique_create(c->name, g_cornell, p, NULL, &t, &err);
+    fv_status rc = fv_technique_create(c->name, suite_of(c)->cornell, p, NULL, &t, &err);
     fv_test_expect_fail(rc, &err, FV_ERR_INVALID, "no_such_key", c->name);
     fv_test_expect_msg(&err, c->name, c->name);
     assert_null(t);
@@ -251,10 +285,10 @@ static void test_params(void **st)
 static void test_threads(void **st)
 {
     const fv_technique_class *c = cls_of(st);
-    fv_technique *t1 = create(c, g_cornell), *t2 = create(c, g_cornell);
+    fv_technique *t1 = create(c, suite_of(c)->cornell), *t2 = create(c, suite_of(c)->cornell);
     fv_film *a = film_new(W, H), *b = film_new(W, H);
     for (int i = 0; i < 2; i++) {
-        fv_frame f1 = frame_at(&g_cornell_cam, i, 1), f2 = frame_at(&g_cornell_cam, i, 2);
+        fv_frame f1 = frame_at(&suite_of(c)->cornell_cam, i, 1), f2 = frame_at(&suite_of(c)->cornell_cam, i, 2);
         fv_test_render_frames(t1, &f1, 1, a, NULL);
         fv_test_render_frames(t2, &f2, 1, b, NULL);
         finite_mean(a, c->name);
@@ -272,10 +306,10 @@ static void test_threads(void **st)
 static void test_stereo(void **st)
 {
     const fv_technique_class *c = cls_of(st);
-    fv_technique *t = create(c, g_cornell);
+    fv_technique *t = create(c, suite_of(c)->cornell);
     fv_film *fl = film_new(W, H), *fr = film_new(W, H);
     fv_camera l, r;
-    fv_camera_stereo(&g_cornell_cam, 60.0f, &l, &r); /* the box is 556 wide: a clear disparity */
+    fv_camera_stereo(&suite_of(c)->cornell_cam, suite_of(c)->stereo_sep, &l, &r);
     for (int i = 0; i < 2; i++) {
         fv_frame e0 = frame_at(&l, i, 0);
         e0.eye_count = 2;
@@ -310,9 +344,9 @@ static void expect_refused(fv_technique *t, const fv_frame *f, fv_film *film, co
 static void test_refusals(void **st)
 {
     const fv_technique_class *c = cls_of(st);
-    fv_technique *t = create(c, g_cornell);
+    fv_technique *t = create(c, suite_of(c)->cornell);
     fv_film *good = film_new(W, H), *half = film_new(W / 2, H / 2);
-    fv_frame f = frame_at(&g_cornell_cam, 0, 0);
+    fv_frame f = frame_at(&suite_of(c)->cornell_cam, 0, 0);
     /* registry.c: "camera size 40x32 differs from the film's 20x16" */
     expect_refused(t, &f, half, "20x16", "film of half the camera's size");
     const struct {
@@ -322,7 +356,7 @@ static void test_refusals(void **st)
         fv_frame e = f;
         e.eye = eyes[i].eye;
         e.eye_count = eyes[i].count;
-        e.left_camera = &g_cornell_cam;
+        e.left_camera = &suite_of(c)->cornell_cam;
         char what[64];
         snprintf(what, sizeof what, "eye %d of %d", e.eye, e.eye_count);
         expect_refused(t, &e, good, what, what);
@@ -362,12 +396,12 @@ static void test_overflow_scene(void **st)
 {
     (void)st;
     fv_light_sample ls;
-    assert_true(fv_light_sample_li(g_overflow, fv_v3(0, 0, 0), 0.0f, 0.5f, 0.5f, &ls));
+    assert_true(fv_light_sample_li(g_mesh.overflow, fv_v3(0, 0, 0), 0.0f, 0.5f, 0.5f, &ls));
     assert_true(ls.delta);
     assert_false(isfinite(ls.li.y));
     const float u[5] = {0.0f, 0.5f, 0.75f, 0.5f, 0.5f};
     fv_vec3 o, d, power, n;
-    assert_true(fv_light_sample_emission(g_overflow, u, &o, &d, &power, &n));
+    assert_true(fv_light_sample_emission(g_mesh.overflow, u, &o, &d, &power, &n));
     assert_float_equal(d.y, -1.0f, 1e-6f);
     assert_false(isfinite(power.y));
 }
@@ -375,10 +409,10 @@ static void test_overflow_scene(void **st)
 static void test_overflow(void **st)
 {
     const fv_technique_class *c = cls_of(st);
-    fv_technique *t = create(c, g_overflow);
+    fv_technique *t = create(c, suite_of(c)->overflow);
     fv_film *f = film_new(W, H);
     for (int i = 0; i < 2; i++) {
-        fv_frame fr = frame_at(&g_overflow_cam, i, 0);
+        fv_frame fr = frame_at(&suite_of(c)->overflow_cam, i, 0);
         fv_stats s;
         fv_test_render_frames(t, &fr, 1, f, &s);
         finite_mean(f, c->name);
@@ -421,10 +455,11 @@ static void progress_init(progress_log *p, int cancel_at)
     p->cancel_at = cancel_at;
 }
 
-/* Renders frame `index` of cornell with progress into f; returns the status. */
+/* Renders frame `index` of cornell (or its SDF twin) with progress into f; returns the status. */
 static fv_status render_progress(fv_technique *t, int index, int threads, progress_log *p, fv_film *f)
 {
-    fv_frame fr = frame_at(&g_cornell_cam, index, threads);
+    const fv_technique_class *c = fv_technique_class_find(fv_technique_name_of(t));
+    fv_frame fr = frame_at(&suite_of(c)->cornell_cam, index, threads);
     fr.progress = on_progress;
     fr.progress_user = p;
     fv_stats s;
@@ -457,7 +492,7 @@ static void test_progress(void **st)
     progress_log *p = calloc(1, sizeof *p);
     assert_non_null(p);
     /* One thread reports every step; two threads at least the end, in order. */
-    fv_technique *t = create(c, g_cornell);
+    fv_technique *t = create(c, suite_of(c)->cornell);
     progress_init(p, 0);
     assert_int_equal(render_progress(t, 0, 1, p, f), FV_OK);
     check_fractions(p, true, c->name);
@@ -472,15 +507,15 @@ static void test_progress(void **st)
     print_message("%-15s progress: %d calls in frame 1 with one thread\n", c->name, calls);
 
     /* The reference: frames 0 and 1 uninterrupted. */
-    fv_technique *r = create(c, g_cornell);
-    fv_frame f0 = frame_at(&g_cornell_cam, 0, 1), f1 = frame_at(&g_cornell_cam, 1, 1);
+    fv_technique *r = create(c, suite_of(c)->cornell);
+    fv_frame f0 = frame_at(&suite_of(c)->cornell_cam, 0, 1), f1 = frame_at(&suite_of(c)->cornell_cam, 1, 1);
     fv_test_render_frames(r, &f0, 1, ref, NULL);
     fv_test_render_frames(r, &f1, 1, ref, NULL);
     fv_technique_destroy(r);
     /* Frame 1 cancelled at the first call, then half-way; asked again, it is the reference's. */
     const int at[2] = {1, calls / 2 + 1};
     for (int k = 0; k < 2; k++) {
-        t = create(c, g_cornell);
+        t = create(c, suite_of(c)->cornell);
         fv_test_render_frames(t, &f0, 1, f, NULL);
         progress_init(p, at[k]);
         if (render_progress(t, 1, 1, p, f) != FV_ERR_CANCELLED) fail_msg("%s: cancel at call %d was not reported", c->name, at[k]);

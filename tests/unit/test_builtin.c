@@ -68,8 +68,8 @@ static void test_table(void **st)
 {
     (void)st;
     int n = fv_builtin_count();
-    assert_int_equal(n, 8);
-    const char *want[] = {"cornell", "cornell-glossy", "cornell-fpm", "city", "sdf-primitives", "sdf-columns", "sdf-temple", "furnace"};
+    assert_int_equal(n, 9);
+    const char *want[] = {"cornell", "cornell-glossy", "cornell-fpm", "city", "sdf-primitives", "sdf-columns", "sdf-temple", "sdf-furnace", "furnace"};
     for (int i = 0; i < n; i++) {
         assert_string_equal(fv_builtin_name(i), want[i]);
         const char *sum = fv_builtin_summary(i);

@@ -35,6 +35,7 @@ static void help(void)
            "  --camera-trace FILE   camera over time from a CSV trace (docs/gaze.md)\n"
            "  --stereo SEP          render a stereo pair with eye separation SEP: OUT_left.ext, OUT_right.ext\n"
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
+           "  --stats               print every counter of each frame (rays, steps, ...) after its timings\n"
            "  --quiet               no progress bar, warnings or per-frame lines\n"
            "Exit status: 0 ok, 1 internal error, 2 bad input (the message names it).\n");
 }
@@ -61,7 +62,7 @@ typedef struct render_opts {
     int width, height, frames, threads, spp;
     double fps, time0, exposure, stereo;
     unsigned long long seed;
-    bool quiet, has_pos, has_look, has_up, has_fov, has_gaze;
+    bool quiet, show_stats, has_pos, has_look, has_up, has_fov, has_gaze;
     const char *gaze_trace, *camera_trace;
     float pos[3], look[3], up[3], fov, gaze[2];
     int nlights;
@@ -71,13 +72,13 @@ typedef struct render_opts {
 static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
     enum { O_METHOD = 256, O_SPP, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
-           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_HELP };
+           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
         {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
         {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE},
-        {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"help", 0, 0, O_HELP},
+        {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"help", 0, 0, O_HELP},
         {0, 0, 0, 0}};
     const char *cmd = "render";
     long l;
@@ -161,6 +162,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             if (fv_params_parse(params, optarg, &err) != FV_OK) return fv_cli_fail(cmd, err.status, err.msg);
             break;
         case O_QUIET: o->quiet = true; break;
+        case O_STATS: o->show_stats = true; break;
         case O_HELP:
         case 'h': help(); return -1;
         default:
@@ -333,6 +335,11 @@ int fv_cmd_render(int argc, char **argv)
             if (rays > 0) fprintf(stderr, "  %.2f Mrays/s", rays / (ms * 1e3));
             if (bad > 0) fprintf(stderr, "  (%.0f NaN/Inf samples discarded)", bad);
             fputc('\n', stderr);
+            if (o.show_stats) {
+                fprintf(stderr, "  counters:");
+                for (int i = 0; i < stats.n_counters; i++) fprintf(stderr, " %s=%.0f", stats.counter[i].name, stats.counter[i].value);
+                fputc('\n', stderr);
+            }
         }
     }
     fv_cli_progress_done(&prog);

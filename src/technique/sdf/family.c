@@ -1,0 +1,158 @@
+/* fovea — the sphere-tracing family's four registered methods and their parameters: `sdf-gt`,
+ * `sdf-relaxed`, `ipr` and `fipr` (pipeline.h says what each does). All four refuse a scene without
+ * a signed distance field object (the registry checks the class's `sdf_only`).
+ */
+#include <stdlib.h>
+#include <string.h>
+#include "technique/class.h"
+#include "technique/sdf/pipeline.h"
+
+typedef struct family_state {
+    fv_sdf_pipeline *pipe;
+} family_state;
+
+static const char *const k_show[] = {"image", "steps", "level", "mask", "edges", NULL};
+
+static fv_status bad(fv_error *err, const char *key, double v, const char *what)
+{
+    return fv_error_set(err, FV_ERR_INVALID, "parameter %s=%g %s", key, v, what);
+}
+
+static fv_status read_opts(fv_sdf_method m, fv_params *p, fv_sdf_opts *o, fv_error *err)
+{
+    memset(o, 0, sizeof *o);
+    o->method = m;
+    fv_status s;
+    int show;
+    double hit, ambient, relax = 1.0;
+    bool shadows, wide;
+    /* the show modes each method has: the baselines one level, only fipr a mask and edges */
+    int show_max = m == FV_SDF_FIPR ? FV_SDF_SHOW_EDGES : m == FV_SDF_IPR ? FV_SDF_SHOW_LEVEL : FV_SDF_SHOW_STEPS;
+    if ((s = fv_params_int(p, "spp", 1, 1, 16, &o->spp, err)) ||
+        (s = fv_params_int(p, "max_steps", 256, 1, 65535, &o->march.max_steps, err)) ||
+        (s = fv_params_float(p, "hit", 0.25, 1e-4, 16.0, &hit, err)) ||
+        (s = fv_params_float(p, "ambient", 0.0, 0.0, 1.0, &ambient, err)) || (s = fv_params_bool(p, "shadows", true, &shadows, err)) ||
+        (s = fv_params_bool(p, "simd", true, &wide, err)) || (s = fv_params_choice(p, "show", 0, k_show, &show, err)))
+        return s;
+    if (o->spp != 1 && o->spp != 4 && o->spp != 16) return bad(err, "spp", o->spp, "must be 1, 4 or 16 (1, 2 or 4 samples per pixel along each axis)");
+    if (show > show_max) return fv_error_set(err, FV_ERR_INVALID, "parameter show=%s is not an output of this method", k_show[show]);
+    if (m == FV_SDF_RELAXED || m == FV_SDF_IPR || m == FV_SDF_FIPR) {
+        if ((s = fv_params_float(p, "relax", m == FV_SDF_RELAXED ? 1.6 : 1.0, -1e9, 1e9, &relax, err))) return s;
+        if (!(relax >= 1.0 && relax < 2.0)) return bad(err, "relax", relax, "must be in [1, 2) (1: plain sphere tracing)");
+    }
+    o->levels = 1;
+    o->min_filter = true;
+    if (m == FV_SDF_IPR || m == FV_SDF_FIPR) {
+        int lo = m == FV_SDF_FIPR ? 3 : 1;
+        if ((s = fv_params_int(p, "levels", 3, -1000000, 1000000, &o->levels, err)) ||
+            (s = fv_params_bool(p, "min_filter", true, &o->min_filter, err)))
+            return s;
+        if (o->levels < lo || o->levels > FV_PYRAMID_MAX_LEVELS)
+            return fv_error_set(err, FV_ERR_INVALID, "parameter levels=%d must be in [%d, %d]%s", o->levels, lo, FV_PYRAMID_MAX_LEVELS,
+                                m == FV_SDF_FIPR ? " (fipr needs a tip, a middle and a target level)" : "");
+    }
+    if (m == FV_SDF_FIPR) {
+        double fovea, outer, edge, sigma;
+        int refresh;
+        if ((s = fv_params_float(p, "fovea_deg", 7.5, -1e9, 1e9, &fovea, err)) ||
+            (s = fv_params_float(p, "outer_deg", 30.0, -1e9, 1e9, &outer, err)) ||
+            (s = fv_params_float(p, "edge", 0.25, 0.0, 1e6, &edge, err)) ||
+            (s = fv_params_int(p, "refresh", 1, -1000000, 1000000, &refresh, err)) || (s = fv_params_bool(p, "blur", false, &o->blur, err)) ||
+            (s = fv_params_float(p, "blur_sigma", 2.0, 0.0, 100.0, &sigma, err)))
+            return s;
+        if (!(fovea >= 0.0 && fovea < 180.0)) return bad(err, "fovea_deg", fovea, "must be in [0, 180) degrees of eccentricity");
+        if (!(outer > fovea)) return bad(err, "outer_deg", outer, "must be greater than fovea_deg");
+        if (refresh != 1 && refresh != 2 && refresh != 4) return bad(err, "refresh", refresh, "must be 1, 2 or 4 (frames between refreshes outside the mask)");
+        o->fovea_deg = (float)fovea;
+        o->outer_deg = (float)outer;
+        o->edge = (float)edge;
+        o->refresh = refresh;
+        o->blur_sigma = (float)sigma;
+    }
+    o->march.relax = (float)relax;
+    o->march.wide = wide;
+    o->hit = (float)hit;
+    o->shade.ambient = (float)ambient;
+    o->shade.shadows = shadows;
+    o->show = (fv_sdf_show)show;
+    return FV_OK;
+}
+
+static fv_status create_method(fv_sdf_method m, const fv_scene *scene, fv_params *params, const fv_log *log, void **state, fv_error *err)
+{
+    fv_sdf_opts o;
+    fv_status s = read_opts(m, params, &o, err);
+    if (s != FV_OK) return s;
+    int meshes = fv_scene_object_count(scene) - fv_scene_sdf_object_count(scene);
+    if (meshes > 0)
+        fv_log_warn(log, "%d mesh object%s not sphere-traced: this method sees only the signed distance fields (pt renders both)",
+                   meshes, meshes == 1 ? " is" : "s are");
+    family_state *st = calloc(1, sizeof *st);
+    if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if ((s = fv_sdf_pipeline_create(scene, &o, &st->pipe, err)) != FV_OK) {
+        free(st);
+        return s;
+    }
+    *state = st;
+    return FV_OK;
+}
+
+static fv_status render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+{
+    return fv_sdf_pipeline_render(((family_state *)state)->pipe, frame, film, stats, err);
+}
+
+static void destroy(void *state)
+{
+    family_state *st = state;
+    if (!st) return;
+    fv_sdf_pipeline_destroy(st->pipe);
+    free(st);
+}
+
+static fv_status create_gt(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e) { return create_method(FV_SDF_GT, s, p, l, st, e); }
+static fv_status create_relaxed(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e) { return create_method(FV_SDF_RELAXED, s, p, l, st, e); }
+static fv_status create_ipr(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e) { return create_method(FV_SDF_IPR, s, p, l, st, e); }
+static fv_status create_fipr(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e) { return create_method(FV_SDF_FIPR, s, p, l, st, e); }
+
+#define COMMON_HELP                                                                                                  \
+    "spp=int (1): samples per pixel, 1, 4 or 16 (a regular 1x1, 2x2 or 4x4 grid)\n"                                 \
+    "max_steps=int (256): field evaluations per ray; a ray still marching then counts as a hit\n"                     \
+    "hit=float (0.25): hit distance as a fraction of the ray's footprint at its distance\n"                           \
+    "ambient=float (0): constant light, ambient x albedo (0: direct light only, as pt max_depth=1)\n"                 \
+    "shadows=bool (true): hard shadows by sphere tracing towards each light\n"                                      \
+    "simd=bool (true): evaluate the field for 8 rays at once (false: the scalar loop; same image)\n"
+
+/* The conformance suite's scenes for this family are its SDF twins (tests/conformance): in
+ * sdf-furnace the camera and a point light of intensity 2 pi sit at the centre of a hollow sphere
+ * of radius 1 and albedo 0.5, so every pixel sees albedo / pi x I / r^2 = 1 (the hit stops a hit
+ * distance short of the wall: well under the tolerance). */
+#define SDF_CLASS(id, nm, sum, help, fn)                                                                              \
+    const fv_technique_class id = {.name = nm, .summary = sum, .params_help = COMMON_HELP help, .create = fn, .render = render, \
+                                   .destroy = destroy, .sdf_only = true, .test_params = "spp=1", .furnace_radiance = 1.0,      \
+                                   .furnace_tolerance = 0.01}
+
+SDF_CLASS(fv_technique_sdf_gt, "sdf-gt", "sphere tracing of every target sample from the camera (ground truth of ipr/fipr)",
+          "show=image|steps (image): the image, or steps per ray from blue (1) to red (256)\n", create_gt);
+SDF_CLASS(fv_technique_sdf_relaxed, "sdf-relaxed", "over-relaxed sphere tracing (Keinert et al. 2014) of every target sample",
+          "relax=float (1.6): step factor in [1, 2)\n"
+          "show=image|steps (image): the image, or steps per ray from blue (1) to red (256)\n",
+          create_relaxed);
+SDF_CLASS(fv_technique_ipr, "ipr", "inverted-pyramid sphere tracing: each level starts at the min-filtered depth of the one below",
+          "levels=int (3): pyramid levels, 1 = sdf-gt (the tip has 1/4^(levels-1) of the rays)\n"
+          "min_filter=bool (true): start at the 3x3 minimum of the depths below (false: the parent's depth)\n"
+          "relax=float (1): over-relaxation of every level's march, in [1, 2)\n"
+          "show=image|steps|level (image): the image, steps per ray, or the level each pixel came from\n",
+          create_ipr);
+SDF_CLASS(fv_technique_fipr, "fipr", "foveated inverted-pyramid sphere tracing: the five passes of Polychronakis et al. 2023",
+          "levels=int (3): pyramid levels, 3 to 6\n"
+          "min_filter=bool (true): start at the 3x3 minimum of the depths below\n"
+          "relax=float (1): over-relaxation of every level's march, in [1, 2)\n"
+          "fovea_deg=float (7.5): eccentricity traced at the target level (the mask is 1)\n"
+          "outer_deg=float (30): eccentricity beyond which the mask is 0, edges included\n"
+          "edge=float (0.25): Sobel threshold on the tip's depth, relative to the depth\n"
+          "refresh=int (1): frames between refreshes of the pixels outside the mask: 1, 2 or 4\n"
+          "blur=bool (false): pass 5, a Gaussian blur of the mask's transitions\n"
+          "blur_sigma=float (2): its standard deviation in pixels\n"
+          "show=image|steps|level|mask|edges (image): the image or a pass's output\n",
+          create_fipr);

@@ -1,0 +1,31 @@
+/* fovea — the shading of the SDF family (Polychronakis et al. 2023, Sec. 4.1: the scenes without
+ * soft shadows and ambient occlusion): Lambert plus a Blinn-Phong lobe from each point or spot
+ * light, hard shadows by sphere tracing towards the light, normals from the field's gradient.
+ *
+ * The material model is the scene's: `albedo` is the Lambert term, a GLOSSY material's `specular`
+ * and GGX `roughness` alpha become the Blinn-Phong colour and exponent 2 / alpha^2 - 2 (the usual
+ * match of the two lobes' widths); MIRROR and DIELECTRIC materials get a sharp lobe (alpha 0.05)
+ * of their `specular` tint: no reflection or refraction rays, as in the paper's shaders. The lobe is
+ * normalised ((n + 8) / 8 pi), so a diffuse scene shades exactly as `pt max_depth=1` (direct light
+ * only) and the two can be compared. Area lights (emissive triangles) are not seen.
+ */
+#ifndef FV_SDF_SHADE_H
+#define FV_SDF_SHADE_H
+
+#include "technique/sdf/march.h"
+
+typedef struct fv_sdf_shade_opts {
+    float ambient;  /* constant term: ambient x albedo (0: direct light only) */
+    bool shadows;   /* trace shadow rays (off: every light is visible) */
+} fv_sdf_shade_opts;
+
+typedef struct fv_sdf_shade_counts {
+    uint64_t shadow_rays, shadow_steps, normal_evals;
+} fv_sdf_shade_counts;
+
+/* Shades the n marched camera rays: radiance per ray in color (black for a miss), and when normal
+ * is not NULL the unit normal (zero for a miss). FV_ERR_NOMEM without scratch memory. */
+fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_sdf_shade_opts *so, const fv_march_ray *rays,
+                       const fv_march_hit *hits, int n, fv_vec3 *color, fv_vec3 *normal, fv_sdf_shade_counts *counts, fv_error *err);
+
+#endif

@@ -1,0 +1,58 @@
+/* fovea — what the sphere tracers of the SDF family see of a scene at one frame: the union of its
+ * signed distance field objects as one field, the box around them, and the point and spot lights.
+ *
+ * Polychronakis, Koulieris and Mania (EG 2023, Sec. 2.1 and 3) march one implicit scene; a fovea
+ * scene may hold several SDF objects, some moving. The world evaluates them as one field, the
+ * minimum over objects, each taken in its own space (a moving object's points are moved back by
+ * its inverse transform, and its distance scaled by that transform's smallest stretch so it stays
+ * a lower bound). With several objects, each object's distance is also raised to the distance to
+ * its box (both are lower bounds), which lets a whole batch skip an object whose box is farther
+ * than what it already found without changing any value: the 8-wide and the scalar evaluation give
+ * the same numbers bit for bit.
+ *
+ * Meshes are not sphere-traced (the family's techniques warn once); pt renders mixed scenes.
+ */
+#ifndef FV_SDF_WORLD_H
+#define FV_SDF_WORLD_H
+
+#include <stdbool.h>
+#include "scene/light.h"
+#include "scene/query.h"
+
+typedef struct fv_sdf_world_object {
+    const fv_sdf *sdf;
+    bool moved;        /* evaluate at inv * p and scale by lip */
+    fv_xform inv;
+    float lip;         /* 1 / the largest stretch of inv: world distance >= lip * local distance */
+    fv_vec3 lo, hi;    /* world box */
+} fv_sdf_world_object;
+
+typedef struct fv_sdf_point_light {
+    const fv_light *light;
+    fv_vec3 pos;
+} fv_sdf_point_light;
+
+typedef struct fv_sdf_world {
+    const fv_scene *scene;
+    fv_sdf_world_object *objs;
+    int count;
+    fv_vec3 lo, hi;            /* box around every object, padded by a few hit distances */
+    float eps_abs;             /* smallest hit distance: 1e-5 of the box diagonal */
+    fv_sdf_point_light *lights;
+    int light_count;
+} fv_sdf_world;
+
+/* The scene's SDF objects and delta lights at its current time. FV_ERR_INVALID when the scene has
+ * no SDF object; FV_ERR_NOMEM. fv_sdf_world_free releases it (safe on a zeroed world). */
+fv_status fv_sdf_world_build(fv_sdf_world *w, const fv_scene *s, fv_error *err);
+void fv_sdf_world_free(fv_sdf_world *w);
+
+/* The field at eight points (x, y, z need no alignment), with the nearest leaf's material. */
+void fv_sdf_world_eval8(const fv_sdf_world *w, const float *x, const float *y, const float *z, float *d, int *mat);
+/* The same at one point, bit-identical to a lane of fv_sdf_world_eval8. */
+float fv_sdf_world_eval1(const fv_sdf_world *w, float x, float y, float z, int *mat);
+
+/* Clips the ray o + t d (d unit) to the world's box: false when it misses the box. */
+bool fv_sdf_world_clip(const fv_sdf_world *w, fv_vec3 o, fv_vec3 d, float *t0, float *t1);
+
+#endif
