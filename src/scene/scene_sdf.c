@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "core/ray_box.h"
 #include "scene/scene_impl.h"
 
 #define FV_SDF_TRACE_STEPS 512
@@ -100,23 +101,7 @@ static bool sdf_trace(const fv_object *ob, fv_vec3 o, fv_vec3 d, float tnear, fl
     fv_vec3 lo, hi;
     padded_box(ob, &lo, &hi);
     float t0 = tnear, t1 = tfar;
-    const float oa[3] = {o.x, o.y, o.z}, da[3] = {d.x, d.y, d.z}, la[3] = {lo.x, lo.y, lo.z}, ha[3] = {hi.x, hi.y, hi.z};
-    for (int a = 0; a < 3; a++) {
-        if (da[a] == 0.0f) {
-            if (oa[a] < la[a] || oa[a] > ha[a]) return false;
-            continue;
-        }
-        float inv = 1.0f / da[a];
-        float ta = (la[a] - oa[a]) * inv, tb = (ha[a] - oa[a]) * inv;
-        if (ta > tb) {
-            float x = ta;
-            ta = tb;
-            tb = x;
-        }
-        if (ta > t0) t0 = ta;
-        if (tb < t1) t1 = tb;
-    }
-    if (!(t0 <= t1)) return false;
+    if (!fv_ray_box_clip(o, d, lo, hi, &t0, &t1)) return false;
     float dl = fv_length(d);
     if (!(dl > 0.0f) || !isfinite(dl)) return false;
     const float eps = ob->sdf_eps, inv_dl = 1.0f / dl;

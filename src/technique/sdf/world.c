@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "core/ray_box.h"
 #include "sdf/sdf_eval.h"
 #include "technique/sdf/world.h"
 
@@ -157,26 +158,7 @@ float fv_sdf_world_eval1(const fv_sdf_world *w, float x, float y, float z, int *
 
 bool fv_sdf_world_clip(const fv_sdf_world *w, fv_vec3 o, fv_vec3 d, float *t0, float *t1)
 {
-    float a = 0.0f, b = INFINITY;
-    const float oa[3] = {o.x, o.y, o.z}, da[3] = {d.x, d.y, d.z};
-    const float lo[3] = {w->lo.x, w->lo.y, w->lo.z}, hi[3] = {w->hi.x, w->hi.y, w->hi.z};
-    for (int k = 0; k < 3; k++) {
-        if (da[k] == 0.0f) {
-            if (oa[k] < lo[k] || oa[k] > hi[k]) return false;
-            continue;
-        }
-        float inv = 1.0f / da[k];
-        float ta = (lo[k] - oa[k]) * inv, tb = (hi[k] - oa[k]) * inv;
-        if (ta > tb) {
-            float s = ta;
-            ta = tb;
-            tb = s;
-        }
-        a = fmaxf(a, ta);
-        b = fminf(b, tb);
-    }
-    if (!(a <= b)) return false;
-    *t0 = a;
-    *t1 = b;
-    return true;
+    *t0 = 0.0f;
+    *t1 = INFINITY;
+    return fv_ray_box_clip(o, d, w->lo, w->hi, t0, t1);
 }
