@@ -125,11 +125,11 @@ static void test_gltf_pbr(void **state)
     /* Two delta lights and the glowing quad's two triangles. */
     assert_int_equal(fv_scene_light_count(s), 4);
     assert_int_equal(s->ndelta, 2);
-    const fv_light_desc *l = &s->delta[0];
+    const fv_light_desc *l = &s->delta[0].desc;
     assert_int_equal(l->type, FV_LIGHT_POINT);
     assert_vec3(l->pos, 1, 4, 11, 1e-5f);
     assert_vec3(l->intensity, 8, 4, 2, 1e-5f);
-    l = &s->delta[1];
+    l = &s->delta[1].desc;
     assert_int_equal(l->type, FV_LIGHT_SPOT);
     assert_vec3(l->pos, 3, 6, 11, 1e-5f);
     assert_vec3(fv_normalize(l->dir), 0, -1, 0, 1e-5f);
