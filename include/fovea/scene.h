@@ -1,11 +1,11 @@
 /* fovea — the scene: triangle meshes and signed distance fields (static or rigidly animated),
- * materials and lights. How the
+ * materials and lights (point and spot lights may move too). How the
  * scene is looked at (camera, camera path, display, gaze) is an fv_view (fovea/view.h); the
  * loaders return both.
  *
  * Ownership: fv_scene_create returns a scene the caller destroys with fv_scene_destroy. Every
  * fv_scene_add_* call copies what it is given. After fv_scene_commit the geometry is frozen; only
- * the time (fv_scene_set_time, which moves dynamic objects) changes. Area lights are emissive
+ * the time (fv_scene_set_time, which moves dynamic objects and animated lights) changes. Area lights are emissive
  * triangles: any triangle whose material has non-zero emission.
  * Lifetime and threads: techniques and drivers keep a pointer to the scene, which must outlive
  * them. Building (add_*, commit) and fv_scene_set_time must not overlap any other call on the
@@ -116,13 +116,25 @@ FV_API fv_status fv_scene_add_sdf(fv_scene *scene, const char *name, const fv_sd
 FV_API fv_status fv_scene_animate_object(fv_scene *scene, int object_id, const fv_anim_key *keys, int count,
                                   fv_error *err);
 
+/* Adds a point or spot light. The scene numbers its lights 0, 1, 2, ... in the order of these
+ * calls: that number is fv_scene_animate_light's light_index. */
 FV_API fv_status fv_scene_add_light(fv_scene *scene, const fv_light_desc *light, fv_error *err);
+
+/* Moves light light_index (the (light_index + 1)-th fv_scene_add_light) along keys, with the rules
+ * and interpolation of fv_scene_animate_object: at time t the key transform, interpolated at t,
+ * is applied to the light's `pos` (so a key's translate is an offset when pos is the path's
+ * origin, and its scale scales pos about the world origin), and a spot's `dir` is turned by the
+ * key's rotation. Before the first key the first holds, after the last the last. Call before
+ * fv_scene_commit; a second call replaces the keys. Refused (FV_ERR_INVALID): an index that is
+ * not a light added so far, keys that break the rules. */
+FV_API fv_status fv_scene_animate_light(fv_scene *scene, int light_index, const fv_anim_key *keys, int count,
+                                        fv_error *err);
 
 /* Validates the scene and builds the acceleration structures. A scene without any object (mesh
  * or SDF) is refused; a scene without any light gets a default point light (a warning says so). */
 FV_API fv_status fv_scene_commit(fv_scene *scene, const fv_log *log, fv_error *err);
 
-/* Moves dynamic objects to time t (seconds) and refits only what moved. */
+/* Moves dynamic objects and animated lights to time t (seconds) and refits only what moved. */
 FV_API fv_status fv_scene_set_time(fv_scene *scene, double t, fv_error *err);
 FV_API double fv_scene_time(const fv_scene *scene);
 

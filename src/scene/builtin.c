@@ -22,7 +22,7 @@ static const builtin k_builtins[] = {
      fv_builtin_city},
     {"sdf-primitives", "signed distance fields (IPR paper Sec. 4.1, open): seven primitives and a smooth union on a checkerboard",
      fv_builtin_sdf_primitives},
-    {"sdf-columns", "signed distance fields (IPR paper Sec. 4.1, enclosed): a room of 3x3 repeated columns, five point lights",
+    {"sdf-columns", "signed distance fields (IPR paper Sec. 4.1, enclosed): a room of 3x3 repeated columns, five moving lights",
      fv_builtin_sdf_columns},
     {"sdf-temple", "signed distance fields (IPR paper Sec. 4.1): noise cliff terrain with a temple of columns and steps",
      fv_builtin_sdf_temple},

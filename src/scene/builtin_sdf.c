@@ -1,15 +1,15 @@
 /* fovea — the signed distance field scenes of issue 11, after Sec. 4.1 of Polychronakis,
  * Koulieris and Mania, "An Inverted Pyramid Acceleration Structure Guiding Foveated Sphere
  * Tracing for Implicit Surfaces in VR" (EG 2023): `sdf-primitives` (open: the primitives on a
- * checkerboard ground), `sdf-columns` (enclosed: a room of repeated columns, five point lights)
+ * checkerboard ground), `sdf-columns` (enclosed: a room of repeated columns, five moving point lights)
  * and `sdf-temple` (noise terrain with a temple of columns and steps). Each is one or a few
  * fv_scene_add_sdf objects, so every technique renders them (as Embree user geometry) and the
  * sphere tracers of the family can take the fields themselves.
  *
  * Limits: the paper publishes no geometry; sizes, colours and camera paths are ours. Its
  * checkerboard is a shading pattern; here it is geometry (repeated tiles of a second material a
- * hair above the ground) so `pt` shows it too. Its lights move in sdf-columns; fv_scene's delta
- * lights are static, so ours stand still and the camera moves.
+ * hair above the ground) so `pt` shows it too. Its five lights "move around the columns" in
+ * sdf-columns with no path given: ours loop once through the aisles in the 4 s of the camera path.
  */
 #include <string.h>
 #include "scene/builtin_impl.h"
@@ -140,6 +140,19 @@ static fv_status point(fv_scene *s, fv_vec3 pos, fv_vec3 intensity, fv_error *er
     return fv_scene_add_light(s, &l, err);
 }
 
+/* A point light going round the loop corner[0] -> ... -> corner[n-1] -> corner[0] once in `period`
+ * seconds, in straight lines at a steady pace (a key at each corner). It stands at corner[0]; the
+ * keys carry the offsets from there. */
+static fv_status looping_point(fv_scene *s, const fv_vec3 *corner, int n, double period, fv_vec3 intensity, fv_error *err)
+{
+    fv_anim_key keys[9];
+    if (n < 1 || n > 8) return fv_error_set(err, FV_ERR_INTERNAL, "looping light: %d corners (1 to 8)", n);
+    fv_status st = point(s, corner[0], intensity, err);
+    for (int k = 0; k <= n && st == FV_OK; k++)
+        keys[k] = (fv_anim_key){period * k / n, fv_sub(corner[k % n], corner[0]), (fv_quat){0, 0, 0, 1}, fv_v3s(1.0f)};
+    return st ? st : fv_scene_animate_light(s, fv_scene_light_count(s) - 1, keys, n + 1, err);
+}
+
 static fv_quat about_y(float deg) { return fv_quat_axis_angle(P(0, 1, 0), fv_radians(deg)); }
 
 /* A checkerboard ground of 2 x 2 cells of four unit tiles, top at y = 0, over [-half, half]^2:
@@ -221,9 +234,21 @@ fv_status fv_builtin_sdf_columns(fv_scene *s, fv_view *view, const fv_log *log, 
     int columns = at(&t, repeat(&t, at(&t, column, P(0, -3, 0)), P(4, 0, 4), P(1, 0, 1)), P(0, 3, 0));
     int root = op(&t, FV_SDF_UNION, op(&t, FV_SDF_UNION, shell, floor_slab), columns);
     if ((st = fv_scene_add_sdf(s, "columns", t.n, t.count, root, log, NULL, err))) return st;
-    /* Five lights between the columns, under the ceiling. */
-    const fv_vec3 lights[5] = {P(0, 5, 2), P(-5.5, 4.5, -5.5), P(5.5, 4.5, -5.5), P(-5.5, 4.5, 5.5), P(5.5, 4.5, 5.5)};
-    for (int i = 0; i < 5 && st == FV_OK; i++) st = point(s, lights[i], i == 0 ? fv_v3s(7) : P(4, 3.5, 2.8), err);
+    /* Five lights under the ceiling, each looping once in 4 s along the aisles (x or z = +-2, and
+     * +-6 between the outer columns and the walls): a white one around the central column, a warm
+     * one around each corner column. Every corner of a loop is an aisle crossing, at least 2 m
+     * from the nearest column's axis (1.6 m from its shaft) and 1.5 m from the walls, and so is
+     * every point in between. The corner loops pass the crossings they share with the central
+     * one at other times than it does. */
+    const fv_vec3 centre[4] = {P(2, 5, 2), P(-2, 5, 2), P(-2, 5, -2), P(2, 5, -2)};
+    const fv_vec3 corners[4][4] = {
+        {P(-2, 4.5, -6), P(-2, 4.5, -2), P(-6, 4.5, -2), P(-6, 4.5, -6)},
+        {P(6, 4.5, -6), P(6, 4.5, -2), P(2, 4.5, -2), P(2, 4.5, -6)},
+        {P(-6, 4.5, 6), P(-6, 4.5, 2), P(-2, 4.5, 2), P(-2, 4.5, 6)},
+        {P(6, 4.5, 6), P(2, 4.5, 6), P(2, 4.5, 2), P(6, 4.5, 2)},
+    };
+    if ((st = looping_point(s, centre, 4, 4.0, fv_v3s(7), err))) return st;
+    for (int i = 0; i < 4 && st == FV_OK; i++) st = looping_point(s, corners[i], 4, 4.0, P(4, 3.5, 2.8), err);
     if (st) return st;
 
     const fv_vec3 up = P(0, 1, 0);

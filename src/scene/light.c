@@ -155,6 +155,15 @@ bool fv_light_point_power(const fv_scene *s, const fv_light_point *lp, fv_vec3 d
     return true;
 }
 
+int fv_light_delta_count(const fv_scene *s) { return s->nlights_delta; }
+
+/* Delta lights come first in the table (build_lights in scene.c). */
+const fv_light *fv_light_delta_at(const fv_scene *s, int i) { return i >= 0 && i < s->nlights_delta ? &s->lights[i] : NULL; }
+
+fv_vec3 fv_light_delta_pos(const fv_light *l) { return l->desc.pos; }
+
+bool fv_scene_lights_move(const fv_scene *s) { return s->lights_move; }
+
 fv_vec3 fv_light_delta_intensity(const fv_light *l, fv_vec3 w)
 {
     float fall = l->desc.type == FV_LIGHT_SPOT ? spot_falloff(&l->desc, w) : 1.0f;
@@ -177,19 +186,3 @@ fv_vec3 fv_light_total_power(const fv_scene *s)
     }
     return p;
 }
-
-int fv_light_delta_count(const fv_scene *s)
-{
-    int n = 0;
-    for (int i = 0; i < s->nlights; i++) n += s->lights[i].kind == 0;
-    return n;
-}
-
-const fv_light *fv_light_delta_at(const fv_scene *s, int i)
-{
-    for (int k = 0; k < s->nlights; k++)
-        if (s->lights[k].kind == 0 && i-- == 0) return &s->lights[k];
-    return NULL;
-}
-
-fv_vec3 fv_light_delta_pos(const fv_light *l) { return l->desc.pos; }

@@ -2,7 +2,9 @@
  * the density of hitting an emitter by chance (for MIS), and emission of photons/VPLs.
  *
  * A light is picked with probability proportional to its emitted power (table built at commit).
- * Area lights are sampled uniformly by area on the chosen triangle.
+ * Area lights are sampled uniformly by area on the chosen triangle. Point and spot lights may move
+ * (fv_scene_animate_light): every query answers at the scene's current time; the pick table stays
+ * valid because a delta light's power does not depend on where it stands.
  */
 #ifndef FV_SCENE_LIGHT_H
 #define FV_SCENE_LIGHT_H
@@ -54,13 +56,24 @@ bool fv_light_pick_point(const fv_scene *s, fv_rng *rng, fv_light_point *out);
  * area / pdf for an area light. False when an area light does not emit towards dir. */
 bool fv_light_point_power(const fv_scene *s, const fv_light_point *lp, fv_vec3 dir, float pdf, fv_vec3 *power);
 
-/* The delta (point and spot) lights, for techniques that shade them directly (the SDF sphere
- * tracers): how many, the i-th in the order they were added, and its position now. */
+/* ---- delta lights one by one, for techniques that shade point lights themselves (the SDF
+ * sphere tracers) rather than sample them. fv_light stays opaque: these accessors are all there
+ * is. ---- */
+
+/* The point and spot lights that emit (intensity > 0), in the order the scene added them. */
 int fv_light_delta_count(const fv_scene *s);
+/* Delta light i in [0, fv_light_delta_count); NULL outside. Valid as long as the scene. */
 const fv_light *fv_light_delta_at(const fv_scene *s, int i);
+/* Its position at the scene's current time. */
 fv_vec3 fv_light_delta_pos(const fv_light *l);
-/* Radiant intensity of delta light l towards unit direction w (spot fall-off applied). */
+/* Radiant intensity of delta light l towards unit direction w (spot fall-off applied, the spot's
+ * axis at the scene's current time). */
 fv_vec3 fv_light_delta_intensity(const fv_light *l, fv_vec3 w);
+
+/* True when some light moves with time (fv_scene_animate_light): what a technique computed from
+ * the lights (a photon map, say) is then stale after fv_scene_set_time, even where no object
+ * moved. */
+bool fv_scene_lights_move(const fv_scene *s);
 
 /* Total emitted power of all lights (W): the scale of a photon map. */
 fv_vec3 fv_light_total_power(const fv_scene *s);

@@ -156,7 +156,9 @@ static fv_status parse_shape(const cJSON *o, const json_ctx *c, const char *wher
     return FV_OK;
 }
 
-static fv_status parse_animation(const cJSON *arr, const json_ctx *c, const char *where, int first, int count, fv_error *err)
+/* The "animation" array of objects[i] or lights[i] (where), applied to objects first .. first +
+ * count - 1, or to light `light` when it is >= 0: one key format and one set of rules for both. */
+static fv_status parse_animation(const cJSON *arr, const json_ctx *c, const char *where, int first, int count, int light, fv_error *err)
 {
     static const char *const keys[] = {"time", "translate", "rotate_deg", "rotate_quat", "scale", NULL};
     int n = cJSON_GetArraySize(arr);
@@ -177,6 +179,8 @@ static fv_status parse_animation(const cJSON *arr, const json_ctx *c, const char
     }
     for (int o = 0; o < count && st == FV_OK; o++)
         if ((st = fv_scene_animate_object(c->scene, first + o, k, n, err)) != FV_OK) fv_error_prefix(err, "%s: %s: ", c->file, where);
+    if (light >= 0 && st == FV_OK && (st = fv_scene_animate_light(c->scene, light, k, n, err)) != FV_OK)
+        fv_error_prefix(err, "%s: %s.animation: ", c->file, where);
     free(k);
     return st;
 }
@@ -486,7 +490,7 @@ static fv_status parse_object(const cJSON *o, const json_ctx *c, int index, fv_e
     const cJSON *an = cJSON_GetObjectItemCaseSensitive(o, "animation");
     if (cJSON_GetObjectItemCaseSensitive(o, "sdf")) {
         if ((st = parse_sdf_object(o, c, where, oname, mat, &first, err)) != FV_OK) return st;
-        return an ? parse_animation(an, c, where, first, 1, err) : FV_OK;
+        return an ? parse_animation(an, c, where, first, 1, -1, err) : FV_OK;
     }
     fv_xform x = fv_xform_identity();
     const cJSON *tr = cJSON_GetObjectItemCaseSensitive(o, "transform");
@@ -530,12 +534,12 @@ static fv_status parse_object(const cJSON *o, const json_ctx *c, int index, fv_e
         if (st != FV_OK) return st;
         count = 1;
     }
-    return an ? parse_animation(an, c, where, first, count, err) : FV_OK;
+    return an ? parse_animation(an, c, where, first, count, -1, err) : FV_OK;
 }
 
 static fv_status parse_light(const cJSON *o, const json_ctx *c, int index, fv_error *err)
 {
-    static const char *const keys[] = {"type", "pos", "dir", "intensity", "inner_deg", "outer_deg", NULL};
+    static const char *const keys[] = {"type", "pos", "dir", "intensity", "inner_deg", "outer_deg", "animation", NULL};
     char where[64];
     snprintf(where, sizeof where, "lights[%d]", index);
     fv_status st = fv_json_check_keys(o, keys, c->file, where, err);
@@ -556,8 +560,14 @@ static fv_status parse_light(const cJSON *o, const json_ctx *c, int index, fv_er
     else return fv_error_set(err, FV_ERR_INVALID, "%s: %s.type: unknown light type '%s' (point, spot; area lights are emissive materials)", c->file, where, type);
     d.inner_deg = (float)inner;
     d.outer_deg = (float)outer;
-    if ((st = fv_scene_add_light(c->scene, &d, err)) != FV_OK) fv_error_prefix(err, "%s: %s: ", c->file, where);
-    return st;
+    if ((st = fv_scene_add_light(c->scene, &d, err)) != FV_OK) {
+        fv_error_prefix(err, "%s: %s: ", c->file, where);
+        return st;
+    }
+    /* The light just added is the scene's last; lights[i] is not always light i (a loader may
+     * come after lights added by other means). */
+    const cJSON *an = cJSON_GetObjectItemCaseSensitive(o, "animation");
+    return an ? parse_animation(an, c, where, 0, 0, fv_scene_light_count(c->scene) - 1, err) : FV_OK;
 }
 
 static fv_status parse_camera_key(const cJSON *o, const json_ctx *c, const char *where, bool timed, fv_camera_key *k, fv_error *err)

@@ -1,7 +1,8 @@
 /* fovea — scene model and its Embree acceleration structures (see scene_impl.h for the layout).
  *
- * Limits: triangle meshes and signed distance fields (scene_sdf.c) only; rigid animation only;
- * emissive objects must be static (area lights are sampled from a table built once at commit).
+ * Limits: triangle meshes and signed distance fields (scene_sdf.c) only; rigid animation only
+ * (anim.c, for objects and delta lights alike); emissive objects must be static (area lights are
+ * sampled from a table built once at commit; a moving delta light only updates its entry).
  */
 #include <float.h>
 #include <stdio.h>
@@ -39,7 +40,7 @@ void fv_scene_destroy(fv_scene *s)
         free(o->nrm);
         free(o->idx);
         free(o->mat);
-        free(o->keys);
+        fv_anim_free(&o->anim);
         fv_sdf_destroy(o->sdf);
         if (o->rtc_child) rtcReleaseScene(o->rtc_child);
         if (s->tri_light) free(s->tri_light[i]);
@@ -51,6 +52,7 @@ void fv_scene_destroy(fv_scene *s)
     free(s->tri_light);
     free(s->objs);
     free(s->mats);
+    for (int i = 0; i < s->ndelta; i++) fv_anim_free(&s->delta[i].anim);
     free(s->delta);
     free(s->lights);
     free(s->light_cdf);
@@ -188,32 +190,25 @@ fv_status fv_scene_animate_object(fv_scene *s, int id, const fv_anim_key *keys, 
     if (st != FV_OK) return st;
     if (id < 0 || id >= s->nobj) return fv_error_set(err, FV_ERR_INVALID, "animation: object %d does not exist", id);
     fv_object *o = &s->objs[id];
-    if (count < 1) return fv_error_set(err, FV_ERR_INVALID, "animation of '%s': no keys", o->name);
-    for (int i = 0; i < count; i++) {
-        const fv_anim_key *k = &keys[i];
-        float ql = sqrtf(k->rotate.x * k->rotate.x + k->rotate.y * k->rotate.y + k->rotate.z * k->rotate.z + k->rotate.w * k->rotate.w);
-        if (!isfinite(k->time) || !fv_is_finite3(k->translate) || !fv_is_finite3(k->scale) || !(ql > 1e-6f) || !isfinite(ql))
-            return fv_error_set(err, FV_ERR_INVALID, "animation of '%s': key %d has non-finite values or a zero rotation", o->name, i);
-        if (fv_min3(k->scale) <= 0.0f)
-            return fv_error_set(err, FV_ERR_INVALID, "animation of '%s': key %d has a scale <= 0", o->name, i);
-        if (i > 0 && !(k->time > keys[i - 1].time))
-            return fv_error_set(err, FV_ERR_INVALID, "animation of '%s': key times must increase (key %d)", o->name, i);
-    }
+    char who[FV_NAME_MAX + 2];
+    snprintf(who, sizeof who, "'%s'", o->name);
+    if ((st = fv_anim_check(who, keys, count, err)) != FV_OK) return st;
     if (object_emissive(s, o))
         return fv_error_set(err, FV_ERR_INVALID, "animation of '%s': emissive objects cannot be dynamic", o->name);
-    fv_anim_key *copy = fv_alloc_array((size_t)count, sizeof *copy);
-    if (!copy) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    memcpy(copy, keys, (size_t)count * sizeof *copy);
-    for (int i = 0; i < count; i++) {
-        fv_quat q = copy[i].rotate;
-        float l = sqrtf(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
-        copy[i].rotate = (fv_quat){q.x / l, q.y / l, q.z / l, q.w / l};
-    }
-    free(o->keys);
-    o->keys = copy;
-    o->nkeys = count;
+    if ((st = fv_anim_set(&o->anim, who, keys, count, err)) != FV_OK) return st;
     o->dynamic = true;
     return FV_OK;
+}
+
+fv_status fv_scene_animate_light(fv_scene *s, int index, const fv_anim_key *keys, int count, fv_error *err)
+{
+    fv_status st = check_open(s, err);
+    if (st != FV_OK) return st;
+    if (index < 0 || index >= s->ndelta)
+        return fv_error_set(err, FV_ERR_INVALID, "animation: light %d does not exist (the scene has %d point/spot lights)", index, s->ndelta);
+    char who[32];
+    snprintf(who, sizeof who, "light %d", index);
+    return fv_anim_set(&s->delta[index].anim, who, keys, count, err);
 }
 
 fv_status fv_scene_add_light(fv_scene *s, const fv_light_desc *l, fv_error *err)
@@ -234,7 +229,9 @@ fv_status fv_scene_add_light(fv_scene *s, const fv_light_desc *l, fv_error *err)
     }
     if (fv_grow((void **)&s->delta, &s->capdelta, s->ndelta + 1, sizeof *s->delta))
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    s->delta[s->ndelta++] = c;
+    s->delta[s->ndelta].desc = c;
+    s->delta[s->ndelta].anim = (fv_anim){NULL, 0};
+    s->ndelta++;
     return FV_OK;
 }
 
@@ -242,15 +239,21 @@ fv_status fv_scene_add_light(fv_scene *s, const fv_light_desc *l, fv_error *err)
 
 static fv_xform anim_eval(const fv_object *o, double t)
 {
-    const fv_anim_key *k = o->keys;
-    int n = o->nkeys;
-    if (n == 1 || t <= k[0].time) return fv_xform_trs(k[0].translate, k[0].rotate, k[0].scale);
-    if (t >= k[n - 1].time) return fv_xform_trs(k[n - 1].translate, k[n - 1].rotate, k[n - 1].scale);
-    int i = 0;
-    while (i + 1 < n && k[i + 1].time <= t) i++;
-    float a = (float)((t - k[i].time) / (k[i + 1].time - k[i].time));
-    return fv_xform_trs(fv_lerp3(k[i].translate, k[i + 1].translate, a), fv_quat_slerp(k[i].rotate, k[i + 1].rotate, a),
-                        fv_lerp3(k[i].scale, k[i + 1].scale, a));
+    fv_anim_key k = fv_anim_at(&o->anim, t);
+    return fv_anim_key_xform(&k);
+}
+
+/* Delta light entry l at time t: the key's transform moves the light's position, its rotation
+ * turns a spot's axis (a scale would otherwise tilt it). */
+static void light_move(const fv_delta *d, fv_light *l, double t)
+{
+    fv_anim_key k = fv_anim_at(&d->anim, t);
+    fv_xform x = fv_anim_key_xform(&k);
+    l->desc.pos = fv_xform_point(&x, d->desc.pos);
+    if (d->desc.type == FV_LIGHT_SPOT) {
+        fv_xform r = fv_xform_trs(fv_v3s(0.0f), k.rotate, fv_v3s(1.0f));
+        l->desc.dir = fv_normalize(fv_xform_vector(&r, d->desc.dir));
+    }
 }
 
 static void bounds_add_box(fv_vec3 *lo, fv_vec3 *hi, const fv_xform *x, fv_vec3 a, fv_vec3 b)
@@ -309,10 +312,12 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
     s->tri_light = fv_calloc_array((size_t)s->nobj, sizeof(int *));
     if (!s->lights || !s->light_cdf || !s->tri_light) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building lights");
     int k = 0;
+    s->lights_move = false;
     for (int i = 0; i < s->ndelta; i++) {
         fv_light *l = &s->lights[k];
         l->kind = 0;
-        l->desc = s->delta[i];
+        l->desc = s->delta[i].desc;
+        l->delta = i;
         float lum = fv_luminance(l->desc.intensity);
         if (l->desc.type == FV_LIGHT_POINT) {
             l->power = 4.0f * FV_PI * lum;
@@ -323,8 +328,12 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
         /* An emitted power beyond the float range would turn the whole pick table into NaN and
          * silently switch every light off. */
         if (!isfinite(l->power)) return fv_error_set(err, FV_ERR_INVALID, "light %d: intensity %g emits more power than a float holds", i, lum);
-        if (l->power > 0.0f) k++;
+        if (l->power > 0.0f) {
+            k++;
+            s->lights_move |= s->delta[i].anim.nkeys > 0;
+        }
     }
+    s->nlights_delta = k;
     for (int i = 0; i < s->nobj; i++) {
         fv_object *o = &s->objs[i];
         if (!object_emissive(s, o)) continue;
@@ -379,8 +388,8 @@ fv_status fv_scene_commit(fv_scene *s, const fv_log *log, fv_error *err)
             bounds_add_box(&s->lo, &s->hi, &o->xf, o->lo, o->hi);
             continue;
         }
-        for (int k = 0; k < o->nkeys; k++) {
-            fv_xform x = anim_eval(o, o->keys[k].time);
+        for (int k = 0; k < o->anim.nkeys; k++) {
+            fv_xform x = anim_eval(o, o->anim.keys[k].time);
             bounds_add_box(&s->lo, &s->hi, &x, o->lo, o->hi);
         }
     }
@@ -455,6 +464,11 @@ fv_status fv_scene_set_time(fv_scene *s, double t, fv_error *err)
     if (!isfinite(t)) return fv_error_set(err, FV_ERR_INVALID, "scene time must be finite");
     if (t == s->time) return FV_OK;
     s->time = t;
+    /* Lights first: a scene whose only motion is its lights has no dynamic object to update. */
+    for (int i = 0; i < s->nlights_delta && s->lights_move; i++) {
+        fv_light *l = &s->lights[i];
+        if (s->delta[l->delta].anim.nkeys > 0) light_move(&s->delta[l->delta], l, t);
+    }
     if (s->ndynamic == 0) return FV_OK;
     for (int i = 0; i < s->nobj; i++) {
         fv_object *o = &s->objs[i];

@@ -16,6 +16,7 @@
 #include <embree3/rtcore.h>
 #include "fovea/scene.h"
 #include "fovea/sdf.h"
+#include "scene/anim.h"
 #include "scene/query.h"
 
 typedef struct fv_object {
@@ -29,17 +30,23 @@ typedef struct fv_object {
     int *mat;            /* per-triangle material ids */
     int nv, nt;
     bool dynamic;
-    fv_anim_key *keys;
-    int nkeys;
+    fv_anim anim;        /* dynamic objects: their keys */
     fv_xform xf, inv;    /* object -> world at the current time, and its inverse */
     RTCScene rtc_child;  /* dynamic objects: the object's own scene */
     fv_vec3 lo, hi;      /* object-space bounds */
 } fv_object;
 
+/* A delta light as added, and its keys when it moves (fv_scene_animate_light). */
+typedef struct fv_delta {
+    fv_light_desc desc;  /* as given, direction normalised: where it stands when not animated */
+    fv_anim anim;
+} fv_delta;
+
 /* One sampleable light: a delta light or an emissive triangle. */
 typedef struct fv_light {
     int kind;            /* 0: delta light (desc), 1: emissive triangle */
-    fv_light_desc desc;
+    fv_light_desc desc;  /* delta light at the scene's current time: what the samplers read */
+    int delta;           /* delta light: its index in fv_scene.delta */
     int obj, prim;       /* emissive triangle */
     float area;
     fv_vec3 n;           /* unit geometric normal of the triangle */
@@ -53,13 +60,15 @@ struct fv_scene {
     int nmat, capmat;
     fv_object *objs;
     int nobj, capobj;
-    fv_light_desc *delta;
+    fv_delta *delta;           /* delta lights in the order they were added */
     int ndelta, capdelta;
 
     /* Built at commit. */
     bool committed;
-    fv_light *lights;
+    fv_light *lights;          /* the delta lights that emit first (in the order added), then triangles */
     int nlights;
+    int nlights_delta;         /* how many of lights[] are delta lights */
+    bool lights_move;          /* some delta light has keys */
     float *light_cdf;          /* nlights + 1 entries, light_cdf[nlights] = 1 */
     int **tri_light;           /* per object: per triangle light index or -1 (NULL: none) */
     RTCDevice dev;

@@ -24,6 +24,7 @@ expect 2 "bad_syntax.json:4:" -- $R "$D/bad_syntax.json" --size 8x8 --out "$OUT"
 expect 2 "unknown field 'albdo'" -- $R "$D/bad_field.json" --size 8x8 --out "$OUT"
 expect 2 "unknown material 'whte'" -- $R "$D/bad_material.json" --size 8x8 --out "$OUT"
 expect 2 "materials.white.emission" -- $R "$D/bad_inf.json" --size 8x8 --out "$OUT"
+expect 2 "lights[1].animation: animation of light 1: key times must increase" -- $R "$D/bad_light_anim.json" --size 8x8 --out "$OUT"
 expect 2 "unknown or incomplete option" -- $R cornell --frobnicate
 expect 2 "unknown command" -- $FOVEA frobnicate
 [ -e "$OUT" ] && fail "a failed render left $OUT behind"

@@ -340,10 +340,10 @@ static void test_city(void **st)
      * is the open ground, 6 below. */
     int ground = fv_scene_find_material(a, "ground"), points = 0;
     for (int i = 0; i < a->ndelta; i++) {
-        if (a->delta[i].type != FV_LIGHT_POINT) continue;
+        if (a->delta[i].desc.type != FV_LIGHT_POINT) continue;
         points++;
         fv_hit g;
-        assert_true(fv_scene_intersect(a, FV_TRACE_ALL, a->delta[i].pos, fv_v3(0, -1, 0), 1e30f, &g));
+        assert_true(fv_scene_intersect(a, FV_TRACE_ALL, a->delta[i].desc.pos, fv_v3(0, -1, 0), 1e30f, &g));
         assert_int_equal(g.mat, ground);
         assert_float_equal(g.t, 6.0, 1e-3);
     }

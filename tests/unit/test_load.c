@@ -20,6 +20,7 @@
 #include <unistd.h>
 #include <cmocka.h>
 #include "fovea/fovea.h"
+#include "scene/light.h"
 #include "scene/scene_impl.h"
 #include "testkit.h"
 
@@ -125,11 +126,11 @@ static void test_gltf_pbr(void **state)
     /* Two delta lights and the glowing quad's two triangles. */
     assert_int_equal(fv_scene_light_count(s), 4);
     assert_int_equal(s->ndelta, 2);
-    const fv_light_desc *l = &s->delta[0];
+    const fv_light_desc *l = &s->delta[0].desc;
     assert_int_equal(l->type, FV_LIGHT_POINT);
     assert_vec3(l->pos, 1, 4, 11, 1e-5f);
     assert_vec3(l->intensity, 8, 4, 2, 1e-5f);
-    l = &s->delta[1];
+    l = &s->delta[1].desc;
     assert_int_equal(l->type, FV_LIGHT_SPOT);
     assert_vec3(l->pos, 3, 6, 11, 1e-5f);
     assert_vec3(fv_normalize(l->dir), 0, -1, 0, 1e-5f);
@@ -281,6 +282,40 @@ static void expect_bad_text(const char *text, const char *needle)
     unlink(path);
 }
 
+/* A light's "animation" takes the objects' keys: a spot carried 2 along x and turned a quarter
+ * about z (rotate_deg) in one second; lights[1] is light 1. */
+static void test_json_light_animation(void **state)
+{
+    (void)state;
+    static const char text[] =
+        "{\"materials\": {\"w\": {}}, \"objects\": [{\"quad\": [[-1,0,-1],[-1,0,1],[1,0,1],[1,0,-1]], \"material\": \"w\"}],\n"
+        " \"lights\": [{\"pos\": [0,3,0]},\n"
+        "  {\"type\": \"spot\", \"pos\": [0,1,0], \"dir\": [0,-1,0], \"animation\": [{\"time\": 0},\n"
+        "   {\"time\": 1, \"translate\": [2,0,0], \"rotate_deg\": [0,0,90]}]}]}";
+    char path[] = "/tmp/fovea_test_load_XXXXXX.json";
+    int fd = mkstemps(path, 5);
+    assert_true(fd >= 0);
+    FILE *f = fdopen(fd, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    fv_scene *s = load_ok(path, NULL, NULL);
+    unlink(path);
+    assert_true(fv_scene_lights_move(s));
+    assert_int_equal(fv_light_delta_count(s), 2);
+    fv_error err;
+    assert_int_equal(fv_scene_set_time(s, 1.0, &err), FV_OK);
+    assert_vec3(fv_light_delta_pos(fv_light_delta_at(s, 0)), 0, 3, 0, 0);
+    /* (0, 1, 0) turned a quarter about z is (-1, 0, 0), then moved 2 along x; the axis -y turns to +x. */
+    const fv_light *spot = fv_light_delta_at(s, 1);
+    assert_vec3(fv_light_delta_pos(spot), 1, 0, 0, 1e-5f);
+    assert_float_equal(fv_light_delta_intensity(spot, fv_v3(1, 0, 0)).x, 1.0f, 1e-5);
+    assert_int_equal(fv_scene_set_time(s, 0.5, &err), FV_OK);
+    float h = sqrtf(0.5f);
+    assert_vec3(fv_light_delta_pos(spot), 1 - h, h, 0, 1e-5f);
+    fv_scene_destroy(s);
+}
+
 static void test_errors(void **state)
 {
     (void)state;
@@ -302,6 +337,14 @@ static void test_errors(void **state)
     expect_bad_text(buf, "objects[0].transform: give rotate_deg or rotate_quat");
     snprintf(buf, sizeof buf, "{\"materials\": {\"w\": {}}, \"objects\": [{%s, \"animation\": [{\"time\": 1}, {\"time\": 1}]}]}", quad);
     expect_bad_text(buf, "objects[0]");
+    snprintf(buf, sizeof buf, "{\"materials\": {\"w\": {}}, \"objects\": [{%s}], \"lights\": [{\"pos\": [0,1,0], \"animation\": [{\"time\": 0}, {\"time\": 1, \"rotate_quat\": [0,0,0,0]}]}]}", quad);
+    expect_bad_text(buf, "lights[0].animation[1].rotate_quat: not a rotation");
+    snprintf(buf, sizeof buf, "{\"materials\": {\"w\": {}}, \"objects\": [{%s}], \"lights\": [{\"pos\": [0,1,0], \"animation\": [{\"time\": 1}, {\"time\": 0}]}]}", quad);
+    expect_bad_text(buf, "lights[0].animation: animation of light 0: key times must increase (key 1)");
+    snprintf(buf, sizeof buf, "{\"materials\": {\"w\": {}}, \"objects\": [{%s}], \"lights\": [{\"pos\": [0,1,0], \"animation\": [{\"time\": 0, \"spin\": 1}]}]}", quad);
+    expect_bad_text(buf, "lights[0].animation[0]: unknown field 'spin'");
+    snprintf(buf, sizeof buf, "{\"materials\": {\"w\": {}}, \"objects\": [{%s}], \"lights\": [{\"pos\": [0,1,0], \"animation\": {\"time\": 0}}]}", quad);
+    expect_bad_text(buf, "lights[0].animation: expected an array of keys");
     snprintf(buf, sizeof buf, "{\"materials\": {\"w\": {}}, \"objects\": [{%s, \"transform\": {\"scale\": 1e999}}]}", quad);
     expect_bad_text(buf, "objects[0].transform.scale: expected a finite number");
     snprintf(buf, sizeof buf, "{\"materials\": {\"w\": {\"type\": \"metal\"}}, \"objects\": [{%s}]}", quad);
@@ -343,7 +386,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mtl_rules),        cmocka_unit_test(test_gltf_pbr),       cmocka_unit_test(test_json_transforms),
         cmocka_unit_test(test_open_uncommitted), cmocka_unit_test(test_example_scenes), cmocka_unit_test(test_embree_cornell),
-        cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_json_light_animation), cmocka_unit_test(test_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -16,6 +16,12 @@
  * irradiance-cache blending the paper cites. Eq. 4's W uses sum(M_ld) + sum(M_fd) / eta in the
  * numerator (the seed's README notes the printed duplicate).
  *
+ * Moving lights (fv_scene_animate_light) are outside the paper, whose lights stand still: they
+ * relight static surfaces, so M_ls is no longer valid for every frame and a kept foveated path's
+ * flux goes stale. With them, pm-t and fpm retrace M_ls every frame and fpm keeps no foveated path
+ * across frames (as with tpm=false); both say so once when created. Only what the dynamic objects
+ * change is still split off into M_ld and M_fd, as in any single frame.
+ *
  * Stereo (Sec. 3.3): the left eye is shaded fully; each right-eye pixel whose first surface
  * reprojects onto the same surface in the left image copies that colour, the others are shaded.
  * The driver renders the left eye first: its colour, first hits, gather radius and eta are kept
@@ -28,6 +34,7 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "filter/atrous.h"
+#include "scene/light.h"
 #include "technique/class.h"
 #include "technique/kit.h"
 #include "technique/photon/foveated.h"
@@ -56,6 +63,7 @@ typedef struct pm_state {
     pm_opts o;
     fv_photon_map ls, ld, all;
     bool ls_done;
+    bool lights_move;     /* the scene's lights move: nothing lit by them is kept across frames */
     fv_dyn_dirs *dirs;
     fv_foveated *fov;
     int fov_w, fov_h;
@@ -112,7 +120,8 @@ static fv_status read_opts(pm_mode mode, fv_params *p, pm_opts *o, fv_error *err
     return FV_OK;
 }
 
-static fv_status pm_create_mode(pm_mode mode, const fv_scene *scene, fv_params *params, void **state, fv_error *err)
+static fv_status pm_create_mode(pm_mode mode, const fv_scene *scene, fv_params *params, const fv_log *log, void **state,
+                                fv_error *err)
 {
     pm_state *st = calloc(1, sizeof *st);
     if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
@@ -128,6 +137,10 @@ static fv_status pm_create_mode(pm_mode mode, const fv_scene *scene, fv_params *
         free(st);
         return s;
     }
+    st->lights_move = mode != MODE_PM && fv_scene_lights_move(scene);
+    if (st->lights_move)
+        fv_log_warn(log, "%s: the scene's lights move, so its light photons are retraced every frame%s",
+                    mode == MODE_PMT ? "pm-t" : "fpm", mode == MODE_FPM ? " and no foveated path is kept across frames" : "");
     *state = st;
     return FV_OK;
 }
@@ -329,16 +342,19 @@ static fv_status light_tracing(pm_state *st, const fv_frame *frame, float cell, 
     } else {
         bool dyn = fv_scene_dynamic_object_count(s) > 0;
         double n_ls = dyn ? n_light * (1.0 - st->o.dyn_fraction) : n_light, n_ld = dyn ? n_light - n_ls : 0.0;
-        if (!st->ls_done) {
+        bool fresh = !st->ls_done || st->lights_move;
+        if (fresh) {
+            fv_photon_map_clear(&st->ls);
             job.count = (int64_t)n_ls;
-            job.frame = 0; /* traced once, valid for every frame */
+            /* traced once, valid for every frame, unless the lights move */
+            job.frame = st->lights_move ? frame->index : 0;
             job.stream = 1;
             rc = fv_photon_trace_lights(&job, FV_TRACE_STATIC, &st->ls, &rays, err);
             st->ls_done = rc == FV_OK;
             if (!st->ls_done) fv_photon_map_clear(&st->ls); /* a cancelled trace must not leave half a map */
             job.frame = frame->index;
         }
-        if (rc == FV_OK && st->ls.cell != cell) rc = fv_photon_map_build(&st->ls, cell, err);
+        if (rc == FV_OK && (fresh || st->ls.cell != cell)) rc = fv_photon_map_build(&st->ls, cell, err);
         fv_photon_map_clear(&st->ld);
         if (rc == FV_OK && n_ld >= 1.0) {
             if ((rc = fv_dyn_dirs_build(st->dirs, s, err)) == FV_OK) {
@@ -449,7 +465,8 @@ static fv_status foveated_photons(pm_state *st, render_ctx *c, int w, int h, flo
     fv_fov_stats fs;
     memset(&fs, 0, sizeof fs);
     double t0 = fv_time_ms();
-    const fv_camera *prev = st->o.tpm ? frame->prev_camera : NULL;
+    /* No previous camera: Alg. 2 then deletes every old path, whose flux moving lights made stale. */
+    const fv_camera *prev = st->o.tpm && !st->lights_move ? frame->prev_camera : NULL;
     if (rc == FV_OK) rc = fv_foveated_manage(st->fov, s, frame->camera, prev, c->eye, frame->gaze, frame->threads, &fs, err);
     fv_stats_add_ms(stats, "tpm", fv_time_ms() - t0);
     t0 = fv_time_ms();
@@ -568,18 +585,15 @@ static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv
 
 static fv_status pm_create(const fv_scene *s, fv_params *p, const fv_log *log, void **state, fv_error *err)
 {
-    (void)log;
-    return pm_create_mode(MODE_PM, s, p, state, err);
+    return pm_create_mode(MODE_PM, s, p, log, state, err);
 }
 static fv_status pmt_create(const fv_scene *s, fv_params *p, const fv_log *log, void **state, fv_error *err)
 {
-    (void)log;
-    return pm_create_mode(MODE_PMT, s, p, state, err);
+    return pm_create_mode(MODE_PMT, s, p, log, state, err);
 }
 static fv_status fpm_create(const fv_scene *s, fv_params *p, const fv_log *log, void **state, fv_error *err)
 {
-    (void)log;
-    return pm_create_mode(MODE_FPM, s, p, state, err);
+    return pm_create_mode(MODE_FPM, s, p, log, state, err);
 }
 
 #define COMMON_HELP                                                                                 \
