@@ -400,6 +400,10 @@ static fv_status compile_node(compiler *cc, int i, int depth, box3 *out)
         }
         EMIT(op, FV_OP_REPEAT_POP);
         op->f[0] = isfinite(margin) ? margin : 0.0f;
+        for (int k = 0; k < 3; k++) {
+            op->f[1 + k] = fmaxf(out->lo[k], -1e30f);
+            op->f[4 + k] = fminf(out->hi[k], 1e30f);
+        }
         break;
     }
     default: return fv_error_set(cc->err, FV_ERR_INTERNAL, "sdf node %d: unexpected kind", i);

@@ -276,9 +276,18 @@ static inline void k_eval(const fv_sdf *s, kf x0, kf y0, kf z0, kf *dout, ki *mo
             /* The child lies at least m inside its cell, every other copy in another cell: the
              * copies elsewhere are at least w + m away (w: distance to this cell's walls), and the
              * own copy at least m - w. min(max(d, m - w), w + m) is therefore a lower bound, equal
-             * to min(d', m) on both sides of a wall, hence continuous and 1-Lipschitz. */
+             * to min(d', m) on both sides of a wall, hence continuous and 1-Lipschitz. Every copy
+             * also lies in the repetition's box (f1..3, f4..6, in the parent's space), so the
+             * distance e to that box bounds them all: outside the box max(.., e) is still a lower
+             * bound, still continuous and 1-Lipschitz (e and the field are both >= 0 at the box),
+             * and no longer caps the distance at w + m far above a repeated floor, where w + m
+             * alone stops rays on phantom walls along the cells' borders. */
             kf w = PW[pt], m = k_splat(f[0]);
-            DS[dt - 1] = k_min(k_max(DS[dt - 1], m - w), w + m);
+            kf px = PX[pt - 1], py = PY[pt - 1], pz = PZ[pt - 1];
+            kf ex = k_max(k_max(f[1] - px, px - f[4]), zero), ey = k_max(k_max(f[2] - py, py - f[5]), zero);
+            kf ez = k_max(k_max(f[3] - pz, pz - f[6]), zero);
+            kf v = k_min(k_max(DS[dt - 1], m - w), w + m), e = k_len3(ex, ey, ez);
+            DS[dt - 1] = k_sel(e > zero, k_max(v, e), v); /* e is 0 inside the box: keep the sign */
             pt--;
             break;
         }

@@ -29,7 +29,8 @@ typedef enum fv_sdf_opcode {
     FV_OP_XFORM_PUSH,   /* f0..8 R^T row-major, f9..11 t, f12 1/s */
     FV_OP_XFORM_POP,    /* f0 s */
     FV_OP_REPEAT_PUSH,  /* f0..2 period (0: none), f3..5 1/period, f6..8 cell limit n (0: none) */
-    FV_OP_REPEAT_POP    /* f0 margin m between the child's bounds and its cell */
+    FV_OP_REPEAT_POP    /* f0 margin m between the child's bounds and its cell, f1..3 / f4..6 the box
+                           holding every copy (+-1e30 where unlimited) */
 } fv_sdf_opcode;
 
 typedef struct fv_sdf_op {

@@ -331,7 +331,11 @@ static void test_repeat(void **st)
     AT(s, 4, 0, 0, -0.5f);                      /* a copy's centre */
     AT(s, 4.6f, 0, 0, 0.1f);                    /* q = 0.6, wall 0.4: min(max(0.1, 0.1), 0.9) */
     AT(s, 5, 0, 0, 0.5f);                       /* on the wall: exact, 1 - 0.5 */
-    AT(s, 4, 3, 0, 1.5f);                       /* true 2.5; the bound caps at wall + m = 1 + 0.5 */
+    /* Above the row, wall + m = 1.5 would cap the distance; the box holding every copy (|y|, |z|
+     * <= 0.5) lifts it to 2.5: exact over a centre, under the true sqrt(10) - 0.5 over a wall. */
+    AT(s, 4, 3, 0, 2.5f);
+    AT(s, 5, 3, 0, 2.5f);
+    AT(s, 4, 0.4f, 0.4f, 0.0656854f);           /* inside that box: exact, sqrt(0.32) - 0.5 */
     AT(s, -6.2f, 0, 0, -0.3f);
     fv_sdf_destroy(s);
     /* Limited to cells -1..1 (copies at -2, 0, 2): beyond the last cell the distance is exact. */
