@@ -44,6 +44,16 @@ static bool lane_advance(lane *l, const fv_march_ray *r, float d, int m, int max
         l->omega = 1.0f;
         l->step = l->r_prev;
         l->t = l->t_prev + l->step;
+    } else if (!any_hit && d < -fmaxf(r->eps, r->eps_k * l->t) && l->t + d >= 0.0f) {
+        /* The point is inside a solid: a pyramid level's start (the 3x3 minimum of the depths one
+         * level down) can still lie behind a convex surface. |d| never reaches past the surface,
+         * so stepping back by it walks out to where the ray enters the solid, instead of taking
+         * the point inside for a hit. */
+        l->t += d;
+        l->t_prev = l->t;
+        l->r_prev = 0.0f;
+        l->step = 0.0f;
+        l->omega = 1.0f;
     } else {
         float eps = fmaxf(r->eps, r->eps_k * l->t);
         if (d < eps) {

@@ -18,7 +18,9 @@
  * max(eps, eps_k t) (eps_k a fraction of the ray's footprint per unit distance, so coarse pyramid
  * levels stop earlier, in front of the surface); a miss when t passes t1; a ray still marching
  * after max_steps evaluations counts as a hit where it stands (grazing rays along silhouettes), or
- * for a shadow ray as not blocked.
+ * for a shadow ray as not blocked. A camera ray whose point lies inside a solid (distance below
+ * minus the hit distance: a pyramid start behind a surface) steps back by the distance until it
+ * reaches the surface it entered by; a shadow ray there is blocked.
  */
 #ifndef FV_SDF_MARCH_H
 #define FV_SDF_MARCH_H
