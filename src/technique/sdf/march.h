@@ -15,12 +15,14 @@
  * scalar loop" the issue compares against) give bit-identical results in any order.
  *
  * Termination, after the shader convention of the paper's scenes: a hit when the distance is under
- * max(eps, eps_k t) (eps_k a fraction of the ray's footprint per unit distance, so coarse pyramid
- * levels stop earlier, in front of the surface); a miss when t passes t1; a ray still marching
+ * max(eps, eps_k t) (eps_k: a fraction of a target sample's footprint per unit distance, the same
+ * on every pyramid level); a miss when t passes t1; a ray still marching
  * after max_steps evaluations counts as a hit where it stands (grazing rays along silhouettes), or
  * for a shadow ray as not blocked. A camera ray whose point lies inside a solid (distance below
  * minus the hit distance: a pyramid start behind a surface) steps back by the distance until it
- * reaches the surface it entered by; a shadow ray there is blocked.
+ * reaches the surface it entered by; a shadow ray there is blocked. (The paper's shader takes such a
+ * point for a hit; stepping back is ours, docs/sdf-tracing.md: it only changes pixels the 3x3
+ * minimum failed to protect.)
  */
 #ifndef FV_SDF_MARCH_H
 #define FV_SDF_MARCH_H
