@@ -9,7 +9,7 @@ python3 - "$OUT/sdf-quality.json" <<'PY' || fail "sdf-quality.json is incomplete
 import json, sys
 d = json.load(open(sys.argv[1]))
 rows = {r["method"]: r for r in d["results"]}
-assert set(rows) == {"gt", "relaxed", "ipr", "ipr-nomin", "fipr", "fipr-r4", "fipr-blur"}, list(rows)
+assert set(rows) == {"gt", "relaxed", "ipr", "ipr-nomin", "ipr-sr", "fipr", "fipr-r4", "fipr-blur", "fipr-r4-sr"}, list(rows)
 gt, ipr, nomin, fipr = rows["gt"], rows["ipr"], rows["ipr-nomin"], rows["fipr"]
 # the reference is sdf-gt itself: gt's error is exactly zero
 assert gt["error"]["all"]["mse"] == 0.0, gt["error"]["all"]
@@ -26,6 +26,10 @@ assert nomin["error"]["all"]["mse"] > 10 * ipr["error"]["all"]["mse"], (nomin["e
 assert abs(fipr["error"]["fovea"]["mse"] - ipr["error"]["fovea"]["mse"]) <= 1e-9, (fipr["error"]["fovea"], ipr["error"]["fovea"])
 assert 0 < fipr["counters"]["mask_pixels"] < fipr["counters"]["samples"]
 assert fipr["counters"]["rays_level2"] == fipr["counters"]["mask_pixels"]
+# shadow_reuse (ours) traces fewer shadow steps for nearly the same image
+sr = rows["ipr-sr"]
+assert sr["counters"]["shadow_steps"] < ipr["counters"]["shadow_steps"], (sr["counters"], ipr["counters"])
+assert sr["error"]["all"]["ssim"] > ipr["error"]["all"]["ssim"] - 0.02, (sr["error"]["all"], ipr["error"]["all"])
 # refresh 1/4 shades fewer middle-level rays per frame than refresh 1
 assert rows["fipr-r4"]["counters"]["refreshed_pixels"] < fipr["counters"]["refreshed_pixels"]
 PY

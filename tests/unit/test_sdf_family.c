@@ -1034,6 +1034,44 @@ static void test_shading_vs_pt(void **st)
     fv_scene_destroy(s);
 }
 
+/* ======================================================================================== */
+/* shadow_reuse (ours): shadows from the level below where its 3x3 agree                     */
+/* ======================================================================================== */
+
+/* On sdf-columns (five lights, shadows of columns on the floor and walls) shadow_reuse traces
+ * fewer shadow steps; the pixels it changes are few, near shadow edges; and without shadows it
+ * changes nothing (every sample then sees every light facing it). */
+static void test_shadow_reuse(void **st)
+{
+    (void)st;
+    fv_camera cam;
+    fv_scene *s = load("sdf-columns", 320, 256, &cam);
+    shot a = render1("ipr", s, &cam, ""), b = render1("ipr", s, &cam, "shadow_reuse=true");
+    double sa = fv_stats_get_count(&a.stats, "shadow_steps"), sb = fv_stats_get_count(&b.stats, "shadow_steps");
+    int off = 0;
+    for (size_t i = 0; i < npix(&a); i++) off += pix_diff(&a, &b, i) > 1e-3f;
+    print_message("sdf-columns 320x256: shadow steps %.0f -> %.0f (%.3f), %d of %zu pixels differ by > 1e-3\n", sa, sb, sb / sa, off,
+                  npix(&a));
+    assert_true(sb < 0.9 * sa); /* 0.78 here; the share grows with the resolution (0.62 at 360x400) */
+    assert_true(off < 0.02 * (double)npix(&a));
+    drop(&a);
+    drop(&b);
+    /* the camera rays are the pyramid's either way */
+    a = render1("ipr", s, &cam, "shadows=false");
+    b = render1("ipr", s, &cam, "shadows=false shadow_reuse=true");
+    assert_memory_equal(col(&a), col(&b), 3 * npix(&a) * sizeof(float));
+    drop(&a);
+    drop(&b);
+    /* fipr takes it too: its mask pixels trace fewer shadow steps for the same mask */
+    a = render1("fipr", s, &cam, "");
+    b = render1("fipr", s, &cam, "shadow_reuse=true");
+    assert_true(fv_stats_get_count(&a.stats, "mask_pixels") == fv_stats_get_count(&b.stats, "mask_pixels"));
+    assert_true(fv_stats_get_count(&b.stats, "steps") == fv_stats_get_count(&a.stats, "steps"));
+    drop(&a);
+    drop(&b);
+    fv_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1042,6 +1080,7 @@ int main(void)
         cmocka_unit_test(test_simd_identical),   cmocka_unit_test(test_spp_edges),        cmocka_unit_test(test_thin_min_filter),
         cmocka_unit_test(test_ipr_vs_gt),        cmocka_unit_test(test_fipr_mask),        cmocka_unit_test(test_fipr_refresh),
         cmocka_unit_test(test_fipr_fovea),       cmocka_unit_test(test_furnace_exact),    cmocka_unit_test(test_shading_vs_pt),
+        cmocka_unit_test(test_shadow_reuse),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

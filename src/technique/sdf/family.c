@@ -45,7 +45,8 @@ static fv_status read_opts(fv_sdf_method m, fv_params *p, fv_sdf_opts *o, fv_err
     if (m == FV_SDF_IPR || m == FV_SDF_FIPR) {
         int lo = m == FV_SDF_FIPR ? 3 : 1;
         if ((s = fv_params_int(p, "levels", 3, -1000000, 1000000, &o->levels, err)) ||
-            (s = fv_params_bool(p, "min_filter", true, &o->min_filter, err)))
+            (s = fv_params_bool(p, "min_filter", true, &o->min_filter, err)) ||
+            (s = fv_params_bool(p, "shadow_reuse", false, &o->shadow_reuse, err)))
             return s;
         if (o->levels < lo || o->levels > FV_PYRAMID_MAX_LEVELS)
             return fv_error_set(err, FV_ERR_INVALID, "parameter levels=%d must be in [%d, %d]%s", o->levels, lo, FV_PYRAMID_MAX_LEVELS,
@@ -142,12 +143,14 @@ SDF_CLASS(fv_technique_ipr, "ipr", "inverted-pyramid sphere tracing: each level 
           "levels=int (3): pyramid levels, 1 = sdf-gt (the tip has 1/4^(levels-1) of the rays)\n"
           "min_filter=bool (true): start at the 3x3 minimum of the depths below (false: the parent's depth)\n"
           "relax=float (1): over-relaxation of every level's march, in [1, 2)\n"
+          "shadow_reuse=bool (false): ours, for a CPU: take shadows from the level below where its 3x3 agree\n"
           "show=image|steps|level (image): the image, steps per ray, or the level each pixel came from\n",
           create_ipr);
 SDF_CLASS(fv_technique_fipr, "fipr", "foveated inverted-pyramid sphere tracing: the five passes of Polychronakis et al. 2023",
           "levels=int (3): pyramid levels, 3 to 6\n"
           "min_filter=bool (true): start at the 3x3 minimum of the depths below\n"
           "relax=float (1): over-relaxation of every level's march, in [1, 2)\n"
+          "shadow_reuse=bool (false): ours, for a CPU: take shadows from the level below where its 3x3 agree\n"
           "fovea_deg=float (7.5): eccentricity traced at the target level (the mask is 1)\n"
           "outer_deg=float (30): eccentricity beyond which the mask is 0, edges included\n"
           "edge=float (0.25): Sobel threshold on the tip's depth, relative to the depth\n"

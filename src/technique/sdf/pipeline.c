@@ -33,6 +33,7 @@ struct fv_sdf_pipeline {
     float *heat;       /* pixels: camera-ray steps per sample */
     uint8_t *level_of; /* pixels */
     float *sigma;      /* fipr pass 5, pixels */
+    uint32_t *vis;     /* shadow_reuse: which lights reach each hit of level L-2 (shade.h) */
 };
 
 static void free_scratch(fv_sdf_pipeline *p)
@@ -49,6 +50,8 @@ static void free_scratch(fv_sdf_pipeline *p)
     free(p->heat);
     free(p->level_of);
     free(p->sigma);
+    free(p->vis);
+    p->vis = NULL;
     p->need = p->edge = p->mask = p->level_of = NULL;
     p->heat = p->sigma = NULL;
     p->w = p->h = 0;
@@ -97,6 +100,7 @@ static fv_status ensure_size(fv_sdf_pipeline *p, int w, int h, fv_error *err)
         ok &= (p->depth[k] = fv_alloc_array(n, sizeof(float))) != NULL;
         ok &= (p->steps[k] = fv_calloc_array(n, sizeof(uint16_t))) != NULL;
     }
+    if (p->o.shadow_reuse && L > 1) ok &= (p->vis = fv_alloc_array((size_t)p->lv[L - 2].w * p->lv[L - 2].h, sizeof(uint32_t))) != NULL;
     size_t np = (size_t)w * h;
     ok &= (p->heat = fv_alloc_array(np, sizeof(float))) != NULL;
     ok &= (p->level_of = fv_alloc_array(np, 1)) != NULL;
@@ -171,7 +175,8 @@ static void camera_ray(const job *j, float sx, float sy, float eps_k, fv_march_r
 }
 
 /* Marches and (when colour is not NULL) shades n rays, counting what they cost on this thread. */
-static void trace(job *j, int thread, int level, fv_march_ray *rays, fv_march_hit *hits, int n, fv_vec3 *colour, fv_vec3 *normal)
+static void trace(job *j, int thread, int level, fv_march_ray *rays, fv_march_hit *hits, int n, const uint32_t *vis_in, fv_vec3 *colour,
+                  fv_vec3 *normal)
 {
     fv_sdf_pipeline *p = j->p;
     fv_march(&j->world, &p->o.march, rays, hits, n, false);
@@ -185,7 +190,7 @@ static void trace(job *j, int thread, int level, fv_march_ray *rays, fv_march_hi
     if (!colour) return;
     fv_sdf_shade_counts sc = {0, 0, 0};
     fv_error e;
-    fv_status s = fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, colour, normal, &sc, &e);
+    fv_status s = fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, vis_in, NULL, colour, normal, &sc, &e);
     if (s != FV_OK) j->status[thread] = s;
     fv_kit_count(j->c, thread, C_SHADOW, sc.shadow_steps);
     fv_kit_count(j->c, thread, C_NORMAL, sc.normal_evals);
@@ -194,18 +199,39 @@ static void trace(job *j, int thread, int level, fv_march_ray *rays, fv_march_hi
 
 /* ---- a lower level: every ray (or, for fipr's middle level, those `need` asks for) ---- */
 
+/* Shades (colour NULL: visibility only) a compacted batch of a level's rays, counting the cost;
+ * with shadow_reuse the visibility lands in p->vis at the rays' indices. */
+static void shade_level(job *j, int thread, fv_march_ray *rays, fv_march_hit *hits, const int *at, int n, fv_vec3 *colour)
+{
+    fv_sdf_pipeline *p = j->p;
+    if (n == 0) return;
+    fv_sdf_shade_counts sc = {0, 0, 0};
+    fv_error e;
+    uint32_t *bits = p->vis ? malloc((size_t)n * sizeof *bits) : NULL;
+    fv_status s = p->vis && !bits ? FV_ERR_NOMEM
+                                   : fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, NULL, bits, colour, NULL, &sc, &e);
+    if (s != FV_OK) j->status[thread] = s;
+    if (bits && s == FV_OK)
+        for (int r = 0; r < n; r++) p->vis[at[r]] = bits[r];
+    free(bits);
+    fv_kit_count(j->c, thread, C_SHADOW, sc.shadow_steps);
+    fv_kit_count(j->c, thread, C_NORMAL, sc.normal_evals);
+    j->shadow_rays[thread] += sc.shadow_rays;
+}
+
 static void level_tile(void *ctx, const fv_tile *tile)
 {
     job *j = ctx;
     fv_sdf_pipeline *p = j->p;
     const int k = j->level;
     const fv_pyramid_level *lv = &p->lv[k];
+    const bool below_target = k == p->o.levels - 2;
     const int cap = (tile->x1 - tile->x0) * (tile->y1 - tile->y0);
-    fv_march_ray *rays = malloc((size_t)cap * sizeof *rays);
-    fv_march_hit *hits = malloc((size_t)cap * sizeof *hits);
-    int *at = malloc((size_t)cap * sizeof *at);
+    fv_march_ray *rays = malloc((size_t)cap * sizeof *rays), *vrays = malloc((size_t)cap * sizeof *vrays);
+    fv_march_hit *hits = malloc((size_t)cap * sizeof *hits), *vhits = malloc((size_t)cap * sizeof *vhits);
+    int *at = malloc((size_t)cap * sizeof *at), *vat = calloc((size_t)cap, sizeof *vat);
     fv_vec3 *colour = p->need ? malloc((size_t)cap * sizeof *colour) : NULL;
-    if (!rays || !hits || !at || (p->need && !colour)) {
+    if (!rays || !vrays || !hits || !vhits || !at || !vat || (p->need && !colour)) {
         j->status[tile->thread] = FV_ERR_NOMEM;
         goto done;
     }
@@ -214,9 +240,10 @@ static void level_tile(void *ctx, const fv_tile *tile)
     for (int y = tile->y0; y < tile->y1; y++)
         for (int x = tile->x0; x < tile->x1; x++) {
             size_t i = (size_t)y * lv->w + x;
-            if (p->need && k == p->o.levels - 2 && !p->need[i]) {
+            if (p->need && below_target && !p->need[i]) {
                 p->depth[k][i] = 0.0f; /* not read: no mask pixel starts from it */
                 p->steps[k][i] = 0;
+                if (p->vis) p->vis[i] = FV_SDF_VIS_UNKNOWN;
                 continue;
             }
             float sx, sy;
@@ -225,39 +252,41 @@ static void level_tile(void *ctx, const fv_tile *tile)
             if (k > 0) rays[n].t0 = fmaxf(rays[n].t0, fv_pyramid_start(p->depth[k - 1], &p->lv[k - 1], x >> 1, y >> 1, p->o.min_filter));
             at[n++] = (int)i;
         }
-    trace(j, tile->thread, k, rays, hits, n, NULL, NULL);
-    int ns = 0;
+    trace(j, tile->thread, k, rays, hits, n, NULL, NULL, NULL);
+    /* Below the target: fipr's rays due for a refresh are shaded (colour kept in its history);
+     * with shadow_reuse the others get their visibility only. */
+    int ns = 0, nv = 0;
     for (int r = 0; r < n; r++) {
         p->depth[k][at[r]] = hits[r].hit ? hits[r].t : INFINITY;
         p->steps[k][at[r]] = hits[r].steps;
-        /* fipr's middle level: the rays due for a refresh are shaded, the others only give depth */
-        if (p->need && k == p->o.levels - 2 && p->need[at[r]] == 2) {
+        if (!below_target) continue;
+        if (p->need && p->need[at[r]] == 2) {
             rays[ns] = rays[r];
             hits[ns] = hits[r];
             at[ns++] = at[r];
+        } else if (p->vis) {
+            vrays[nv] = rays[r];
+            vhits[nv] = hits[r];
+            vat[nv++] = at[r];
         }
     }
-    if (ns > 0) {
-        fv_sdf_shade_counts sc = {0, 0, 0};
-        fv_error e;
-        fv_status s = fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, ns, colour, NULL, &sc, &e);
-        if (s != FV_OK) j->status[tile->thread] = s;
-        fv_kit_count(j->c, tile->thread, C_SHADOW, sc.shadow_steps);
-        fv_kit_count(j->c, tile->thread, C_NORMAL, sc.normal_evals);
-        j->shadow_rays[tile->thread] += sc.shadow_rays;
-        uint64_t bad = 0;
-        for (int r = 0; r < ns; r++) {
-            fv_vec3 c = fv_kit_guard(colour[r], &bad);
-            float *dst = &j->hist->color[3 * (size_t)at[r]];
-            dst[0] = c.x, dst[1] = c.y, dst[2] = c.z;
-            j->hist->stamp[at[r]] = j->frame->index;
-        }
-        fv_kit_count(j->c, tile->thread, FV_KIT_NAN, bad);
+    shade_level(j, tile->thread, vrays, vhits, vat, nv, NULL);
+    shade_level(j, tile->thread, rays, hits, at, ns, colour);
+    uint64_t bad = 0;
+    for (int r = 0; r < ns; r++) {
+        fv_vec3 c = fv_kit_guard(colour[r], &bad);
+        float *dst = &j->hist->color[3 * (size_t)at[r]];
+        dst[0] = c.x, dst[1] = c.y, dst[2] = c.z;
+        j->hist->stamp[at[r]] = j->frame->index;
     }
+    fv_kit_count(j->c, tile->thread, FV_KIT_NAN, bad);
 done:
     free(rays);
+    free(vrays);
     free(hits);
+    free(vhits);
     free(at);
+    free(vat);
     free(colour);
 }
 
@@ -311,6 +340,23 @@ static float lower_steps(const fv_sdf_pipeline *p, int x, int y, int *top_level)
     return sum / (float)(S * S);
 }
 
+/* shadow_reuse (ours): the lights a target sample sees, taken from the level below when its parent
+ * (pi, pj) and the parent's eight neighbours all hit and all see the same lights, or unknown (the
+ * sample traces its own shadow rays) where they differ: a shadow's edge, a silhouette. */
+static uint32_t agreed_visibility(const fv_sdf_pipeline *p, int pi, int pj)
+{
+    const fv_pyramid_level *lv = &p->lv[p->o.levels - 2];
+    uint32_t v = p->vis[(size_t)pj * lv->w + pi];
+    if (v == FV_SDF_VIS_UNKNOWN) return v;
+    for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+            int x = pi + dx, y = pj + dy;
+            if (x < 0 || x >= lv->w || y < 0 || y >= lv->h) continue;
+            if (p->vis[(size_t)y * lv->w + x] != v) return FV_SDF_VIS_UNKNOWN;
+        }
+    return v;
+}
+
 static void target_tile(void *ctx, const fv_tile *tile)
 {
     job *j = ctx;
@@ -321,7 +367,8 @@ static void target_tile(void *ctx, const fv_tile *tile)
     fv_march_hit *hits = malloc((size_t)cap * sizeof *hits);
     fv_vec3 *colour = malloc((size_t)cap * sizeof *colour), *normal = malloc((size_t)cap * sizeof *normal);
     int *first = malloc((size_t)npix * sizeof *first);
-    if (!rays || !hits || !colour || !normal || !first) {
+    uint32_t *known = p->vis ? malloc((size_t)cap * sizeof *known) : NULL;
+    if (!rays || !hits || !colour || !normal || !first || (p->vis && !known)) {
         j->status[tile->thread] = FV_ERR_NOMEM;
         goto done;
     }
@@ -340,10 +387,11 @@ static void target_tile(void *ctx, const fv_tile *tile)
                     int sx = x * S + a, sy = y * S + b;
                     camera_ray(j, (float)sx + 0.5f, (float)sy + 0.5f, eps_k, &rays[n]);
                     if (L > 1) rays[n].t0 = fmaxf(rays[n].t0, fv_pyramid_start(p->depth[L - 2], &p->lv[L - 2], sx >> 1, sy >> 1, p->o.min_filter));
+                    if (known) known[n] = agreed_visibility(p, sx >> 1, sy >> 1);
                     n++;
                 }
         }
-    trace(j, tile->thread, L - 1, rays, hits, n, colour, normal);
+    trace(j, tile->thread, L - 1, rays, hits, n, known, colour, normal);
     uint64_t bad = 0;
     q = 0;
     for (int y = tile->y0; y < tile->y1; y++)
@@ -381,6 +429,7 @@ static void target_tile(void *ctx, const fv_tile *tile)
         }
     fv_kit_count(j->c, tile->thread, FV_KIT_NAN, bad);
 done:
+    free(known);
     free(rays);
     free(hits);
     free(colour);

@@ -44,6 +44,7 @@ typedef struct fv_sdf_opts {
     fv_march_opts march;
     float hit;           /* hit distance as a fraction of the ray's footprint */
     fv_sdf_shade_opts shade;
+    bool shadow_reuse;   /* ours, for a CPU (ipr, fipr): shadows from the level below where it agrees */
     fv_sdf_show show;
     /* fipr */
     float fovea_deg, outer_deg; /* zones of the mask (Sec. 3.2.3) */

@@ -27,14 +27,18 @@ static lobe lobe_of(const fv_material *m)
 }
 
 fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_sdf_shade_opts *so, const fv_march_ray *rays,
-                       const fv_march_hit *hits, int n, fv_vec3 *color, fv_vec3 *normal, fv_sdf_shade_counts *counts, fv_error *err)
+                       const fv_march_hit *hits, int n, const uint32_t *vis_in, uint32_t *vis_out, fv_vec3 *color, fv_vec3 *normal,
+                       fv_sdf_shade_counts *counts, fv_error *err)
 {
     int nh = 0;
     for (int i = 0; i < n; i++) nh += hits[i].hit;
     for (int i = 0; i < n; i++) {
-        color[i] = fv_v3s(0.0f);
+        if (color) color[i] = fv_v3s(0.0f);
         if (normal) normal[i] = fv_v3s(0.0f);
+        if (vis_out) vis_out[i] = FV_SDF_VIS_UNKNOWN;
     }
+    /* visibility is known per light as one bit, for the first 31 lights */
+    const bool bits = w->light_count <= 31;
     if (nh == 0) return FV_OK;
     int *idx = fv_alloc_array((size_t)nh, sizeof *idx);
     fv_vec3 *pt = fv_alloc_array((size_t)nh * 4, sizeof *pt);
@@ -43,9 +47,10 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
     float *hd = fv_alloc_array((size_t)nh, sizeof *hd);
     fv_march_ray *sray = fv_alloc_array((size_t)nh, sizeof *sray);
     fv_march_hit *shit = fv_alloc_array((size_t)nh, sizeof *shit);
-    int *sidx = fv_alloc_array((size_t)nh, sizeof *sidx);
+    int *sidx = fv_alloc_array((size_t)nh, sizeof *sidx), *lit = fv_alloc_array((size_t)nh, sizeof *lit);
+    uint32_t *vis = fv_calloc_array((size_t)nh, sizeof *vis);
     fv_status st = FV_OK;
-    if (!idx || !pt || !val || !nrm || !pos || !hd || !sray || !shit || !sidx) {
+    if (!idx || !pt || !val || !nrm || !pos || !hd || !sray || !shit || !sidx || !lit || !vis) {
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory shading %d hits", nh);
         goto done;
     }
@@ -69,17 +74,23 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
         /* where the differences cancel (a crease's exact middle), face the ray */
         nrm[k] = len > 0.0f && isfinite(len) ? fv_scale(g, 1.0f / len) : fv_neg(rays[idx[k]].d);
         const fv_material *m = fv_scene_material(w->scene, hits[idx[k]].mat);
-        color[idx[k]] = fv_scale(m->albedo, so->ambient);
+        if (color) color[idx[k]] = fv_scale(m->albedo, so->ambient);
         if (normal) normal[idx[k]] = nrm[k];
     }
     for (int li = 0; li < w->light_count; li++) {
         const fv_sdf_point_light *L = &w->lights[li];
-        int ns = 0;
+        int ns = 0, nl = 0;
         for (int k = 0; k < nh; k++) {
             fv_vec3 o = fv_madd(pos[k], nrm[k], 2.0f * hd[k]);
             fv_vec3 to = fv_sub(L->pos, o);
             float dist = fv_length(to);
             if (!(dist > 0.0f) || fv_dot(nrm[k], to) <= 0.0f) continue;
+            uint32_t known = vis_in && bits ? vis_in[idx[k]] : FV_SDF_VIS_UNKNOWN;
+            if (known != FV_SDF_VIS_UNKNOWN || !so->shadows) {
+                /* the caller knows this point's visibility (ipr's shadow_reuse), or no shadows */
+                if (!so->shadows || (known >> li & 1u)) lit[nl++] = k;
+                continue;
+            }
             fv_march_ray *s = &sray[ns];
             s->o = o;
             s->d = fv_scale(to, 1.0f / dist);
@@ -94,7 +105,7 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
             s->eps_k = 0.0f;
             sidx[ns++] = k;
         }
-        if (so->shadows) {
+        if (so->shadows && ns > 0) {
             /* The same march for every technique, so shadows never differ between them:
              * over-relaxed (a CPU choice: a quarter fewer shadow steps on the built-in scenes,
              * docs/sdf-tracing.md), whatever the method's own relax. */
@@ -104,12 +115,15 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
             counts->shadow_rays += (uint64_t)ns;
         }
         for (int s = 0; s < ns; s++) {
-            if (so->shadows) {
-                counts->shadow_steps += shit[s].steps;
-                if (shit[s].hit) continue;
-            }
-            int k = sidx[s], i = idx[k];
-            fv_vec3 wi = sray[s].d, wo = fv_neg(rays[i].d);
+            counts->shadow_steps += shit[s].steps;
+            if (!shit[s].hit) lit[nl++] = sidx[s];
+        }
+        for (int q = 0; q < nl; q++) {
+            int k = lit[q], i = idx[k];
+            if (bits) vis[k] |= 1u << li;
+            if (!color) continue;
+            fv_vec3 o = fv_madd(pos[k], nrm[k], 2.0f * hd[k]);
+            fv_vec3 wi = fv_normalize(fv_sub(L->pos, o)), wo = fv_neg(rays[i].d);
             float cos_i = fv_dot(nrm[k], wi);
             fv_vec3 to = fv_sub(L->pos, pos[k]);
             float d2 = fv_dot(to, to);
@@ -127,7 +141,11 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
             color[i] = fv_add(color[i], fv_scale(fv_mul(f, inc), cos_i));
         }
     }
+    if (vis_out && bits)
+        for (int k = 0; k < nh; k++) vis_out[idx[k]] = vis[k];
 done:
+    free(lit);
+    free(vis);
     free(idx);
     free(pt);
     free(val);

@@ -23,9 +23,16 @@ typedef struct fv_sdf_shade_counts {
     uint64_t shadow_rays, shadow_steps, normal_evals;
 } fv_sdf_shade_counts;
 
-/* Shades the n marched camera rays: radiance per ray in color (black for a miss), and when normal
- * is not NULL the unit normal (zero for a miss). FV_ERR_NOMEM without scratch memory. */
+/* Which lights reach a shaded point: bit l for light l (scenes with up to 31 delta lights), or
+ * FV_SDF_VIS_UNKNOWN (also for a miss). */
+#define FV_SDF_VIS_UNKNOWN 0xffffffffu
+
+/* Shades the n marched camera rays: radiance per ray in color (black for a miss; color NULL:
+ * visibility only), when normal is not NULL the unit normal (zero for a miss), when vis_out is
+ * not NULL which lights reach each hit. vis_in (NULL: none) gives, per ray, visibility already
+ * known (ipr's shadow_reuse): those rays trace no shadow ray. FV_ERR_NOMEM without scratch. */
 fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_sdf_shade_opts *so, const fv_march_ray *rays,
-                       const fv_march_hit *hits, int n, fv_vec3 *color, fv_vec3 *normal, fv_sdf_shade_counts *counts, fv_error *err);
+                       const fv_march_hit *hits, int n, const uint32_t *vis_in, uint32_t *vis_out, fv_vec3 *color, fv_vec3 *normal,
+                       fv_sdf_shade_counts *counts, fv_error *err);
 
 #endif
