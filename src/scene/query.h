@@ -58,6 +58,10 @@ static inline fv_vec3 fv_offset_point(const fv_scene *s, fv_vec3 p, fv_vec3 ng, 
 
 /* World-space vertices of triangle `prim` of object `obj` at the current time. */
 void fv_scene_triangle(const fv_scene *s, int obj, int prim, fv_vec3 *a, fv_vec3 *b, fv_vec3 *c);
+/* How many triangles object `obj` has (0 for an SDF object): prim runs over [0, count) above. */
+int fv_scene_object_triangle_count(const fv_scene *s, int obj);
+/* The material id of triangle `prim` of object `obj` (what a hit on it reports as fv_hit.mat). */
+int fv_scene_triangle_material(const fv_scene *s, int obj, int prim);
 
 /* ---- objects ---- */
 

@@ -661,6 +661,10 @@ void fv_scene_triangle(const fv_scene *s, int obj, int prim, fv_vec3 *a, fv_vec3
     *c = fv_xform_point(&o->xf, o->pos[ix[2]]);
 }
 
+int fv_scene_object_triangle_count(const fv_scene *s, int obj) { return obj >= 0 && obj < s->nobj ? s->objs[obj].nt : 0; }
+
+int fv_scene_triangle_material(const fv_scene *s, int obj, int prim) { return s->objs[obj].mat[prim]; }
+
 /* ---- queries ---- */
 
 void fv_scene_bounds(const fv_scene *s, fv_vec3 *lo, fv_vec3 *hi)
