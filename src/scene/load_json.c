@@ -290,6 +290,17 @@ static fv_status sdf_children(sdf_build *b, const cJSON *arr, const char *where,
     return FV_OK;
 }
 
+/* The single "child" of a TRANSFORM or REPEAT object `it` at JSON path `w`, parsed one level deeper. */
+static fv_status sdf_child(sdf_build *b, const cJSON *it, const char *w, int mat, int depth, int *id, fv_error *err)
+{
+    const json_ctx *c = b->c;
+    char w2[SDF_WHERE + 32];
+    snprintf(w2, sizeof w2, "%s.child", w);
+    const cJSON *ch = cJSON_GetObjectItemCaseSensitive(it, "child");
+    if (!ch) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: missing 'child'", c->file, w);
+    return sdf_node(b, ch, w2, mat, depth + 1, id, err);
+}
+
 static fv_status sdf_node(sdf_build *b, const cJSON *o, const char *where, int mat, int depth, int *id, fv_error *err)
 {
     static const char *const kinds[] = {"sphere", "box", "round_box", "torus", "capsule", "cylinder", "cone", "plane", "heightfield",
@@ -395,11 +406,7 @@ static fv_status sdf_node(sdf_build *b, const cJSON *o, const char *where, int m
         if (sc.x != sc.y || sc.y != sc.z)
             return fv_error_set(err, FV_ERR_INVALID, "%s: %s.scale: must be one number (a non-uniform scale breaks the distance bound)", c->file, w);
         n.p[0] = sc.x;
-        char w2[SDF_WHERE + 32];
-        snprintf(w2, sizeof w2, "%s.child", w);
-        const cJSON *ch = cJSON_GetObjectItemCaseSensitive(it, "child");
-        if (!ch) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: missing 'child'", c->file, w);
-        if ((st = sdf_node(b, ch, w2, mat, depth + 1, &n.a, err))) return st;
+        if ((st = sdf_child(b, it, w, mat, depth, &n.a, err))) return st;
         break;
     }
     case FV_SDF_REPEAT: {
@@ -412,11 +419,7 @@ static fv_status sdf_node(sdf_build *b, const cJSON *o, const char *where, int m
         for (int a = 0; a < 3; a++)
             if (cn[a] != floorf(cn[a]))
                 return fv_error_set(err, FV_ERR_INVALID, "%s: %s.count: each must be an integer (0: unlimited)", c->file, w);
-        char w2[SDF_WHERE + 32];
-        snprintf(w2, sizeof w2, "%s.child", w);
-        const cJSON *ch = cJSON_GetObjectItemCaseSensitive(it, "child");
-        if (!ch) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: missing 'child'", c->file, w);
-        if ((st = sdf_node(b, ch, w2, mat, depth + 1, &n.a, err))) return st;
+        if ((st = sdf_child(b, it, w, mat, depth, &n.a, err))) return st;
         break;
     }
     default: break;

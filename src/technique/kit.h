@@ -44,6 +44,8 @@ enum {
     FV_KIT_USER1,
     FV_KIT_USER2,
     FV_KIT_USER3,
+    FV_KIT_USER4,
+    FV_KIT_USER5,
     FV_KIT_SLOTS = 8
 };
 

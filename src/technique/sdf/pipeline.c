@@ -154,14 +154,21 @@ typedef struct job {
     float foot;              /* a target sample's angular footprint per unit distance */
     int level;               /* the level of a level pass */
     eye_history *hist;
-    fv_kit_counters *c;      /* RAYS (all rays), NAN, USER0 steps, USER1 shadow steps, USER2 normal evals, USER3 exhausted */
+    fv_kit_counters *c;      /* RAYS (all rays), NAN, USER0 steps, USER1 shadow steps, USER2 normal evals, USER3 exhausted, USER4 shadow rays */
     fv_kit_counters *lsteps; /* per level: steps */
     fv_kit_counters *lrays;  /* per level: rays */
-    uint64_t shadow_rays[FV_MAX_THREADS];
     fv_status status[FV_MAX_THREADS];
 } job;
 
-enum { C_STEPS = FV_KIT_USER0, C_SHADOW = FV_KIT_USER1, C_NORMAL = FV_KIT_USER2, C_EXHAUSTED = FV_KIT_USER3 };
+enum { C_STEPS = FV_KIT_USER0, C_SHADOW = FV_KIT_USER1, C_NORMAL = FV_KIT_USER2, C_EXHAUSTED = FV_KIT_USER3, C_SHADOW_RAYS = FV_KIT_USER4 };
+
+/* What shading cost on this thread. */
+static void count_shading(job *j, int thread, const fv_sdf_shade_counts *sc)
+{
+    fv_kit_count(j->c, thread, C_SHADOW, sc->shadow_steps);
+    fv_kit_count(j->c, thread, C_NORMAL, sc->normal_evals);
+    fv_kit_count(j->c, thread, C_SHADOW_RAYS, sc->shadow_rays);
+}
 
 /* The camera ray through target-grid position (sx, sy), its range clipped to the world's box. */
 static void camera_ray(const job *j, float sx, float sy, float eps_k, fv_march_ray *r)
@@ -192,9 +199,7 @@ static void trace(job *j, int thread, int level, fv_march_ray *rays, fv_march_hi
     fv_error e;
     fv_status s = fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, vis_in, NULL, colour, normal, &sc, &e);
     if (s != FV_OK) j->status[thread] = s;
-    fv_kit_count(j->c, thread, C_SHADOW, sc.shadow_steps);
-    fv_kit_count(j->c, thread, C_NORMAL, sc.normal_evals);
-    j->shadow_rays[thread] += sc.shadow_rays;
+    count_shading(j, thread, &sc);
 }
 
 /* ---- a lower level: every ray (or, for fipr's middle level, those `need` asks for) ---- */
@@ -214,9 +219,7 @@ static void shade_level(job *j, int thread, fv_march_ray *rays, fv_march_hit *hi
     if (bits && s == FV_OK)
         for (int r = 0; r < n; r++) p->vis[at[r]] = bits[r];
     free(bits);
-    fv_kit_count(j->c, thread, C_SHADOW, sc.shadow_steps);
-    fv_kit_count(j->c, thread, C_NORMAL, sc.normal_evals);
-    j->shadow_rays[thread] += sc.shadow_rays;
+    count_shading(j, thread, &sc);
 }
 
 static void level_tile(void *ctx, const fv_tile *tile)
@@ -373,6 +376,7 @@ static void target_tile(void *ctx, const fv_tile *tile)
         goto done;
     }
     const float eps_k = p->o.hit * j->foot;
+    const bool diagnostics = p->o.show == FV_SDF_SHOW_STEPS || p->o.show == FV_SDF_SHOW_LEVEL;
     int n = 0, q = 0;
     for (int y = tile->y0; y < tile->y1; y++)
         for (int x = tile->x0; x < tile->x1; x++, q++) {
@@ -398,7 +402,8 @@ static void target_tile(void *ctx, const fv_tile *tile)
         for (int x = tile->x0; x < tile->x1; x++, q++) {
             size_t pix = (size_t)y * w + x;
             int top = 0;
-            float share = L > 1 ? lower_steps(p, x, y, &top) : 0.0f;
+            /* the lower levels' share only feeds show=steps and show=level */
+            float share = L > 1 && diagnostics ? lower_steps(p, x, y, &top) : 0.0f;
             fv_vec3 c;
             if (first[q] < 0) {
                 c = reconstruct(j, x, y);
@@ -616,9 +621,7 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
     fv_stats_add_count(stats, "shadow_steps", (double)fv_kit_sum(j->c, C_SHADOW));
     fv_stats_add_count(stats, "normal_evals", (double)fv_kit_sum(j->c, C_NORMAL));
     fv_stats_add_count(stats, "exhausted_rays", (double)fv_kit_sum(j->c, C_EXHAUSTED));
-    uint64_t sr = 0;
-    for (int t = 0; t < FV_MAX_THREADS; t++) sr += j->shadow_rays[t];
-    fv_stats_add_count(stats, "shadow_rays", (double)sr);
+    fv_stats_add_count(stats, "shadow_rays", (double)fv_kit_sum(j->c, C_SHADOW_RAYS));
     for (int k = 0; k < L; k++) {
         snprintf(stage, sizeof stage, "rays_level%d", k);
         fv_stats_add_count(stats, stage, (double)fv_kit_sum(j->lrays, k));

@@ -49,8 +49,9 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
     fv_march_hit *shit = fv_alloc_array((size_t)nh, sizeof *shit);
     int *sidx = fv_alloc_array((size_t)nh, sizeof *sidx), *lit = fv_alloc_array((size_t)nh, sizeof *lit);
     uint32_t *vis = fv_calloc_array((size_t)nh, sizeof *vis);
+    lobe *lobes = color ? fv_alloc_array((size_t)nh, sizeof *lobes) : NULL;
     fv_status st = FV_OK;
-    if (!idx || !pt || !val || !nrm || !pos || !hd || !sray || !shit || !sidx || !lit || !vis) {
+    if (!idx || !pt || !val || !nrm || !pos || !hd || !sray || !shit || !sidx || !lit || !vis || (color && !lobes)) {
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory shading %d hits", nh);
         goto done;
     }
@@ -74,7 +75,10 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
         /* where the differences cancel (a crease's exact middle), face the ray */
         nrm[k] = len > 0.0f && isfinite(len) ? fv_scale(g, 1.0f / len) : fv_neg(rays[idx[k]].d);
         const fv_material *m = fv_scene_material(w->scene, hits[idx[k]].mat);
-        if (color) color[idx[k]] = fv_scale(m->albedo, so->ambient);
+        if (color) {
+            color[idx[k]] = fv_scale(m->albedo, so->ambient);
+            lobes[k] = lobe_of(m);
+        }
         if (normal) normal[idx[k]] = nrm[k];
     }
     for (int li = 0; li < w->light_count; li++) {
@@ -129,7 +133,7 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
             float d2 = fv_dot(to, to);
             if (!(cos_i > 0.0f) || !(d2 > 0.0f)) continue;
             fv_vec3 I = fv_light_delta_intensity(L->light, fv_neg(wi));
-            lobe lb = lobe_of(fv_scene_material(w->scene, hits[i].mat));
+            const lobe lb = lobes[k];
             fv_vec3 f = fv_scale(lb.albedo, 1.0f / FV_PI);
             if (lb.has_spec) {
                 fv_vec3 h = fv_normalize(fv_add(wi, wo));
@@ -146,6 +150,7 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
 done:
     free(lit);
     free(vis);
+    free(lobes);
     free(idx);
     free(pt);
     free(val);
