@@ -46,6 +46,11 @@ bool fv_scene_occluded(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d
  * The ray starts off the surface and stops eps short of q, so q may lie on a light's surface. */
 bool fv_scene_visible(const fv_scene *s, fv_trace_set set, fv_vec3 p, fv_vec3 ng, fv_vec3 q);
 
+/* fv_scene_visible for up to eight points q[i] (lanes with active[i]) from one surface point p,
+ * as one packet of occlusion rays (all geometry): visible[i] false for inactive lanes. Returns how
+ * many rays were cast (a q within 2 eps of p is visible without a ray). */
+int fv_scene_visible8(const fv_scene *s, fv_vec3 p, fv_vec3 ng, const fv_vec3 *q, const bool *active, bool *visible);
+
 /* How far a new ray starts off a surface, scaled to the scene's size. */
 float fv_scene_ray_eps(const fv_scene *s);
 

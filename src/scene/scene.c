@@ -652,6 +652,54 @@ bool fv_scene_visible(const fv_scene *s, fv_trace_set set, fv_vec3 p, fv_vec3 ng
     return !fv_scene_occluded(s, set, o, fv_scale(d, 1.0f / len), len - s->eps);
 }
 
+int fv_scene_visible8(const fv_scene *s, fv_vec3 p, fv_vec3 ng, const fv_vec3 *q, const bool *active, bool *visible)
+{
+    /* Eight shadow rays leaving one surface point (a pixel towards eight VPLs): they share the
+     * origin up to the side of the surface they leave from, so one packet traverses the BVH
+     * together. Lanes too short to need a ray are visible without one. */
+    struct RTCRay8 r __attribute__((aligned(32)));
+    int valid[8] __attribute__((aligned(32)));
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    int traced = 0;
+    for (int i = 0; i < 8; i++) {
+        valid[i] = 0;
+        r.org_x[i] = p.x;
+        r.org_y[i] = p.y;
+        r.org_z[i] = p.z;
+        r.dir_x[i] = 0.0f;
+        r.dir_y[i] = 0.0f;
+        r.dir_z[i] = 1.0f;
+        r.tnear[i] = 0.0f;
+        r.tfar[i] = 0.0f;
+        r.time[i] = 0.0f;
+        r.mask[i] = 0xffffffffu;
+        r.id[i] = (unsigned)i;
+        r.flags[i] = 0;
+        visible[i] = active[i];
+        if (!active[i]) continue;
+        fv_vec3 o = fv_offset_point(s, p, ng, fv_sub(q[i], p));
+        fv_vec3 d = fv_sub(q[i], o);
+        float len = fv_length(d);
+        if (!(len > 2.0f * s->eps)) continue;
+        d = fv_scale(d, 1.0f / len);
+        r.org_x[i] = o.x;
+        r.org_y[i] = o.y;
+        r.org_z[i] = o.z;
+        r.dir_x[i] = d.x;
+        r.dir_y[i] = d.y;
+        r.dir_z[i] = d.z;
+        r.tfar[i] = len - s->eps;
+        valid[i] = -1;
+        traced++;
+    }
+    if (!traced) return 0;
+    rtcOccluded8(valid, s->rtc_all, &ctx, &r);
+    for (int i = 0; i < 8; i++)
+        if (valid[i] && r.tfar[i] < 0.0f) visible[i] = false;
+    return traced;
+}
+
 void fv_scene_triangle(const fv_scene *s, int obj, int prim, fv_vec3 *a, fv_vec3 *b, fv_vec3 *c)
 {
     const fv_object *o = &s->objs[obj];

@@ -22,8 +22,9 @@ typedef struct block_out {
 } block_out;
 
 /* The light path's visit: a photon is stored at every diffuse or glossy vertex. */
-static void deposit(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 ng)
+static void deposit(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 ng, int mat)
 {
+    (void)mat; /* a photon keeps its flux; the gather applies the receiving BSDF */
     block_out *b = ctx;
     if (b->oom) return;
     if (fv_grow((void **)&b->p, &b->cap, b->n + 1, sizeof *b->p)) {

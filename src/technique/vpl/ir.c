@@ -1,0 +1,258 @@
+/* fovea — `ir` and `ir-low`: classic instant radiosity, the baselines of Foveated Instant Radiosity
+ * (Sec. 4: IR with 1024^2 VPL shadow maps and IR' with 128^2, both with 2000 VPLs, all regenerated
+ * every frame, every VPL shading every pixel).
+ *
+ * ir's visibility is exact: shadow rays to the VPLs, eight per Embree packet (a shadow map of
+ * unlimited resolution). ir-low builds a 128^2 depth cube map per VPL every frame by casting rays
+ * (cubemap.h: the CPU equivalent of rasterising the paper's shadow maps) and looks visibility up in
+ * it; maps are built and used in batches so memory stays bounded whatever the VPL count.
+ * Both add the family's direct light (direct.h) and use the same clamped geometry term (gather.h).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "scene/light.h"
+#include "technique/class.h"
+#include "technique/vpl/lightvpl.h"
+#include "technique/vpl/shade.h"
+
+/* ir-low's maps are built this many at a time (about 100 MB of 128^2 maps). */
+#define IR_LOW_BATCH_BYTES (100u << 20)
+
+typedef struct ir_state {
+    const fv_scene *scene;
+    bool low; /* ir-low: cube maps */
+    int vpls, bounces, area_samples, cube_size;
+    int cube_filter;
+    int show; /* 0 all, 1 direct, 2 indirect */
+    float clamp;
+    fv_gbuffer gb;
+    fv_vec3 *direct, *indirect;
+    size_t npix;
+    fv_vpl_light *lights;
+    int *ident;       /* 0 .. vpls-1, the lists of one tile */
+    fv_cubemaps *maps; /* ir-low: one batch */
+    int batch;
+    fv_vec3 *pos, *nrm; /* ir-low: a batch's centres for build_many */
+    int *slots;
+} ir_state;
+
+static const char *const k_filters[] = {"nearest", "pcf", NULL};
+static const char *const k_show[] = {"all", "direct", "indirect", NULL};
+
+static void ir_destroy(void *state)
+{
+    ir_state *st = state;
+    if (!st) return;
+    fv_gbuffer_free(&st->gb);
+    free(st->direct);
+    free(st->indirect);
+    free(st->lights);
+    free(st->ident);
+    fv_cubemaps_destroy(st->maps);
+    free(st->pos);
+    free(st->nrm);
+    free(st->slots);
+    free(st);
+}
+
+static fv_status ir_create_common(const fv_scene *scene, fv_params *params, bool low, void **state, fv_error *err)
+{
+    ir_state *st = calloc(1, sizeof *st);
+    if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    st->scene = scene;
+    st->low = low;
+    double clamp = 0.03;
+    fv_status s;
+    if ((s = fv_params_int(params, "vpls", 2000, 1, 1000000, &st->vpls, err)) != FV_OK ||
+        (s = fv_params_int(params, "bounces", 7, 1, 64, &st->bounces, err)) != FV_OK ||
+        (s = fv_params_int(params, "area_samples", 16, 1, 4096, &st->area_samples, err)) != FV_OK ||
+        (s = fv_params_float(params, "clamp", 0.03, 0.0, 1.0, &clamp, err)) != FV_OK ||
+        (s = fv_params_choice(params, "show", 0, k_show, &st->show, err)) != FV_OK)
+        goto fail;
+    st->clamp = (float)clamp;
+    if (low) {
+        if ((s = fv_params_int(params, "cube_size", 128, FV_CUBE_MIN_SIZE, FV_CUBE_MAX_SIZE, &st->cube_size, err)) != FV_OK ||
+            (s = fv_params_choice(params, "cube_filter", 0, k_filters, &st->cube_filter, err)) != FV_OK)
+            goto fail;
+        size_t per_map = 6u * (size_t)st->cube_size * (size_t)st->cube_size * sizeof(float);
+        size_t batch = IR_LOW_BATCH_BYTES / per_map;
+        st->batch = (int)(batch < 1 ? 1 : batch > (size_t)st->vpls ? (size_t)st->vpls : batch);
+        if ((s = fv_cubemaps_create(st->batch, st->cube_size, &st->maps, err)) != FV_OK) goto fail;
+        st->pos = malloc((size_t)st->batch * sizeof *st->pos);
+        st->nrm = malloc((size_t)st->batch * sizeof *st->nrm);
+        st->slots = malloc((size_t)st->batch * sizeof *st->slots);
+        if (!st->pos || !st->nrm || !st->slots) {
+            s = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        for (int i = 0; i < st->batch; i++) st->slots[i] = i;
+    }
+    st->lights = malloc((size_t)st->vpls * sizeof *st->lights);
+    st->ident = malloc((size_t)st->vpls * sizeof *st->ident);
+    if (!st->lights || !st->ident) {
+        s = fv_error_set(err, FV_ERR_NOMEM, "out of memory for %d VPLs", st->vpls);
+        goto fail;
+    }
+    for (int i = 0; i < st->vpls; i++) st->ident[i] = i;
+    *state = st;
+    return FV_OK;
+fail:
+    ir_destroy(st);
+    return s;
+}
+
+static fv_status ir_create(const fv_scene *scene, fv_params *params, const fv_log *log, void **state, fv_error *err)
+{
+    (void)log;
+    return ir_create_common(scene, params, false, state, err);
+}
+
+static fv_status ir_low_create(const fv_scene *scene, fv_params *params, const fv_log *log, void **state, fv_error *err)
+{
+    (void)log;
+    return ir_create_common(scene, params, true, state, err);
+}
+
+static fv_status ir_reserve(ir_state *st, int w, int h, fv_error *err)
+{
+    fv_status s = fv_gbuffer_reserve(&st->gb, w, h, err);
+    if (s != FV_OK) return s;
+    size_t n = (size_t)w * (size_t)h;
+    if (n != st->npix) {
+        free(st->direct);
+        free(st->indirect);
+        st->direct = malloc(n * sizeof *st->direct);
+        st->indirect = malloc(n * sizeof *st->indirect);
+        st->npix = st->direct && st->indirect ? n : 0;
+        if (!st->npix) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d frame", w, h);
+    }
+    return FV_OK;
+}
+
+static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+{
+    ir_state *st = state;
+    const fv_scene *s = st->scene;
+    fv_camera_basis cam;
+    fv_status status = fv_frame_camera(frame->camera, film, &cam, err);
+    if (status != FV_OK) return status;
+    if ((status = ir_reserve(st, cam.width, cam.height, err)) != FV_OK) return status;
+    fv_kit_counters *counters = fv_kit_counters_create();
+    if (!counters) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    fv_film_views out = fv_film_views_of(film);
+    fv_kit_progress prog = {0};
+    uint64_t rays = 0;
+    bool ok = true;
+
+    double t0 = fv_time_ms();
+    fv_gbuffer_trace(&st->gb, s, &cam, &out, frame->threads, &rays);
+    double t1 = fv_time_ms();
+    fv_stats_add_ms(stats, "gbuffer", t1 - t0);
+
+    /* The same VPLs for both eyes of a frame: they depend on the frame, not the eye. */
+    int64_t walks = 0;
+    int n = fv_vpl_from_light_walks(s, frame->seed, (uint64_t)frame->index, st->vpls, st->bounces, st->lights, &walks, &rays);
+    double t2 = fv_time_ms();
+    fv_stats_add_ms(stats, "vpls", t2 - t1);
+
+    fv_kit_phase(&prog, frame, 0.0, 0.1);
+    ok = fv_vpl_pass_direct(s, &st->gb, frame, st->area_samples, st->direct, counters, &prog);
+    double t3 = fv_time_ms();
+    fv_stats_add_ms(stats, "direct", t3 - t2);
+
+    memset(st->indirect, 0, st->npix * sizeof *st->indirect);
+    fv_vpl_gather g = {s, st->lights, NULL, FV_CUBE_NEAREST, 0.0f};
+    const float c = fv_vpl_clamp_distance(s, st->clamp);
+    g.clamp2 = c * c;
+    double cube_ms = 0.0, shade_ms = 0.0;
+    int built = 0;
+    if (!st->low) {
+        int offset[2] = {0, n};
+        fv_vpl_tiles all = {1, 1, st->ident, offset};
+        fv_kit_phase(&prog, frame, 0.1, 0.9);
+        if (ok) ok = fv_vpl_pass_indirect(&g, &st->gb, &all, frame->threads, st->indirect, counters, &prog);
+        shade_ms = fv_time_ms() - t3;
+    } else {
+        /* ir-low: a batch of maps is built, every pixel gathers from it, then the next batch. */
+        g.maps = st->maps;
+        g.filter = (fv_cube_filter)st->cube_filter;
+        for (int b0 = 0; ok && b0 < n; b0 += st->batch) {
+            const int m = n - b0 < st->batch ? n - b0 : st->batch;
+            double ta = fv_time_ms();
+            for (int k = 0; k < m; k++) {
+                st->lights[b0 + k].map = k;
+                st->pos[k] = st->lights[b0 + k].p;
+                st->nrm[k] = st->lights[b0 + k].n;
+            }
+            status = fv_cubemaps_build_many(st->maps, s, st->slots, st->pos, st->nrm, m, frame->threads, err);
+            if (status != FV_OK) break;
+            built += m;
+            double tb = fv_time_ms();
+            cube_ms += tb - ta;
+            int offset[2] = {0, m};
+            fv_vpl_tiles batch = {1, 1, st->ident + b0, offset};
+            fv_kit_phase(&prog, frame, 0.1 + 0.9 * b0 / n, 0.9 * m / n);
+            ok = fv_vpl_pass_indirect(&g, &st->gb, &batch, frame->threads, st->indirect, counters, &prog);
+            shade_ms += fv_time_ms() - tb;
+        }
+        /* the cube maps' rays: six faces of n^2 at most per map, counted as built */
+        fv_stats_add_ms(stats, "cube_maps", cube_ms);
+        fv_stats_add_count(stats, "cube_maps_built", built);
+    }
+    fv_stats_add_ms(stats, "shading", shade_ms);
+    if (status == FV_OK) {
+        uint64_t bad = 0;
+        double t4 = fv_time_ms();
+        fv_vpl_compose(&st->gb, st->show == 2 ? NULL : st->direct, st->show == 1 ? NULL : st->indirect, st->show == 0,
+                       out.color, &bad);
+        fv_stats_add_ms(stats, "compose", fv_time_ms() - t4);
+        fv_kit_count(counters, 0, FV_KIT_NAN, bad);
+        fv_kit_count(counters, 0, FV_KIT_RAYS, rays);
+        fv_kit_report(counters, stats);
+        fv_stats_add_count(stats, "vpls", n);
+        fv_stats_add_count(stats, "walks", (double)walks);
+        fv_stats_add_count(stats, "vpl_shadow_rays", (double)fv_kit_sum(counters, FV_VPL_SLOT_VPL_RAYS));
+        fv_stats_add_count(stats, "cube_lookups", (double)fv_kit_sum(counters, FV_VPL_SLOT_LOOKUPS));
+        fv_stats_add_count(stats, "direct_rays", (double)fv_kit_sum(counters, FV_VPL_SLOT_DIRECT_RAYS));
+    }
+    fv_kit_counters_destroy(counters);
+    if (status != FV_OK) return status;
+    return ok ? fv_kit_phase_end(&prog, err) : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+}
+
+#define IR_COMMON_HELP                                                                                                 \
+    "vpls=int (2000): VPLs from light random walks, all regenerated every frame\n"                                     \
+    "bounces=int (7): light-path vertices that become VPLs (1 = one-bounce indirect light)\n"                          \
+    "area_samples=int (16): light samples per pixel for area lights (point and spot lights are exact)\n"              \
+    "clamp=float (0.03): geometry-term clamp, as a fraction of the scene's bounding-sphere radius (0 = off)\n"          \
+    "show=all|direct|indirect (all): the image, or one of its two terms alone (without emitted light)\n"
+
+const fv_technique_class fv_technique_ir = {
+    .name = "ir",
+    .summary = "instant radiosity (Keller): VPLs from light walks, exact shadow rays to every VPL (FIR's IR baseline)",
+    .params_help = IR_COMMON_HELP,
+    .create = ir_create,
+    .render = ir_render,
+    .destroy = ir_destroy,
+    /* furnace: every bounce through VPLs; the clamp loses a little near each VPL */
+    .test_params = "vpls=64,area_samples=2",
+    .furnace_params = "vpls=2000,area_samples=16",
+    .furnace_radiance = 1.0,
+    .furnace_tolerance = 0.08,
+};
+
+const fv_technique_class fv_technique_ir_low = {
+    .name = "ir-low",
+    .summary = "instant radiosity with a 128^2 depth cube map per VPL rebuilt every frame (FIR's IR' baseline)",
+    .params_help = IR_COMMON_HELP "cube_size=int (128): texels per cube-map face edge\n"
+                                  "cube_filter=nearest|pcf (nearest): cube-map lookup (pcf: 2x2 percentage-closer)\n",
+    .create = ir_low_create,
+    .render = ir_render,
+    .destroy = ir_destroy,
+    .test_params = "vpls=32,area_samples=2,cube_size=16",
+    .furnace_params = "vpls=2000,area_samples=16,cube_size=32",
+    .furnace_radiance = 1.0,
+    .furnace_tolerance = 0.08,
+};

@@ -1,0 +1,163 @@
+/* fovea — deferred shading for the instant-radiosity family (see shade.h). */
+#include <math.h>
+#include <string.h>
+#include "technique/vpl/direct.h"
+#include "technique/vpl/shade.h"
+
+typedef struct direct_job {
+    const fv_scene *s;
+    const fv_gbuffer *gb;
+    const fv_frame *frame;
+    int area_samples;
+    fv_vec3 *out;
+    fv_kit_counters *counters;
+} direct_job;
+
+static void direct_tile(void *ctx, const fv_tile *t)
+{
+    direct_job *j = ctx;
+    uint64_t rays = 0;
+    const int w = j->gb->width;
+    for (int y = t->y0; y < t->y1; y++)
+        for (int x = t->x0; x < t->x1; x++) {
+            const size_t pix = (size_t)y * (size_t)w + (size_t)x;
+            const fv_gpixel *g = &j->gb->px[pix];
+            if (!fv_gpixel_hit(g)) {
+                j->out[pix] = fv_v3s(0.0f);
+                continue;
+            }
+            fv_rng rng = fv_kit_rng(j->frame, pix, 0);
+            j->out[pix] = fv_vpl_direct_irradiance(j->s, g->p, g->n, g->ng, j->area_samples, &rng, &rays);
+        }
+    fv_kit_count(j->counters, t->thread, FV_KIT_RAYS, rays);
+    fv_kit_count(j->counters, t->thread, FV_VPL_SLOT_DIRECT_RAYS, rays);
+}
+
+bool fv_vpl_pass_direct(const fv_scene *s, const fv_gbuffer *gb, const fv_frame *frame, int area_samples, fv_vec3 *direct,
+                        fv_kit_counters *counters, fv_kit_progress *prog)
+{
+    direct_job j = {s, gb, frame, area_samples, direct, counters};
+    return fv_parallel_tiles(gb->width, gb->height, frame->threads, direct_tile, &j, fv_kit_progress_fn, prog);
+}
+
+typedef struct indirect_job {
+    const fv_vpl_gather *g;
+    const fv_gbuffer *gb;
+    const fv_vpl_tiles *tiles;
+    fv_vec3 *sum;
+    fv_kit_counters *counters;
+} indirect_job;
+
+/* Exact visibility: pixel by pixel, each pixel's shadow rays to its VPLs go eight per packet. */
+static void indirect_tile_rays(indirect_job *j, const fv_tile *t)
+{
+    uint64_t rays = 0, lookups = 0;
+    const int w = j->gb->width, nx = j->tiles->nx, ny = j->tiles->ny;
+    for (int y = t->y0; y < t->y1; y++)
+        for (int x = t->x0; x < t->x1; x++) {
+            const size_t pix = (size_t)y * (size_t)w + (size_t)x;
+            const fv_gpixel *g = &j->gb->px[pix];
+            if (!fv_gpixel_hit(g)) continue;
+            const int tile = (x % nx) + nx * (y % ny);
+            const int b = j->tiles->offset[tile], e = j->tiles->offset[tile + 1];
+            fv_vec3 v = fv_vpl_gather_at(j->g, g->p, g->n, g->ng, j->tiles->list + b, e - b, &rays, &lookups);
+            j->sum[pix] = fv_add(j->sum[pix], v);
+        }
+    fv_kit_count(j->counters, t->thread, FV_KIT_RAYS, rays);
+    fv_kit_count(j->counters, t->thread, FV_VPL_SLOT_VPL_RAYS, rays);
+}
+
+/* Cube maps: VPL by VPL over the pixels of a block of the screen that see it, so one VPL's map stays
+ * in cache while it is read (a 128^2 map is 393 KB, and pixel by pixel every lookup would miss);
+ * the order a GPU shades in, one light's shadow map at a time. Blocks are larger than the tile
+ * loop's 16^2: a map is loaded once per block, and with 4x4 interleaving a 16^2 tile would give each
+ * VPL only 16 pixels to amortise it over. */
+#define MAP_BLOCK 64
+
+typedef struct map_job {
+    indirect_job *j;
+    int bx; /* blocks per row */
+    uint64_t lookups[FV_MAX_THREADS];
+} map_job;
+
+static void indirect_blocks_maps(void *ctx, int64_t b0, int64_t b1, int thread)
+{
+    map_job *mj = ctx;
+    indirect_job *j = mj->j;
+    const int w = j->gb->width, h = j->gb->height, nx = j->tiles->nx, ny = j->tiles->ny;
+    int pix[MAP_BLOCK * MAP_BLOCK];
+    fv_vec3 acc[MAP_BLOCK * MAP_BLOCK];
+    uint64_t lookups = 0;
+    for (int64_t b = b0; b < b1; b++) {
+        const int x0 = (int)(b % mj->bx) * MAP_BLOCK, y0 = (int)(b / mj->bx) * MAP_BLOCK;
+        const int x1 = x0 + MAP_BLOCK < w ? x0 + MAP_BLOCK : w, y1 = y0 + MAP_BLOCK < h ? y0 + MAP_BLOCK : h;
+        for (int cy = 0; cy < ny; cy++)
+            for (int cx = 0; cx < nx; cx++) {
+                /* the pixels of this block in interleave class (cx, cy) */
+                int np = 0;
+                for (int y = y0 + ((cy - y0 % ny) + ny) % ny; y < y1; y += ny)
+                    for (int x = x0 + ((cx - x0 % nx) + nx) % nx; x < x1; x += nx) {
+                        const size_t p = (size_t)y * (size_t)w + (size_t)x;
+                        if (!fv_gpixel_hit(&j->gb->px[p])) continue;
+                        pix[np] = (int)p;
+                        acc[np] = fv_v3s(0.0f);
+                        np++;
+                    }
+                if (!np) continue;
+                const int tile = cx + nx * cy;
+                for (int k = j->tiles->offset[tile]; k < j->tiles->offset[tile + 1]; k++) {
+                    const fv_vpl_light *v = &j->g->vpls[j->tiles->list[k]];
+                    for (int i = 0; i < np; i++) {
+                        const fv_gpixel *g = &j->gb->px[pix[i]];
+                        fv_vec3 c;
+                        if (!fv_vpl_term(j->g, v, g->p, g->n, &c)) continue;
+                        lookups++;
+                        const float vis = fv_cubemaps_visibility(j->g->maps, v->map, g->p, j->g->filter);
+                        if (vis > 0.0f) acc[i] = fv_madd(acc[i], c, vis);
+                    }
+                }
+                for (int i = 0; i < np; i++) j->sum[pix[i]] = fv_add(j->sum[pix[i]], acc[i]);
+            }
+    }
+    mj->lookups[thread] += lookups;
+}
+
+static void indirect_tile(void *ctx, const fv_tile *t) { indirect_tile_rays(ctx, t); }
+
+bool fv_vpl_pass_indirect(const fv_vpl_gather *g, const fv_gbuffer *gb, const fv_vpl_tiles *tiles, int threads,
+                          fv_vec3 *sum, fv_kit_counters *counters, fv_kit_progress *prog)
+{
+    indirect_job j = {g, gb, tiles, sum, counters};
+    if (!g->maps) return fv_parallel_tiles(gb->width, gb->height, threads, indirect_tile, &j, fv_kit_progress_fn, prog);
+    map_job mj;
+    memset(&mj, 0, sizeof mj);
+    mj.j = &j;
+    mj.bx = (gb->width + MAP_BLOCK - 1) / MAP_BLOCK;
+    const int64_t blocks = (int64_t)mj.bx * ((gb->height + MAP_BLOCK - 1) / MAP_BLOCK);
+    bool ok = fv_parallel_for_progress(blocks, 1, threads, indirect_blocks_maps, &mj, fv_kit_progress_fn, prog);
+    uint64_t lookups = 0;
+    for (int t = 0; t < FV_MAX_THREADS; t++) lookups += mj.lookups[t];
+    fv_kit_count(counters, 0, FV_VPL_SLOT_LOOKUPS, lookups);
+    return ok;
+}
+
+void fv_vpl_compose(const fv_gbuffer *gb, const fv_vec3 *direct, const fv_vec3 *indirect, bool emitted, float *rgb,
+                    uint64_t *dropped)
+{
+    const size_t n = (size_t)gb->width * (size_t)gb->height;
+    for (size_t i = 0; i < n; i++) {
+        const fv_gpixel *g = &gb->px[i];
+        fv_vec3 L = fv_v3s(0.0f);
+        if (fv_gpixel_hit(g)) {
+            fv_vec3 e = fv_v3s(0.0f);
+            if (direct) e = direct[i];
+            if (indirect) e = fv_add(e, indirect[i]);
+            L = fv_scale(fv_mul(g->albedo, e), 1.0f / (float)M_PI);
+            if (emitted) L = fv_add(L, g->emit);
+        }
+        L = fv_kit_guard(L, dropped);
+        rgb[3 * i] = L.x;
+        rgb[3 * i + 1] = L.y;
+        rgb[3 * i + 2] = L.z;
+    }
+}

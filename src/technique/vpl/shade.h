@@ -1,0 +1,44 @@
+/* fovea — deferred shading of the first-hit buffer for the instant-radiosity family (Foveated Instant
+ * Radiosity, Sec. 3.4): a direct pass, an indirect pass over VPLs (all of them per pixel, or the
+ * VPLs of the pixel's interleaved tile), and the composition
+ *     L = emitted + albedo / pi * (E_direct + E_vpl).
+ * The two sums are kept apart so fir can filter the interleaved indirect sum alone (the 5x5 box of
+ * Sec. 3.4) before composing.
+ *
+ * Interleaved sampling (Keller and Heidrich; the paper's [21]): pixel (x, y) belongs to tile
+ * (x mod nx) + nx (y mod ny) of an nx x ny pattern, and sees only that tile's VPLs, so a pixel pays
+ * for about 1 / (nx ny) of the VPLs and a block of nx x ny neighbours together sees all of them.
+ */
+#ifndef FV_TECHNIQUE_VPL_SHADE_H
+#define FV_TECHNIQUE_VPL_SHADE_H
+
+#include "technique/kit.h"
+#include "technique/vpl/gather.h"
+#include "technique/vpl/gbuffer.h"
+
+/* Counter slots the passes fill (the kit's RAYS counts every ray as well). */
+enum { FV_VPL_SLOT_VPL_RAYS = FV_KIT_USER0, FV_VPL_SLOT_LOOKUPS = FV_KIT_USER1, FV_VPL_SLOT_DIRECT_RAYS = FV_KIT_USER2 };
+
+/* The VPLs of each tile of an nx x ny pattern, concatenated: tile t has list[offset[t] ..
+ * offset[t + 1]). nx = ny = 1 is one tile with every VPL. */
+typedef struct fv_vpl_tiles {
+    int nx, ny;
+    const int *list;
+    const int *offset;
+} fv_vpl_tiles;
+
+/* E_direct of every pixel that hit (0 elsewhere) into direct[]: fv_vpl_direct_irradiance with the
+ * kit's camera stream. False when cancelled. */
+bool fv_vpl_pass_direct(const fv_scene *s, const fv_gbuffer *gb, const fv_frame *frame, int area_samples, fv_vec3 *direct,
+                        fv_kit_counters *counters, fv_kit_progress *prog);
+
+/* Adds the VPL sum of every pixel that hit (its tile's list) to sum[]. False when cancelled. */
+bool fv_vpl_pass_indirect(const fv_vpl_gather *g, const fv_gbuffer *gb, const fv_vpl_tiles *tiles, int threads,
+                          fv_vec3 *sum, fv_kit_counters *counters, fv_kit_progress *prog);
+
+/* rgb = emit + albedo / pi (direct + indirect), with the kit's NaN guard (counted in *dropped).
+ * direct or indirect NULL: left out; emitted false: no emitted light (to show one term alone). */
+void fv_vpl_compose(const fv_gbuffer *gb, const fv_vec3 *direct, const fv_vec3 *indirect, bool emitted, float *rgb,
+                    uint64_t *dropped);
+
+#endif
