@@ -334,8 +334,9 @@ fv_status fv_voxels_create(const fv_scene *scene, int resolution, fv_voxels **ou
         ok = v->mip[l] != NULL;
     }
     if (!ok) {
+        const int d0 = v->dims[0][0], d1 = v->dims[0][1], d2 = v->dims[0][2];
         fv_voxels_destroy(v);
-        return fv_error_set(err, FV_ERR_NOMEM, "voxels: out of memory for a %dx%dx%d grid", v->dims[0][0], v->dims[0][1], v->dims[0][2]);
+        return fv_error_set(err, FV_ERR_NOMEM, "voxels: out of memory for a %dx%dx%d grid", d0, d1, d2);
     }
 
     /* Alg. 1 line 1: the static part once; line 4's dynamic part at the current time. */
