@@ -30,12 +30,14 @@ extern const fv_technique_class fv_technique_ipr;
 extern const fv_technique_class fv_technique_fipr;
 extern const fv_technique_class fv_technique_ir;
 extern const fv_technique_class fv_technique_ir_low;
+extern const fv_technique_class fv_technique_fir;
 
 static const fv_technique_class *const k_classes[] = {
     &fv_technique_pt,       &fv_technique_pm,        &fv_technique_pm_t,           &fv_technique_fpm,
     &fv_technique_vpolar,   &fv_technique_cartesian, &fv_technique_cartesian_full, &fv_technique_linear_falloff,
     &fv_technique_logpolar, &fv_technique_sdf_gt,   &fv_technique_sdf_relaxed,    &fv_technique_ipr,
     &fv_technique_fipr,     &fv_technique_ir,        &fv_technique_ir_low,
+    &fv_technique_fir,
 };
 
 #define N_CLASSES ((int)(sizeof k_classes / sizeof k_classes[0]))

@@ -182,6 +182,16 @@ void fv_density_grid_destroy(fv_density_grid *g)
 
 int fv_density_grid_cells(const fv_density_grid *g) { return g ? g->dims[0] * g->dims[1] * g->dims[2] : 0; }
 
+void fv_density_grid_dims(const fv_density_grid *g, int dims[3])
+{
+    for (int a = 0; a < 3; a++) dims[a] = g ? g->dims[a] : 0;
+}
+
+int fv_density_grid_count_cell(const fv_density_grid *g, int cell)
+{
+    return g && cell >= 0 && cell < fv_density_grid_cells(g) ? g->counts[cell] : 0;
+}
+
 void fv_density_grid_clear(fv_density_grid *g)
 {
     if (g) memset(g->counts, 0, (size_t)fv_density_grid_cells(g) * sizeof *g->counts);

@@ -53,6 +53,8 @@ void fv_density_grid_destroy(fv_density_grid *g);
 void fv_density_grid_clear(fv_density_grid *g);
 int fv_density_grid_cell(const fv_density_grid *g, fv_vec3 p); /* row-major index, x fastest */
 int fv_density_grid_cells(const fv_density_grid *g);           /* how many cells in all */
+void fv_density_grid_dims(const fv_density_grid *g, int dims[3]); /* cells per axis */
+int fv_density_grid_count_cell(const fv_density_grid *g, int cell); /* the count of one cell (0 outside) */
 void fv_density_grid_add(fv_density_grid *g, fv_vec3 p, int delta); /* a count stays in [0, INT_MAX] */
 int fv_density_grid_count(const fv_density_grid *g, fv_vec3 p);
 

@@ -499,9 +499,14 @@ float fv_voxels_cone(const fv_voxels *v, fv_vec3 origin, fv_vec3 dir, float aper
         rad = fv_lerp3(rad, rad1, fl);
         float step = 0.5f * diam;
         if (occ > 0.0f) {
-            /* The occupancy is that of one cell crossed; a step of another length sees
-             * 1 - (1 - occ)^(step / cell). Radiance keeps its ratio to occupancy. */
-            float a = 1.0f - powf(fv_maxf(0.0f, 1.0f - occ), step / (v->h * exp2f(lvl)));
+            /* Surface voxels: a sheet one level-0 cell thick fills 2^-l of a level-l cell's volume
+             * but covers all of it across, so the cone sees the occupancy times 2^l (at most 1) as
+             * its coverage (without this a thin wall lets most of a wide cone through, and the
+             * cone-traced bounce lost more than half its light in the furnace). The coverage is
+             * that of one cell crossed; a step of another length sees 1 - (1 - cov)^(step / cell).
+             * Radiance keeps its ratio to occupancy. */
+            const float cov = fv_minf(1.0f, occ * exp2f(lvl));
+            float a = 1.0f - powf(fv_maxf(0.0f, 1.0f - cov), step / (v->h * exp2f(lvl)));
             acc = fv_madd(acc, rad, (1.0f - alpha) * a / occ);
             alpha += (1.0f - alpha) * a;
         }

@@ -106,8 +106,9 @@ bool fv_voxels_cast(const fv_voxels *v, fv_vec3 origin, fv_vec3 dir, float tmax,
 
 /* Voxel cone tracing (Crassin et al. 2011, the paper's [2]) along unit dir from origin, up to
  * tmax: at distance t the cone is d = max(cell, 2 t aperture_tan) wide; the pyramid is sampled
- * there at level log2(d / cell) (trilinear in the two nearest levels, blended), the sample's
- * occupancy corrected for a step of d/2, and composited front to back. Returns the occlusion
+ * there at level l = log2(d / cell) (trilinear in the two nearest levels, blended), the sample's
+ * occupancy turned into the coverage of a surface sheet (times 2^l, at most 1: the voxelization is
+ * of surfaces), corrected for a step of d/2, and composited front to back. Returns the occlusion
  * reached (0..1) and the radiance in *radiance. Stops when the occlusion passes 0.995 or the cone
  * leaves the grid. */
 float fv_voxels_cone(const fv_voxels *v, fv_vec3 origin, fv_vec3 dir, float aperture_tan, float tmax, fv_vec3 *radiance);
