@@ -74,6 +74,8 @@ static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *
     cJSON_AddStringToObject(o, "technique", r->m->method);
     cJSON_AddItemToObject(o, "params", params_json(r->m->params));
     if (r->m->from_sweep) cJSON_AddItemToObject(o, "sweep_value", num(r->m->sweep_value));
+    /* With several sweeps a row also says which parameter it varies (one sweep: the old output). */
+    if (r->m->from_sweep && info->sc->sweep_array) cJSON_AddStringToObject(o, "sweep_param", info->sc->sweeps[r->m->sweep].param);
     if (r->m->match > 0) {
         const fv_bench_match *mt = &info->sc->matches[r->m->match - 1];
         cJSON *mo = cJSON_AddObjectToObject(o, "match");
@@ -143,6 +145,18 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     if (sc->description) cJSON_AddStringToObject(root, "description", sc->description);
     cJSON_AddStringToObject(root, "fovea_version", FOVEA_VERSION_STRING);
     cJSON_AddStringToObject(root, "scene", sc->scene);
+    /* The scene edits, only when asked for (reports of other scenarios stay as they were). */
+    if (sc->diffuse) cJSON_AddBoolToObject(root, "diffuse", true);
+    if (sc->nanimate) {
+        cJSON *an = cJSON_AddArrayToObject(root, "animate");
+        for (int i = 0; an && i < sc->nanimate; i++) {
+            cJSON *e = cJSON_CreateObject();
+            if (sc->animate[i].light >= 0) cJSON_AddNumberToObject(e, "light", sc->animate[i].light);
+            else cJSON_AddStringToObject(e, "object", sc->animate[i].object);
+            cJSON_AddNumberToObject(e, "keys", sc->animate[i].nkeys);
+            cJSON_AddItemToArray(an, e);
+        }
+    }
     cJSON *size = cJSON_AddArrayToObject(root, "size");
     cJSON_AddItemToArray(size, cJSON_CreateNumber(sc->width));
     cJSON_AddItemToArray(size, cJSON_CreateNumber(sc->height));
@@ -179,6 +193,14 @@ static const char *sci(char *buf, double v)
     if (!isfinite(v)) return strcpy(buf, "–");
     snprintf(buf, 32, "%.3g", v);
     return buf;
+}
+
+/* Sweep k's CSV and plot, without the extension: NAME-sweep for the single-object form,
+ * NAME-sweep-PARAM for each sweep of an array. */
+static void sweep_stem(const fv_scenario *sc, int k, char *out, size_t n)
+{
+    if (sc->sweep_array) snprintf(out, n, "%s-sweep-%s", sc->name, sc->sweeps[k].param);
+    else snprintf(out, n, "%s-sweep", sc->name);
 }
 
 static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
@@ -226,7 +248,11 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
     tprintf(&t, "| reference | ![](%s) | | |\n", info->ref_img);
     for (int i = 0; i < n; i++)
         tprintf(&t, "| %s | ![](%s) | ![](%s) | ![](%s) |\n", res[i].m->label, res[i].img, res[i].heat, res[i].crop);
-    if (sc->has_sweep) tprintf(&t, "\nSweep of `%s` over `%s`: ![](%s-sweep.png) (data: %s-sweep.csv)\n", sc->sweep_method, sc->sweep_param, sc->name, sc->name);
+    for (int k = 0; k < sc->nsweeps; k++) {
+        char stem[2 * FV_BENCH_LABEL_MAX + 8];
+        sweep_stem(sc, k, stem, sizeof stem);
+        tprintf(&t, "%sSweep of `%s` over `%s`: ![](%s.png) (data: %s.csv)\n", k ? "" : "\n", sc->sweeps[k].method, sc->sweeps[k].param, stem, stem);
+    }
     char path[4096 + 128];
     snprintf(path, sizeof path, "%s/%s.md", info->out_dir, sc->name);
     return text_write(&t, path, err);
@@ -247,17 +273,20 @@ static bool run_gnuplot(const char *script_path)
     return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
-static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
+static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_result *res, int n, int k, fv_error *err)
 {
     const fv_scenario *sc = info->sc;
+    const char *param = sc->sweeps[k].param;
+    char stem[2 * FV_BENCH_LABEL_MAX + 8];
+    sweep_stem(sc, k, stem, sizeof stem);
     text t = {0};
     tprintf(&t, "%s,ms_per_frame,speedup,mse_fovea,mse_transition,mse_periphery,mse_all,ssim_fovea,ssim_all,flip_fovea,flip_"
                 "transition,flip_periphery,flip_all\n",
-            sc->sweep_param);
+            param);
     double lo = INFINITY, hi = -INFINITY;
     for (int i = 0; i < n; i++) {
         const fv_bench_result *r = &res[i];
-        if (!r->m->from_sweep) continue;
+        if (!r->m->from_sweep || r->m->sweep != k) continue;
         const fv_metric_values *v = r->error.region;
         lo = fmin(lo, r->m->sweep_value);
         hi = fmax(hi, r->m->sweep_value);
@@ -265,9 +294,9 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
                 v[0].mse, v[1].mse, v[2].mse, v[3].mse, v[0].ssim, v[3].ssim, v[0].flip, v[1].flip, v[2].flip, v[3].flip);
     }
     char csv[4096 + 128], png[4096 + 128], gp[4096 + 128];
-    snprintf(csv, sizeof csv, "%s/%s-sweep.csv", info->out_dir, sc->name);
-    snprintf(png, sizeof png, "%s/%s-sweep.png", info->out_dir, sc->name);
-    snprintf(gp, sizeof gp, "%s/%s-sweep.gp", info->out_dir, sc->name);
+    snprintf(csv, sizeof csv, "%s/%s.csv", info->out_dir, stem);
+    snprintf(png, sizeof png, "%s/%s.png", info->out_dir, stem);
+    snprintf(gp, sizeof gp, "%s/%s.gp", info->out_dir, stem);
     fv_status st = text_write(&t, csv, err);
     if (st != FV_OK) return st;
     /* MSE per region against the swept value; log axes when the values span a decade. gnuplot
@@ -286,7 +315,7 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
             "plot '%s' every ::1 using 1:4 with linespoints lw 2 title 'fovea', "
             "'' every ::1 using 1:5 with linespoints lw 2 title 'transition', "
             "'' every ::1 using 1:6 with linespoints lw 2 title 'periphery'\n",
-            fv_atomic_file_path(&plot), sc->name, sc->sweep_param, sc->sweep_param, logx ? "set logscale x 2" : "", csv);
+            fv_atomic_file_path(&plot), sc->name, param, param, logx ? "set logscale x 2" : "", csv);
     if ((st = text_write(&t, gp, err)) != FV_OK) {
         fv_atomic_file_abort(&plot);
         return st;
@@ -303,6 +332,6 @@ fv_status fv_bench_write_reports(const fv_bench_run_info *info, const fv_bench_r
 {
     fv_status st = write_json(info, res, n, err);
     if (st == FV_OK) st = write_markdown(info, res, n, err);
-    if (st == FV_OK && info->sc->has_sweep) st = write_sweep(info, res, n, err);
+    for (int k = 0; k < info->sc->nsweeps && st == FV_OK; k++) st = write_sweep(info, res, n, k, err);
     return st;
 }

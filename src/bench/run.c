@@ -16,6 +16,7 @@
 #include "core/fileio.h"
 #include "core/rng.h"
 #include "fovea/fovea.h"
+#include "scene/edit.h"
 
 typedef struct frame_setup {
     double time;
@@ -53,13 +54,35 @@ static double median(const double *v, int n)
     return m;
 }
 
-/* FNV-1a, 64 bits: a stable name for a reference frame in the cache. */
-static uint64_t fnv1a(const char *s)
+#define FNV_BASIS 1469598103934665603ULL
+
+/* FNV-1a, 64 bits, continuing from h (FNV_BASIS to start): a stable name for a reference frame
+ * in the cache. */
+static uint64_t fnv1a(uint64_t h, const char *s)
 {
-    uint64_t h = 1469598103934665603ULL;
     for (; *s; s++) {
         h ^= (unsigned char)*s;
         h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+/* The scenario's "animate" entries as one hash, so any number of keys fits in the reference
+ * key (the text of every key would not). */
+static uint64_t animate_hash(const fv_scenario *sc)
+{
+    uint64_t h = FNV_BASIS;
+    for (int i = 0; i < sc->nanimate; i++) {
+        const fv_bench_animate *a = &sc->animate[i];
+        char t[512];
+        snprintf(t, sizeof t, "|%d:%s:%d", a->light, a->light >= 0 ? "" : a->object, a->nkeys);
+        h = fnv1a(h, t);
+        for (int k = 0; k < a->nkeys; k++) {
+            const fv_anim_key *q = &a->keys[k];
+            snprintf(t, sizeof t, "|%.17g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", q->time, q->translate.x, q->translate.y,
+                     q->translate.z, q->rotate.x, q->rotate.y, q->rotate.z, q->rotate.w, q->scale.x, q->scale.y, q->scale.z);
+            h = fnv1a(h, t);
+        }
     }
     return h;
 }
@@ -78,6 +101,9 @@ static void reference_key(const fv_scenario *sc, const fv_bench_method *m, const
     KEY("fovea %s|scene=%s", FOVEA_VERSION_STRING, sc->scene);
     struct stat sb;
     if (stat(sc->scene, &sb) == 0) KEY("|bytes=%lld|mtime=%lld", (long long)sb.st_size, (long long)sb.st_mtime);
+    /* Only when set, so the references of scenarios without them keep their names. */
+    if (sc->diffuse) KEY("|diffuse");
+    if (sc->nanimate) KEY("|animate=%016llx", (unsigned long long)animate_hash(sc));
     KEY("|%dx%d|frame=%d|t=%.9g|seed=%llu|stream=reference|method=%s", sc->width, sc->height, index, f->time, sc->seed, m->method);
     for (int i = 0; i < fv_params_count(m->params); i++) KEY("|%s=%s", fv_params_key(m->params, i), fv_params_value(m->params, i));
     const fv_camera *c = &f->cam;
@@ -159,7 +185,7 @@ static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene,
         char key[2048];
         reference_key(sc, m, &frames[i], i, key, sizeof key);
         char path[4096 + 64];
-        snprintf(path, sizeof path, "%s/ref-%016llx.pfm", cache_dir, (unsigned long long)fnv1a(key));
+        snprintf(path, sizeof path, "%s/ref-%016llx.pfm", cache_dir, (unsigned long long)fnv1a(FNV_BASIS, key));
         fv_image img;
         fv_error e2;
         if (fv_file_exists(path) && fv_image_read(path, &img, &e2) == FV_OK) {
@@ -409,6 +435,50 @@ static fv_status run_match(const fv_bench_run_info *info, fv_scene *scene, frame
     return st;
 }
 
+/* ---- the scene ---- */
+
+/* Opens the scenario's scene uncommitted, applies "diffuse" and "animate", then commits it. An
+ * error names the scenario file and the field. */
+static fv_status open_scene(const fv_scenario *sc, const char *path, const fv_log *log, fv_scene **out, fv_view **view, fv_error *err)
+{
+    fv_scene *scene = NULL;
+    fv_status st = fv_scene_open(sc->scene, log, &scene, view, err);
+    if (st != FV_OK) return st;
+    if (sc->diffuse && (st = fv_scene_make_diffuse(scene, err)) != FV_OK) fv_error_prefix(err, "%s: diffuse: ", path);
+    for (int i = 0; i < sc->nanimate && st == FV_OK; i++) {
+        const fv_bench_animate *a = &sc->animate[i];
+        if (a->light >= 0) {
+            /* Before commit the scene counts only its point and spot lights: the lights that can move. */
+            int n = fv_scene_light_count(scene);
+            if (a->light >= n)
+                st = fv_error_set(err, FV_ERR_INVALID,
+                                  "%s: animate[%d].light: scene %s has no light %d (it has %d point/spot light%s, numbered from 0; area lights cannot move)",
+                                  path, i, sc->scene, a->light, n, n == 1 ? "" : "s");
+            else if ((st = fv_scene_animate_light(scene, a->light, a->keys, a->nkeys, err)) != FV_OK)
+                fv_error_prefix(err, "%s: animate[%d].light: ", path, i);
+            continue;
+        }
+        int obj = fv_scene_find_object(scene, a->object);
+        if (obj < 0)
+            st = fv_error_set(err, FV_ERR_INVALID, "%s: animate[%d].object: scene %s has no object named '%s'", path, i, sc->scene, a->object);
+        else if ((st = fv_scene_animate_object(scene, obj, a->keys, a->nkeys, err)) != FV_OK)
+            fv_error_prefix(err, "%s: animate[%d].object: ", path, i);
+    }
+    /* A commit error names the scene, as fv_scene_load's does. */
+    if (st == FV_OK && (st = fv_scene_commit(scene, log, err)) != FV_OK && strncmp(err->msg, sc->scene, strlen(sc->scene)) != 0)
+        fv_error_prefix(err, "%s: ", sc->scene);
+    if (st != FV_OK) {
+        fv_scene_destroy(scene);
+        if (view) {
+            fv_view_destroy(*view);
+            *view = NULL;
+        }
+        return st;
+    }
+    *out = scene;
+    return FV_OK;
+}
+
 /* ---- entry points ---- */
 
 fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err)
@@ -440,11 +510,10 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
     snprintf(cache_dir, sizeof cache_dir, "%s", opt->cache_dir ? opt->cache_dir : "");
     if (!opt->cache_dir) snprintf(cache_dir, sizeof cache_dir, "%s/cache", info.out_dir);
     snprintf(img_dir, sizeof img_dir, "%s/%s", info.out_dir, sc->name);
-    if ((st = fv_mkdirs(info.out_dir, err)) || (st = fv_mkdirs(cache_dir, err)) || (st = fv_mkdirs(img_dir, err))) goto done;
 
     say(opt, "scenario %s: scene %s, %dx%d, %d frame(s), %d method(s)", sc->name, sc->scene, sc->width, sc->height, sc->frames,
         sc->nmethods);
-    if ((st = fv_scene_load(sc->scene, opt->log, &scene, &view, err)) != FV_OK) goto done;
+    if ((st = open_scene(sc, path, opt->log, &scene, &view, err)) != FV_OK) goto done;
     /* Every method's parameters are checked before anything is rendered. */
     for (int i = -1 - sc->nextra; i < sc->nmethods && st == FV_OK; i++) {
         const fv_bench_method *m = i >= 0 ? &sc->methods[i] : i == -1 ? &sc->reference : &sc->extra[-2 - i];
@@ -453,6 +522,9 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
         fv_technique_destroy(t);
     }
     if (st != FV_OK) goto done;
+    /* Folders only once the scenario, its scene and every method are known to be good: bad input
+     * writes nothing. */
+    if ((st = fv_mkdirs(info.out_dir, err)) || (st = fv_mkdirs(cache_dir, err)) || (st = fv_mkdirs(img_dir, err))) goto done;
     /* The frames: the same driver policy as `fovea render`; the scenario's camera path, gaze and
      * eye model when it has them, else the scene file's. */
     fv_camera_path cpath = {sc->cam_keys, sc->ncam_keys};

@@ -12,6 +12,8 @@
 #include "core/alloc.h"
 #include "core/json_util.h"
 #include "gaze/gaze_json.h"
+#include "scene/anim.h"
+#include "scene/load_impl.h"
 
 /* Objects merge key by key, recursively; any other value replaces. */
 static bool json_merge(cJSON *dst, const cJSON *src)
@@ -132,14 +134,26 @@ static fv_status add_method(fv_scenario *s, int *cap, fv_bench_method *m, const 
     return FV_OK;
 }
 
-static fv_status parse_sweep(const cJSON *o, const char *file, fv_scenario *s, int *cap, fv_error *err)
+/* One sweep object; where is "sweep" for the single-object form, "sweep[i]" in an array. */
+static fv_status parse_sweep(const cJSON *o, const char *file, const char *where, fv_scenario *s, int *cap, fv_error *err)
 {
     static const char *const keys[] = {"label", "method", "params", "param", "values", NULL};
     fv_status st;
     const char *param = NULL;
-    if ((st = fv_json_check_keys(o, keys, file, "sweep", err)) || (st = fv_json_require(o, "param", file, "sweep", err)) ||
-        (st = fv_json_require(o, "values", file, "sweep", err)) || (st = fv_json_string(o, "param", file, "sweep", &param, err)))
+    if (!cJSON_IsObject(o)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an object {label, method, params, param, values}", file, where);
+    if ((st = fv_json_check_keys(o, keys, file, where, err)) || (st = fv_json_require(o, "param", file, where, err)) ||
+        (st = fv_json_require(o, "values", file, where, err)) || (st = fv_json_string(o, "param", file, where, &param, err)))
         return st;
+    if (s->sweep_array) {
+        /* The parameter names the sweep's CSV and plot, so it must make a file name and be unique. */
+        if (!label_ok(param))
+            return fv_error_set(err, FV_ERR_INVALID, "%s: %s.param: '%s' must be 1-63 characters of [A-Za-z0-9._=-] (it names %s-sweep-%s.csv)",
+                                file, where, param, s->name, param);
+        for (int k = 0; k < s->nsweeps; k++)
+            if (!strcmp(s->sweeps[k].param, param))
+                return fv_error_set(err, FV_ERR_INVALID, "%s: %s.param: another sweep already varies '%s' (each writes %s-sweep-%s.csv)", file,
+                                    where, param, s->name, param);
+    }
     /* Reuse the method parser on a copy without the sweep-only keys. */
     cJSON *mo = cJSON_CreateObject();
     if (!mo) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
@@ -147,7 +161,7 @@ static fv_status parse_sweep(const cJSON *o, const char *file, fv_scenario *s, i
         if (strcmp(it->string, "param") != 0 && strcmp(it->string, "values") != 0) cJSON_AddItemToObject(mo, it->string, cJSON_Duplicate(it, 1));
     fv_bench_method base;
     memset(&base, 0, sizeof base);
-    st = parse_method(mo, file, "sweep", true, &base, err);
+    st = parse_method(mo, file, where, true, &base, err);
     cJSON_Delete(mo);
     if (st != FV_OK) {
         fv_params_destroy(base.params);
@@ -157,17 +171,18 @@ static fv_status parse_sweep(const cJSON *o, const char *file, fv_scenario *s, i
     int n = cJSON_GetArraySize(vals);
     if (!cJSON_IsArray(vals) || n < 2 || n > 64) {
         fv_params_destroy(base.params);
-        return fv_error_set(err, FV_ERR_INVALID, "%s: sweep.values: expected an array of 2 to 64 numbers", file);
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.values: expected an array of 2 to 64 numbers", file, where);
     }
-    snprintf(s->sweep_param, sizeof s->sweep_param, "%s", param);
-    snprintf(s->sweep_method, sizeof s->sweep_method, "%s", base.method);
-    s->sweep_first = s->nmethods;
-    s->has_sweep = true;
+    fv_bench_sweep *sw = &s->sweeps[s->nsweeps];
+    snprintf(sw->param, sizeof sw->param, "%s", param);
+    snprintf(sw->method, sizeof sw->method, "%s", base.method);
+    sw->first = s->nmethods;
+    sw->count = 0;
     int i = 0;
     for (const cJSON *v = vals->child; v && st == FV_OK; v = v->next, i++) {
         char text[64];
         if (!cJSON_IsNumber(v) || !fv_json_scalar_text(v, text, sizeof text)) {
-            st = fv_error_set(err, FV_ERR_INVALID, "%s: sweep.values[%d]: expected a finite number", file, i);
+            st = fv_error_set(err, FV_ERR_INVALID, "%s: %s.values[%d]: expected a finite number", file, where, i);
             break;
         }
         fv_bench_method m;
@@ -175,20 +190,81 @@ static fv_status parse_sweep(const cJSON *o, const char *file, fv_scenario *s, i
         snprintf(m.method, sizeof m.method, "%s", base.method);
         int w = snprintf(m.label, sizeof m.label, "%s-%s=%s", base.label, param, text);
         if (w < 0 || w >= (int)sizeof m.label) {
-            st = fv_error_set(err, FV_ERR_INVALID, "%s: sweep: label '%s-%s=%s' is too long", file, base.label, param, text);
+            st = fv_error_set(err, FV_ERR_INVALID, "%s: %s: label '%s-%s=%s' is too long", file, where, base.label, param, text);
             break;
         }
         m.from_sweep = true;
+        m.sweep = s->nsweeps;
         m.sweep_value = v->valuedouble;
         if ((st = fv_params_clone(base.params, &m.params, err)) != FV_OK) break;
         if ((st = fv_params_set(m.params, param, text, err)) != FV_OK) {
             fv_params_destroy(m.params);
-            fv_error_prefix(err, "%s: sweep.param: ", file);
+            fv_error_prefix(err, "%s: %s.param: ", file, where);
             break;
         }
-        st = add_method(s, cap, &m, file, err);
+        if ((st = add_method(s, cap, &m, file, err)) == FV_OK) sw->count++;
     }
+    s->nsweeps++;
     fv_params_destroy(base.params);
+    return st;
+}
+
+/* "sweep": one sweep object, or an array of them. */
+static fv_status parse_sweeps(const cJSON *o, const char *file, fv_scenario *s, int *cap, fv_error *err)
+{
+    if (!cJSON_IsArray(o)) return parse_sweep(o, file, "sweep", s, cap, err);
+    int n = cJSON_GetArraySize(o);
+    if (n < 1 || n > FV_BENCH_MAX_SWEEPS)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: sweep: expected a sweep object or an array of 1 to %d of them", file, FV_BENCH_MAX_SWEEPS);
+    s->sweep_array = true;
+    int i = 0;
+    fv_status st = FV_OK;
+    for (const cJSON *e = o->child; e && st == FV_OK; e = e->next, i++) {
+        char where[32];
+        snprintf(where, sizeof where, "sweep[%d]", i);
+        st = parse_sweep(e, file, where, s, cap, err);
+    }
+    return st;
+}
+
+/* "animate": [{"light": INDEX | "object": NAME, "animation": [keys]}]. The keys are read by the
+ * scene format's own parser and checked with the scene's rules here, so a bad list is refused
+ * before anything is loaded; whether the light or object exists is known only once the scene is
+ * open (run.c). */
+static fv_status parse_animate(const cJSON *arr, const char *file, fv_scenario *s, fv_error *err)
+{
+    static const char *const keys[] = {"light", "object", "animation", NULL};
+    int n = cJSON_GetArraySize(arr);
+    if (!cJSON_IsArray(arr) || n < 1 || n > FV_BENCH_MAX_ANIMATE)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: animate: expected an array of 1 to %d {light or object, animation} entries", file,
+                            FV_BENCH_MAX_ANIMATE);
+    if (!(s->animate = fv_calloc_array((size_t)n, sizeof *s->animate))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    int i = 0;
+    fv_status st = FV_OK;
+    for (const cJSON *e = arr->child; e && st == FV_OK; e = e->next, i++) {
+        char where[32];
+        snprintf(where, sizeof where, "animate[%d]", i);
+        fv_bench_animate *a = &s->animate[i];
+        const char *obj = NULL;
+        a->light = -1;
+        if (!cJSON_IsObject(e)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an object {light or object, animation}", file, where);
+        bool has_light = cJSON_GetObjectItemCaseSensitive(e, "light") != NULL, has_obj = cJSON_GetObjectItemCaseSensitive(e, "object") != NULL;
+        if ((st = fv_json_check_keys(e, keys, file, where, err)) || (st = fv_json_require(e, "animation", file, where, err)))
+            return st;
+        if (has_light == has_obj) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: give exactly one of 'light' (an index) and 'object' (a name)", file, where);
+        if ((st = fv_json_int(e, "light", 0, 1000000, file, where, &a->light, err)) || (st = fv_json_string(e, "object", file, where, &obj, err)))
+            return st;
+        if (obj) {
+            if (!obj[0] || strlen(obj) >= FV_NAME_MAX)
+                return fv_error_set(err, FV_ERR_INVALID, "%s: %s.object: expected an object name of 1 to %d characters", file, where, FV_NAME_MAX - 1);
+            snprintf(a->object, sizeof a->object, "%s", obj);
+        }
+        s->nanimate = i + 1;
+        if ((st = fv_load_json_anim_keys(cJSON_GetObjectItemCaseSensitive(e, "animation"), file, where, &a->keys, &a->nkeys, err)) != FV_OK)
+            return st;
+        /* Reads "FILE: animation of animate[i]: key times must increase (key 1)". */
+        if ((st = fv_anim_check(where, a->keys, a->nkeys, err)) != FV_OK) fv_error_prefix(err, "%s: ", file);
+    }
     return st;
 }
 
@@ -246,7 +322,7 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
 {
     static const char *const keys[] = {"name", "description", "scene", "size", "frames", "measure_from", "fps", "start_time", "repeats",
                                        "exposure", "seed", "eye", "gaze", "camera_path", "reference", "baseline", "methods",
-                                       "sweep", "match", "extra_references", "quick", "full", NULL};
+                                       "sweep", "match", "extra_references", "diffuse", "animate", "quick", "full", NULL};
     fv_status st = fv_json_check_keys(root, keys, file, "", err);
     if (st != FV_OK) return st;
     const char *name = NULL, *desc = NULL, *scene = NULL, *baseline = NULL;
@@ -261,8 +337,11 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
         (st = fv_json_number(root, "start_time", -1e9, 1e9, file, "", &s->start_time, err)) ||
         (st = fv_json_int(root, "repeats", 1, 1000, file, "", &s->repeats, err)) ||
         (st = fv_json_number(root, "exposure", 0, 1e9, file, "", &exposure, err)) ||
-        (st = fv_json_number(root, "seed", 0, 9007199254740992.0, file, "", &seed, err)))
+        (st = fv_json_number(root, "seed", 0, 9007199254740992.0, file, "", &seed, err)) ||
+        (st = fv_json_bool(root, "diffuse", file, "", &s->diffuse, err)))
         return st;
+    const cJSON *an = cJSON_GetObjectItemCaseSensitive(root, "animate");
+    if (an && (st = parse_animate(an, file, s, err)) != FV_OK) return st;
     if (s->measure_from >= s->frames)
         return fv_error_set(err, FV_ERR_INVALID, "%s: measure_from %d must be below frames (%d)", file, s->measure_from, s->frames);
     if (size[0] != floor(size[0]) || size[1] != floor(size[1]))
@@ -339,7 +418,7 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
         }
         if ((st = add_method(s, &cap, &bm, file, err)) != FV_OK) return st;
     }
-    if ((o = cJSON_GetObjectItemCaseSensitive(root, "sweep")) && (st = parse_sweep(o, file, s, &cap, err))) return st;
+    if ((o = cJSON_GetObjectItemCaseSensitive(root, "sweep")) && (st = parse_sweeps(o, file, s, &cap, err))) return st;
     if (s->nmethods == 0) return fv_error_set(err, FV_ERR_INVALID, "%s: no methods to compare (give 'methods' or 'sweep')", file);
     const cJSON *ma = cJSON_GetObjectItemCaseSensitive(root, "match");
     if (ma) {
@@ -416,6 +495,8 @@ void fv_scenario_destroy(fv_scenario *s)
     for (int i = 0; i < s->nmethods; i++) fv_params_destroy(s->methods[i].params);
     for (int i = 0; i < s->nmatches; i++) fv_params_destroy(s->matches[i].base.params);
     free(s->matches);
+    for (int i = 0; i < s->nanimate; i++) free(s->animate[i].keys);
+    free(s->animate);
     fv_params_destroy(s->reference.params);
     for (int i = 0; i < s->nextra; i++) fv_params_destroy(s->extra[i].params);
     fv_gaze_path_destroy(s->gaze);

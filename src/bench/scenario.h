@@ -6,16 +6,20 @@
 #include "fovea/bench.h"
 #include "fovea/camera.h"
 #include "fovea/gaze.h"
+#include "fovea/scene.h"
 #include "fovea/technique.h"
 
 #define FV_BENCH_LABEL_MAX 64
 #define FV_BENCH_MAX_EXTRA 4   /* extra references a scenario may measure errors against */
+#define FV_BENCH_MAX_SWEEPS 16  /* sweeps in a "sweep" array */
+#define FV_BENCH_MAX_ANIMATE 64 /* entries of "animate" */
 
 typedef struct fv_bench_method {
     char label[FV_BENCH_LABEL_MAX];
     char method[FV_BENCH_LABEL_MAX];
     fv_params *params;
     bool from_sweep;
+    int sweep;               /* from_sweep: which of fv_scenario.sweeps made it */
     double sweep_value;
     int match;               /* 0: an ordinary row; k > 0: the row "match" search k - 1 chose */
     bool match_reached;
@@ -34,10 +38,30 @@ typedef struct fv_bench_match {
     fv_region region;
 } fv_bench_match;
 
+/* One sweep: a method run once per value of one parameter; its rows are methods[first ..
+ * first + count - 1]. */
+typedef struct fv_bench_sweep {
+    char param[FV_BENCH_LABEL_MAX];
+    char method[FV_BENCH_LABEL_MAX];
+    int first, count;
+} fv_bench_sweep;
+
+/* One entry of "animate": keys that replace the animation of a point/spot light or an object of
+ * the scene before it is committed (docs/bench.md). */
+typedef struct fv_bench_animate {
+    int light;                  /* >= 0: the light of this index (fv_scene_add_light order) */
+    char object[FV_NAME_MAX];   /* light < 0: the first object of this name */
+    fv_anim_key *keys;
+    int nkeys;
+} fv_bench_animate;
+
 typedef struct fv_scenario {
     char name[FV_BENCH_LABEL_MAX];
     char *description;
     char *scene;             /* built-in name or a path resolved against the scenario's folder */
+    bool diffuse;            /* every material made diffuse before commit (fv_scene_make_diffuse) */
+    fv_bench_animate *animate; /* applied, in order, before commit */
+    int nanimate;
     int width, height;
     int frames;
     int measure_from;        /* errors over frames [measure_from, frames): earlier ones build history */
@@ -56,10 +80,9 @@ typedef struct fv_scenario {
     char baseline[FV_BENCH_LABEL_MAX]; /* label of the method speed-ups are relative to */
     fv_bench_method *methods;          /* listed methods, then the sweep's */
     int nmethods;
-    bool has_sweep;
-    char sweep_param[FV_BENCH_LABEL_MAX];
-    char sweep_method[FV_BENCH_LABEL_MAX];
-    int sweep_first;                   /* index of the first sweep method in methods[] */
+    fv_bench_sweep sweeps[FV_BENCH_MAX_SWEEPS];
+    int nsweeps;
+    bool sweep_array;                  /* "sweep" was an array: one NAME-sweep-PARAM.csv/png each */
     fv_bench_match *matches;
     int nmatches;
 } fv_scenario;

@@ -18,6 +18,8 @@ static const builtin k_builtins[] = {
      fv_builtin_cornell_glossy},
     {"cornell-fpm", "Foveated Photon Mapping Fig. 2: glass sphere (caustic), moving mirror cube, camera path, 0-4 s",
      fv_builtin_cornell_fpm},
+    {"cornell-fir", "Foveated Instant Radiosity: all-diffuse Cornell box, circling point light, moving yellow cube, 0-4 s",
+     fv_builtin_cornell_fir},
     {"city", "performance scene: 180,906 triangles of towers and spheres, mixed materials, sun + lamps",
      fv_builtin_city},
     {"sdf-primitives", "signed distance fields (IPR paper Sec. 4.1, open): seven primitives and a smooth union on a checkerboard",

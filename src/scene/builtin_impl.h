@@ -13,6 +13,7 @@
 fv_status fv_builtin_cornell(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 fv_status fv_builtin_cornell_glossy(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 fv_status fv_builtin_cornell_fpm(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
+fv_status fv_builtin_cornell_fir(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 fv_status fv_builtin_city(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 fv_status fv_builtin_sdf_primitives(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 fv_status fv_builtin_sdf_columns(fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
@@ -35,8 +36,15 @@ typedef struct fv_cornell_mats {
 
 /* The four materials of the measured box: white, red, green walls and the warm-white light. */
 fv_status fv_cornell_materials(fv_scene *scene, fv_cornell_mats *out, fv_error *err);
+/* Only the three wall materials (out->light = -1), for boxes lit by delta lights: no emissive
+ * material is left in the scene for a technique to mistake for a light. */
+fv_status fv_cornell_wall_materials(fv_scene *scene, fv_cornell_mats *out, fv_error *err);
 /* Adds the room (floor, ceiling, back, red and green walls) and the light as two static objects. */
 fv_status fv_cornell_room(fv_scene *scene, const fv_cornell_mats *m, const fv_log *log, fv_error *err);
+/* Adds only the room, as the static object "room" (10 triangles), without the light. */
+fv_status fv_cornell_walls(fv_scene *scene, const fv_cornell_mats *m, const fv_log *log, fv_error *err);
+/* Adds the measured tall block (10 triangles, 330 high, standing on the floor) as "tall_block". */
+fv_status fv_cornell_tall_block(fv_scene *scene, int mat, const fv_log *log, fv_error *err);
 /* The camera of the measured data set (sized 512 x 512; callers resize). */
 fv_camera fv_cornell_camera(void);
 

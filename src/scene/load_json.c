@@ -156,14 +156,15 @@ static fv_status parse_shape(const cJSON *o, const json_ctx *c, const char *wher
     return FV_OK;
 }
 
-/* The "animation" array of objects[i] or lights[i] (where), applied to objects first .. first +
- * count - 1, or to light `light` when it is >= 0: one key format and one set of rules for both. */
-static fv_status parse_animation(const cJSON *arr, const json_ctx *c, const char *where, int first, int count, int light, fv_error *err)
+fv_status fv_load_json_anim_keys(const cJSON *arr, const char *file, const char *where, fv_anim_key **out, int *count, fv_error *err)
 {
     static const char *const keys[] = {"time", "translate", "rotate_deg", "rotate_quat", "scale", NULL};
+    json_ctx c;
+    memset(&c, 0, sizeof c);
+    c.file = file;
     int n = cJSON_GetArraySize(arr);
     if (!cJSON_IsArray(arr) || n < 1 || n > 100000)
-        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.animation: expected an array of keys", c->file, where);
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.animation: expected an array of keys", file, where);
     fv_anim_key *k = fv_alloc_array((size_t)n, sizeof *k);
     if (!k) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_status st = FV_OK;
@@ -172,11 +173,27 @@ static fv_status parse_animation(const cJSON *arr, const json_ctx *c, const char
         char w2[128];
         snprintf(w2, sizeof w2, "%s.animation[%d]", where, i);
         double t = 0;
-        if ((st = parse_trs(e, c, w2, keys, &k[i].translate, &k[i].rotate, &k[i].scale, err)) ||
-            (st = fv_json_require(e, "time", c->file, w2, err)) || (st = fv_json_number(e, "time", -1e9, 1e9, c->file, w2, &t, err)))
+        if ((st = parse_trs(e, &c, w2, keys, &k[i].translate, &k[i].rotate, &k[i].scale, err)) ||
+            (st = fv_json_require(e, "time", file, w2, err)) || (st = fv_json_number(e, "time", -1e9, 1e9, file, w2, &t, err)))
             break;
         k[i].time = t;
     }
+    if (st != FV_OK) {
+        free(k);
+        return st;
+    }
+    *out = k;
+    *count = n;
+    return FV_OK;
+}
+
+/* The "animation" array of objects[i] or lights[i] (where), applied to objects first .. first +
+ * count - 1, or to light `light` when it is >= 0: one key format and one set of rules for both. */
+static fv_status parse_animation(const cJSON *arr, const json_ctx *c, const char *where, int first, int count, int light, fv_error *err)
+{
+    fv_anim_key *k = NULL;
+    int n = 0;
+    fv_status st = fv_load_json_anim_keys(arr, c->file, where, &k, &n, err);
     for (int o = 0; o < count && st == FV_OK; o++)
         if ((st = fv_scene_animate_object(c->scene, first + o, k, n, err)) != FV_OK) fv_error_prefix(err, "%s: %s: ", c->file, where);
     if (light >= 0 && st == FV_OK && (st = fv_scene_animate_light(c->scene, light, k, n, err)) != FV_OK)

@@ -2,7 +2,8 @@
  * every built-in builds and commits without warnings with the hand-counted number of triangles
  * and at least one light; the Cornell box has the measured bounds, a camera whose centre ray hits
  * the tall block at z = 292, rays above it the back wall at z = 559.2, and the red wall on the
- * left; cornell-fpm's mirror cube moves with time; the furnace is a closed unit sphere; the
+ * left; cornell-fpm's mirror cube moves with time; cornell-fir is all diffuse, lit by one point
+ * light that circles under the ceiling, with a yellow cube that slides and returns; the furnace is a closed unit sphere; the
  * city is large and deterministic; unknown names are refused with a message naming them;
  * generated spheres and boxes have the right areas, counts and outward normals. */
 #include <setjmp.h>
@@ -14,6 +15,8 @@
 #include <cmocka.h>
 #include "scene/mesh_gen.h"
 #include "fovea/view.h"
+#include "scene/edit.h"
+#include "scene/light.h"
 #include "scene/scene_impl.h"
 #include "testkit.h"
 
@@ -68,8 +71,8 @@ static void test_table(void **st)
 {
     (void)st;
     int n = fv_builtin_count();
-    assert_int_equal(n, 9);
-    const char *want[] = {"cornell", "cornell-glossy", "cornell-fpm", "city", "sdf-primitives", "sdf-columns", "sdf-temple", "sdf-furnace", "furnace"};
+    assert_int_equal(n, 10);
+    const char *want[] = {"cornell", "cornell-glossy", "cornell-fpm", "cornell-fir", "city", "sdf-primitives", "sdf-columns", "sdf-temple", "sdf-furnace", "furnace"};
     for (int i = 0; i < n; i++) {
         assert_string_equal(fv_builtin_name(i), want[i]);
         const char *sum = fv_builtin_summary(i);
@@ -111,6 +114,8 @@ static void test_counts(void **st)
         {"cornell-glossy", 32, 2},
         /* room 10 + light 2 + sphere 2*64*31 + cube 12 */
         {"cornell-fpm", 10 + 2 + 2 * 64 * 31 + 12, 2},
+        /* room 10 + tall block 10 + cube 12; one point light */
+        {"cornell-fir", 10 + 10 + 12, 1},
         /* 2*48*23 triangles, every one emissive */
         {"furnace", 2 * 48 * 23, 2 * 48 * 23},
     };
@@ -273,6 +278,101 @@ static void test_fpm(void **st)
     assert_float_equal(cam.pos.z, -740.0, 1e-2);
     assert_int_equal(cam.width, 64);
     fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+/* ---- cornell-fir ---- */
+
+static void test_fir(void **st)
+{
+    (void)st;
+    fv_view *v;
+    fv_scene *s = build("cornell-fir", &v, NULL);
+    /* Diffuse only, lit by exactly one delta light: no material emits, so no triangle does. */
+    for (int i = 0; i < fv_scene_material_count(s); i++) {
+        const fv_material *m = fv_scene_material(s, i);
+        assert_int_equal(m->type, FV_MAT_DIFFUSE);
+        assert_float_equal(fv_max3(m->emission), 0.0, 0.0);
+    }
+    assert_int_equal(fv_scene_light_count(s), 1);
+    assert_int_equal(fv_light_delta_count(s), 1);
+    assert_true(fv_scene_lights_move(s));
+    assert_int_equal(fv_scene_dynamic_object_count(s), 1);
+    assert_false(fv_view_has_camera_path(v));
+    int cube = fv_scene_find_object(s, "yellow_cube");
+    assert_true(cube >= 0 && fv_scene_object_dynamic(s, cube));
+    assert_false(fv_scene_object_dynamic(s, fv_scene_find_object(s, "tall_block")));
+    assert_int_equal(fv_scene_find_object(s, "short_block"), -1);
+
+    /* The light: on a circle of radius 120 at y = 500 around the ceiling's centre, a quarter turn
+     * per second, back at its start after 4 s. */
+    fv_error err;
+    fv_vec3 p[3], lo[3], hi[3];
+    const double t[3] = {0.0, 1.0, 4.0};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(fv_scene_set_time(s, t[k], &err), FV_OK);
+        p[k] = fv_light_delta_pos(fv_light_delta_at(s, 0));
+        fv_scene_object_bounds(s, cube, &lo[k], &hi[k]);
+        assert_float_equal(p[k].y, 500.0, 1e-3);
+        assert_float_equal(fv_length(fv_sub(p[k], fv_v3(278, 500, 279.6f))), 120.0, 0.1);
+    }
+    assert_true(fv_length(fv_sub(p[0], p[1])) > 150.0f); /* a quarter of the circle: 120 sqrt 2 */
+    assert_float_equal(fv_length(fv_sub(p[0], p[2])), 0.0, 1e-3);
+    /* The cube stands on the floor, inside the box, and has moved by t = 1 (and more by 2). */
+    for (int k = 0; k < 3; k++) {
+        assert_float_equal(lo[k].y, 0.0, 0.01);
+        assert_float_equal(hi[k].y, 160.0, 0.01);
+        assert_true(lo[k].x > 20.0f && hi[k].x < 530.0f && lo[k].z > 0.0f && hi[k].z < 247.0f);
+    }
+    assert_true(lo[1].x - lo[0].x > 50.0f);
+    assert_float_equal(lo[2].x, lo[0].x, 1e-2);
+    assert_float_equal(hi[2].z, hi[0].z, 1e-2);
+
+    /* The camera is cornell's. */
+    fv_camera cam;
+    fv_view_camera(v, s, 0.0, 64, 64, &cam);
+    assert_float_equal(cam.pos.x, 278.0, 1e-3);
+    assert_float_equal(cam.pos.z, -800.0, 1e-3);
+    assert_float_equal(cam.fov_y, 37.5, 1e-4);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+/* fv_scene_make_diffuse (scene/edit.h) on cornell-fpm and cornell-glossy: every material diffuse, a specular one
+ * takes albedo + specular up to 0.95, a diffuse one and every emission are untouched. */
+static void test_make_diffuse(void **st)
+{
+    (void)st;
+    fv_scene *s;
+    fv_error err;
+    assert_int_equal(fv_scene_create(&s, &err), FV_OK);
+    assert_int_equal(fv_builtin_build("cornell-fpm", s, NULL, NULL, &err), FV_OK);
+    fv_material white = *fv_scene_material(s, fv_scene_find_material(s, "white"));
+    fv_material light = *fv_scene_material(s, fv_scene_find_material(s, "light"));
+    assert_int_equal(fv_scene_make_diffuse(s, &err), FV_OK);
+    for (int i = 0; i < fv_scene_material_count(s); i++) assert_int_equal(fv_scene_material(s, i)->type, FV_MAT_DIFFUSE);
+    const fv_material *g = fv_scene_material(s, fv_scene_find_material(s, "glass"));
+    const fv_material *m = fv_scene_material(s, fv_scene_find_material(s, "mirror"));
+    assert_float_equal(g->albedo.x, 0.95, 1e-6); /* 0 + 1 */
+    assert_float_equal(m->albedo.y, 0.95, 1e-6); /* 0 + 0.95 */
+    assert_string_equal(g->name, "glass");
+    const fv_material *w = fv_scene_material(s, fv_scene_find_material(s, "white"));
+    assert_memory_equal(&w->albedo, &white.albedo, sizeof white.albedo);
+    const fv_material *l = fv_scene_material(s, fv_scene_find_material(s, "light"));
+    assert_memory_equal(&l->emission, &light.emission, sizeof light.emission);
+    assert_int_equal(fv_scene_commit(s, NULL, &err), FV_OK);
+    assert_int_equal(fv_scene_make_diffuse(s, &err), FV_ERR_INTERNAL);
+    fv_scene_destroy(s);
+    /* A glossy plastic keeps its Lambert albedo plus its 4 % F0; the copper its F0. */
+    assert_int_equal(fv_scene_create(&s, &err), FV_OK);
+    assert_int_equal(fv_builtin_build("cornell-glossy", s, NULL, NULL, &err), FV_OK);
+    assert_int_equal(fv_scene_make_diffuse(s, &err), FV_OK);
+    const fv_material *p = fv_scene_material(s, fv_scene_find_material(s, "plastic"));
+    const fv_material *c = fv_scene_material(s, fv_scene_find_material(s, "copper"));
+    assert_float_equal(p->albedo.x, 0.725 + 0.04, 1e-6);
+    assert_float_equal(c->albedo.x, 0.95, 1e-6);
+    assert_float_equal(c->albedo.y, 0.64, 1e-6);
+    assert_int_equal(p->type, FV_MAT_DIFFUSE);
     fv_scene_destroy(s);
 }
 
@@ -481,6 +581,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_table),       cmocka_unit_test(test_unknown_name), cmocka_unit_test(test_counts),
         cmocka_unit_test(test_cornell_geometry), cmocka_unit_test(test_cornell_glossy), cmocka_unit_test(test_fpm),
+        cmocka_unit_test(test_fir),         cmocka_unit_test(test_make_diffuse),
         cmocka_unit_test(test_furnace),     cmocka_unit_test(test_city),         cmocka_unit_test(test_sphere),
         cmocka_unit_test(test_box),         cmocka_unit_test(test_quads_and_grid), cmocka_unit_test(test_oom_contract),
     };
