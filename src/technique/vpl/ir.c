@@ -240,7 +240,7 @@ const fv_technique_class fv_technique_ir = {
     .test_params = "vpls=64,area_samples=2",
     .furnace_params = "vpls=2000,area_samples=16",
     .furnace_radiance = 1.0,
-    .furnace_tolerance = 0.08,
+    .furnace_tolerance = 0.03,
 };
 
 const fv_technique_class fv_technique_ir_low = {
@@ -254,5 +254,5 @@ const fv_technique_class fv_technique_ir_low = {
     .test_params = "vpls=32,area_samples=2,cube_size=16",
     .furnace_params = "vpls=2000,area_samples=16,cube_size=32",
     .furnace_radiance = 1.0,
-    .furnace_tolerance = 0.08,
+    .furnace_tolerance = 0.03,
 };
