@@ -28,6 +28,7 @@
 #include "scene/light.h"
 #include "technique/class.h"
 #include "technique/vpl/direct.h"
+#include "technique/vpl/fir.h"
 #include "technique/vpl/manage.h"
 #include "technique/vpl/radiosity.h"
 #include "technique/vpl/shade.h"
@@ -111,7 +112,8 @@ typedef struct fir_state {
     float *fbuf;        /* atrous: rgb, normal, position */
     size_t npix;
     /* last management's counts, reported by both eyes */
-    int reused, fresh, dropped, built_maps, made_candidates, fovea_cells;
+    int moved_count[FV_MAX_THREADS];
+    int reused, fresh, dropped, moved, built_maps, made_candidates, fovea_cells;
 } fir_state;
 
 /* ---- create / destroy ---- */
@@ -297,6 +299,14 @@ static void object_maps(const fv_scene *s, int obj, fv_xform *w2l, fv_xform *l2w
     if (!fv_xform_inverse(w2l, l2w)) *l2w = fv_xform_identity();
 }
 
+void fv_fir_follow(const fv_scene *s, int obj, fv_vec3 lp, fv_vec3 ln, fv_vec3 *p, fv_vec3 *n)
+{
+    fv_xform w2l, l2w;
+    object_maps(s, obj, &w2l, &l2w);
+    *p = fv_xform_point(&l2w, lp);
+    *n = fv_normalize(fv_xform_vector(&l2w, ln));
+}
+
 /* A new VPL at hit h (normal turned towards dir's origin side). */
 static void vpl_from_hit(const fv_scene *s, const fv_hit *h, fv_vec3 dir, fir_vpl *v)
 {
@@ -383,17 +393,18 @@ static void cand_importance_range(void *ctx, int64_t b, int64_t e, int thread)
 /* Alg. 4 line 3 for VPL i: follow its object, check the voxel it now lies in, importance now. */
 static void update_range(void *ctx, int64_t b, int64_t e, int thread)
 {
-    (void)thread;
     fir_state *st = ((par_ctx *)ctx)->st;
     for (int64_t i = b; i < e; i++) {
         fir_vpl *v = &st->vpl[i];
         if (v->obj >= 0 && fv_scene_object_dynamic(st->scene, v->obj)) {
-            fv_xform w2l, l2w;
-            object_maps(st->scene, v->obj, &w2l, &l2w);
-            const fv_vec3 p = fv_xform_point(&l2w, v->lp);
-            if (fv_length(fv_sub(p, v->p)) > 0.0f) v->built = -2; /* moved: its map is stale */
+            fv_vec3 p, n;
+            fv_fir_follow(st->scene, v->obj, v->lp, v->ln, &p, &n);
+            if (fv_length(fv_sub(p, v->p)) > 0.0f) {
+                v->built = -2; /* moved: its map is stale */
+                st->moved_count[thread]++;
+            }
             v->p = p;
-            v->n = fv_normalize(fv_xform_vector(&l2w, v->ln));
+            v->n = n;
         }
         fv_voxel vx;
         bool keep = voxel_at(st->vox, v->p, &vx) && vx.occupied && fv_dot(vx.normal, v->n) >= st->drop_cos * fv_length(vx.normal);
@@ -403,36 +414,37 @@ static void update_range(void *ctx, int64_t b, int64_t e, int thread)
     }
 }
 
-/* The density cells the frame's candidates landed in, and their six face neighbours: about a thousand
- * candidates leave holes between the cells they hit on a surface they all reach (in the furnace they
- * marked 71% of the sphere's cells). Measured on the fovea's indirect light against pt: without
- * the neighbours 82% of the truth on cornell and 80% in the furnace; with all 26, 122% on cornell
- * (corners add cells of surfaces that do not face the fovea); with the six, 112% and 99%. */
-static void mark_reached(fir_state *st, int made)
+/* The density cells the valid VPLs lie in, and their six face neighbours: the surfaces the VPLs
+ * stand for. The VPLs are where the candidates from the fovea landed and were kept, so this is the
+ * region one bounce from the fovea reaches; a neighbour fills the holes a thousand VPLs leave
+ * between the cells they hold on a surface they all reach. Measured on the fovea's indirect light
+ * against pt (cornell; furnace; 128x128, frame 4): the VPLs' own cells only, 82% and 80% of the
+ * truth; with the six neighbours 109% and 97%; with all 26, 122% on cornell (corners add cells of
+ * surfaces that do not face the fovea). It depends on the VPLs alone, so a still scene keeps it
+ * (E' = 0); the frame's candidates instead would change it every frame. */
+static void mark_reached(fir_state *st)
 {
     int dims[3];
     fv_density_grid_dims(st->grid, dims);
     memset(st->reached, 0, (size_t)fv_density_grid_cells(st->grid));
-    for (int j = 0; j < made; j++) {
-        const int c = fv_density_grid_cell(st->grid, st->cand[j].p);
+    for (int i = 0; i < st->nvpl; i++) {
+        const int c = fv_density_grid_cell(st->grid, st->vpl[i].p);
         const int x = c % dims[0], y = (c / dims[0]) % dims[1], z = c / (dims[0] * dims[1]);
-        for (int dz = -1; dz <= 1; dz++)
-            for (int dy = -1; dy <= 1; dy++)
-                for (int dx = -1; dx <= 1; dx++) {
-                    if (abs(dx) + abs(dy) + abs(dz) > 1) continue;
-                    const int X = x + dx, Y = y + dy, Z = z + dz;
-                    if (X < 0 || Y < 0 || Z < 0 || X >= dims[0] || Y >= dims[1] || Z >= dims[2]) continue;
-                    st->reached[X + dims[0] * (Y + dims[1] * Z)] = 1;
-                }
+        const int nb[7][3] = {{x, y, z}, {x - 1, y, z}, {x + 1, y, z}, {x, y - 1, z}, {x, y + 1, z}, {x, y, z - 1}, {x, y, z + 1}};
+        for (int k = 0; k < 7; k++) {
+            const int X = nb[k][0], Y = nb[k][1], Z = nb[k][2];
+            if (X < 0 || Y < 0 || Z < 0 || X >= dims[0] || Y >= dims[1] || Z >= dims[2]) continue;
+            st->reached[X + dims[0] * (Y + dims[1] * Z)] = 1;
+        }
     }
 }
 
 /* The area the VPLs of each density cell stand for (Sec. 3.4, "uniform density"; radiosity.h): a
- * cell's own surface, plus that of the cells the frame's candidates reached but no VPL took, each
- * given to the nearest cell holding VPLs (a breadth-first search over the grid from all of them at
- * once). Surfaces no candidate reached do not light the fovea by the candidates' construction and
- * stand for nothing; without this, a density cell that no VPL took would lose its light, and every
- * region would come out darker the fewer VPLs it has. */
+ * cell's own surface, plus that of the reached cells (mark_reached) no VPL took, each given to the
+ * nearest cell holding VPLs (a breadth-first search over the grid from all of them at once).
+ * Surfaces farther from the VPLs do not light the fovea by the candidates' construction and stand
+ * for nothing; without the neighbours, a density cell that no VPL took would lose its light, and
+ * every region would come out darker the fewer VPLs it has. */
 static void vpl_cell_areas(fir_state *st)
 {
     int dims[3];
@@ -529,7 +541,10 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     /* Alg. 2 */
     st->fovea_cells = fv_vpl_foveated_weights(st->vox, cam, &st->gb, pc.gx, pc.gy, pc.R, st->weight, threads);
     /* Alg. 4 line 3 */
+    memset(st->moved_count, 0, sizeof st->moved_count);
     fv_parallel_for(st->nvpl, 16, threads, update_range, &pc);
+    st->moved = 0;
+    for (int t = 0; t < FV_MAX_THREADS; t++) st->moved += st->moved_count[t];
     int n_old = 0;
     st->dropped = 0;
     for (int i = 0; i < st->nvpl; i++) {
@@ -605,7 +620,7 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     /* the density of the final set, for the VPLs' area */
     fv_density_grid_clear(st->grid);
     for (int i = 0; i < n; i++) fv_density_grid_add(st->grid, st->vpl[i].p, 1);
-    mark_reached(st, made);
+    mark_reached(st);
     vpl_cell_areas(st);
     double t3 = fv_time_ms();
 
@@ -792,6 +807,7 @@ static fv_status fir_render(void *state, const fv_frame *frame, fv_film *film, f
         fv_stats_add_count(stats, "reused_vpls", st->reused);
         fv_stats_add_count(stats, "new_vpls", st->fresh);
         fv_stats_add_count(stats, "dropped_vpls", st->dropped);
+        fv_stats_add_count(stats, "moved_vpls", st->moved);
         fv_stats_add_count(stats, "cube_maps_built", st->built_maps);
         fv_stats_add_count(stats, "candidates", st->made_candidates);
         fv_stats_add_count(stats, "fovea_voxels", st->fovea_cells);
