@@ -7,15 +7,15 @@
 OUT=$TMP/out.png
 R="$FOVEA render cornell-fir --size 24x24"
 
-expect 2 "'vpls'" -- $R --method fir --param vpls=0 --out "$OUT"
-expect 2 "'vpls'" -- $R --method ir --param vpls=-3 --out "$OUT"
-expect 2 "'vpls'" -- $R --method ir-low --param vpls=0 --out "$OUT"
-expect 2 "'tiles_x'" -- $R --method fir --param vpls=20 --param tiles_x=5 --param tiles_y=5 --out "$OUT"
-expect 2 "'radius'" -- $R --method fir --param radius=0 --out "$OUT"
-expect 2 "'radius'" -- $R --method fir --param radius=1.01 --out "$OUT"
-expect 2 "'cube_size'" -- $R --method fir --param cube_size=7 --out "$OUT"
-expect 2 "'cube_size'" -- $R --method ir-low --param cube_size=2 --out "$OUT"
-expect 2 "'filter'" -- $R --method fir --param filter=median --out "$OUT"
+expect 2 "vpls=" -- $R --method fir --param vpls=0 --out "$OUT"
+expect 2 "vpls=" -- $R --method ir --param vpls=-3 --out "$OUT"
+expect 2 "vpls=" -- $R --method ir-low --param vpls=0 --out "$OUT"
+expect 2 "tiles_x=" -- $R --method fir --param vpls=20 --param tiles_x=5 --param tiles_y=5 --out "$OUT"
+expect 2 "radius=" -- $R --method fir --param radius=0 --out "$OUT"
+expect 2 "radius=" -- $R --method fir --param radius=1.01 --out "$OUT"
+expect 2 "cube_size=" -- $R --method fir --param cube_size=7 --out "$OUT"
+expect 2 "cube_size=" -- $R --method ir-low --param cube_size=2 --out "$OUT"
+expect 2 "filter=" -- $R --method fir --param filter=median --out "$OUT"
 expect 2 "unknown parameter 'cube_size'" -- $R --method ir --param cube_size=64 --out "$OUT"
 [ -e "$OUT" ] && fail "a refused render left $OUT behind"
 
@@ -23,7 +23,7 @@ for m in ir ir-low fir; do
   expect 0 "" -- $R --method $m --param vpls=50 --frames 2 --stats --out "$TMP/$m.png"
   [ -s "$TMP/${m}_0001.png" ] || fail "$m wrote no second frame"
 done
-$R --method fir --param vpls=50 --frames 3 --stats --out "$TMP/f.png" >"$TMP/stats" 2>/dev/null || fail "fir --stats failed"
+$R --method fir --param vpls=50 --frames 3 --stats --out "$TMP/f.png" 2>"$TMP/stats" >/dev/null || fail "fir --stats failed"
 for k in valid_vpls= reused_vpls= new_vpls= cube_maps_built= voxelize vpl_generation cube_maps shading; do
   grep -q "$k" "$TMP/stats" || fail "fir --stats does not report $k: $(cat "$TMP/stats")"
 done

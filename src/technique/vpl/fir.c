@@ -140,7 +140,7 @@ static fv_status read_params(fir_state *st, fv_params *p, fv_error *err)
     double resample, density_c, drop_imp, drop_deg, rebuild, radius, clamp;
     fv_status s;
     if ((s = fv_params_int(p, "vpls", 1000, -2147483647, 1000000, &st->total, err)) != FV_OK) return s;
-    if (st->total <= 0) return fv_error_set(err, FV_ERR_INVALID, "parameter 'vpls' must be at least 1 (got %d)", st->total);
+    if (st->total <= 0) return fv_error_set(err, FV_ERR_INVALID, "parameter vpls=%d: must be at least 1", st->total);
     if ((s = fv_params_int(p, "candidates", 1000, 1, 1000000, &st->ncand, err)) != FV_OK ||
         (s = fv_params_float(p, "resample", 0.1, 0.0, 1.0, &resample, err)) != FV_OK ||
         (s = fv_params_int(p, "resolution", 64, 8, 1024, &st->resolution, err)) != FV_OK ||
@@ -155,12 +155,12 @@ static fv_status read_params(fir_state *st, fv_params *p, fv_error *err)
         (s = fv_params_int(p, "cube_size", 128, -2147483647, 2147483647, &st->cube_size, err)) != FV_OK)
         return s;
     if (st->cube_size < FV_CUBE_MIN_SIZE || st->cube_size > FV_CUBE_MAX_SIZE)
-        return fv_error_set(err, FV_ERR_INVALID, "parameter 'cube_size' must be in [%d, %d] (got %d)", FV_CUBE_MIN_SIZE,
-                            FV_CUBE_MAX_SIZE, st->cube_size);
+        return fv_error_set(err, FV_ERR_INVALID, "parameter cube_size=%d: out of range [%d, %d]", st->cube_size, FV_CUBE_MIN_SIZE,
+                            FV_CUBE_MAX_SIZE);
     if (st->tiles_x * st->tiles_y > st->total)
         return fv_error_set(err, FV_ERR_INVALID,
-                            "parameters 'tiles_x' x 'tiles_y' = %d tiles do not divide %d VPLs (each tile needs one)",
-                            st->tiles_x * st->tiles_y, st->total);
+                            "parameters tiles_x=%d, tiles_y=%d: %d tiles do not divide vpls=%d (each tile needs a VPL)", st->tiles_x,
+                            st->tiles_y, st->tiles_x * st->tiles_y, st->total);
     if ((s = fv_params_float(p, "rebuild", 0.2, 0.0, 1.0, &rebuild, err)) != FV_OK ||
         (s = fv_params_choice(p, "cube_filter", 0, k_cube_filters, &st->cube_filter, err)) != FV_OK ||
         (s = fv_params_choice(p, "filter", FILTER_BOX, k_filters, &st->filter, err)) != FV_OK ||
@@ -171,7 +171,7 @@ static fv_status read_params(fir_state *st, fv_params *p, fv_error *err)
         (s = fv_params_choice(p, "visibility", 0, k_visibility, &st->visibility, err)) != FV_OK)
         return s;
     if (!(radius > 0.0 && radius <= 1.0))
-        return fv_error_set(err, FV_ERR_INVALID, "parameter 'radius' must be in (0, 1] (a fraction of the width; got %g)", radius);
+        return fv_error_set(err, FV_ERR_INVALID, "parameter radius=%g: outside (0, 1] (a fraction of the image width)", radius);
     st->resample = (float)resample;
     st->density_c = (float)density_c;
     st->drop_importance = (float)drop_imp;
