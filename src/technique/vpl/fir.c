@@ -60,7 +60,6 @@ typedef struct build_key {
 enum { FILTER_BOX = 0, FILTER_ATROUS, FILTER_NONE };
 static const char *const k_filters[] = {"box", "atrous", "none", NULL};
 static const char *const k_cube_filters[] = {"nearest", "pcf", NULL};
-static const char *const k_show[] = {"all", "direct", "indirect", NULL};
 static const char *const k_visibility[] = {"cube", "rays", NULL};
 
 typedef struct fir_state {
@@ -107,10 +106,10 @@ typedef struct fir_state {
     fv_vpl_light *lights;
     int *tile_list, *tile_offset;
     int *tiles;         /* scratch for fv_vpl_assign_tiles */
-    fv_gbuffer gb;
-    fv_vec3 *direct, *indirect, *tmp;
+    fv_vpl_frame vf;
+    fv_vec3 *tmp;       /* the box filter's horizontal pass */
     float *fbuf;        /* atrous: rgb, normal, position */
-    size_t npix;
+    size_t ntmp;
     /* last management's counts, reported by both eyes */
     int moved_count[FV_MAX_THREADS];
     int reused, fresh, dropped, moved, built_maps, made_candidates, fovea_cells;
@@ -125,12 +124,12 @@ static void fir_destroy(void *state)
     fv_voxels_destroy(st->vox);
     fv_density_grid_destroy(st->grid);
     fv_cubemaps_destroy(st->maps);
-    fv_gbuffer_free(&st->gb);
+    fv_vpl_frame_free(&st->vf);
     void *bufs[] = {st->reached, st->owner, st->queue, st->cell_area, st->weight,   st->scratch,   st->dens_vox,    st->vpl,       st->next,         st->cand,
                     st->cand_ok,  st->cand_imp,  st->picked,      st->old_pos,   st->cand_pos,     st->sel_cand_pos,
                     st->old_prev, st->old_new,   st->old_u,       st->sel_cand_imp, st->keep_old,  st->take_cand,
                     st->free_slots, st->build_idx, st->build_keys, st->build_pos, st->build_nrm, st->lights,       st->tile_list,
-                    st->tile_offset, st->tiles,  st->direct,      st->indirect,  st->tmp,          st->fbuf};
+                    st->tile_offset, st->tiles,  st->tmp,          st->fbuf};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) free(bufs[i]);
     free(st);
 }
@@ -167,7 +166,7 @@ static fv_status read_params(fir_state *st, fv_params *p, fv_error *err)
         (s = fv_params_float(p, "radius", 0.25, -1e30, 1e30, &radius, err)) != FV_OK ||
         (s = fv_params_int(p, "area_samples", 16, 1, 4096, &st->area_samples, err)) != FV_OK ||
         (s = fv_params_float(p, "clamp", 0.03, 0.0, 1.0, &clamp, err)) != FV_OK ||
-        (s = fv_params_choice(p, "show", 0, k_show, &st->show, err)) != FV_OK ||
+        (s = fv_params_choice(p, "show", 0, fv_vpl_show_names, &st->show, err)) != FV_OK ||
         (s = fv_params_choice(p, "visibility", 0, k_visibility, &st->visibility, err)) != FV_OK)
         return s;
     if (!(radius > 0.0 && radius <= 1.0))
@@ -272,22 +271,17 @@ fail:
     return s;
 }
 
-static fv_status fir_reserve(fir_state *st, int w, int h, fv_error *err)
+/* The filters' scratch, sized with the image. */
+static fv_status fir_reserve(fir_state *st, fv_error *err)
 {
-    fv_status s = fv_gbuffer_reserve(&st->gb, w, h, err);
-    if (s != FV_OK) return s;
-    const size_t n = (size_t)w * (size_t)h;
-    if (n == st->npix) return FV_OK;
-    free(st->direct);
-    free(st->indirect);
+    const size_t n = st->vf.npix;
+    if (n == st->ntmp) return FV_OK;
     free(st->tmp);
     free(st->fbuf);
-    st->direct = malloc(n * sizeof *st->direct);
-    st->indirect = malloc(n * sizeof *st->indirect);
     st->tmp = malloc(n * sizeof *st->tmp);
     st->fbuf = st->filter == FILTER_ATROUS ? malloc(9 * n * sizeof *st->fbuf) : NULL;
-    st->npix = st->direct && st->indirect && st->tmp && (st->filter != FILTER_ATROUS || st->fbuf) ? n : 0;
-    if (!st->npix) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d frame", w, h);
+    st->ntmp = st->tmp && (st->filter != FILTER_ATROUS || st->fbuf) ? n : 0;
+    if (!st->ntmp) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d frame", st->vf.cam.width, st->vf.cam.height);
     return FV_OK;
 }
 
@@ -366,8 +360,8 @@ static void candidates_range(void *ctx, int64_t b, int64_t e, int thread)
         const float u = fv_rng_next(&rng), v = fv_rng_next(&rng);
         fv_vpl_polar_sample(u, v, &dx, &dy);
         const float px = c->gx + c->R * dx, py = c->gy + c->R * dy;
-        if (!(px >= 0.0f && py >= 0.0f && px < (float)st->gb.width && py < (float)st->gb.height)) continue;
-        const fv_gpixel *g = &st->gb.px[(size_t)py * (size_t)st->gb.width + (size_t)px];
+        if (!(px >= 0.0f && py >= 0.0f && px < (float)st->vf.gb.width && py < (float)st->vf.gb.height)) continue;
+        const fv_gpixel *g = &st->vf.gb.px[(size_t)py * (size_t)st->vf.gb.width + (size_t)px];
         if (!fv_gpixel_hit(g)) continue;
         fv_vec3 t, bb;
         fv_basis(g->n, &t, &bb);
@@ -539,7 +533,7 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     double t2 = fv_time_ms();
 
     /* Alg. 2 */
-    st->fovea_cells = fv_vpl_foveated_weights(st->vox, cam, &st->gb, pc.gx, pc.gy, pc.R, st->weight, threads);
+    st->fovea_cells = fv_vpl_foveated_weights(st->vox, cam, &st->vf.gb, pc.gx, pc.gy, pc.R, st->weight, threads);
     /* Alg. 4 line 3 */
     memset(st->moved_count, 0, sizeof st->moved_count);
     fv_parallel_for(st->nvpl, 16, threads, update_range, &pc);
@@ -676,20 +670,20 @@ static void build_tile_lists(fir_state *st)
  * sum times n / n_tile (Sec. 3.4, interleaved sampling). */
 static void scale_tiles(fir_state *st)
 {
-    const int w = st->gb.width, h = st->gb.height, nx = st->tiles_x;
+    const int w = st->vf.gb.width, h = st->vf.gb.height, nx = st->tiles_x;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             const int t = (x % nx) + nx * (y % st->tiles_y);
             const int cnt = st->tile_offset[t + 1] - st->tile_offset[t];
             const size_t p = (size_t)y * (size_t)w + (size_t)x;
-            st->indirect[p] = cnt > 0 ? fv_scale(st->indirect[p], (float)st->nvpl / (float)cnt) : fv_v3s(0.0f);
+            st->vf.indirect[p] = cnt > 0 ? fv_scale(st->vf.indirect[p], (float)st->nvpl / (float)cnt) : fv_v3s(0.0f);
         }
 }
 
 /* The 5x5 box of Sec. 3.4 over the pixels that hit, as two 1D passes of sums and counts. */
 static void box5(fir_state *st)
 {
-    const int w = st->gb.width, h = st->gb.height;
+    const int w = st->vf.gb.width, h = st->vf.gb.height;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             fv_vec3 s = fv_v3s(0.0f);
@@ -697,14 +691,14 @@ static void box5(fir_state *st)
                 const int xx = x + k;
                 if (xx < 0 || xx >= w) continue;
                 const size_t q = (size_t)y * (size_t)w + (size_t)xx;
-                if (fv_gpixel_hit(&st->gb.px[q])) s = fv_add(s, st->indirect[q]);
+                if (fv_gpixel_hit(&st->vf.gb.px[q])) s = fv_add(s, st->vf.indirect[q]);
             }
             st->tmp[(size_t)y * (size_t)w + (size_t)x] = s;
         }
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             const size_t p = (size_t)y * (size_t)w + (size_t)x;
-            if (!fv_gpixel_hit(&st->gb.px[p])) continue;
+            if (!fv_gpixel_hit(&st->vf.gb.px[p])) continue;
             fv_vec3 s = fv_v3s(0.0f);
             int n = 0;
             for (int k = -2; k <= 2; k++) {
@@ -713,10 +707,10 @@ static void box5(fir_state *st)
                 s = fv_add(s, st->tmp[(size_t)yy * (size_t)w + (size_t)x]);
                 for (int l = -2; l <= 2; l++) {
                     const int xx = x + l;
-                    if (xx >= 0 && xx < w && fv_gpixel_hit(&st->gb.px[(size_t)yy * (size_t)w + (size_t)xx])) n++;
+                    if (xx >= 0 && xx < w && fv_gpixel_hit(&st->vf.gb.px[(size_t)yy * (size_t)w + (size_t)xx])) n++;
                 }
             }
-            st->indirect[p] = fv_scale(s, 1.0f / (float)n);
+            st->vf.indirect[p] = fv_scale(s, 1.0f / (float)n);
         }
 }
 
@@ -727,22 +721,22 @@ static fv_status filter_indirect(fir_state *st, fv_error *err)
         return FV_OK;
     }
     if (st->filter == FILTER_NONE) return FV_OK;
-    const size_t n = st->npix;
+    const size_t n = st->vf.npix;
     float *rgb = st->fbuf, *nrm = st->fbuf + 3 * n, *pos = st->fbuf + 6 * n;
     for (size_t i = 0; i < n; i++) {
-        const fv_gpixel *g = &st->gb.px[i];
+        const fv_gpixel *g = &st->vf.gb.px[i];
         const fv_vec3 zero = fv_v3s(0.0f);
         const fv_vec3 nn = fv_gpixel_hit(g) ? g->n : zero, pp = fv_gpixel_hit(g) ? g->p : zero;
-        rgb[3 * i] = st->indirect[i].x, rgb[3 * i + 1] = st->indirect[i].y, rgb[3 * i + 2] = st->indirect[i].z;
+        rgb[3 * i] = st->vf.indirect[i].x, rgb[3 * i + 1] = st->vf.indirect[i].y, rgb[3 * i + 2] = st->vf.indirect[i].z;
         nrm[3 * i] = nn.x, nrm[3 * i + 1] = nn.y, nrm[3 * i + 2] = nn.z;
         pos[3 * i] = pp.x, pos[3 * i + 1] = pp.y, pos[3 * i + 2] = pp.z;
     }
     fv_atrous_opts o;
     fv_atrous_opts_default(&o);
     o.sigma_position = INFINITY;
-    fv_status s = fv_atrous_filter(rgb, nrm, NULL, st->gb.width, st->gb.height, &o, err);
+    fv_status s = fv_atrous_filter(rgb, nrm, NULL, st->vf.gb.width, st->vf.gb.height, &o, err);
     if (s != FV_OK) return s;
-    for (size_t i = 0; i < n; i++) st->indirect[i] = fv_v3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
+    for (size_t i = 0; i < n; i++) st->vf.indirect[i] = fv_v3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
     return FV_OK;
 }
 
@@ -750,59 +744,39 @@ static fv_status fir_render(void *state, const fv_frame *frame, fv_film *film, f
 {
     fir_state *st = state;
     const fv_scene *s = st->scene;
-    fv_camera_basis cam;
-    fv_status status = fv_frame_camera(frame->camera, film, &cam, err);
-    if (status != FV_OK) return status;
-    if ((status = fir_reserve(st, cam.width, cam.height, err)) != FV_OK) return status;
-    fv_kit_counters *counters = fv_kit_counters_create();
-    if (!counters) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    fv_film_views out = fv_film_views_of(film);
-    fv_kit_progress prog = {0};
-    uint64_t rays = 0;
+    fv_vpl_frame *vf = &st->vf;
+    fv_status status = fv_vpl_frame_begin(vf, s, frame, film, stats, err);
+    if (status == FV_OK) status = fir_reserve(st, err);
     bool ok = true;
-
-    double t0 = fv_time_ms();
-    fv_gbuffer_trace(&st->gb, s, &cam, &out, frame->threads, &rays);
-    fv_stats_add_ms(stats, "gbuffer", fv_time_ms() - t0);
 
     /* One VPL set per frame index, managed with the view and gaze of the first eye rendered (the left
      * one, or the only one). A frame rendered again after a cancel keeps the set its first attempt
      * made, so it comes out as if it had not been interrupted. */
-    if (!st->managed || st->managed_index != frame->index) {
-        status = manage(st, frame, &cam, stats, &rays, err);
+    if (status == FV_OK && (!st->managed || st->managed_index != frame->index)) {
+        status = manage(st, frame, &vf->cam, stats, &vf->rays, err);
         st->managed = status == FV_OK;
         st->managed_index = frame->index;
     }
     if (status == FV_OK) {
         double t1 = fv_time_ms();
         build_tile_lists(st);
-        memset(st->indirect, 0, st->npix * sizeof *st->indirect);
         fv_vpl_gather g = {s, st->lights, st->visibility == 0 ? st->maps : NULL, (fv_cube_filter)st->cube_filter, 0.0f};
         const float c = fv_vpl_clamp_distance(s, st->clamp);
         g.clamp2 = c * c;
         fv_vpl_tiles tiles = {st->tiles_x, st->tiles_y, st->tile_list, st->tile_offset};
-        fv_kit_phase(&prog, frame, 0.0, 0.8);
-        ok = fv_vpl_pass_indirect(&g, &st->gb, &tiles, frame->threads, st->indirect, counters, &prog);
+        fv_kit_phase(&vf->prog, frame, 0.0, 0.8);
+        ok = fv_vpl_pass_indirect(&g, &vf->gb, &tiles, frame->threads, vf->indirect, vf->counters, &vf->prog);
         if (ok) {
             scale_tiles(st);
             status = filter_indirect(st, err);
         }
         double t2 = fv_time_ms();
         fv_stats_add_ms(stats, "shading", t2 - t1);
-        fv_kit_phase(&prog, frame, 0.8, 0.2);
-        if (ok && status == FV_OK) ok = fv_vpl_pass_direct(s, &st->gb, frame, st->area_samples, st->direct, counters, &prog);
-        double t3 = fv_time_ms();
-        fv_stats_add_ms(stats, "direct", t3 - t2);
-        if (ok && status == FV_OK) {
-            uint64_t bad = 0;
-            fv_vpl_compose(&st->gb, st->show == 2 ? NULL : st->direct, st->show == 1 ? NULL : st->indirect, st->show == 0,
-                           out.color, &bad);
-            fv_kit_count(counters, 0, FV_KIT_NAN, bad);
-        }
+        fv_kit_phase(&vf->prog, frame, 0.8, 0.2);
+        if (ok && status == FV_OK) ok = fv_vpl_pass_direct(s, &vf->gb, frame, st->area_samples, vf->direct, vf->counters, &vf->prog);
+        fv_stats_add_ms(stats, "direct", fv_time_ms() - t2);
     }
     if (status == FV_OK && ok) {
-        fv_kit_count(counters, 0, FV_KIT_RAYS, rays);
-        fv_kit_report(counters, stats);
         fv_stats_add_count(stats, "valid_vpls", st->nvpl);
         fv_stats_add_count(stats, "reused_vpls", st->reused);
         fv_stats_add_count(stats, "new_vpls", st->fresh);
@@ -811,12 +785,8 @@ static fv_status fir_render(void *state, const fv_frame *frame, fv_film *film, f
         fv_stats_add_count(stats, "cube_maps_built", st->built_maps);
         fv_stats_add_count(stats, "candidates", st->made_candidates);
         fv_stats_add_count(stats, "fovea_voxels", st->fovea_cells);
-        fv_stats_add_count(stats, "cube_lookups", (double)fv_kit_sum(counters, FV_VPL_SLOT_LOOKUPS));
-        fv_stats_add_count(stats, "direct_rays", (double)fv_kit_sum(counters, FV_VPL_SLOT_DIRECT_RAYS));
     }
-    fv_kit_counters_destroy(counters);
-    if (status != FV_OK) return status;
-    return ok ? fv_kit_phase_end(&prog, err) : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    return fv_vpl_frame_end(vf, (fv_vpl_show)st->show, ok, status, stats, err);
 }
 
 const fv_technique_class fv_technique_fir = {

@@ -25,11 +25,9 @@ typedef struct ir_state {
     bool low; /* ir-low: cube maps */
     int vpls, bounces, area_samples, cube_size;
     int cube_filter;
-    int show; /* 0 all, 1 direct, 2 indirect */
+    int show; /* fv_vpl_show */
     float clamp;
-    fv_gbuffer gb;
-    fv_vec3 *direct, *indirect;
-    size_t npix;
+    fv_vpl_frame vf;
     fv_vpl_light *lights;
     int *ident;       /* 0 .. vpls-1, the lists of one tile */
     fv_cubemaps *maps; /* ir-low: one batch */
@@ -39,15 +37,12 @@ typedef struct ir_state {
 } ir_state;
 
 static const char *const k_filters[] = {"nearest", "pcf", NULL};
-static const char *const k_show[] = {"all", "direct", "indirect", NULL};
 
 static void ir_destroy(void *state)
 {
     ir_state *st = state;
     if (!st) return;
-    fv_gbuffer_free(&st->gb);
-    free(st->direct);
-    free(st->indirect);
+    fv_vpl_frame_free(&st->vf);
     free(st->lights);
     free(st->ident);
     fv_cubemaps_destroy(st->maps);
@@ -69,7 +64,7 @@ static fv_status ir_create_common(const fv_scene *scene, fv_params *params, bool
         (s = fv_params_int(params, "bounces", 7, 1, 64, &st->bounces, err)) != FV_OK ||
         (s = fv_params_int(params, "area_samples", 16, 1, 4096, &st->area_samples, err)) != FV_OK ||
         (s = fv_params_float(params, "clamp", 0.03, 0.0, 1.0, &clamp, err)) != FV_OK ||
-        (s = fv_params_choice(params, "show", 0, k_show, &st->show, err)) != FV_OK)
+        (s = fv_params_choice(params, "show", 0, fv_vpl_show_names, &st->show, err)) != FV_OK)
         goto fail;
     st->clamp = (float)clamp;
     if (low) {
@@ -115,69 +110,41 @@ static fv_status ir_low_create(const fv_scene *scene, fv_params *params, const f
     return ir_create_common(scene, params, true, state, err);
 }
 
-static fv_status ir_reserve(ir_state *st, int w, int h, fv_error *err)
-{
-    fv_status s = fv_gbuffer_reserve(&st->gb, w, h, err);
-    if (s != FV_OK) return s;
-    size_t n = (size_t)w * (size_t)h;
-    if (n != st->npix) {
-        free(st->direct);
-        free(st->indirect);
-        st->direct = malloc(n * sizeof *st->direct);
-        st->indirect = malloc(n * sizeof *st->indirect);
-        st->npix = st->direct && st->indirect ? n : 0;
-        if (!st->npix) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d frame", w, h);
-    }
-    return FV_OK;
-}
-
 static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
     ir_state *st = state;
     const fv_scene *s = st->scene;
-    fv_camera_basis cam;
-    fv_status status = fv_frame_camera(frame->camera, film, &cam, err);
+    fv_vpl_frame *vf = &st->vf;
+    fv_status status = fv_vpl_frame_begin(vf, s, frame, film, stats, err);
     if (status != FV_OK) return status;
-    if ((status = ir_reserve(st, cam.width, cam.height, err)) != FV_OK) return status;
-    fv_kit_counters *counters = fv_kit_counters_create();
-    if (!counters) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    fv_film_views out = fv_film_views_of(film);
-    fv_kit_progress prog = {0};
-    uint64_t rays = 0;
-    bool ok = true;
-
-    double t0 = fv_time_ms();
-    fv_gbuffer_trace(&st->gb, s, &cam, &out, frame->threads, &rays);
-    double t1 = fv_time_ms();
-    fv_stats_add_ms(stats, "gbuffer", t1 - t0);
 
     /* The same VPLs for both eyes of a frame: they depend on the frame, not the eye. */
+    double t1 = fv_time_ms();
     int64_t walks = 0;
-    int n = fv_vpl_from_light_walks(s, frame->seed, (uint64_t)frame->index, st->vpls, st->bounces, st->lights, &walks, &rays);
+    int n = fv_vpl_from_light_walks(s, frame->seed, (uint64_t)frame->index, st->vpls, st->bounces, st->lights, &walks, &vf->rays);
     double t2 = fv_time_ms();
     fv_stats_add_ms(stats, "vpls", t2 - t1);
 
-    fv_kit_phase(&prog, frame, 0.0, 0.1);
-    ok = fv_vpl_pass_direct(s, &st->gb, frame, st->area_samples, st->direct, counters, &prog);
+    fv_kit_phase(&vf->prog, frame, 0.0, 0.1);
+    bool ok = fv_vpl_pass_direct(s, &vf->gb, frame, st->area_samples, vf->direct, vf->counters, &vf->prog);
     double t3 = fv_time_ms();
     fv_stats_add_ms(stats, "direct", t3 - t2);
 
-    memset(st->indirect, 0, st->npix * sizeof *st->indirect);
     fv_vpl_gather g = {s, st->lights, NULL, FV_CUBE_NEAREST, 0.0f};
     const float c = fv_vpl_clamp_distance(s, st->clamp);
     g.clamp2 = c * c;
-    double cube_ms = 0.0, shade_ms = 0.0;
-    int built = 0;
     if (!st->low) {
         int offset[2] = {0, n};
         fv_vpl_tiles all = {1, 1, st->ident, offset};
-        fv_kit_phase(&prog, frame, 0.1, 0.9);
-        if (ok) ok = fv_vpl_pass_indirect(&g, &st->gb, &all, frame->threads, st->indirect, counters, &prog);
-        shade_ms = fv_time_ms() - t3;
+        fv_kit_phase(&vf->prog, frame, 0.1, 0.9);
+        if (ok) ok = fv_vpl_pass_indirect(&g, &vf->gb, &all, frame->threads, vf->indirect, vf->counters, &vf->prog);
+        fv_stats_add_ms(stats, "shading", fv_time_ms() - t3);
     } else {
         /* ir-low: a batch of maps is built, every pixel gathers from it, then the next batch. */
         g.maps = st->maps;
         g.filter = (fv_cube_filter)st->cube_filter;
+        double cube_ms = 0.0, shade_ms = 0.0;
+        int built = 0;
         for (int b0 = 0; ok && b0 < n; b0 += st->batch) {
             const int m = n - b0 < st->batch ? n - b0 : st->batch;
             double ta = fv_time_ms();
@@ -193,33 +160,19 @@ static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv
             cube_ms += tb - ta;
             int offset[2] = {0, m};
             fv_vpl_tiles batch = {1, 1, st->ident + b0, offset};
-            fv_kit_phase(&prog, frame, 0.1 + 0.9 * b0 / n, 0.9 * m / n);
-            ok = fv_vpl_pass_indirect(&g, &st->gb, &batch, frame->threads, st->indirect, counters, &prog);
+            fv_kit_phase(&vf->prog, frame, 0.1 + 0.9 * b0 / n, 0.9 * m / n);
+            ok = fv_vpl_pass_indirect(&g, &vf->gb, &batch, frame->threads, vf->indirect, vf->counters, &vf->prog);
             shade_ms += fv_time_ms() - tb;
         }
-        /* the cube maps' rays: six faces of n^2 at most per map, counted as built */
         fv_stats_add_ms(stats, "cube_maps", cube_ms);
+        fv_stats_add_ms(stats, "shading", shade_ms);
         fv_stats_add_count(stats, "cube_maps_built", built);
     }
-    fv_stats_add_ms(stats, "shading", shade_ms);
-    if (status == FV_OK) {
-        uint64_t bad = 0;
-        double t4 = fv_time_ms();
-        fv_vpl_compose(&st->gb, st->show == 2 ? NULL : st->direct, st->show == 1 ? NULL : st->indirect, st->show == 0,
-                       out.color, &bad);
-        fv_stats_add_ms(stats, "compose", fv_time_ms() - t4);
-        fv_kit_count(counters, 0, FV_KIT_NAN, bad);
-        fv_kit_count(counters, 0, FV_KIT_RAYS, rays);
-        fv_kit_report(counters, stats);
+    if (status == FV_OK && ok) {
         fv_stats_add_count(stats, "vpls", n);
         fv_stats_add_count(stats, "walks", (double)walks);
-        fv_stats_add_count(stats, "vpl_shadow_rays", (double)fv_kit_sum(counters, FV_VPL_SLOT_VPL_RAYS));
-        fv_stats_add_count(stats, "cube_lookups", (double)fv_kit_sum(counters, FV_VPL_SLOT_LOOKUPS));
-        fv_stats_add_count(stats, "direct_rays", (double)fv_kit_sum(counters, FV_VPL_SLOT_DIRECT_RAYS));
     }
-    fv_kit_counters_destroy(counters);
-    if (status != FV_OK) return status;
-    return ok ? fv_kit_phase_end(&prog, err) : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    return fv_vpl_frame_end(vf, (fv_vpl_show)st->show, ok, status, stats, err);
 }
 
 #define IR_COMMON_HELP                                                                                                 \

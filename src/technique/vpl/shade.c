@@ -1,5 +1,6 @@
 /* fovea — deferred shading for the instant-radiosity family (see shade.h). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "technique/vpl/direct.h"
 #include "technique/vpl/shade.h"
@@ -160,4 +161,63 @@ void fv_vpl_compose(const fv_gbuffer *gb, const fv_vec3 *direct, const fv_vec3 *
         rgb[3 * i + 1] = L.y;
         rgb[3 * i + 2] = L.z;
     }
+}
+
+const char *const fv_vpl_show_names[] = {"all", "direct", "indirect", NULL};
+
+fv_status fv_vpl_frame_begin(fv_vpl_frame *vf, const fv_scene *s, const fv_frame *frame, fv_film *film, fv_stats *stats,
+                             fv_error *err)
+{
+    fv_status st = fv_frame_camera(frame->camera, film, &vf->cam, err);
+    if (st != FV_OK) return st;
+    const int w = vf->cam.width, h = vf->cam.height;
+    if ((st = fv_gbuffer_reserve(&vf->gb, w, h, err)) != FV_OK) return st;
+    const size_t n = (size_t)w * (size_t)h;
+    if (n != vf->npix) {
+        free(vf->direct);
+        free(vf->indirect);
+        vf->direct = malloc(n * sizeof *vf->direct);
+        vf->indirect = malloc(n * sizeof *vf->indirect);
+        vf->npix = vf->direct && vf->indirect ? n : 0;
+        if (!vf->npix) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d frame", w, h);
+    }
+    if (!(vf->counters = fv_kit_counters_create())) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    vf->out = fv_film_views_of(film);
+    memset(&vf->prog, 0, sizeof vf->prog);
+    vf->rays = 0;
+    const double t0 = fv_time_ms();
+    fv_gbuffer_trace(&vf->gb, s, &vf->cam, &vf->out, frame->threads, &vf->rays);
+    fv_stats_add_ms(stats, "gbuffer", fv_time_ms() - t0);
+    memset(vf->indirect, 0, n * sizeof *vf->indirect);
+    return FV_OK;
+}
+
+fv_status fv_vpl_frame_end(fv_vpl_frame *vf, fv_vpl_show show, bool ok, fv_status status, fv_stats *stats, fv_error *err)
+{
+    if (status == FV_OK && ok) {
+        uint64_t bad = 0;
+        const double t0 = fv_time_ms();
+        fv_vpl_compose(&vf->gb, show == FV_VPL_SHOW_INDIRECT ? NULL : vf->direct, show == FV_VPL_SHOW_DIRECT ? NULL : vf->indirect,
+                       show == FV_VPL_SHOW_ALL, vf->out.color, &bad);
+        fv_stats_add_ms(stats, "compose", fv_time_ms() - t0);
+        fv_kit_count(vf->counters, 0, FV_KIT_NAN, bad);
+        fv_kit_count(vf->counters, 0, FV_KIT_RAYS, vf->rays);
+        fv_kit_report(vf->counters, stats);
+        fv_stats_add_count(stats, "vpl_shadow_rays", (double)fv_kit_sum(vf->counters, FV_VPL_SLOT_VPL_RAYS));
+        fv_stats_add_count(stats, "cube_lookups", (double)fv_kit_sum(vf->counters, FV_VPL_SLOT_LOOKUPS));
+        fv_stats_add_count(stats, "direct_rays", (double)fv_kit_sum(vf->counters, FV_VPL_SLOT_DIRECT_RAYS));
+    }
+    fv_kit_counters_destroy(vf->counters);
+    vf->counters = NULL;
+    if (status != FV_OK) return status;
+    return ok ? fv_kit_phase_end(&vf->prog, err) : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+}
+
+void fv_vpl_frame_free(fv_vpl_frame *vf)
+{
+    fv_gbuffer_free(&vf->gb);
+    free(vf->direct);
+    free(vf->indirect);
+    fv_kit_counters_destroy(vf->counters);
+    memset(vf, 0, sizeof *vf);
 }

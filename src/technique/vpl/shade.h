@@ -36,6 +36,33 @@ bool fv_vpl_pass_direct(const fv_scene *s, const fv_gbuffer *gb, const fv_frame 
 bool fv_vpl_pass_indirect(const fv_vpl_gather *g, const fv_gbuffer *gb, const fv_vpl_tiles *tiles, int threads,
                           fv_vec3 *sum, fv_kit_counters *counters, fv_kit_progress *prog);
 
+/* ---- the buffers of one frame, and its first and last steps ---- */
+
+/* What `show` selects: the image, or one of its two terms alone (without emitted light). */
+typedef enum fv_vpl_show { FV_VPL_SHOW_ALL = 0, FV_VPL_SHOW_DIRECT, FV_VPL_SHOW_INDIRECT } fv_vpl_show;
+extern const char *const fv_vpl_show_names[]; /* "all", "direct", "indirect", NULL */
+
+typedef struct fv_vpl_frame {
+    fv_gbuffer gb;
+    fv_vec3 *direct, *indirect; /* E_direct and the VPL sum per pixel */
+    size_t npix;
+    fv_camera_basis cam;
+    fv_film_views out;
+    fv_kit_counters *counters;
+    fv_kit_progress prog;
+    uint64_t rays; /* rays cast outside the passes (first hits, VPLs, cube maps) */
+} fv_vpl_frame;
+
+/* The first step of every frame of the family: camera and film checked, buffers (re)sized for the
+ * film, counters created, the first-hit buffer traced (stage "gbuffer"), the VPL sum zeroed. */
+fv_status fv_vpl_frame_begin(fv_vpl_frame *vf, const fv_scene *s, const fv_frame *frame, fv_film *film, fv_stats *stats,
+                             fv_error *err);
+/* The last: compose what `show` asks into the film (stage "compose"), report the counters (rays,
+ * nan_samples, vpl_shadow_rays, cube_lookups, direct_rays) and release them. ok false (a pass was
+ * cancelled) or status != FV_OK: nothing is composed or reported; the status to return. */
+fv_status fv_vpl_frame_end(fv_vpl_frame *vf, fv_vpl_show show, bool ok, fv_status status, fv_stats *stats, fv_error *err);
+void fv_vpl_frame_free(fv_vpl_frame *vf);
+
 /* rgb = emit + albedo / pi (direct + indirect), with the kit's NaN guard (counted in *dropped).
  * direct or indirect NULL: left out; emitted false: no emitted light (to show one term alone). */
 void fv_vpl_compose(const fv_gbuffer *gb, const fv_vec3 *direct, const fv_vec3 *indirect, bool emitted, float *rgb,
