@@ -281,7 +281,7 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
     sweep_stem(sc, k, stem, sizeof stem);
     text t = {0};
     tprintf(&t, "%s,ms_per_frame,speedup,mse_fovea,mse_transition,mse_periphery,mse_all,ssim_fovea,ssim_all,flip_fovea,flip_"
-                "transition,flip_periphery,flip_all\n",
+                "transition,flip_periphery,flip_all,e_fovea,e_transition,e_periphery,e_all\n",
             param);
     double lo = INFINITY, hi = -INFINITY;
     for (int i = 0; i < n; i++) {
@@ -290,8 +290,9 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
         const fv_metric_values *v = r->error.region;
         lo = fmin(lo, r->m->sweep_value);
         hi = fmax(hi, r->m->sweep_value);
-        tprintf(&t, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", r->m->sweep_value, r->ms_median, r->speedup,
-                v[0].mse, v[1].mse, v[2].mse, v[3].mse, v[0].ssim, v[3].ssim, v[0].flip, v[1].flip, v[2].flip, v[3].flip);
+        tprintf(&t, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", r->m->sweep_value,
+                r->ms_median, r->speedup, v[0].mse, v[1].mse, v[2].mse, v[3].mse, v[0].ssim, v[3].ssim, v[0].flip, v[1].flip, v[2].flip,
+                v[3].flip, v[0].e, v[1].e, v[2].e, v[3].e);
     }
     char csv[4096 + 128], png[4096 + 128], gp[4096 + 128];
     snprintf(csv, sizeof csv, "%s/%s.csv", info->out_dir, stem);
@@ -299,7 +300,8 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
     snprintf(gp, sizeof gp, "%s/%s.gp", info->out_dir, stem);
     fv_status st = text_write(&t, csv, err);
     if (st != FV_OK) return st;
-    /* MSE per region against the swept value; log axes when the values span a decade. gnuplot
+    /* MSE per region against the swept value, and the time per frame on the right axis (the
+     * papers' Figs. 5 and 7 side by side); log axes when the values span a decade. gnuplot
      * writes the plot by name, into the temporary file of an fv_atomic_file. */
     bool logx = lo > 0 && hi / lo >= 10.0;
     fv_atomic_file plot;
@@ -311,10 +313,11 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
     tprintf(&t,
             "set terminal png size 800,500\nset output '%s'\nset datafile separator ','\nset key top right\n"
             "set title \"%s: error per region vs %s\" noenhanced\nset xlabel '%s' noenhanced\nset ylabel 'MSE'\n"
-            "set logscale y\n%s\nset grid\n"
+            "set logscale y\n%s\nset grid\nset y2label 'ms per frame'\nset y2tics\nset ytics nomirror\n"
             "plot '%s' every ::1 using 1:4 with linespoints lw 2 title 'fovea', "
             "'' every ::1 using 1:5 with linespoints lw 2 title 'transition', "
-            "'' every ::1 using 1:6 with linespoints lw 2 title 'periphery'\n",
+            "'' every ::1 using 1:6 with linespoints lw 2 title 'periphery', "
+            "'' every ::1 using 1:2 axes x1y2 with linespoints lw 1 dt 2 title 'ms per frame'\n",
             fv_atomic_file_path(&plot), sc->name, param, param, logx ? "set logscale x 2" : "", csv);
     if ((st = text_write(&t, gp, err)) != FV_OK) {
         fv_atomic_file_abort(&plot);
