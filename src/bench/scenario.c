@@ -185,12 +185,23 @@ static fv_status parse_sweep(const cJSON *o, const char *file, const char *where
             st = fv_error_set(err, FV_ERR_INVALID, "%s: %s.values[%d]: expected a finite number", file, where, i);
             break;
         }
+        /* the label shows the shortest text that reads back as the value (0.35, not
+         * 0.34999999999999998; 50, not 5e+01); the parameter keeps the exact text */
+        char shown[64];
+        snprintf(shown, sizeof shown, "%s", text);
+        if (v->valuedouble == floor(v->valuedouble) && fabs(v->valuedouble) < 1e15)
+            snprintf(shown, sizeof shown, "%.0f", v->valuedouble);
+        else
+            for (int prec = 1; prec <= 17; prec++) {
+                snprintf(shown, sizeof shown, "%.*g", prec, v->valuedouble);
+                if (strtod(shown, NULL) == v->valuedouble) break;
+            }
         fv_bench_method m;
         memset(&m, 0, sizeof m);
         snprintf(m.method, sizeof m.method, "%s", base.method);
-        int w = snprintf(m.label, sizeof m.label, "%s-%s=%s", base.label, param, text);
+        int w = snprintf(m.label, sizeof m.label, "%s-%s=%s", base.label, param, shown);
         if (w < 0 || w >= (int)sizeof m.label) {
-            st = fv_error_set(err, FV_ERR_INVALID, "%s: %s: label '%s-%s=%s' is too long", file, where, base.label, param, text);
+            st = fv_error_set(err, FV_ERR_INVALID, "%s: %s: label '%s-%s=%s' is too long", file, where, base.label, param, shown);
             break;
         }
         m.from_sweep = true;

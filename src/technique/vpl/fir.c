@@ -34,8 +34,8 @@
 #include "technique/vpl/shade.h"
 #include "technique/vpl/weights.h"
 
-/* purposes within FV_STREAM_VPL (lightvpl.c uses the walk index with purpose-free streams of its own
- * frame; these index ranges start at 1 << 40 so the two never meet) */
+/* index ranges within FV_STREAM_VPL, one per purpose (radiosity.h: ir's walks use 0 .. walks - 1,
+ * the injection 5 << 40 on) */
 #define FIR_RNG_CANDIDATE ((uint64_t)1 << 40)
 #define FIR_RNG_RESAMPLE ((uint64_t)2 << 40)
 #define FIR_RNG_ACCEPT ((uint64_t)3 << 40)

@@ -33,7 +33,7 @@ static void inject_range(void *ctx, int64_t b, int64_t e, int thread)
         /* Either side of the cell's surface may be the lit one (a wall seen from inside a room, a sphere
          * lit from within, a thin panel): the voxel's radiance is isotropic, so it takes the side that
          * receives more light. */
-        fv_rng rng = fv_rng_stream(j->seed, FV_STREAM_VPL, 2, (uint64_t)c, j->frame);
+        fv_rng rng = fv_rng_stream(j->seed, FV_STREAM_VPL, FV_VPL_RNG_INJECT + (uint64_t)c, 0, j->frame);
         const float off = 0.5f * sqrtf(3.0f) * h;
         const fv_vec3 nb = fv_neg(vx.normal);
         fv_vec3 E1 = fv_vpl_direct_irradiance(j->s, fv_madd(centre, vx.normal, off), vx.normal, vx.normal, j->area_samples, &rng,

@@ -26,9 +26,13 @@
 #include <stdint.h>
 #include "technique/vpl/voxels.h"
 
+/* Index ranges within FV_STREAM_VPL: light walk w of ir is index w; fir's draws start at 1 << 40
+ * (fir.c), the injection's at 5 << 40, so no two purposes share a stream. */
+#define FV_VPL_RNG_INJECT ((uint64_t)5 << 40)
+
 /* Injects direct light into every occupied cell (scratch: 3 floats per level-0 cell) and rebuilds
  * the pyramid's radiance. Area lights use `area_samples` samples from stream (seed, FV_STREAM_VPL,
- * purpose 2). Returns the shadow rays cast. */
+ * FV_VPL_RNG_INJECT + cell, 0, frame). Returns the shadow rays cast. */
 uint64_t fv_vpl_inject(fv_voxels *v, const fv_scene *s, uint64_t seed, uint64_t frame, int area_samples, float *scratch,
                        int threads);
 
