@@ -80,6 +80,10 @@ FV_API const fv_eye_model *fv_driver_eye_model(const fv_driver *d);
 FV_API int fv_driver_eye_count(const fv_driver *d);
 /* From now on every frame uses gaze g for both eyes (the viewer's mouse or eye tracker). */
 FV_API void fv_driver_set_gaze(fv_driver *d, fv_gaze g);
+/* From now on every frame uses camera c's position, look-at point, up vector and field of view
+ * (the viewer's flying camera); its size is ignored (the driver's). Not validated here: a bad
+ * camera fails the next render with the camera's message. */
+FV_API void fv_driver_set_camera(fv_driver *d, const fv_camera *c);
 
 /* Renders frame `index` with technique t: sets the scene's time, then renders eye 0 (and eye 1)
  * into films[0] (and films[1]), adding both eyes' stats to *stats. `continues`: t's previous

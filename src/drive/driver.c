@@ -64,6 +64,17 @@ void fv_driver_set_gaze(fv_driver *d, fv_gaze g)
     d->o.gaze = g;
 }
 
+void fv_driver_set_camera(fv_driver *d, const fv_camera *c)
+{
+    /* the options' overrides, all four at once: the camera path still moves the view's camera
+     * first, and then everything it set is replaced */
+    d->o.camera_set = FV_DRIVE_POS | FV_DRIVE_LOOK | FV_DRIVE_UP | FV_DRIVE_FOV;
+    d->o.pos = c->pos;
+    d->o.look = c->look;
+    d->o.up = c->up;
+    d->o.fov_y = c->fov_y;
+}
+
 void fv_driver_views(const fv_driver *d, int index, fv_frame_views *out)
 {
     const fv_drive_opts *o = &d->o;
