@@ -401,7 +401,9 @@ static void update_range(void *ctx, int64_t b, int64_t e, int thread)
             v->n = n;
         }
         fv_voxel vx;
-        bool keep = voxel_at(st->vox, v->p, &vx) && vx.occupied && fv_dot(vx.normal, v->n) >= st->drop_cos * fv_length(vx.normal);
+        /* the voxel's normal is as wound, the VPL's faces the side it was found from: compare the
+         * lines, not the sides (a wall wound away from the room would drop every VPL on it) */
+        bool keep = voxel_at(st->vox, v->p, &vx) && vx.occupied && fabsf(fv_dot(vx.normal, v->n)) >= st->drop_cos * fv_length(vx.normal);
         float imp = keep ? fv_vpl_importance(st->vox, st->weight, &st->dirs, v->p, v->n) : 0.0f;
         if (keep && imp < st->drop_importance) keep = false;
         st->old_new[i] = keep ? imp : -1.0f; /* -1: dropped by the update */
