@@ -184,19 +184,12 @@ static fv_status read_params(fir_state *st, fv_params *p, fv_error *err)
 /* The occupied level-0 cells of each density cell: the area a density cell's VPLs share. */
 static void count_density_voxels(fir_state *st)
 {
-    int dims[3];
-    fv_voxels_dims(st->vox, 0, dims);
-    const float h = fv_voxels_cell_size(st->vox);
-    const fv_vec3 org = fv_voxels_origin(st->vox);
     memset(st->dens_vox, 0, (size_t)fv_density_grid_cells(st->grid) * sizeof *st->dens_vox);
     for (size_t c = 0; c < st->ncells; c++) {
         fv_voxel vx;
         fv_voxels_cell(st->vox, (int)c, &vx);
         if (!vx.occupied) continue;
-        const int i = (int)(c % (size_t)dims[0]), j = (int)((c / (size_t)dims[0]) % (size_t)dims[1]),
-                  k = (int)(c / ((size_t)dims[0] * (size_t)dims[1]));
-        fv_vec3 centre = fv_v3(org.x + ((float)i + 0.5f) * h, org.y + ((float)j + 0.5f) * h, org.z + ((float)k + 0.5f) * h);
-        st->dens_vox[fv_density_grid_cell(st->grid, centre)]++;
+        st->dens_vox[fv_density_grid_cell(st->grid, fv_voxels_centre(st->vox, (int)c))]++;
     }
 }
 

@@ -20,16 +20,13 @@ static void inject_range(void *ctx, int64_t b, int64_t e, int thread)
 {
     inject_job *j = ctx;
     const float h = fv_voxels_cell_size(j->v);
-    const fv_vec3 org = fv_voxels_origin(j->v);
-    const int nx = j->dims[0], ny = j->dims[1];
     for (int64_t c = b; c < e; c++) {
         float *o = &j->out[3 * c];
         o[0] = o[1] = o[2] = 0.0f;
         fv_voxel vx;
         fv_voxels_cell(j->v, (int)c, &vx);
         if (!vx.occupied || !(fv_dot(vx.normal, vx.normal) > 0.0f)) continue;
-        const int i = (int)(c % nx), jj = (int)((c / nx) % ny), k = (int)(c / ((int64_t)nx * ny));
-        const fv_vec3 centre = fv_v3(org.x + ((float)i + 0.5f) * h, org.y + ((float)jj + 0.5f) * h, org.z + ((float)k + 0.5f) * h);
+        const fv_vec3 centre = fv_voxels_centre(j->v, (int)c);
         /* Either side of the cell's surface may be the lit one (a wall seen from inside a room, a sphere
          * lit from within, a thin panel): the voxel's radiance is isotropic, so it takes the side that
          * receives more light. */

@@ -374,6 +374,13 @@ fv_vec3 fv_voxels_origin(const fv_voxels *v) { return v->org; }
 
 int fv_voxels_index(const fv_voxels *v, int i, int j, int k) { return in_level(v, 0, i, j, k) ? (int)cell_index(v, i, j, k) : -1; }
 
+fv_vec3 fv_voxels_centre(const fv_voxels *v, int cell)
+{
+    const size_t c = (size_t)cell, nx = (size_t)v->dims[0][0], ny = (size_t)v->dims[0][1];
+    const size_t i = c % nx, j = (c / nx) % ny, k = c / (nx * ny);
+    return fv_v3(v->org.x + ((float)i + 0.5f) * v->h, v->org.y + ((float)j + 0.5f) * v->h, v->org.z + ((float)k + 0.5f) * v->h);
+}
+
 void fv_voxels_cell(const fv_voxels *v, int cell, fv_voxel *out) { resolve(v, (size_t)cell, out); }
 
 void fv_voxels_set_radiance(fv_voxels *v, int cell, fv_vec3 radiance)

@@ -85,6 +85,8 @@ float fv_voxels_cell_size(const fv_voxels *v);
 fv_vec3 fv_voxels_origin(const fv_voxels *v);
 /* Level-0 index of (i, j, k) (x fastest), -1 outside the grid. */
 int fv_voxels_index(const fv_voxels *v, int i, int j, int k);
+/* The world-space centre of level-0 cell `cell`. */
+fv_vec3 fv_voxels_centre(const fv_voxels *v, int cell);
 /* The level-0 cell `cell` (0 <= cell < the product of the level-0 dims). */
 void fv_voxels_cell(const fv_voxels *v, int cell, fv_voxel *out);
 /* Cell (i, j, k) of `level`; all zeros outside the grid. */

@@ -37,16 +37,13 @@ static void weight_range(void *ctx, int64_t b, int64_t e, int thread)
 {
     weight_job *j = ctx;
     const float h = fv_voxels_cell_size(j->v);
-    const fv_vec3 org = fv_voxels_origin(j->v);
     const float tol = h * sqrtf(3.0f);
-    const int nx = j->dims[0], ny = j->dims[1];
     for (int64_t c = b; c < e; c++) {
         j->weight[c] = 0.0f;
         fv_voxel vx;
         fv_voxels_cell(j->v, (int)c, &vx);
         if (!vx.occupied) continue;
-        const int i = (int)(c % nx), jj = (int)((c / nx) % ny), k = (int)(c / ((int64_t)nx * ny));
-        const fv_vec3 centre = fv_v3(org.x + ((float)i + 0.5f) * h, org.y + ((float)jj + 0.5f) * h, org.z + ((float)k + 0.5f) * h);
+        const fv_vec3 centre = fv_voxels_centre(j->v, (int)c);
         float px, py;
         if (!fv_camera_project(j->cam, centre, &px, &py)) continue;
         if (!(px >= 0.0f && py >= 0.0f && px < (float)j->gb->width && py < (float)j->gb->height)) continue;
