@@ -65,13 +65,19 @@ typedef struct sdl_out {
 
 static int open_window(const fv_vw_args *a, sdl_out *o)
 {
-    /* one line naming the problem, as for any bad input: no display is the user's setting */
+    /* one line naming the problem, as for any bad input: no display is the user's setting. Asked
+     * first, as SDL's probing would print the Wayland library's own complaints on stderr. */
+    const char *asked = SDL_getenv("SDL_VIDEODRIVER");
+    if (!asked && !SDL_getenv("DISPLAY") && !SDL_getenv("WAYLAND_DISPLAY"))
+        return fv_cli_usage_error(k_cmd, "no display: DISPLAY and WAYLAND_DISPLAY are unset (run under X or Wayland, or xvfb-run)");
     if (SDL_Init(SDL_INIT_VIDEO) != 0) return fv_cli_usage_error(k_cmd, "no display (SDL: %s)", SDL_GetError());
     /* Without a display SDL falls back on its invisible "offscreen" driver; that is only wanted
      * when asked for by name (SDL_VIDEODRIVER=offscreen, e.g. to time methods headless). */
-    const char *drv = SDL_GetCurrentVideoDriver(), *asked = SDL_getenv("SDL_VIDEODRIVER");
-    if (drv && (!strcmp(drv, "offscreen") || !strcmp(drv, "dummy")) && !(asked && strstr(asked, drv)))
-        return fv_cli_usage_error(k_cmd, "no display: DISPLAY and WAYLAND_DISPLAY are unset (run under X or Wayland, or xvfb-run)");
+    const char *drv = SDL_GetCurrentVideoDriver();
+    if (drv && (!strcmp(drv, "offscreen") || !strcmp(drv, "dummy")) && !(asked && strstr(asked, drv))) {
+        const char *x = SDL_getenv("DISPLAY"), *w = SDL_getenv("WAYLAND_DISPLAY");
+        return fv_cli_usage_error(k_cmd, "no display: cannot connect to DISPLAY '%s' or WAYLAND_DISPLAY '%s'", x ? x : "", w ? w : "");
+    }
     o->win = SDL_CreateWindow("fovea view", SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, a->width, a->height, 0);
     if (!o->win) return fv_cli_usage_error(k_cmd, "cannot open a window (SDL: %s)", SDL_GetError());
     o->ren = SDL_CreateRenderer(o->win, -1, 0);
