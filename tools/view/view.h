@@ -146,7 +146,7 @@ typedef struct fv_vw_app {
     fv_gaze_path *gaze_trace;
     int user_method;                 /* the method --param applies to */
     fv_vw_slot main, base;           /* the technique, and its baseline in the split view */
-    bool split, overlay, paused, running, cancelled;
+    bool split, overlay, paused, running, cancelled, hide_text;
     fv_gaze gaze;                    /* mouse or scripted gaze (normalised, in a panel) */
     bool script_gaze;                /* a script drives the gaze: the real mouse does not */
     fv_vw_fly fly;

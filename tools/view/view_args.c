@@ -19,7 +19,7 @@ static void help(void)
            "  --threads N           worker threads, 0 = all cores [0]\n"
            "  --script FILE         timed commands by frame number (docs/viewer.md)\n"
            "  --fps-log FILE        one CSV line per frame: render and frame milliseconds\n"
-           "Keys: Tab/Shift-Tab method, +/- main parameter, V split with the baseline, O overlay,\n"
+           "Keys: Tab/Shift-Tab method, +/- main parameter, V split with the baseline, O overlay, H text,\n"
            "WASD/QE move, right-drag look, P pause, R record gaze+camera, F12 screenshot, Esc quit.\n"
            "Exit status: 0 ok, 1 internal error, 2 bad input or no display.\n");
 }

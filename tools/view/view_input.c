@@ -17,6 +17,7 @@ void fv_vw_on_key(fv_vw_app *app, int key, unsigned mod, const char *shot_path, 
     case SDLK_MINUS:
     case SDLK_KP_MINUS: fv_vw_step_param(app, -1); break;
     case SDLK_o: app->overlay = !app->overlay; break;
+    case SDLK_h: app->hide_text = !app->hide_text; break;
     case SDLK_p:
         app->paused = !app->paused;
         fv_vw_say(app, app->paused ? "animation paused" : "animation runs");

@@ -151,7 +151,7 @@ static int run(fv_vw_app *app, sdl_out *o, fv_vw_script *script)
         if (app->overlay)
             for (int i = 0; i < np; i++)
                 fv_vw_overlay_gaze(&canvas, panels[i].r, &panels[i].slot->eye, panels[i].slot->fw, panels[i].slot->gaze[panels[i].eye]);
-        fv_vw_hud(&canvas, app, panels, np);
+        if (!app->hide_text) fv_vw_hud(&canvas, app, panels, np);
         SDL_UpdateTexture(o->tex, NULL, canvas.px, canvas.w * (int)sizeof(uint32_t));
         SDL_RenderClear(o->ren);
         SDL_RenderCopy(o->ren, o->tex, NULL, NULL);
