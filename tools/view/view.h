@@ -59,7 +59,8 @@ void fv_vw_overlay_gaze(fv_vw_canvas *c, fv_vw_rect panel, const fv_eye_model *m
 typedef struct fv_vw_slot {
     int method;          /* registry index, -1 when empty */
     fv_technique *tech;
-    int value;           /* position in the main parameter's list, -1: the method's default */
+    int value;           /* position in the main parameter's list, -1: --param's or the default */
+    char label[48];      /* "key=value" of the main parameter as created */
     fv_film *film[2];
     int fw, fh, eyes;
     bool rendered;       /* has rendered since it was created (its history continues) */

@@ -42,7 +42,7 @@ static int prepare(fv_vw_app *app, fv_vw_script *script)
         return fv_cli_fail(k_cmd, s, err.msg);
     if (a->fps_log) {
         if (!(app->fps_log = fopen(a->fps_log, "w"))) return fv_cli_usage_error(k_cmd, "--fps-log %s: cannot write there", a->fps_log);
-        fprintf(app->fps_log, "frame,method,render_ms,frame_ms,baseline,baseline_ms\n");
+        fprintf(app->fps_log, "frame,method,render_ms,frame_ms,baseline,baseline_ms,stages_ms\n");
     }
     fv_camera c;
     fv_view_camera(app->view, app->scene, 0.0, a->width, a->height, &c);
@@ -170,9 +170,13 @@ static int run(fv_vw_app *app, sdl_out *o, fv_vw_script *script)
         app->frame_ms = ms;
         dt = ms / 1000.0;
         if (dt > 0.25) dt = 0.25; /* a slow frame (or a method switch) must not throw the camera far */
-        if (app->fps_log)
-            fprintf(app->fps_log, "%ld,%s,%.2f,%.2f,%s,%.2f\n", app->frame, fv_technique_name(app->main.method), app->main.ms, ms,
+        if (app->fps_log) {
+            fprintf(app->fps_log, "%ld,%s,%.2f,%.2f,%s,%.2f,", app->frame, fv_technique_name(app->main.method), app->main.ms, ms,
                     app->split && app->base.tech ? fv_technique_name(app->base.method) : "", app->split && app->base.tech ? app->base.ms : 0.0);
+            for (int i = 0; i < app->main.stats.n_stages; i++)
+                fprintf(app->fps_log, "%s%s=%.2f", i ? " " : "", app->main.stats.stage[i].name, app->main.stats.stage[i].value);
+            fputc('\n', app->fps_log);
+        }
         app->frame++;
     }
     free(canvas.px);

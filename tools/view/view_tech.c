@@ -69,6 +69,13 @@ fv_status fv_vw_slot_create(fv_vw_slot *s, const fv_scene *scene, int m, int val
     if (st != FV_OK) return st;
     fv_technique_destroy(s->tech);
     s->tech = t;
+    s->label[0] = '\0';
+    if (mp) {
+        const char *v = value >= 0 ? mp->values[value] : "default";
+        for (int i = 0; value < 0 && user_params && i < fv_params_count(user_params); i++)
+            if (!strcmp(fv_params_key(user_params, i), mp->key)) v = fv_params_value(user_params, i);
+        snprintf(s->label, sizeof s->label, "%s=%s", mp->key, v);
+    }
     s->method = m;
     s->value = value;
     s->rendered = false;
@@ -106,13 +113,7 @@ fv_status fv_vw_slot_films(fv_vw_slot *s, int w, int h, int eyes, fv_error *err)
     return FV_OK;
 }
 
-void fv_vw_slot_param_label(const fv_vw_slot *s, char *out, size_t n)
-{
-    out[0] = '\0';
-    if (s->method < 0) return;
-    const fv_vw_main_param *mp = fv_vw_main_param_of(fv_technique_name(s->method));
-    if (mp) snprintf(out, n, "%s=%s", mp->key, s->value >= 0 ? mp->values[s->value] : "default");
-}
+void fv_vw_slot_param_label(const fv_vw_slot *s, char *out, size_t n) { snprintf(out, n, "%s", s->method >= 0 ? s->label : ""); }
 
 void fv_vw_cycle(fv_vw_app *app, int dir)
 {
