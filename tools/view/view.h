@@ -78,6 +78,7 @@ typedef struct fv_vw_main_param {
     const char *key;
     const char *values[8];
     int count;
+    int dflt;         /* position of the method's own default in values */
     bool progressive; /* frames may be averaged while nothing moves */
 } fv_vw_main_param;
 const fv_vw_main_param *fv_vw_main_param_of(const char *method);

@@ -83,13 +83,13 @@ void fv_vw_hud(fv_vw_canvas *c, fv_vw_app *app, const fv_vw_panel *p, int np)
         if (s->accum_n > 1) snprintf(line + strlen(line), sizeof line - strlen(line), "  accum %d", s->accum_n);
         fv_vw_text(c, p[i].r.x + 4, p[i].r.y + 4, green, line);
     }
-    /* bottom: the main technique's frame */
+    /* bottom: the main technique's frame, and the gaze it was given (the trace's, with --gaze-trace) */
     text_lines t;
     memset(&t, 0, sizeof t);
     t.cols = c->w / FV_VW_CELL_W - 1;
     const fv_stats *st = &app->main.stats;
     add(&t, "%.1f fps  frame %.1f ms  t %.2f s%s%s  gaze %.3f,%.3f", app->frame_ms > 0 ? 1000.0 / app->frame_ms : 0.0, app->frame_ms,
-        app->anim_time, app->paused ? " PAUSED" : "", app->rec.gaze ? " REC" : "", app->gaze.x, app->gaze.y);
+        app->anim_time, app->paused ? " PAUSED" : "", app->rec.gaze ? " REC" : "", app->main.gaze[0].x, app->main.gaze[0].y);
     newline(&t);
     for (int i = 0; i < st->n_stages; i++) add(&t, "%s %.1f  ", st->stage[i].name, st->stage[i].value);
     if (st->n_stages) add(&t, "(ms)");

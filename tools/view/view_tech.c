@@ -12,22 +12,22 @@ static const struct {
     const char *method;
     fv_vw_main_param p;
 } k_main[] = {
-    {"pt", {"spp", {"1", "2", "4", "8", "16", "32", "64"}, 7, true}},
-    {"pm", {"photons", {"10000", "30000", "100000", "300000", "1000000"}, 5, false}},
-    {"pm-t", {"photons", {"10000", "30000", "100000", "300000", "1000000"}, 5, false}},
-    {"fpm", {"photons", {"10000", "30000", "100000", "300000", "1000000"}, 5, false}},
-    {"ir", {"vpls", {"250", "500", "1000", "2000", "4000", "8000"}, 6, false}},
-    {"ir-low", {"vpls", {"250", "500", "1000", "2000", "4000", "8000"}, 6, false}},
-    {"fir", {"vpls", {"250", "500", "1000", "2000", "4000"}, 5, false}},
-    {"sdf-gt", {"spp", {"1", "4", "16"}, 3, false}},
-    {"sdf-relaxed", {"spp", {"1", "4", "16"}, 3, false}},
-    {"ipr", {"spp", {"1", "4", "16"}, 3, false}},
-    {"fipr", {"spp", {"1", "4", "16"}, 3, false}},
-    {"vpolar", {"reduction", {"0.61", "0.71", "0.88"}, 3, false}},
-    {"cartesian", {"reduction", {"0.61", "0.71", "0.88"}, 3, false}},
-    {"cartesian-full", {"bounces", {"1", "2", "3"}, 3, false}},
-    {"linear-falloff", {"bounces", {"1", "2", "3"}, 3, false}},
-    {"log-polar", {"bounces", {"1", "2", "3"}, 3, false}},
+    {"pt", {"spp", {"1", "2", "4", "8", "16", "32", "64"}, 7, 4, true}},
+    {"pm", {"photons", {"10000", "30000", "100000", "300000", "1000000"}, 5, 3, false}},
+    {"pm-t", {"photons", {"10000", "30000", "100000", "300000", "1000000"}, 5, 3, false}},
+    {"fpm", {"photons", {"10000", "30000", "100000", "300000", "1000000"}, 5, 3, false}},
+    {"ir", {"vpls", {"250", "500", "1000", "2000", "4000", "8000"}, 6, 3, false}},
+    {"ir-low", {"vpls", {"250", "500", "1000", "2000", "4000", "8000"}, 6, 3, false}},
+    {"fir", {"vpls", {"250", "500", "1000", "2000", "4000"}, 5, 2, false}},
+    {"sdf-gt", {"spp", {"1", "4", "16"}, 3, 0, false}},
+    {"sdf-relaxed", {"spp", {"1", "4", "16"}, 3, 0, false}},
+    {"ipr", {"spp", {"1", "4", "16"}, 3, 0, false}},
+    {"fipr", {"spp", {"1", "4", "16"}, 3, 0, false}},
+    {"vpolar", {"reduction", {"0.61", "0.71", "0.88"}, 3, 0, false}},
+    {"cartesian", {"reduction", {"0.61", "0.71", "0.88"}, 3, 0, false}},
+    {"cartesian-full", {"bounces", {"1", "2", "3"}, 3, 0, false}},
+    {"linear-falloff", {"bounces", {"1", "2", "3"}, 3, 0, false}},
+    {"log-polar", {"bounces", {"1", "2", "3"}, 3, 0, false}},
 };
 
 const fv_vw_main_param *fv_vw_main_param_of(const char *method)
@@ -148,11 +148,12 @@ void fv_vw_step_param(fv_vw_app *app, int dir)
     }
     int v = s->value;
     if (v < 0) {
-        /* from the method's default: the nearest offered value on the side asked for */
-        v = dir > 0 ? mp->count / 2 : mp->count / 2 - 1;
-    } else {
-        v += dir;
+        /* from --param's value when it is one of the list, else from the method's default */
+        v = mp->dflt;
+        for (int i = 0; i < mp->count; i++)
+            if (!strcmp(s->label + strlen(mp->key) + 1, mp->values[i])) v = i;
     }
+    v += dir;
     if (v < 0 || v >= mp->count) {
         fv_vw_say(app, "%s: %s is at the end of its range", name, mp->key);
         return;
