@@ -132,3 +132,36 @@ void fv_cli_progress_done(fv_cli_progress *p)
 {
     if (p->enabled) fprintf(stderr, "\r%*s\r", 78, "");
 }
+
+int fv_cli_check_method(const char *cmd, const char *method)
+{
+    if (fv_technique_index(method) >= 0) return 0;
+    fv_error err;
+    fv_error_clear(&err);
+    fv_technique *t = NULL;
+    fv_status s = fv_technique_create(method, NULL, NULL, NULL, &t, &err); /* builds the message listing methods */
+    fv_technique_destroy(t);
+    return fv_cli_fail(cmd, s, err.msg);
+}
+
+int fv_cli_open_scene(const char *cmd, const char *name, const fv_log *log, int nlights, const float (*lights)[6], fv_scene **scene,
+                      fv_view **view)
+{
+    fv_error err;
+    fv_error_clear(&err);
+    *scene = NULL;
+    *view = NULL;
+    fv_status s = fv_scene_open(name, log, scene, view, &err);
+    for (int i = 0; i < nlights && s == FV_OK; i++) {
+        const float *v = lights[i];
+        fv_light_desc l = {FV_LIGHT_POINT, fv_v3(v[0], v[1], v[2]), fv_v3(0, -1, 0), fv_v3(v[3], v[4], v[5]), 0, 0};
+        s = fv_scene_add_light(*scene, &l, &err);
+    }
+    if (s == FV_OK && (s = fv_scene_commit(*scene, log, &err)) != FV_OK) fv_error_prefix(&err, "%s: ", name);
+    if (s == FV_OK) return 0;
+    fv_scene_destroy(*scene);
+    fv_view_destroy(*view);
+    *scene = NULL;
+    *view = NULL;
+    return fv_cli_fail(cmd, s, err.msg);
+}

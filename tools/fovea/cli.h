@@ -37,11 +37,21 @@ void fv_cli_progress_init(fv_cli_progress *p, bool quiet, int frames);
 bool fv_cli_progress_frame(void *user, double fraction); /* fv_progress_fn; never cancels */
 void fv_cli_progress_done(fv_cli_progress *p);
 
+/* The method check every rendering command makes before loading anything: an unknown name fails
+ * with the library's message listing the methods. Returns 0 or the exit code (message printed). */
+int fv_cli_check_method(const char *cmd, const char *method);
+/* Opens a scene (built-in name or file), adds point lights (x,y,z,r,g,b each; may be none) and
+ * commits it, with the messages `fovea render` prints. Returns 0 or the exit code; on failure
+ * whatever was opened is released and *scene, *view are NULL. */
+int fv_cli_open_scene(const char *cmd, const char *name, const fv_log *log, int nlights, const float (*lights)[6], fv_scene **scene,
+                      fv_view **view);
+
 /* Subcommands. */
 int fv_cmd_render(int argc, char **argv);
 int fv_cmd_methods(int argc, char **argv);
 int fv_cmd_scenes(int argc, char **argv);
 int fv_cmd_compare(int argc, char **argv);
 int fv_cmd_bench(int argc, char **argv);
+int fv_cmd_view(int argc, char **argv);
 
 #endif

@@ -221,11 +221,7 @@ int fv_cmd_render(int argc, char **argv)
         rc = fv_cli_usage_error(cmd, "--out %s: cannot write there (%s)", o.out, strerror(errno));
         goto done;
     }
-    if (fv_technique_index(o.method) < 0) {
-        s = fv_technique_create(o.method, NULL, NULL, NULL, &tech, &err); /* builds the message listing methods */
-        rc = fv_cli_fail(cmd, s, err.msg);
-        goto done;
-    }
+    if ((rc = fv_cli_check_method(cmd, o.method)) != 0) goto done;
     if (o.spp > 0) {
         char v[32];
         snprintf(v, sizeof v, "%d", o.spp);
@@ -234,23 +230,7 @@ int fv_cmd_render(int argc, char **argv)
 
     bool quiet = o.quiet;
     fv_log log = fv_cli_log(&quiet);
-    if ((s = fv_scene_open(o.scene, &log, &scene, &view, &err)) != FV_OK) {
-        rc = fv_cli_fail(cmd, s, err.msg);
-        goto done;
-    }
-    for (int i = 0; i < o.nlights; i++) {
-        float *v = o.lights[i];
-        fv_light_desc l = {FV_LIGHT_POINT, fv_v3(v[0], v[1], v[2]), fv_v3(0, -1, 0), fv_v3(v[3], v[4], v[5]), 0, 0};
-        if ((s = fv_scene_add_light(scene, &l, &err)) != FV_OK) {
-            rc = fv_cli_fail(cmd, s, err.msg);
-            goto done;
-        }
-    }
-    if ((s = fv_scene_commit(scene, &log, &err)) != FV_OK) {
-        fv_error_prefix(&err, "%s: ", o.scene);
-        rc = fv_cli_fail(cmd, s, err.msg);
-        goto done;
-    }
+    if ((rc = fv_cli_open_scene(cmd, o.scene, &log, o.nlights, (const float(*)[6])o.lights, &scene, &view)) != 0) goto done;
     if ((s = fv_technique_create(o.method, scene, params, &log, &tech, &err)) != FV_OK) {
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;

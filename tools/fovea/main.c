@@ -15,6 +15,7 @@ static const fv_command k_commands[] = {
     {"scenes", fv_cmd_scenes, "list the built-in scenes"},
     {"compare", fv_cmd_compare, "error metrics per region between two images"},
     {"bench", fv_cmd_bench, "run a benchmark scenario: timings and errors side by side"},
+    {"view", fv_cmd_view, "interactive viewer: the fovea follows the mouse (needs SDL2)"},
 };
 
 static void usage(FILE *f)

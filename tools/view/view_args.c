@@ -1,0 +1,79 @@
+/* fovea-view — the command line. Values are checked with the CLI's own parsers and messages
+ * (tools/fovea/cli.c), so `fovea view` and `fovea render` reject the same typos the same way. */
+#include <getopt.h>
+#include <string.h>
+#include "cli.h"
+#include "view.h"
+
+static void help(void)
+{
+    printf("usage: fovea view [SCENE] [options]\n"
+           "  SCENE                 built-in name (fovea scenes) or a scene file [cornell]\n"
+           "  --method NAME         rendering method (fovea methods) [vpolar]\n"
+           "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
+           "  --size WxH            window size [640x360]\n"
+           "  --scale S             render at S x the window size, scaled to it [1]\n"
+           "  --gaze X,Y            fixed gaze (normalised) instead of the mouse\n"
+           "  --gaze-trace FILE     replay a gaze trace (docs/gaze.md) instead of the mouse\n"
+           "  --stereo SEP          left and right eye side by side, eye separation SEP\n"
+           "  --threads N           worker threads, 0 = all cores [0]\n"
+           "  --script FILE         timed commands by frame number (docs/viewer.md)\n"
+           "  --fps-log FILE        one CSV line per frame: render and frame milliseconds\n"
+           "Keys: Tab/Shift-Tab method, +/- main parameter, V split with the baseline, O overlay, H text,\n"
+           "WASD/QE move, right-drag look, P pause, R record gaze+camera, F12 screenshot, Esc quit.\n"
+           "Exit status: 0 ok, 1 internal error, 2 bad input or no display.\n");
+}
+
+int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
+{
+    enum { O_METHOD = 256, O_PARAM, O_SIZE, O_SCALE, O_GAZE, O_TRACE, O_STEREO, O_THREADS, O_SCRIPT, O_FPSLOG, O_HELP };
+    static const struct option longs[] = {
+        {"method", 1, 0, O_METHOD}, {"param", 1, 0, O_PARAM},   {"size", 1, 0, O_SIZE},       {"scale", 1, 0, O_SCALE},
+        {"gaze", 1, 0, O_GAZE},     {"gaze-trace", 1, 0, O_TRACE}, {"stereo", 1, 0, O_STEREO}, {"threads", 1, 0, O_THREADS},
+        {"script", 1, 0, O_SCRIPT}, {"fps-log", 1, 0, O_FPSLOG}, {"help", 0, 0, O_HELP},      {0, 0, 0, 0}};
+    const char *cmd = "view";
+    long l;
+    double d;
+    fv_error err;
+    opterr = 0;
+    optind = 1;
+    int c;
+    while ((c = getopt_long(argc, argv, "h", longs, NULL)) != -1) {
+        switch (c) {
+        case O_METHOD: a->method = optarg; break;
+        case O_PARAM:
+            if (fv_params_parse(a->params, optarg, &err) != FV_OK) return fv_cli_fail(cmd, err.status, err.msg);
+            break;
+        case O_SIZE:
+            if (!fv_cli_parse_size(optarg, &a->width, &a->height)) return fv_cli_usage_error(cmd, "--size %s: expected WxH, e.g. 640x480", optarg);
+            break;
+        case O_SCALE:
+            if (!fv_cli_parse_float(optarg, &d) || d <= 0 || d > 4) return fv_cli_usage_error(cmd, "--scale %s: expected a number in (0, 4]", optarg);
+            a->scale = d;
+            break;
+        case O_GAZE:
+            if (!fv_cli_parse_floats(optarg, 2, a->gaze) || a->gaze[0] < 0 || a->gaze[0] > 1 || a->gaze[1] < 0 || a->gaze[1] > 1)
+                return fv_cli_usage_error(cmd, "--gaze %s: expected X,Y with both in [0,1]", optarg);
+            a->has_gaze = true;
+            break;
+        case O_TRACE: a->gaze_trace = optarg; break;
+        case O_STEREO:
+            if (!fv_cli_parse_float(optarg, &d) || d <= 0) return fv_cli_usage_error(cmd, "--stereo %s: expected a positive eye separation", optarg);
+            a->stereo = d;
+            break;
+        case O_THREADS:
+            if (!fv_cli_parse_int(optarg, 0, 256, &l)) return fv_cli_usage_error(cmd, "--threads %s: expected an integer in [0, 256]", optarg);
+            a->threads = (int)l;
+            break;
+        case O_SCRIPT: a->script = optarg; break;
+        case O_FPSLOG: a->fps_log = optarg; break;
+        case O_HELP:
+        case 'h': help(); return -1;
+        default: return fv_cli_usage_error(cmd, "unknown or incomplete option '%s' (see fovea view --help)", argv[optind - 1]);
+        }
+    }
+    if (optind < argc) a->scene = argv[optind++];
+    if (optind < argc) return fv_cli_usage_error(cmd, "unexpected argument '%s'", argv[optind]);
+    if (a->has_gaze && a->gaze_trace) return fv_cli_usage_error(cmd, "--gaze and --gaze-trace exclude each other");
+    return 0;
+}
