@@ -14,6 +14,13 @@ if [ ! -x "$VIEW" ]; then
   exit 0
 fi
 command -v xvfb-run >/dev/null || { fail "xvfb-run is missing (scripts/install-deps --with-tests installs xvfb)"; finish; }
+# Under the sanitizers (scripts/test's second pass), LeakSanitizer reports at exit what D-Bus and the
+# X11 libraries SDL loads (and unloads again in SDL_Quit) keep: 1.2 KB in libdbus and in modules it
+# can no longer name, so no suppression can match them, and the viewer's exit status becomes 23.
+# Leak checking stays on for everything else; AddressSanitizer's other checks stay on here.
+if [ "${FOVEA_SANITIZED:-0}" = 1 ]; then
+  export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
+fi
 
 # bad input: the same message as fovea render, exit 2, before any window opens
 expect 2 "unknown method 'nope' (known: pt," -- "$VIEW" cornell --method nope
