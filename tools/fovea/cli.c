@@ -165,3 +165,20 @@ int fv_cli_open_scene(const char *cmd, const char *name, const fv_log *log, int 
     *view = NULL;
     return fv_cli_fail(cmd, s, err.msg);
 }
+
+int fv_cli_opt_size(const char *cmd, const char *arg, int *w, int *h)
+{
+    return fv_cli_parse_size(arg, w, h) ? 0 : fv_cli_usage_error(cmd, "--size %s: expected WxH, e.g. 640x480", arg);
+}
+
+int fv_cli_opt_gaze(const char *cmd, const char *arg, float xy[2])
+{
+    if (fv_cli_parse_floats(arg, 2, xy) && xy[0] >= 0 && xy[0] <= 1 && xy[1] >= 0 && xy[1] <= 1) return 0;
+    return fv_cli_usage_error(cmd, "--gaze %s: expected X,Y with both in [0,1]", arg);
+}
+
+int fv_cli_opt_stereo(const char *cmd, const char *arg, double *sep)
+{
+    if (fv_cli_parse_float(arg, sep) && *sep > 0) return 0;
+    return fv_cli_usage_error(cmd, "--stereo %s: expected a positive eye separation", arg);
+}

@@ -83,6 +83,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
     const char *cmd = "render";
     long l;
     double d;
+    int rc;
     fv_error err;
     opterr = 0;
     optind = 1;
@@ -95,7 +96,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             o->spp = (int)l;
             break;
         case O_SIZE:
-            if (!fv_cli_parse_size(optarg, &o->width, &o->height)) return fv_cli_usage_error(cmd, "--size %s: expected WxH, e.g. 640x480", optarg);
+            if ((rc = fv_cli_opt_size(cmd, optarg, &o->width, &o->height))) return rc;
             break;
         case O_FRAMES:
             if (!fv_cli_parse_int(optarg, 1, 1000000, &l)) return fv_cli_usage_error(cmd, "--frames %s: expected an integer in [1, 1000000]", optarg);
@@ -148,14 +149,13 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             o->nlights++;
             break;
         case O_GAZE:
-            if (!fv_cli_parse_floats(optarg, 2, o->gaze) || o->gaze[0] < 0 || o->gaze[0] > 1 || o->gaze[1] < 0 || o->gaze[1] > 1)
-                return fv_cli_usage_error(cmd, "--gaze %s: expected X,Y with both in [0,1]", optarg);
+            if ((rc = fv_cli_opt_gaze(cmd, optarg, o->gaze))) return rc;
             o->has_gaze = true;
             break;
         case O_TRACE: o->gaze_trace = optarg; break;
         case O_CTRACE: o->camera_trace = optarg; break;
         case O_STEREO:
-            if (!fv_cli_parse_float(optarg, &d) || d <= 0) return fv_cli_usage_error(cmd, "--stereo %s: expected a positive eye separation", optarg);
+            if ((rc = fv_cli_opt_stereo(cmd, optarg, &d))) return rc;
             o->stereo = d;
             break;
         case O_PARAM:

@@ -34,6 +34,7 @@ int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
     const char *cmd = "view";
     long l;
     double d;
+    int rc;
     fv_error err;
     opterr = 0;
     optind = 1;
@@ -45,20 +46,19 @@ int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
             if (fv_params_parse(a->params, optarg, &err) != FV_OK) return fv_cli_fail(cmd, err.status, err.msg);
             break;
         case O_SIZE:
-            if (!fv_cli_parse_size(optarg, &a->width, &a->height)) return fv_cli_usage_error(cmd, "--size %s: expected WxH, e.g. 640x480", optarg);
+            if ((rc = fv_cli_opt_size(cmd, optarg, &a->width, &a->height))) return rc;
             break;
         case O_SCALE:
             if (!fv_cli_parse_float(optarg, &d) || d <= 0 || d > 4) return fv_cli_usage_error(cmd, "--scale %s: expected a number in (0, 4]", optarg);
             a->scale = d;
             break;
         case O_GAZE:
-            if (!fv_cli_parse_floats(optarg, 2, a->gaze) || a->gaze[0] < 0 || a->gaze[0] > 1 || a->gaze[1] < 0 || a->gaze[1] > 1)
-                return fv_cli_usage_error(cmd, "--gaze %s: expected X,Y with both in [0,1]", optarg);
+            if ((rc = fv_cli_opt_gaze(cmd, optarg, a->gaze))) return rc;
             a->has_gaze = true;
             break;
         case O_TRACE: a->gaze_trace = optarg; break;
         case O_STEREO:
-            if (!fv_cli_parse_float(optarg, &d) || d <= 0) return fv_cli_usage_error(cmd, "--stereo %s: expected a positive eye separation", optarg);
+            if ((rc = fv_cli_opt_stereo(cmd, optarg, &d))) return rc;
             a->stereo = d;
             break;
         case O_THREADS:
