@@ -75,6 +75,11 @@ typedef struct fv_frame_views {
     fv_gaze gaze[2];
 } fv_frame_views;
 FV_API void fv_driver_views(const fv_driver *d, int index, fv_frame_views *out);
+/* The views a continuing render of frame `index` hands its technique as the previous frame's
+ * (fv_frame.prev_camera): those frame index - 1 was actually rendered with when it was the last
+ * frame this driver rendered, since a camera set since then (fv_driver_set_camera) must not
+ * rewrite the past; otherwise derived as fv_driver_views(index - 1) (index 0: frame 0). */
+FV_API void fv_driver_prev_views(const fv_driver *d, int index, fv_frame_views *out);
 /* The eye model every frame uses (lives as long as the driver). */
 FV_API const fv_eye_model *fv_driver_eye_model(const fv_driver *d);
 FV_API int fv_driver_eye_count(const fv_driver *d);

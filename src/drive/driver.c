@@ -9,6 +9,11 @@ struct fv_driver {
     const fv_view *view;
     fv_drive_opts o;
     fv_eye_model eye;
+    /* The views of the last frame rendered: the viewer changes the camera between frames
+     * (fv_driver_set_camera), so frame i-1's camera can only be known by remembering it, not by
+     * deriving it again from today's overrides. */
+    fv_frame_views last;
+    int last_index; /* -1: none yet */
 };
 
 void fv_drive_opts_init(fv_drive_opts *o)
@@ -49,6 +54,7 @@ fv_status fv_driver_create(fv_scene *scene, const fv_view *view, const fv_drive_
         }
     }
     d->o.eye_model = &d->eye;
+    d->last_index = -1;
     *out = d;
     return FV_OK;
 }
@@ -97,6 +103,12 @@ void fv_driver_views(const fv_driver *d, int index, fv_frame_views *out)
     if (!o->fixed_gaze && gp) fv_gaze_path_eval(gp, t, &out->gaze[0], &out->gaze[1]);
 }
 
+void fv_driver_prev_views(const fv_driver *d, int index, fv_frame_views *out)
+{
+    if (index > 0 && d->last_index == index - 1) *out = d->last;
+    else fv_driver_views(d, index - 1 > 0 ? index - 1 : 0, out);
+}
+
 /* Progress of one eye -> progress of the whole frame. */
 typedef struct eye_progress {
     fv_progress_fn fn;
@@ -117,7 +129,7 @@ fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool contin
     fv_frame_views v, pv;
     fv_driver_views(d, index, &v);
     bool has_prev = continues && index > 0;
-    if (has_prev) fv_driver_views(d, index - 1, &pv);
+    if (has_prev) fv_driver_prev_views(d, index, &pv);
     fv_status s = fv_scene_set_time(d->scene, v.time, err);
     eye_progress ep = {progress, progress_user, 0, v.eye_count};
     for (int e = 0; e < v.eye_count && s == FV_OK; e++) {
@@ -140,6 +152,10 @@ fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool contin
             fr.progress_user = &ep;
         }
         s = fv_technique_render(t, &fr, films[e], stats, err);
+    }
+    if (s == FV_OK) {
+        d->last = v;
+        d->last_index = index;
     }
     return s;
 }

@@ -267,12 +267,59 @@ static void test_render_progress_and_cancel(void **st)
     fv_params_destroy(p);
 }
 
+/* The viewer flies the camera with fv_driver_set_camera between frames: the previous frame's
+ * camera a technique reprojects from must be the one that frame was rendered with, not the new
+ * one (which would make every reprojection an identity while the camera moves). */
+static void test_set_camera_keeps_the_past(void **st)
+{
+    (void)st;
+    fv_error err;
+    fv_params *p;
+    assert_int_equal(fv_params_create(&p, &err), FV_OK);
+    assert_int_equal(fv_params_set(p, "spp", "1", &err), FV_OK);
+    fv_technique *t;
+    assert_int_equal(fv_technique_create("pt", g_scene, p, NULL, &t, &err), FV_OK);
+    fv_drive_opts o;
+    fv_drive_opts_init(&o);
+    o.width = o.height = 16, o.threads = 1;
+    fv_driver *d = make(g_view, &o);
+    fv_film *film;
+    assert_int_equal(fv_film_create(16, 16, 0, &film, &err), FV_OK);
+    fv_stats stats;
+    fv_stats_clear(&stats);
+    fv_frame_views v0, pv;
+    fv_driver_views(d, 0, &v0);
+    assert_int_equal(fv_driver_render(d, t, 0, false, &film, &stats, NULL, NULL, &err), FV_OK);
+    fv_camera c = v0.camera[0];
+    c.pos.x += 100.0f;
+    c.look.x += 100.0f;
+    fv_driver_set_camera(d, &c);
+    fv_driver_prev_views(d, 1, &pv);
+    assert_float_equal(pv.camera[0].pos.x, v0.camera[0].pos.x, 0.0f);
+    assert_float_equal(pv.camera[0].look.x, v0.camera[0].look.x, 0.0f);
+    fv_frame_views v1;
+    fv_driver_views(d, 1, &v1);
+    assert_float_equal(v1.camera[0].pos.x, c.pos.x, 0.0f);
+    assert_int_equal(fv_driver_render(d, t, 1, true, &film, &stats, NULL, NULL, &err), FV_OK);
+    /* after frame 1, frame 2's past is frame 1 as rendered, the moved camera */
+    fv_driver_prev_views(d, 2, &pv);
+    assert_float_equal(pv.camera[0].pos.x, c.pos.x, 0.0f);
+    /* a frame that was not the last rendered is derived from today's settings */
+    fv_driver_prev_views(d, 5, &pv);
+    assert_float_equal(pv.camera[0].pos.x, c.pos.x, 0.0f);
+    fv_film_destroy(film);
+    fv_driver_destroy(d);
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_time_and_camera), cmocka_unit_test(test_stereo),
         cmocka_unit_test(test_gaze_precedence), cmocka_unit_test(test_eye_model),
         cmocka_unit_test(test_bad_options),     cmocka_unit_test(test_render_progress_and_cancel),
+        cmocka_unit_test(test_set_camera_keeps_the_past),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
