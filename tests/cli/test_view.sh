@@ -29,6 +29,8 @@ sed 's/^fovea render:/fovea view:/' "$TMP/render.err" | cmp -s - "$TMP/err" || f
 expect 2 "unknown parameter 'foo'" -- "$VIEW" cornell --method vpolar --param foo=1
 expect 2 "no display" -- env -u DISPLAY -u SDL_VIDEODRIVER -u WAYLAND_DISPLAY "$VIEW" cornell --method vpolar
 expect 2 "unknown or incomplete command 'jump'" -- "$VIEW" --script /dev/stdin <<<"0 jump"
+expect 2 "move needs R U F" -- "$VIEW" --script /dev/stdin <<<"0 move 1 nan 2"
+expect 2 "look needs YAW PITCH" -- "$VIEW" --script /dev/stdin <<<"0 look 400 0"
 
 # frames are counted from 0; keys and gaze act before their frame, screenshots after it
 cat >"$TMP/s.txt" <<SCRIPT
@@ -49,7 +51,11 @@ cat >"$TMP/bare.txt" <<SCRIPT
 3 screenshot $TMP/p.png
 4 key shift+Tab
 6 screenshot $TMP/q.png
-7 quit
+7 screenshot $TMP/q2.png
+8 move 0 0 150
+8 look 15 0
+9 screenshot $TMP/r.png
+10 quit
 SCRIPT
 (cd "$TMP" && xvfb-run -a "$VIEW" cornell --method vpolar --size 320x180 --threads 2 --script "$TMP/s.txt" --fps-log "$TMP/fps.csv") \
   >"$TMP/run.out" 2>&1 || fail "the scripted session failed: $(cat "$TMP/run.out")"
@@ -139,6 +145,10 @@ def mean_diff(x, y):
 same, switched = mean_diff('o', 'p'), mean_diff('p', 'q')
 print(f'mean difference per channel: {same:.2f} between two frames of one method, {switched:.2f} across Tab')
 check(switched > 2 * same + 1.0, 'Tab did not change the image')
+# (4) the script's move/look fly the camera: the view changes more than between two still frames
+still, flown = mean_diff('q', 'q2'), mean_diff('q2', 'r')
+print(f'mean difference per channel: {still:.2f} between two still frames, {flown:.2f} after move + look')
+check(flown > 2 * still + 1.0, 'move/look did not move the camera')
 sys.exit(0 if ok else 1)
 PY
 finish

@@ -109,13 +109,14 @@ void fv_vw_fly_look(fv_vw_fly *f, float yaw, float pitch);
 void fv_vw_fly_camera(const fv_vw_fly *f, fv_camera *out);
 
 /* ---- script: timed commands by viewer frame number ---- */
-typedef enum { FV_VW_CMD_KEY, FV_VW_CMD_MOUSE, FV_VW_CMD_SHOT, FV_VW_CMD_QUIT } fv_vw_cmd_kind;
+typedef enum { FV_VW_CMD_KEY, FV_VW_CMD_MOUSE, FV_VW_CMD_MOVE, FV_VW_CMD_LOOK, FV_VW_CMD_SHOT, FV_VW_CMD_QUIT } fv_vw_cmd_kind;
 typedef struct fv_vw_cmd {
     long frame;
     fv_vw_cmd_kind kind;
     int key;          /* SDL_Keycode */
     unsigned mod;     /* SDL_Keymod */
     float x, y;       /* gaze, normalised */
+    float v[3];       /* move: right, up, forward (scene units); look: yaw, pitch (radians) */
     char *path;       /* screenshot file (owned) */
 } fv_vw_cmd;
 typedef struct fv_vw_script {

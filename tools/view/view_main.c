@@ -134,6 +134,8 @@ static int run(fv_vw_app *app, sdl_out *o, fv_vw_script *script)
             const fv_vw_cmd *c = &script->cmd[i];
             if (c->kind == FV_VW_CMD_KEY) fv_vw_on_key(app, c->key, c->mod, NULL, &canvas);
             else if (c->kind == FV_VW_CMD_MOUSE) app->gaze = (fv_gaze){c->x, c->y};
+            else if (c->kind == FV_VW_CMD_MOVE) fv_vw_fly_move(&app->fly, c->v[0], c->v[1], c->v[2]);
+            else if (c->kind == FV_VW_CMD_LOOK) fv_vw_fly_look(&app->fly, c->v[0], c->v[1]);
         }
         if (!app->running) break;
         fly_keys(app, dt);
