@@ -12,6 +12,7 @@
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "scene/query.h"
+#include "technique/vpl/cube_raster.h"
 #include "technique/vpl/cubemap.h"
 
 typedef struct fv_cube_meta {
@@ -21,6 +22,7 @@ typedef struct fv_cube_meta {
 
 struct fv_cubemaps {
     int count, n;
+    fv_cube_build how;
     size_t texels;      /* per map: 6 n^2 */
     float *depth;       /* count x texels */
     fv_cube_meta *meta; /* count */
@@ -65,6 +67,31 @@ int fv_cubemaps_face_size(const fv_cubemaps *m) { return m->n; }
 fv_vec3 fv_cubemaps_centre(const fv_cubemaps *m, int i) { return m->meta[i].centre; }
 const float *fv_cubemaps_depths(const fv_cubemaps *m, int i) { return m->depth + (size_t)i * m->texels; }
 
+const char *const fv_cube_build_names[] = {"auto", "raster", "rays", NULL};
+
+void fv_cubemaps_set_build(fv_cubemaps *m, fv_cube_build how) { m->how = how; }
+
+bool fv_cube_build_rasterises(fv_cube_build how, const fv_scene *s)
+{
+    if (how != FV_CUBE_BUILD_AUTO) return how == FV_CUBE_BUILD_RASTER && fv_scene_sdf_object_count(s) == 0;
+    return fv_scene_sdf_object_count(s) == 0 && fv_scene_triangle_count(s) <= FV_CUBE_RASTER_MAX_TRIANGLES;
+}
+
+/* Texel (x, y) of face f faces the VPL's lit side: its centre direction (not unit, the sign is
+ * what matters) has a positive cosine with the normal. Rays and rasteriser share this rule. The
+ * direction is fv_cube_dir's, component by component (its other terms add exact zeros), so the
+ * dot product is computed in fv_dot's order without building vectors. */
+static inline bool texel_in_front(fv_vec3 nrm, int f, int x, int y, float inv)
+{
+    const int a = f >> 1;
+    const float s = (f & 1) ? -1.0f : 1.0f;
+    float d[3];
+    d[a] = s;
+    d[(a + 1) % 3] = s * (2.0f * (((float)x + 0.5f) * inv) - 1.0f);
+    d[(a + 2) % 3] = 2.0f * (((float)y + 0.5f) * inv) - 1.0f;
+    return nrm.x * d[0] + nrm.y * d[1] + nrm.z * d[2] > 0.0f;
+}
+
 /* Traces one face of one map from o; with a normal, texels not in front of it store 0. */
 static void trace_face(const fv_scene *s, int n, int f, fv_vec3 o, const fv_vec3 *nrm, float *out)
 {
@@ -78,7 +105,7 @@ static void trace_face(const fv_scene *s, int n, int f, fv_vec3 o, const fv_vec3
             for (int k = 0; k < 8; k++) {
                 const int x = x0 + k;
                 dirs[k] = fv_normalize(fv_cube_dir(f, ((float)(x < n ? x : n - 1) + 0.5f) * inv, v));
-                active[k] = x < n && (!nrm || fv_dot(*nrm, dirs[k]) > 0.0f);
+                active[k] = x < n && (!nrm || texel_in_front(*nrm, f, x, y, inv));
             }
             fv_scene_intersect8_active(s, o, dirs, active, hits, ok);
             /* Unit directions: a hit's t is its distance from o. */
@@ -97,12 +124,64 @@ static bool face_behind(int f, fv_vec3 nrm)
     return fv_dot(nrm, A) + fabsf(fv_dot(nrm, U)) + fabsf(fv_dot(nrm, V)) <= 0.0f;
 }
 
-static void build_one(fv_cubemaps *m, const fv_scene *s, int i, fv_vec3 p, const fv_vec3 *nrm)
+/* Row y of face f: texels behind the normal store 0 (texel_in_front's rule, texel by texel). Along
+ * a row the cosine is linear in x, so only the texels within two of its zero crossing are
+ * evaluated; the rest take the sign of the line, which is far from zero there. */
+static void clear_behind(fv_vec3 nrm, int f, int y, int n, float inv, float *row)
+{
+    const int a = f >> 1;
+    const float s = (f & 1) ? -1.0f : 1.0f;
+    const float c = fv_cube_comp(nrm, a) * s + fv_cube_comp(nrm, (a + 2) % 3) * (2.0f * (((float)y + 0.5f) * inv) - 1.0f);
+    const float g = fv_cube_comp(nrm, (a + 1) % 3) * s; /* cosine = c + g sx */
+    if (!(fabsf(g) > 1e-6f * (fabsf(c) + 1e-30f))) {
+        for (int x = 0; x < n; x++)
+            if (!texel_in_front(nrm, f, x, y, inv)) row[x] = 0.0f;
+        return;
+    }
+    /* sx = 2 (x + 0.5) / n - 1 = -c / g at the crossing */
+    const float xc = (-c / g + 1.0f) * 0.5f * (float)n - 0.5f;
+    const int lo = xc < -4.0f ? -4 : xc > (float)n + 4.0f ? n + 4 : (int)floorf(xc) - 2;
+    const int hi = lo + 5;
+    for (int x = 0; x < n; x++) {
+        bool front;
+        if (x >= lo && x <= hi) front = texel_in_front(nrm, f, x, y, inv);
+        else front = (g > 0.0f) == (x > hi); /* right of the crossing: the sign of g */
+        if (!front) row[x] = 0.0f;
+    }
+}
+
+/* Map i by rasterising soup: the faces in front of the normal start at +inf, take the nearest
+ * triangle of each texel, and texels behind the normal store 0 as trace_face's do. */
+static void raster_one(fv_cubemaps *m, const fv_tri_soup *soup, int i, fv_vec3 o, const fv_vec3 *nrm)
+{
+    const int n = m->n;
+    const size_t face = (size_t)n * (size_t)n;
+    float *d = m->depth + (size_t)i * m->texels;
+    unsigned mask = 0;
+    for (int f = 0; f < 6; f++) {
+        const bool behind = nrm && face_behind(f, *nrm);
+        for (size_t k = 0; k < face; k++) d[f * face + k] = behind ? 0.0f : INFINITY;
+        if (!behind) mask |= 1u << f;
+    }
+    fv_cube_raster(soup, o, n, mask, d);
+    if (!nrm) return;
+    const float inv = 1.0f / (float)n;
+    for (int f = 0; f < 6; f++)
+        if (mask & (1u << f))
+            for (int y = 0; y < n; y++) clear_behind(*nrm, f, y, n, inv, d + f * face + (size_t)y * n);
+}
+
+/* soup NULL: by rays. */
+static void build_one(fv_cubemaps *m, const fv_scene *s, const fv_tri_soup *soup, int i, fv_vec3 p, const fv_vec3 *nrm)
 {
     /* Off the VPL's own surface, on its lit side, so the rays do not find the surface they leave. */
     const fv_vec3 o = nrm ? fv_offset_point(s, p, *nrm, *nrm) : p;
     m->meta[i].centre = o;
     m->meta[i].eps = fv_scene_ray_eps(s);
+    if (soup) {
+        raster_one(m, soup, i, o, nrm);
+        return;
+    }
     const size_t face = (size_t)m->n * (size_t)m->n;
     float *d = m->depth + (size_t)i * m->texels;
     for (int f = 0; f < 6; f++) {
@@ -114,19 +193,31 @@ static void build_one(fv_cubemaps *m, const fv_scene *s, int i, fv_vec3 p, const
     }
 }
 
+/* The triangles to rasterise when this pool rasterises in scene s, else NULL (*soup). */
+static fv_status soup_for(const fv_cubemaps *m, const fv_scene *s, fv_tri_soup **soup, fv_error *err)
+{
+    *soup = NULL;
+    return fv_cube_build_rasterises(m->how, s) ? fv_tri_soup_create(s, soup, err) : FV_OK;
+}
+
 fv_status fv_cubemaps_build(fv_cubemaps *m, const fv_scene *s, int i, fv_vec3 p, const fv_vec3 *n, fv_error *err)
 {
     if (i < 0 || i >= m->count)
         return fv_error_set(err, FV_ERR_INVALID, "cube map %d: not in [0, %d) (vpls)", i, m->count);
     if (!fv_is_finite3(p) || (n && !fv_is_finite3(*n)))
         return fv_error_set(err, FV_ERR_INVALID, "cube map %d: VPL position or normal is not finite", i);
-    build_one(m, s, i, p, n);
+    fv_tri_soup *soup;
+    fv_status st = soup_for(m, s, &soup, err);
+    if (st != FV_OK) return st;
+    build_one(m, s, soup, i, p, n);
+    fv_tri_soup_destroy(soup);
     return FV_OK;
 }
 
 typedef struct build_job {
     fv_cubemaps *m;
     const fv_scene *s;
+    const fv_tri_soup *soup;
     const int *idx;
     const fv_vec3 *pos, *nrm;
 } build_job;
@@ -135,7 +226,7 @@ static void build_range(void *ctx, int64_t b, int64_t e, int thread)
 {
     (void)thread;
     const build_job *j = ctx;
-    for (int64_t k = b; k < e; k++) build_one(j->m, j->s, j->idx[k], j->pos[k], j->nrm ? &j->nrm[k] : NULL);
+    for (int64_t k = b; k < e; k++) build_one(j->m, j->s, j->soup, j->idx[k], j->pos[k], j->nrm ? &j->nrm[k] : NULL);
 }
 
 fv_status fv_cubemaps_build_many(fv_cubemaps *m, const fv_scene *s, const int *indices, const fv_vec3 *positions,
@@ -147,9 +238,14 @@ fv_status fv_cubemaps_build_many(fv_cubemaps *m, const fv_scene *s, const int *i
         if (!fv_is_finite3(positions[k]) || (normals && !fv_is_finite3(normals[k])))
             return fv_error_set(err, FV_ERR_INVALID, "cube map %d: VPL position or normal is not finite", indices[k]);
     }
-    build_job j = {m, s, indices, positions, normals};
+    if (count == 0) return FV_OK;
+    fv_tri_soup *soup;
+    fv_status st = soup_for(m, s, &soup, err);
+    if (st != FV_OK) return st;
+    build_job j = {m, s, soup, indices, positions, normals};
     /* One map per chunk: a map is the unit of work and is written by one thread only. */
-    if (count > 0) fv_parallel_for(count, 1, threads, build_range, &j);
+    fv_parallel_for(count, 1, threads, build_range, &j);
+    fv_tri_soup_destroy(soup);
     return FV_OK;
 }
 

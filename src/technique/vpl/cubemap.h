@@ -1,8 +1,12 @@
 /* fovea — a pool of depth cube maps, one per virtual point light (VPL), for the visibility of
  * VPLs (Foveated Instant Radiosity, Sec. 3.4 and Sec. 4.1: each VPL's light is
- * shadowed by a low-resolution shadow map, 128x128 in the paper). On a CPU a map is built by
- * casting one ray per texel with Embree from the VPL, in packets of eight rays sharing the
- * VPL as origin (fv_scene_intersect8), instead of rasterising the scene six times.
+ * shadowed by a low-resolution shadow map, 128x128 in the paper). A map is built either by
+ * rasterising the scene's triangles into its faces, as the paper's GPU does (cube_raster.h), or by
+ * casting one ray per texel with Embree from the VPL, in packets of eight rays sharing the VPL as
+ * origin (fv_scene_intersect8). Both store the same depths (up to rounding and ties on shared
+ * edges); rasterising costs per triangle and covered texel, rays per texel, so the automatic choice
+ * rasterises scenes up to FV_CUBE_RASTER_MAX_TRIANGLES triangles and traces larger ones and any
+ * scene with signed distance fields, which have no triangles.
  *
  * Cube face convention (one mapping, used by build and lookup alike):
  *   face f = 2 a + k looks along axis a (0 x, 1 y, 2 z), positive for k = 0, negative for k = 1:
@@ -49,8 +53,21 @@
 #define FV_CUBE_MIN_SIZE 8
 #define FV_CUBE_MAX_SIZE 2048
 #define FV_CUBE_BIAS_TEXELS 2.0f
+/* Above this many triangles FV_CUBE_BUILD_AUTO casts rays. Measured (docs/results.md, "Cube maps:
+ * rasterised or traced"): a rasterised 128^2 map costs about 0.2 us per triangle and thread, a
+ * traced one 4-7 ms per thread whatever the triangle count, so they cross near 20-35 thousand
+ * triangles (cornell-fir's 32: raster 7x faster; city's 180,906: rays 8x faster). */
+#define FV_CUBE_RASTER_MAX_TRIANGLES 20000
+#define FV_CUBE_STR_(x) #x
+#define FV_CUBE_STR(x) FV_CUBE_STR_(x)
 
 typedef struct fv_cubemaps fv_cubemaps;
+
+typedef enum fv_cube_build {
+    FV_CUBE_BUILD_AUTO = 0, /* raster up to FV_CUBE_RASTER_MAX_TRIANGLES and without SDFs, else rays */
+    FV_CUBE_BUILD_RASTER,   /* rasterise (rays when the scene has SDF objects) */
+    FV_CUBE_BUILD_RAYS      /* cast a ray per texel */
+} fv_cube_build;
 
 typedef enum fv_cube_filter {
     FV_CUBE_NEAREST = 0, /* the texel q falls in: 0 or 1 */
@@ -107,6 +124,15 @@ static inline int fv_cube_face_of(fv_vec3 d, float *u, float *v)
  * (*out NULL); no memory -> FV_ERR_NOMEM. */
 fv_status fv_cubemaps_create(int count, int face_size, fv_cubemaps **out, fv_error *err);
 void fv_cubemaps_destroy(fv_cubemaps *maps);
+/* The parameter cube_build=auto|raster|rays of the techniques with cube maps, in enum order. */
+extern const char *const fv_cube_build_names[];
+#define FV_CUBE_BUILD_HELP                                                                                             \
+    "cube_build=auto|raster|rays (auto): how depth cube maps are made: rasterising the triangles (the paper's way), " \
+    "a ray per texel, or auto (raster up to " FV_CUBE_STR(FV_CUBE_RASTER_MAX_TRIANGLES) " triangles and without SDFs)\n"
+/* How maps are built from now on (FV_CUBE_BUILD_AUTO at creation). */
+void fv_cubemaps_set_build(fv_cubemaps *maps, fv_cube_build how);
+/* Whether `how` rasterises in scene s. */
+bool fv_cube_build_rasterises(fv_cube_build how, const fv_scene *s);
 int fv_cubemaps_count(const fv_cubemaps *maps);
 int fv_cubemaps_face_size(const fv_cubemaps *maps);
 

@@ -13,8 +13,8 @@
  *
  * CPU choices, each said in docs/instant-radiosity.md: candidates are placed by an Embree ray (as
  * cheap here as a voxel walk, and it puts the VPL on the surface its cube map must start from);
- * visibility from the VPLs is a depth cube map built by casting rays (cubemap.h) instead of a
- * rasterised shadow map; the two eyes of a stereo frame share one VPL set, managed with the left
+ * visibility from the VPLs is a depth cube map, rasterised as the paper's shadow maps are when
+ * the scene is small and built by casting rays when it is large (cubemap.h); the two eyes of a stereo frame share one VPL set, managed with the left
  * eye's view and gaze (both eyes then see the same light, and the management runs once a frame).
  *
  * All arrays are sized at create (VPLs, candidates, cube maps, voxels) or when the image size
@@ -66,7 +66,7 @@ typedef struct fir_state {
     const fv_scene *scene;
     /* parameters */
     int total, ncand, resolution, ndirs, density_res, density_limit, tiles_x, tiles_y, cube_size, cube_filter, filter,
-        area_samples, show, visibility;
+        area_samples, show, visibility, cube_build;
     float resample, density_c, drop_importance, drop_cos, rebuild, radius, clamp;
     /* scene side */
     fv_voxels *vox;
@@ -167,7 +167,8 @@ static fv_status read_params(fir_state *st, fv_params *p, fv_error *err)
         (s = fv_params_int(p, "area_samples", 16, 1, 4096, &st->area_samples, err)) != FV_OK ||
         (s = fv_params_float(p, "clamp", 0.03, 0.0, 1.0, &clamp, err)) != FV_OK ||
         (s = fv_params_choice(p, "show", 0, fv_vpl_show_names, &st->show, err)) != FV_OK ||
-        (s = fv_params_choice(p, "visibility", 0, k_visibility, &st->visibility, err)) != FV_OK)
+        (s = fv_params_choice(p, "visibility", 0, k_visibility, &st->visibility, err)) != FV_OK ||
+        (s = fv_params_choice(p, "cube_build", FV_CUBE_BUILD_AUTO, fv_cube_build_names, &st->cube_build, err)) != FV_OK)
         return s;
     if (!(radius > 0.0 && radius <= 1.0))
         return fv_error_set(err, FV_ERR_INVALID, "parameter radius=%g: outside (0, 1] (a fraction of the image width)", radius);
@@ -209,6 +210,7 @@ static fv_status fir_create(const fv_scene *scene, fv_params *params, const fv_l
     fv_scene_bounds(scene, &lo, &hi);
     if ((s = fv_density_grid_create(lo, hi, st->density_res, &st->grid, err)) != FV_OK) goto fail;
     if ((s = fv_cubemaps_create(st->total, st->cube_size, &st->maps, err)) != FV_OK) goto fail;
+    fv_cubemaps_set_build(st->maps, (fv_cube_build)st->cube_build);
     fv_vpl_dirs_make(st->ndirs, &st->dirs);
     for (int o = 0, n = fv_scene_object_count(scene); o < n; o++) st->has_dynamic |= fv_scene_object_dynamic(scene, o);
     const int N = st->total;
@@ -803,6 +805,7 @@ const fv_technique_class fv_technique_fir = {
         "cube_size=int (128): texels per cube-map face edge of a VPL's depth map (Sec. 4.1)\n"
         "rebuild=float (0.2): fraction of the VPLs' cube maps rebuilt per frame, new VPLs' always (Sec. 4.1)\n"
         "cube_filter=nearest|pcf (nearest): cube-map lookup\n"
+        FV_CUBE_BUILD_HELP
         "filter=box|atrous|none (box): filter of the interleaved indirect light (Sec. 3.4: a 5x5 box)\n"
         "radius=float (0.25): foveal radius as a fraction of the image width (Sec. 4.1)\n"
         "area_samples=int (16): light samples per pixel for area lights (point and spot lights are exact)\n"

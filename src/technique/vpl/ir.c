@@ -3,9 +3,9 @@
  * every frame, every VPL shading every pixel).
  *
  * ir's visibility is exact: shadow rays to the VPLs, eight per Embree packet (a shadow map of
- * unlimited resolution). ir-low builds a 128^2 depth cube map per VPL every frame by casting rays
- * (cubemap.h: the CPU equivalent of rasterising the paper's shadow maps) and looks visibility up in
- * it; maps are built and used in batches so memory stays bounded whatever the VPL count.
+ * unlimited resolution). ir-low builds a 128^2 depth cube map per VPL every frame (cubemap.h:
+ * rasterised like the paper's shadow maps, or by casting rays in large scenes) and looks
+ * visibility up in it; maps are built and used in batches so memory stays bounded whatever the VPL count.
  * Both add the family's direct light (direct.h) and use the same clamped geometry term (gather.h).
  */
 #include <math.h>
@@ -59,6 +59,7 @@ static fv_status ir_create_common(const fv_scene *scene, fv_params *params, bool
     st->scene = scene;
     st->low = low;
     double clamp = 0.03;
+    int cube_build = FV_CUBE_BUILD_AUTO;
     fv_status s;
     if ((s = fv_params_int(params, "vpls", 2000, 1, 1000000, &st->vpls, err)) != FV_OK ||
         (s = fv_params_int(params, "bounces", 7, 1, 64, &st->bounces, err)) != FV_OK ||
@@ -69,12 +70,14 @@ static fv_status ir_create_common(const fv_scene *scene, fv_params *params, bool
     st->clamp = (float)clamp;
     if (low) {
         if ((s = fv_params_int(params, "cube_size", 128, FV_CUBE_MIN_SIZE, FV_CUBE_MAX_SIZE, &st->cube_size, err)) != FV_OK ||
-            (s = fv_params_choice(params, "cube_filter", 0, k_filters, &st->cube_filter, err)) != FV_OK)
+            (s = fv_params_choice(params, "cube_filter", 0, k_filters, &st->cube_filter, err)) != FV_OK ||
+            (s = fv_params_choice(params, "cube_build", FV_CUBE_BUILD_AUTO, fv_cube_build_names, &cube_build, err)) != FV_OK)
             goto fail;
         size_t per_map = 6u * (size_t)st->cube_size * (size_t)st->cube_size * sizeof(float);
         size_t batch = IR_LOW_BATCH_BYTES / per_map;
         st->batch = (int)(batch < 1 ? 1 : batch > (size_t)st->vpls ? (size_t)st->vpls : batch);
         if ((s = fv_cubemaps_create(st->batch, st->cube_size, &st->maps, err)) != FV_OK) goto fail;
+        fv_cubemaps_set_build(st->maps, (fv_cube_build)cube_build);
         st->pos = malloc((size_t)st->batch * sizeof *st->pos);
         st->nrm = malloc((size_t)st->batch * sizeof *st->nrm);
         st->slots = malloc((size_t)st->batch * sizeof *st->slots);
@@ -200,7 +203,8 @@ const fv_technique_class fv_technique_ir_low = {
     .name = "ir-low",
     .summary = "instant radiosity with a 128^2 depth cube map per VPL rebuilt every frame (FIR's IR' baseline)",
     .params_help = IR_COMMON_HELP "cube_size=int (128): texels per cube-map face edge\n"
-                                  "cube_filter=nearest|pcf (nearest): cube-map lookup (pcf: 2x2 percentage-closer)\n",
+                                  "cube_filter=nearest|pcf (nearest): cube-map lookup (pcf: 2x2 percentage-closer)\n"
+                                  FV_CUBE_BUILD_HELP,
     .create = ir_low_create,
     .render = ir_render,
     .destroy = ir_destroy,
