@@ -1,11 +1,13 @@
 /* Tests of the VPL depth cube maps (src/technique/vpl/cubemap.c; Foveated Instant Radiosity
- * Sec. 3.4's VPL shadow maps, built with rays):
+ * Sec. 3.4's VPL shadow maps, rasterised or built with rays):
  *  - the face mapping: direction -> (face, u, v) -> direction round-trips, the six axes land on
  *    the face centres, every texel centre maps back to its own texel;
  *  - refusals: cube_size 7, 0 and 2049 and vpls 0 name their key; cube_size 8 works;
  *  - against Embree's own shadow rays (fv_scene_visible): in `cornell`, VPLs on the walls and
  *    blocks, thousands of camera-visible points in each VPL's hemisphere, agreement > 97% (nearest
- *    and 2x2 filtered, printed with the build speed); in an open scene with one floating occluder,
+ *    and 2x2 filtered, printed with the build speed), for both builds;
+ *  - rasterised against traced: texel by texel the same depths in cornell-fir with its cube moved,
+ *    with and without a normal; in an open scene with one floating occluder,
  *    100% agreement with the analytic shadow for points away from its silhouette;
  *  - a point straight behind the occluder is hidden, and seen once the occluder is gone;
  *  - determinism: the same map built twice, or many maps on 1 or 2 threads, is bit-identical.
