@@ -18,7 +18,8 @@ static void help(void)
     printf("usage: fovea render [SCENE] [options]\n"
            "  SCENE                 built-in name (fovea scenes) or a .json/.obj/.gltf/.glb/.ply file [cornell]\n"
            "  --method NAME         rendering method (fovea methods) [pt]\n"
-           "  --spp N               samples per pixel (sets the method's spp parameter)\n"
+           "  --spp N               samples per pixel: sets the method's own parameter for it (an error names\n"
+           "                        what to use instead for a method without one)\n"
            "  --size WxH            image size [512x512]\n"
            "  --frames N            number of frames; >1 writes numbered files OUT_0000.ext ... [1]\n"
            "  --fps F               frames per second of scene time [30]\n"
@@ -222,10 +223,9 @@ int fv_cmd_render(int argc, char **argv)
         goto done;
     }
     if ((rc = fv_cli_check_method(cmd, o.method)) != 0) goto done;
-    if (o.spp > 0) {
-        char v[32];
-        snprintf(v, sizeof v, "%d", o.spp);
-        fv_params_set(params, "spp", v, &err);
+    if (o.spp > 0 && (s = fv_technique_set_spp(o.method, params, o.spp, &err)) != FV_OK) {
+        rc = fv_cli_fail(cmd, s, err.msg);
+        goto done;
     }
 
     bool quiet = o.quiet;

@@ -131,7 +131,7 @@ static fv_status create_fipr(const fv_scene *s, fv_params *p, const fv_log *l, v
 #define SDF_CLASS(id, nm, sum, help, fn)                                                                              \
     const fv_technique_class id = {.name = nm, .summary = sum, .params_help = COMMON_HELP help, .create = fn, .render = render, \
                                    .destroy = destroy, .sdf_only = true, .test_params = "spp=1", .furnace_radiance = 1.0,      \
-                                   .furnace_tolerance = 0.01}
+                                   .furnace_tolerance = 0.01, .spp_param = "spp"}
 
 SDF_CLASS(fv_technique_sdf_gt, "sdf-gt", "sphere tracing of every target sample from the camera (ground truth of ipr/fipr)",
           "show=image|steps (image): the image, or steps per ray from blue (1) to red (256)\n", create_gt);
