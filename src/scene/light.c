@@ -133,6 +133,17 @@ bool fv_light_sample_li(const fv_scene *s, fv_vec3 p, float u0, float u1, float 
     return true;
 }
 
+bool fv_light_sample_li_area(const fv_scene *s, fv_vec3 p, float u0, float u1, float u2, fv_light_sample *out)
+{
+    /* the delta lights come first in the table: map u0 onto the rest of the cdf */
+    float lo = s->nlights_delta > 0 ? s->light_cdf[s->nlights_delta] : 0.0f;
+    if (s->nlights == s->nlights_delta || !(lo < 1.0f)) return false;
+    float u = fv_minf(lo + u0 * (1.0f - lo), 0.99999994f);
+    if (!fv_light_sample_li(s, p, u, u1, u2, out) || out->delta) return false;
+    out->pdf /= 1.0f - lo;
+    return true;
+}
+
 float fv_light_pdf_li(const fv_scene *s, int obj, int prim, fv_vec3 p, fv_vec3 hit_p, fv_vec3 hit_ng, fv_vec3 w)
 {
     if (!s->tri_light || !s->tri_light[obj]) return 0.0f;

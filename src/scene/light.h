@@ -31,6 +31,11 @@ typedef struct fv_light_sample {
  * (no light, or the point is behind a one-sided emitter). Visibility is NOT tested. */
 bool fv_light_sample_li(const fv_scene *s, fv_vec3 p, float u0, float u1, float u2, fv_light_sample *out);
 
+/* The same restricted to the lights that are not delta lights (area lights, the environment),
+ * picked by power among themselves; pdf is the density of that restricted choice. For a technique
+ * that shades delta lights one by one and samples only the rest. */
+bool fv_light_sample_li_area(const fv_scene *s, fv_vec3 p, float u0, float u1, float u2, fv_light_sample *out);
+
 /* Radiance emitted by triangle (obj, prim) toward direction w (unit, pointing away from the
  * surface), given its geometric normal ng. */
 fv_vec3 fv_light_emitted(const fv_scene *s, const fv_material *m, fv_vec3 ng, fv_vec3 w);
