@@ -125,6 +125,23 @@ static void test_pdf(void **st)
     float R = 1.001f * sqrtf(2.0f);
     assert_float_equal(pw / n, FV_PI * R * R * want.y, 0.01 * FV_PI * R * R * want.y);
     assert_float_equal(fv_light_total_power(s).y, FV_PI * R * R * want.y, 1e-3 * FV_PI * R * R * want.y);
+    /* The walks that aim themselves (photons towards dynamic objects) start on the sphere of
+     * radius R emitting L(-dir) inwards: with uniform directions (pdf 1 / (4 pi)) their mean power
+     * is the same total, and none leaves outwards. */
+    pw = 0.0;
+    for (int k = 0; k < n; k++) {
+        fv_light_point lp;
+        assert_true(fv_light_pick_point(s, &rng, &lp));
+        assert_false(lp.delta);
+        assert_float_equal(fv_length(lp.p), R, 1e-4f);
+        float cz = 1.0f - 2.0f * fv_rng_next(&rng), r = sqrtf(fmaxf(0.0f, 1.0f - cz * cz)), ph = 2.0f * FV_PI * fv_rng_next(&rng);
+        fv_vec3 d = fv_v3(r * cosf(ph), r * sinf(ph), cz), power;
+        if (fv_light_point_power(s, &lp, d, lp.pmf / (4.0f * FV_PI), &power)) {
+            assert_true(fv_dot(d, lp.p) < 0.0f);
+            pw += power.y;
+        }
+    }
+    assert_float_equal(pw / n, FV_PI * R * R * want.y, 0.02 * FV_PI * R * R * want.y);
     fv_scene_destroy(s);
 }
 
