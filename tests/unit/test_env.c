@@ -24,46 +24,53 @@
 #include "transport/path.h"
 #include "testkit.h"
 
-/* A 2 x 2 diffuse quad at y = 0 (flat shading: both faces are exactly Lambertian about the same
- * normal), facing +y, albedo a, and the environment env; committed. */
-static fv_scene *quad_under(const fv_env_desc *env, float a)
+/* An empty scene with one diffuse material of albedo a (its id in *mat). */
+static fv_scene *diffuse_scene(float a, int *mat)
 {
     fv_scene *s;
     fv_error err;
     assert_int_equal(fv_scene_create(&s, &err), FV_OK);
     fv_material m = fv_material_default(FV_MAT_DIFFUSE);
     m.albedo = fv_v3s(a);
-    int mat;
-    assert_int_equal(fv_scene_add_material(s, &m, &mat, &err), FV_OK);
-    const fv_vec3 p[4] = {{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}};
-    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    fv_mesh_desc d = {"quad", p, 4, NULL, idx, 2, NULL, mat};
-    assert_int_equal(fv_scene_add_mesh(s, &d, NULL, NULL, &err), FV_OK);
+    assert_int_equal(fv_scene_add_material(s, &m, mat, &err), FV_OK);
+    return s;
+}
+
+/* Adds mesh d (flat shading: exactly Lambertian about each facet's normal) and the environment,
+ * and commits. */
+static fv_scene *finish_under(fv_scene *s, fv_mesh_desc *d, const fv_env_desc *env)
+{
+    fv_error err;
+    d->normals = NULL;
+    assert_int_equal(fv_scene_add_mesh(s, d, NULL, NULL, &err), FV_OK);
     assert_int_equal(fv_scene_set_env(s, env, &err), FV_OK);
     assert_int_equal(fv_scene_commit(s, NULL, &err), FV_OK);
     return s;
 }
 
+/* A 2 x 2 diffuse quad at y = 0 facing +y, albedo a, under env; committed. */
+static fv_scene *quad_under(const fv_env_desc *env, float a)
+{
+    int mat;
+    fv_scene *s = diffuse_scene(a, &mat);
+    const fv_vec3 p[4] = {{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}};
+    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    fv_mesh_desc d = {"quad", p, 4, NULL, idx, 2, NULL, mat};
+    return finish_under(s, &d, env);
+}
+
 /* A flat-shaded sphere of radius 1 (a convex polyhedron), albedo a, under env; committed. */
 static fv_scene *sphere_under(const fv_env_desc *env, float a)
 {
-    fv_scene *s;
-    fv_error err;
-    assert_int_equal(fv_scene_create(&s, &err), FV_OK);
-    fv_material m = fv_material_default(FV_MAT_DIFFUSE);
-    m.albedo = fv_v3s(a);
     int mat;
-    assert_int_equal(fv_scene_add_material(s, &m, &mat, &err), FV_OK);
+    fv_scene *s = diffuse_scene(a, &mat);
     fv_meshbuf mb;
     fv_meshbuf_init(&mb);
     fv_mesh_sphere(&mb, fv_v3(0, 0, 0), 1.0f, 32, 16, false, mat);
     fv_mesh_desc d;
     fv_meshbuf_desc(&mb, "ball", &d);
-    d.normals = NULL;
-    assert_int_equal(fv_scene_add_mesh(s, &d, NULL, NULL, &err), FV_OK);
+    finish_under(s, &d, env);
     fv_meshbuf_free(&mb);
-    assert_int_equal(fv_scene_set_env(s, env, &err), FV_OK);
-    assert_int_equal(fv_scene_commit(s, NULL, &err), FV_OK);
     return s;
 }
 
@@ -247,12 +254,9 @@ static void test_api(void **st)
 static void test_default_lighting(void **st)
 {
     (void)st;
-    fv_scene *s;
     fv_error err;
-    assert_int_equal(fv_scene_create(&s, &err), FV_OK);
-    fv_material m = fv_material_default(FV_MAT_DIFFUSE);
     int mat;
-    assert_int_equal(fv_scene_add_material(s, &m, &mat, &err), FV_OK);
+    fv_scene *s = diffuse_scene(0.8f, &mat);
     fv_meshbuf mb;
     fv_meshbuf_init(&mb);
     fv_mesh_box(&mb, fv_v3(0, 0, 0), fv_v3s(0.5f), 0.0f, mat);
