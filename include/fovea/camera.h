@@ -75,6 +75,31 @@ FV_API void fv_camera_keys_free(fv_camera_key *keys);
 /* Camera at time t along path (count >= 1); width/height are taken from base. */
 FV_API void fv_camera_path_eval(const fv_camera_path *path, double t, const fv_camera *base, fv_camera *out);
 
+/* ---- framing a model (src/scene/framing.c, docs/scene-format.md "Default view and light") ----
+ * A model's front is +z when its up axis is +y or x (glTF's convention) and -y when its up axis is
+ * z (the convention of z-up tools). The views look at the centre of the bounding box: front, back,
+ * left and right from the horizon, top from above (the front at the bottom of the image), and
+ * three-quarter, the default, from the front 35 degrees to the right and 25 degrees above. */
+typedef enum fv_frame_view {
+    FV_FRAME_THREE_QUARTER = 0,
+    FV_FRAME_FRONT,
+    FV_FRAME_BACK,
+    FV_FRAME_LEFT,
+    FV_FRAME_RIGHT,
+    FV_FRAME_TOP
+} fv_frame_view;
+
+/* "three-quarter" | "front" | "back" | "left" | "right" | "top" <-> view; false when unknown. */
+FV_API bool fv_frame_view_from_name(const char *name, fv_frame_view *out);
+FV_API const char *fv_frame_view_name(fv_frame_view view);
+/* The unit axis (+x, +y or +z) taken as the up of a model with bounds [lo, hi] whose file does
+ * not say: the axis of the smallest extent when the model is flat (that extent under half of the
+ * middle one: a relief, a plan, a terrain lies on it), else +y. */
+FV_API fv_vec3 fv_up_axis_guess(fv_vec3 lo, fv_vec3 hi);
+/* A camera (fov 45 degrees, width x height) that sees box [lo, hi] from `view`, with `up` the
+ * model's up axis (unit), as close as keeps all eight corners inside the frame with a 5% margin. */
+FV_API void fv_camera_frame(fv_vec3 lo, fv_vec3 hi, fv_vec3 up, fv_frame_view view, int width, int height, fv_camera *out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -68,6 +68,19 @@ typedef struct fv_light_desc {
     float outer_deg;     /* SPOT: zero outside this half-angle, smooth in between */
 } fv_light_desc;
 
+/* The environment light: radiance arriving from infinitely far away, a function of direction only
+ * (what escapes the scene sees). A sky gradient about `up`: for a unit direction w towards the
+ * sky with t = dot(w, up), the radiance is horizon + (zenith - horizon) t above the horizon (t >= 0)
+ * and horizon + (ground - horizon) (-t) below; the three equal make a uniform environment. Every
+ * technique that samples lights sees it (docs/scene-format.md, "environment", says which do). */
+typedef struct fv_env_desc {
+    fv_vec3 zenith, horizon, ground; /* radiance, W/m^2/sr, each channel >= 0 */
+    fv_vec3 up;                      /* the zenith's direction (normalised when set) */
+} fv_env_desc;
+
+/* A uniform environment of the given radiance, up +y. */
+FV_API fv_env_desc fv_env_uniform(fv_vec3 radiance);
+
 typedef struct fv_mesh_desc {
     const char *name;
     const fv_vec3 *positions;
@@ -130,6 +143,21 @@ FV_API fv_status fv_scene_add_light(fv_scene *scene, const fv_light_desc *light,
 FV_API fv_status fv_scene_animate_light(fv_scene *scene, int light_index, const fv_anim_key *keys, int count,
                                         fv_error *err);
 
+/* Sets the scene's environment light (one per scene: a second call replaces it). Refused
+ * (FV_ERR_INVALID): a non-finite or negative radiance, a zero or non-finite up. All-zero radiance
+ * removes it. */
+FV_API fv_status fv_scene_set_env(fv_scene *scene, const fv_env_desc *env, fv_error *err);
+/* Copies the environment into *out; false (and *out untouched) when the scene has none. */
+FV_API bool fv_scene_env(const fv_scene *scene, fv_env_desc *out);
+
+/* When the scene has no light at all (no point or spot light, no emissive triangle, no
+ * environment), adds the default lighting a mesh file without lights gets: a sky-gradient
+ * environment and a point key light above and in front of the view's default camera (view may be
+ * NULL: the scene's default framing), both scaled to the scene's bounding sphere; log receives
+ * one line saying what was added. Call before fv_scene_commit; a no-op when the scene has a
+ * light. *added (may be NULL) says whether anything was added. */
+FV_API fv_status fv_scene_add_default_lighting(fv_scene *scene, const fv_view *view, const fv_log *log, bool *added, fv_error *err);
+
 /* Validates the scene and builds the acceleration structures. A scene without any object (mesh
  * or SDF) is refused; a scene without any light gets a default point light (a warning says so). */
 FV_API fv_status fv_scene_commit(fv_scene *scene, const fv_log *log, fv_error *err);
@@ -143,7 +171,7 @@ FV_API void fv_scene_bounds(const fv_scene *scene, fv_vec3 *lo, fv_vec3 *hi);
 FV_API int fv_scene_triangle_count(const fv_scene *scene);
 FV_API int fv_scene_object_count(const fv_scene *scene);
 FV_API int fv_scene_dynamic_object_count(const fv_scene *scene);
-FV_API int fv_scene_light_count(const fv_scene *scene);       /* delta lights + emissive triangles */
+FV_API int fv_scene_light_count(const fv_scene *scene);       /* delta lights + emissive triangles + environment */
 FV_API int fv_scene_material_count(const fv_scene *scene);
 FV_API const fv_material *fv_scene_material(const fv_scene *scene, int id);
 

@@ -35,6 +35,13 @@ FV_API const char *fv_technique_summary(int i);
 FV_API const char *fv_technique_params_help(int i);
 /* Index of a method by name, -1 when unknown. */
 FV_API int fv_technique_index(const char *name);
+/* The key of method i's samples-per-pixel parameter ("spp" for pt), NULL when the method has no
+ * such notion (or i is out of range). */
+FV_API const char *fv_technique_spp_param(int i);
+/* Sets method `name`'s samples-per-pixel parameter to spp in params (what the CLI's --spp means
+ * for every method). FV_ERR_INVALID, with a one-line message naming the parameter to use instead,
+ * when the method has none; the message of fv_technique_create when the name is unknown. */
+FV_API fv_status fv_technique_set_spp(const char *name, fv_params *params, int spp, fv_error *err);
 
 typedef struct fv_technique fv_technique;
 

@@ -35,9 +35,17 @@ FV_API bool fv_view_has_camera(const fv_view *v);
  * keeps its earlier path. */
 FV_API fv_status fv_view_set_camera_path(fv_view *v, const fv_camera_key *keys, int count, fv_error *err);
 FV_API bool fv_view_has_camera_path(const fv_view *v);
+/* The model's up axis (unit; a zero or non-finite vector is ignored): the loaders set it (glTF +y,
+ * other mesh files fv_up_axis_guess) and the default camera keeps it up. +y when never set. */
+FV_API void fv_view_set_up_axis(fv_view *v, fv_vec3 up);
+FV_API fv_vec3 fv_view_up_axis(const fv_view *v);
+/* Frames the scene from `frame` (fv_camera_frame): drops the view's camera, so fv_view_camera
+ * gives that framing (a camera path still moves it). Without this call the framing is
+ * three-quarter. */
+FV_API void fv_view_set_frame(fv_view *v, fv_frame_view frame);
 /* The camera at time t with the given size: the view's camera (when it has none and scene is a
- * committed scene: one framing the scene's bounds from +z, 45 degrees; else all zero but the
- * size), moved along the camera path when there is one. v and scene may each be NULL; v == NULL
+ * committed scene: fv_camera_frame of the scene's bounds with the view's up axis and frame, by
+ * default three-quarter; else all zero but the size), moved along the camera path when there is one. v and scene may each be NULL; v == NULL
  * gives the scene's framing camera. Reads only: safe from several threads at once. */
 FV_API void fv_view_camera(const fv_view *v, const fv_scene *scene, double t, int width, int height, fv_camera *out);
 

@@ -464,6 +464,8 @@ static fv_status open_scene(const fv_scenario *sc, const char *path, const fv_lo
         else if ((st = fv_scene_animate_object(scene, obj, a->keys, a->nkeys, err)) != FV_OK)
             fv_error_prefix(err, "%s: animate[%d].object: ", path, i);
     }
+    /* A file without lights is lit as fovea render lights it (the default sky and key light). */
+    if (st == FV_OK) st = fv_scene_add_default_lighting(scene, view ? *view : NULL, log, NULL, err);
     /* A commit error names the scene, as fv_scene_load's does. */
     if (st == FV_OK && (st = fv_scene_commit(scene, log, err)) != FV_OK && strncmp(err->msg, sc->scene, strlen(sc->scene)) != 0)
         fv_error_prefix(err, "%s: ", sc->scene);

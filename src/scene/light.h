@@ -2,7 +2,11 @@
  * the density of hitting an emitter by chance (for MIS), and emission of photons/VPLs.
  *
  * A light is picked with probability proportional to its emitted power (table built at commit).
- * Area lights are sampled uniformly by area on the chosen triangle. Point and spot lights may move
+ * Area lights are sampled uniformly by area on the chosen triangle. The environment (kind 2) is
+ * sampled by direction: a hemisphere about its up axis in proportion to the hemisphere's mean
+ * luminance, then uniformly within it, so a uniform environment is sampled uniformly over the
+ * sphere (density 1/(4 pi)); its photons start on a disc of the scene's bounding-sphere radius
+ * facing their direction (power L pi R^2 / pdf). Point and spot lights may move
  * (fv_scene_animate_light): every query answers at the scene's current time; the pick table stays
  * valid because a delta light's power does not depend on where it stands.
  */
@@ -17,15 +21,20 @@ typedef struct fv_light fv_light;
 
 typedef struct fv_light_sample {
     fv_vec3 wi;      /* unit direction from the shading point to the light */
-    float dist;      /* distance to the sampled point */
-    fv_vec3 li;      /* incident radiance (area) or intensity / dist^2 (delta) */
-    float pdf;       /* solid-angle density including the light pick (area); pick probability (delta) */
+    float dist;      /* distance to the sampled point (environment: a point beyond the scene's bounds) */
+    fv_vec3 li;      /* incident radiance (area, environment) or intensity / dist^2 (delta) */
+    float pdf;       /* solid-angle density including the light pick (area, environment); pick probability (delta) */
     bool delta;
 } fv_light_sample;
 
 /* Samples incident light at p with three uniform numbers; false when nothing was sampled
  * (no light, or the point is behind a one-sided emitter). Visibility is NOT tested. */
 bool fv_light_sample_li(const fv_scene *s, fv_vec3 p, float u0, float u1, float u2, fv_light_sample *out);
+
+/* The same restricted to the lights that are not delta lights (area lights, the environment),
+ * picked by power among themselves; pdf is the density of that restricted choice. For a technique
+ * that shades delta lights one by one and samples only the rest. */
+bool fv_light_sample_li_area(const fv_scene *s, fv_vec3 p, float u0, float u1, float u2, fv_light_sample *out);
 
 /* Radiance emitted by triangle (obj, prim) toward direction w (unit, pointing away from the
  * surface), given its geometric normal ng. */
@@ -35,6 +44,13 @@ fv_vec3 fv_light_emitted(const fv_scene *s, const fv_material *m, fv_vec3 ng, fv
  * triangle (obj, prim) seen from p along direction w (unit). */
 float fv_light_pdf_li(const fv_scene *s, int obj, int prim, fv_vec3 p, fv_vec3 hit_p, fv_vec3 hit_ng, fv_vec3 w);
 
+/* The environment's radiance arriving along -w, i.e. seen looking towards unit direction w (what a
+ * ray escaping the scene along w carries); zero when the scene has none. */
+fv_vec3 fv_light_env_radiance(const fv_scene *s, fv_vec3 w);
+/* Solid-angle density with which fv_light_sample_li picks direction w (unit) on the environment,
+ * including the light pick; 0 when the scene has none. */
+float fv_light_env_pdf(const fv_scene *s, fv_vec3 w);
+
 /* Photon emission: origin, unit direction and the power the photon carries (already divided
  * by the pick and sampling densities; divide by the number of photons emitted). u[5]. */
 bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *origin, fv_vec3 *dir, fv_vec3 *power,
@@ -43,7 +59,9 @@ bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *orig
 /* A point on a light picked by power (the walk's start when it must aim somewhere itself, as
  * photons towards the dynamic objects do): the light index, its pick probability, the point, and
  * for an area light its unit normal (zero for a delta light). Draws one number, two more for an
- * area light. False when the scene has no light or the pick has zero probability. */
+ * area light. The environment is picked as what it equals inside the bounding sphere: the sphere
+ * itself (radius a little over R) emitting inwards, radiance L(-dir) towards dir; its point is
+ * uniform on it with the inward normal. False when the scene has no light or the pick has zero probability. */
 typedef struct fv_light_point {
     int light;
     float pmf;

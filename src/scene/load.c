@@ -7,6 +7,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 #include "scene/load_impl.h"
+#include "scene/scene_impl.h"
 
 static bool is_builtin(const char *name)
 {
@@ -68,6 +69,13 @@ fv_status fv_scene_open(const char *name, const fv_log *log, fv_scene **out, fv_
         } else {
             fv_import_opts o = {-1, NULL, true, true, ""};
             st = fv_load_assimp(name, s, v, &o, log, NULL, NULL, err);
+            /* The model's up axis, for the default camera and light: glTF says +y; the others
+             * do not say, so it is guessed from the shape (fv_up_axis_guess). */
+            if (st == FV_OK) {
+                fv_vec3 lo, hi;
+                fv_scene_world_bounds(s, &lo, &hi);
+                fv_view_set_up_axis(v, has_ext(name, ".gltf") || has_ext(name, ".glb") ? fv_v3(0, 1, 0) : fv_up_axis_guess(lo, hi));
+            }
         }
     }
     if (st != FV_OK) {
@@ -85,9 +93,13 @@ fv_status fv_scene_load(const char *name, const fv_log *log, fv_scene **out, fv_
 {
     fv_scene *s;
     fv_view *v = NULL;
-    fv_status st = fv_scene_open(name, log, &s, view ? &v : NULL, err);
+    fv_view *own = NULL; /* the default light is placed by the view's camera, wanted or not */
+    fv_status st = fv_scene_open(name, log, &s, &own, err);
     if (st != FV_OK) return st;
-    if ((st = fv_scene_commit(s, log, err)) != FV_OK) {
+    if (!is_builtin(name)) st = fv_scene_add_default_lighting(s, own, log, NULL, err);
+    if (view) v = own;
+    else fv_view_destroy(own);
+    if (st != FV_OK || (st = fv_scene_commit(s, log, err)) != FV_OK) {
         if (err && strncmp(err->msg, name, strlen(name)) != 0) fv_error_prefix(err, "%s: ", name);
         fv_view_destroy(v);
         fv_scene_destroy(s);

@@ -590,6 +590,32 @@ static fv_status parse_light(const cJSON *o, const json_ctx *c, int index, fv_er
     return an ? parse_animation(an, c, where, 0, 0, fv_scene_light_count(c->scene) - 1, err) : FV_OK;
 }
 
+/* "environment": [r, g, b] (uniform) or {"horizon": [...], "zenith", "ground", "up"}, a colour
+ * left out taking the horizon's. */
+static fv_status parse_environment(const cJSON *root, const json_ctx *c, fv_error *err)
+{
+    static const char *const keys[] = {"zenith", "horizon", "ground", "up", NULL};
+    const cJSON *o = cJSON_GetObjectItemCaseSensitive(root, "environment");
+    fv_env_desc e = fv_env_uniform(fv_v3s(0.0f));
+    fv_status st;
+    if (!cJSON_IsArray(o) && !cJSON_IsObject(o))
+        return fv_error_set(err, FV_ERR_INVALID, "%s: environment: expected [r, g, b] or an object with horizon, zenith, ground, up", c->file);
+    if (cJSON_IsArray(o)) {
+        if ((st = vec3(root, "environment", 0, BIG, c, "", &e.horizon, err)) != FV_OK) return st;
+        e.zenith = e.ground = e.horizon;
+    } else {
+        if ((st = fv_json_check_keys(o, keys, c->file, "environment", err)) || (st = fv_json_require(o, "horizon", c->file, "environment", err)) ||
+            (st = vec3(o, "horizon", 0, BIG, c, "environment", &e.horizon, err)))
+            return st;
+        e.zenith = e.ground = e.horizon;
+        if ((st = vec3(o, "zenith", 0, BIG, c, "environment", &e.zenith, err)) || (st = vec3(o, "ground", 0, BIG, c, "environment", &e.ground, err)) ||
+            (st = vec3(o, "up", -BIG, BIG, c, "environment", &e.up, err)))
+            return st;
+    }
+    if ((st = fv_scene_set_env(c->scene, &e, err)) != FV_OK) fv_error_prefix(err, "%s: environment: ", c->file);
+    return st;
+}
+
 static fv_status parse_camera_key(const cJSON *o, const json_ctx *c, const char *where, bool timed, fv_camera_key *k, fv_error *err)
 {
     static const char *const keys[] = {"time", "pos", "look", "up", "fov", NULL};
@@ -613,7 +639,7 @@ static fv_status parse_camera_key(const cJSON *o, const json_ctx *c, const char 
 
 fv_status fv_load_json(const char *path, fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err)
 {
-    static const char *const keys[] = {"materials", "objects", "lights", "camera", "camera_path", "display", "gaze", "description", NULL};
+    static const char *const keys[] = {"materials", "objects", "lights", "environment", "camera", "camera_path", "display", "gaze", "description", NULL};
     cJSON *root = NULL;
     fv_status st = fv_json_parse_file(path, &root, err);
     if (st != FV_OK) return st;
@@ -648,6 +674,7 @@ fv_status fv_load_json(const char *path, fv_scene *scene, fv_view *view, const f
     i = 0;
     for (const cJSON *l = it ? it->child : NULL; l && st == FV_OK; l = l->next, i++) st = parse_light(l, &c, i, err);
     if (st != FV_OK) goto done;
+    if (cJSON_GetObjectItemCaseSensitive(root, "environment") && (st = parse_environment(root, &c, err)) != FV_OK) goto done;
     if ((it = cJSON_GetObjectItemCaseSensitive(root, "camera"))) {
         fv_camera_key k;
         if ((st = parse_camera_key(it, &c, "camera", false, &k, err)) != FV_OK) goto done;

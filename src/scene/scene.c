@@ -266,6 +266,52 @@ static void bounds_add_box(fv_vec3 *lo, fv_vec3 *hi, const fv_xform *x, fv_vec3 
     }
 }
 
+fv_env_desc fv_env_uniform(fv_vec3 radiance)
+{
+    fv_env_desc e = {radiance, radiance, radiance, fv_v3(0, 1, 0)};
+    return e;
+}
+
+fv_status fv_scene_set_env(fv_scene *s, const fv_env_desc *e, fv_error *err)
+{
+    fv_status st = check_open(s, err);
+    if (st != FV_OK) return st;
+    const fv_vec3 c[3] = {e->zenith, e->horizon, e->ground};
+    for (int i = 0; i < 3; i++)
+        if (!fv_is_finite3(c[i]) || fv_min3(c[i]) < 0.0f)
+            return fv_error_set(err, FV_ERR_INVALID, "environment: radiance (%g, %g, %g) must be finite and >= 0", c[i].x, c[i].y, c[i].z);
+    if (!fv_is_finite3(e->up) || !(fv_length(e->up) > 0.0f) || !isfinite(fv_length(e->up)))
+        return fv_error_set(err, FV_ERR_INVALID, "environment: up must be finite and non-zero");
+    s->env = *e;
+    s->env.up = fv_normalize(e->up);
+    s->has_env = fv_max3(fv_vmax(fv_vmax(e->zenith, e->horizon), e->ground)) > 0.0f;
+    return FV_OK;
+}
+
+bool fv_scene_env(const fv_scene *s, fv_env_desc *out)
+{
+    if (s->has_env) *out = s->env;
+    return s->has_env;
+}
+
+void fv_scene_world_bounds(const fv_scene *s, fv_vec3 *lo, fv_vec3 *hi)
+{
+    /* Static objects as they are, dynamic ones at every key. */
+    *lo = fv_v3s(FLT_MAX);
+    *hi = fv_v3s(-FLT_MAX);
+    for (int i = 0; i < s->nobj; i++) {
+        const fv_object *o = &s->objs[i];
+        if (!o->dynamic) {
+            bounds_add_box(lo, hi, &o->xf, o->lo, o->hi);
+            continue;
+        }
+        for (int k = 0; k < o->anim.nkeys; k++) {
+            fv_xform x = anim_eval(o, o->anim.keys[k].time);
+            bounds_add_box(lo, hi, &x, o->lo, o->hi);
+        }
+    }
+}
+
 /* ---- commit ---- */
 
 static fv_status embree_status(fv_scene *s, const char *what, fv_error *err)
@@ -303,7 +349,7 @@ static float tri_area(const fv_object *o, int t)
 
 static fv_status build_lights(fv_scene *s, fv_error *err)
 {
-    int n = s->ndelta;
+    int n = s->ndelta + (s->has_env ? 1 : 0);
     for (int i = 0; i < s->nobj; i++)
         for (int t = 0; t < s->objs[i].nt; t++)
             if (fv_max3(s->mats[s->objs[i].mat[t]].emission) > 0.0f) n++;
@@ -359,6 +405,22 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
             if (l->power > 0.0f) s->tri_light[i][t] = k++;
         }
     }
+    s->env_light = -1;
+    if (s->has_env) {
+        /* Its photons leave a disc of the bounding sphere's radius (light.c), so its power is
+         * pi R^2 times the integral of the radiance over the sphere of directions: 2 pi times the
+         * two hemispheres' mean radiances, (horizon + zenith) / 2 and (horizon + ground) / 2. */
+        s->env_c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
+        s->env_r = 0.5f * fv_length(fv_sub(s->hi, s->lo));
+        float up = 0.5f * fv_luminance(fv_add(s->env.horizon, s->env.zenith));
+        float down = 0.5f * fv_luminance(fv_add(s->env.horizon, s->env.ground));
+        s->env_p_up = up + down > 0.0f ? up / (up + down) : 0.5f;
+        fv_light *l = &s->lights[k];
+        l->kind = 2;
+        l->power = FV_PI * s->env_r * s->env_r * 2.0f * FV_PI * (up + down);
+        if (!isfinite(l->power)) return fv_error_set(err, FV_ERR_INVALID, "environment: radiance too large (its power overflows a float)");
+        if (l->power > 0.0f) s->env_light = k++;
+    }
     s->nlights = k;
     double total = 0.0;
     for (int i = 0; i < k; i++) total += s->lights[i].power;
@@ -379,20 +441,7 @@ fv_status fv_scene_commit(fv_scene *s, const fv_log *log, fv_error *err)
     for (int i = 0; i < s->nobj; i++)
         if (s->objs[i].dynamic) s->ndynamic++;
 
-    /* World bounds: static objects as they are, dynamic ones at every key. */
-    s->lo = fv_v3s(FLT_MAX);
-    s->hi = fv_v3s(-FLT_MAX);
-    for (int i = 0; i < s->nobj; i++) {
-        fv_object *o = &s->objs[i];
-        if (!o->dynamic) {
-            bounds_add_box(&s->lo, &s->hi, &o->xf, o->lo, o->hi);
-            continue;
-        }
-        for (int k = 0; k < o->anim.nkeys; k++) {
-            fv_xform x = anim_eval(o, o->anim.keys[k].time);
-            bounds_add_box(&s->lo, &s->hi, &x, o->lo, o->hi);
-        }
-    }
+    fv_scene_world_bounds(s, &s->lo, &s->hi);
     fv_vec3 ext = fv_sub(s->hi, s->lo);
     float diag = fv_length(ext);
     if (!(diag > 0.0f) || !isfinite(diag)) return fv_error_set(err, FV_ERR_INVALID, "scene has zero or non-finite extent");

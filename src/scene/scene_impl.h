@@ -42,9 +42,9 @@ typedef struct fv_delta {
     fv_anim anim;
 } fv_delta;
 
-/* One sampleable light: a delta light or an emissive triangle. */
+/* One sampleable light: a delta light, an emissive triangle or the environment. */
 typedef struct fv_light {
-    int kind;            /* 0: delta light (desc), 1: emissive triangle */
+    int kind;            /* 0: delta light (desc), 1: emissive triangle, 2: the environment (fv_scene.env) */
     fv_light_desc desc;  /* delta light at the scene's current time: what the samplers read */
     int delta;           /* delta light: its index in fv_scene.delta */
     int obj, prim;       /* emissive triangle */
@@ -62,10 +62,17 @@ struct fv_scene {
     int nobj, capobj;
     fv_delta *delta;           /* delta lights in the order they were added */
     int ndelta, capdelta;
+    bool has_env;              /* the environment light (fv_scene_set_env) */
+    fv_env_desc env;
 
     /* Built at commit. */
     bool committed;
-    fv_light *lights;          /* the delta lights that emit first (in the order added), then triangles */
+    fv_light *lights;          /* the delta lights that emit first (in the order added), then triangles, then
+                                  the environment */
+    int env_light;             /* index of the environment in lights[], -1: none */
+    float env_p_up;            /* probability of sampling the environment's upper hemisphere */
+    fv_vec3 env_c;             /* the bounding sphere the environment's photons are aimed at */
+    float env_r;
     int nlights;
     int nlights_delta;         /* how many of lights[] are delta lights */
     bool lights_move;          /* some delta light has keys */
@@ -80,6 +87,9 @@ struct fv_scene {
     double time;
     char embree_msg[256];      /* last message from Embree's error callback */
 };
+
+/* World bounds of the objects, dynamic ones over all their keys; valid before commit too. */
+void fv_scene_world_bounds(const fv_scene *s, fv_vec3 *lo, fv_vec3 *hi);
 
 /* The Embree user geometry of SDF object o (scene_sdf.c), ready to attach. */
 RTCGeometry fv_scene_sdf_geometry(fv_scene *s, fv_object *o);

@@ -7,10 +7,14 @@
 #include "core/alloc.h"
 #include "fovea/view.h"
 #include "scene/scene_impl.h"
+#include "scene/view_impl.h"
 
 struct fv_view {
     bool has_camera;
     fv_camera camera;
+    bool has_up;               /* the model's up axis, when the loader knows or guessed it (else +y) */
+    fv_vec3 up;
+    fv_frame_view frame;       /* how the default camera frames the scene */
     fv_camera_key *cam_keys;
     int ncam_keys;
 
@@ -64,18 +68,30 @@ fv_status fv_view_set_camera_path(fv_view *v, const fv_camera_key *keys, int cou
 
 bool fv_view_has_camera_path(const fv_view *v) { return v->ncam_keys > 0; }
 
-/* Frames the bounding sphere from the +z side with a 45 degree view. The arithmetic is the one
- * fv_scene_commit used when the scene carried the camera, so images framed this way are unchanged. */
-static fv_camera framing_camera(const fv_scene *s)
+void fv_view_set_up_axis(fv_view *v, fv_vec3 up)
 {
-    fv_vec3 lo, hi;
-    fv_scene_bounds(s, &lo, &hi);
-    float diag = fv_length(fv_sub(hi, lo));
-    fv_vec3 c = fv_scale(fv_add(lo, hi), 0.5f);
-    float r = 0.5f * diag, fov = 45.0f;
-    float dist = 1.05f * r / sinf(fv_radians(fov) * 0.5f);
-    fv_camera cam = {fv_add(c, fv_v3(0, 0, dist)), c, fv_v3(0, 1, 0), fov, 512, 512};
-    return cam;
+    if (!fv_is_finite3(up) || !(fv_length(up) > 0.0f)) return;
+    v->up = fv_normalize(up);
+    v->has_up = true;
+}
+
+fv_vec3 fv_view_up_axis(const fv_view *v) { return v && v->has_up ? v->up : fv_v3(0, 1, 0); }
+
+void fv_view_set_frame(fv_view *v, fv_frame_view frame)
+{
+    v->frame = frame;
+    v->has_camera = false;
+}
+
+void fv_view_frame_bounds(const fv_view *v, fv_vec3 lo, fv_vec3 hi, int width, int height, fv_camera *out)
+{
+    if (v && v->has_camera) {
+        *out = v->camera;
+        out->width = width;
+        out->height = height;
+        return;
+    }
+    fv_camera_frame(lo, hi, fv_view_up_axis(v), v ? v->frame : FV_FRAME_THREE_QUARTER, width, height, out);
 }
 
 void fv_view_camera(const fv_view *v, const fv_scene *scene, double t, int width, int height, fv_camera *out)
@@ -85,7 +101,7 @@ void fv_view_camera(const fv_view *v, const fv_scene *scene, double t, int width
     fv_camera base;
     memset(&base, 0, sizeof base);
     if (v && v->has_camera) base = v->camera;
-    else if (scene && scene->committed) base = framing_camera(scene);
+    else if (scene && scene->committed) fv_view_frame_bounds(v, scene->lo, scene->hi, width, height, &base);
     base.width = width;
     base.height = height;
     if (v && v->ncam_keys > 0) {

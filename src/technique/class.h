@@ -30,6 +30,9 @@ typedef struct fv_technique_class {
      * should see there, with the relative tolerance its estimator and filters deserve. */
     const char *test_params, *furnace_params;
     double furnace_radiance, furnace_tolerance;
+    /* The key of the method's samples-per-pixel parameter (what `--spp N` sets), NULL when it has
+     * none; then spp_instead names what to use instead, as a clause of one line. */
+    const char *spp_param, *spp_instead;
 } fv_technique_class;
 
 /* The class of a registered method by index or name (NULL when unknown). */

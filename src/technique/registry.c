@@ -58,6 +58,22 @@ const fv_technique_class *fv_technique_class_find(const char *name) { return fv_
 const char *fv_technique_name(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->name : NULL; }
 const char *fv_technique_summary(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->summary : NULL; }
 const char *fv_technique_params_help(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->params_help : NULL; }
+const char *fv_technique_spp_param(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->spp_param : NULL; }
+
+fv_status fv_technique_set_spp(const char *name, fv_params *params, int spp, fv_error *err)
+{
+    const fv_technique_class *cls = fv_technique_class_find(name);
+    if (!cls) {
+        fv_technique *t = NULL;
+        return fv_technique_create(name, NULL, NULL, NULL, &t, err); /* the message listing the methods */
+    }
+    if (!cls->spp_param)
+        return fv_error_set(err, FV_ERR_INVALID, "--spp: method '%s' has no samples-per-pixel parameter (%s)", cls->name,
+                            cls->spp_instead ? cls->spp_instead : "see fovea methods");
+    char v[32];
+    snprintf(v, sizeof v, "%d", spp);
+    return fv_params_set(params, cls->spp_param, v, err);
+}
 
 struct fv_technique {
     const fv_technique_class *cls;

@@ -3,8 +3,9 @@
  * Next-event estimation at every non-delta vertex, combined with BSDF sampling by multiple
  * importance sampling (balance heuristic, Veach 1997 ch. 9) for area lights; delta lights are
  * sampled only by NEE, delta lobes only by the BSDF. Russian roulette from `rr_depth` on, with
- * survival probability max(throughput) capped at 0.95. No environment light: rays leaving the
- * scene carry nothing.
+ * survival probability max(throughput) capped at 0.95. A ray leaving the scene carries the
+ * environment light (when the scene has one), weighted by MIS against its light sampling like an
+ * area light's emission.
  */
 #include "core/params_read.h"
 #include "scene/bsdf.h"
@@ -30,10 +31,13 @@ fv_vec3 fv_path_trace_from(const fv_scene *s, const fv_path_opts *opt, fv_vec3 o
     for (int depth = 1; depth <= opt->max_depth; depth++) {
         fv_hit h;
         nrays++;
-        if (depth == 1 && pre) {
-            if (!pre_ok) break;
-            h = *pre;
-        } else if (!fv_scene_intersect(s, FV_TRACE_ALL, o, d, INFINITY, &h)) {
+        if (depth == 1 && pre) h = *pre;
+        if (depth == 1 && pre ? !pre_ok : !fv_scene_intersect(s, FV_TRACE_ALL, o, d, INFINITY, &h)) {
+            fv_vec3 le = fv_light_env_radiance(s, d);
+            if (fv_max3(le) > 0.0f) {
+                float w = delta_prev ? 1.0f : mis_weight(pdf_prev, fv_light_env_pdf(s, d));
+                L = fv_add(L, fv_mul(beta, fv_scale(le, w)));
+            }
             break;
         }
         const fv_material *m = fv_hit_material(s, &h);

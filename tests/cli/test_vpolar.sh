@@ -16,7 +16,7 @@ expect 2 "sigma" -- $R --method log-polar --param sigma=0.5 --out "$OUT"
 expect 2 "alpha" -- $R --method log-polar --param alpha=-4 --out "$OUT"
 expect 2 "falloff_probability" -- $R --method linear-falloff --param falloff_probability=2 --out "$OUT"
 expect 2 "order" -- $R --method vpolar --param order=spiral --out "$OUT"
-expect 2 "unknown parameter 'spp'" -- $R --method vpolar --spp 4 --out "$OUT"
+expect 2 "spp=0" -- $R --method vpolar --param spp=0 --out "$OUT"
 expect 2 "unknown parameter 'reduction'" -- $R --method cartesian-full --param reduction=0.5 --out "$OUT"
 expect 2 "fovea" -- $R --method vpolar --param reduction=0.999 --out "$OUT"
 [ -e "$OUT" ] && fail "a refused render left $OUT behind"
@@ -26,6 +26,7 @@ for m in vpolar cartesian cartesian-full linear-falloff log-polar; do
   [ -s "$TMP/${m}_0001.png" ] || fail "$m wrote no second frame"
 done
 expect 0 "" -- $R --method vpolar --param show=space --out "$TMP/space.exr" --quiet
+expect 0 "" -- $R --method vpolar --spp 2 --out "$TMP/spp2.png" --quiet
 expect 0 "" -- $R --method vpolar --stereo 60 --out "$TMP/st.png" --quiet
 [ -s "$TMP/st_left.png" ] && [ -s "$TMP/st_right.png" ] || fail "stereo vpolar wrote $(ls "$TMP")"
 

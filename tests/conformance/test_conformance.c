@@ -278,6 +278,22 @@ static void test_params(void **st)
     assert_null(t);
     bag_unchanged(p, &before, c->name);
     fv_params_destroy(p);
+    /* --spp: a method with a samples-per-pixel key accepts 4 through it (1, 4 and 16 are valid
+     * everywhere); one without refuses in one line that names what to use instead. */
+    p = params_of(c, NULL);
+    rc = fv_technique_set_spp(c->name, p, 4, &err);
+    if (c->spp_param) {
+        assert_int_equal(rc, FV_OK);
+        assert_string_equal(fv_technique_spp_param(fv_technique_index(c->name)), c->spp_param);
+        t = NULL;
+        if (fv_technique_create(c->name, suite_of(c)->cornell, p, NULL, &t, &err) != FV_OK) fail_msg("%s spp=4: %s", c->name, err.msg);
+        fv_technique_destroy(t);
+    } else {
+        fv_test_expect_fail(rc, &err, FV_ERR_INVALID, "--param", c->name);
+        assert_non_null(c->spp_instead);
+        assert_null(strchr(err.msg, '\n'));
+    }
+    fv_params_destroy(p);
 }
 
 /* ---- 3. threads ---- */

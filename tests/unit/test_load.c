@@ -78,7 +78,7 @@ static void test_mtl_rules(void **state)
     m = mat_named(s, "flat");
     assert_int_equal(m->type, FV_MAT_DIFFUSE);
     assert_vec3(m->albedo, 0.6f, 0.5f, 0.4f, 1e-6f);
-    assert_int_equal(fv_scene_light_count(s), 1);
+    assert_int_equal(fv_scene_light_count(s), 2); /* the default sky and key light */
     assert_int_equal(w.count, 1);
     assert_non_null(strstr(w.all, "no lights"));
     fv_scene_destroy(s);
@@ -189,7 +189,7 @@ static void test_json_transforms(void **state)
     fv_view_camera(v, s, 0.0, 64, 64, &cam);
     assert_vec3(cam.pos, 4, 6, 12, 0);
     assert_float_equal(cam.fov_y, 30.0f, 0);
-    assert_int_equal(fv_scene_light_count(s), 1); /* the default light */
+    assert_int_equal(fv_scene_light_count(s), 2); /* the default sky and key light */
     assert_int_equal(w.count, 1);
     fv_view_destroy(v);
     fv_scene_destroy(s);

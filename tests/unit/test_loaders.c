@@ -92,8 +92,8 @@ static void test_gltf_and_ply(void **st)
     fv_vec3 lo, hi;
     fv_scene_bounds(s, &lo, &hi);
     assert_float_equal(lo.y, 1.0f, 1e-5f);
-    /* No lights in the file: one default point light, announced. */
-    assert_int_equal(fv_scene_light_count(s), 1);
+    /* No lights in the file: the default sky and key light, announced. */
+    assert_int_equal(fv_scene_light_count(s), 2);
     assert_int_equal(w.count, 1);
     assert_non_null(strstr(w.last, "no lights"));
     fv_scene_destroy(s);

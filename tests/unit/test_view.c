@@ -67,7 +67,6 @@ static void test_framing(void **st)
 
     assert_int_equal(fv_scene_commit(s, NULL, &err), FV_OK);
     fv_view_camera(v, s, 0.0, 64, 48, &c);
-    assert_vec3(c.pos, 4, 6, 18.718911f, 1e-4f);
     assert_vec3(c.look, 4, 6, 5, 1e-6f);
     assert_vec3(c.up, 0, 1, 0, 0);
     assert_float_equal(c.fov_y, 45.0f, 0.0f);
@@ -77,10 +76,54 @@ static void test_framing(void **st)
     fv_camera n;
     fv_view_camera(NULL, s, 3.0, 64, 48, &n);
     assert_memory_equal(&c, &n, sizeof c);
-    /* A usable camera whose centre ray runs straight down -z onto the quad's centre. */
+    /* Three-quarter: from the front (+z) 35 degrees to the right (+x) and 25 above, so the centre
+     * ray runs along minus that direction onto the quad's centre; as close as keeps the four
+     * corners inside the frame with a 5% margin, one of them on it. */
     fv_camera_basis b;
     assert_int_equal(fv_camera_basis_make(&c, &b, &err), FV_OK);
-    assert_vec3(fv_camera_dir(&b, 32, 24), 0, 0, -1, 1e-6f);
+    const float az = 35.0f * FV_PI / 180.0f, el = 25.0f * FV_PI / 180.0f;
+    assert_vec3(fv_camera_dir(&b, 32, 24), -cosf(el) * sinf(az), -sinf(el), -cosf(el) * cosf(az), 1e-5f);
+    float margin = 1e9f;
+    const fv_vec3 corner[4] = {{1, 2, 5}, {7, 2, 5}, {7, 10, 5}, {1, 10, 5}};
+    for (int k = 0; k < 4; k++) {
+        float px, py;
+        assert_true(fv_camera_project(&b, corner[k], &px, &py));
+        float m = fminf(fminf(px - 0.025f * 64, 0.975f * 64 - px), fminf(py - 0.025f * 48, 0.975f * 48 - py));
+        assert_true(m > -1e-3f);
+        margin = fminf(margin, m);
+    }
+    assert_float_equal(margin, 0.0f, 1e-3f);
+    /* The named views, worked by hand for this 6 x 8 quad (zero depth) and a 64 x 48 film:
+     * tan(22.5 deg) = 0.414214 vertically, 4/3 of it across. Front: the height binds,
+     * D = 4 / (0.95 x 0.414214) = 10.16524 from the centre along +z. */
+    fv_view_set_frame(v, FV_FRAME_FRONT);
+    fv_view_camera(v, s, 0.0, 64, 48, &c);
+    assert_vec3(c.pos, 4, 6, 5 + 10.16524f, 1e-3f);
+    assert_vec3(c.up, 0, 1, 0, 0);
+    fv_view_set_frame(v, FV_FRAME_BACK);
+    fv_view_camera(v, s, 0.0, 64, 48, &c);
+    assert_vec3(c.pos, 4, 6, 5 - 10.16524f, 1e-3f);
+    /* Top: looking down -y with the front (+z) at the bottom, so the image's up is -z and its
+     * right +x; the width (6) binds at the near edge y = 10, 4 closer: D = 3 / (0.95 x 0.552285) + 4. */
+    fv_view_set_frame(v, FV_FRAME_TOP);
+    fv_view_camera(v, s, 0.0, 64, 48, &c);
+    assert_vec3(c.pos, 4, 6 + 9.71779f, 5, 1e-3f);
+    assert_vec3(c.up, 0, 0, -1, 0);
+    /* Left and right: the quad seen edge-on from -x and +x. */
+    fv_view_set_frame(v, FV_FRAME_RIGHT);
+    fv_view_camera(v, s, 0.0, 64, 48, &c);
+    assert_true(c.pos.x > 7.0f && fabsf(c.pos.y - 6) < 1e-4f && fabsf(c.pos.z - 5) < 1e-4f);
+    fv_view_set_frame(v, FV_FRAME_LEFT);
+    fv_view_camera(v, s, 0.0, 64, 48, &c);
+    assert_true(c.pos.x < 1.0f && fabsf(c.pos.y - 6) < 1e-4f && fabsf(c.pos.z - 5) < 1e-4f);
+    /* A z-up model: its front is -y, the three-quarter view comes from -y, +x and above (+z). */
+    fv_view_set_frame(v, FV_FRAME_THREE_QUARTER);
+    fv_view_set_up_axis(v, fv_v3(0, 0, 2));
+    assert_vec3(fv_view_up_axis(v), 0, 0, 1, 0);
+    fv_view_camera(v, s, 0.0, 64, 48, &c);
+    assert_vec3(c.up, 0, 0, 1, 0);
+    assert_true(c.pos.y < 6.0f && c.pos.x > 4.0f && c.pos.z > 5.0f);
+    fv_view_set_up_axis(v, fv_v3(0, 1, 0));
 
     /* The view's own camera wins over the framing one, resized to each call. */
     fv_camera mine = {{1, 2, 3}, {1, 2, 0}, {0, 1, 0}, 30.0f, 512, 512};
@@ -215,6 +258,24 @@ static void test_gaze_ownership(void **st)
 /* The loaders: a scene file's view blocks come back in the view (scene.json: camera path,
  * display, gaze); a mesh file without a camera gives an empty view that frames the scene; with
  * view NULL the blocks are still checked (a bad gaze block fails) and nothing is returned. */
+/* The up axis of a model whose file does not say: the smallest extent's axis when that extent is
+ * under half the middle one, else +y. */
+static void test_up_guess(void **st)
+{
+    (void)st;
+    fv_vec3 o = fv_v3(0, 0, 0);
+    assert_vec3(fv_up_axis_guess(o, fv_v3(10, 1, 8)), 0, 1, 0, 0);    /* a terrain */
+    assert_vec3(fv_up_axis_guess(o, fv_v3(10, 10, 2)), 0, 0, 1, 0);   /* a plan lying in xy */
+    assert_vec3(fv_up_axis_guess(o, fv_v3(0.4f, 3, 2)), 1, 0, 0, 0);  /* a relief facing x */
+    assert_vec3(fv_up_axis_guess(o, fv_v3(1, 1, 1)), 0, 1, 0, 0);     /* a box */
+    assert_vec3(fv_up_axis_guess(o, fv_v3(0.5f, 1.8f, 0.3f)), 0, 1, 0, 0); /* a standing figure: not flat */
+    fv_frame_view f;
+    assert_true(fv_frame_view_from_name("three-quarter", &f) && f == FV_FRAME_THREE_QUARTER);
+    assert_true(fv_frame_view_from_name("top", &f) && f == FV_FRAME_TOP);
+    assert_false(fv_frame_view_from_name("bottom", &f));
+    assert_string_equal(fv_frame_view_name(FV_FRAME_LEFT), "left");
+}
+
 static void test_loaders(void **st)
 {
     (void)st;
@@ -235,9 +296,16 @@ static void test_loaders(void **st)
     assert_false(fv_view_has_camera_path(v));
     assert_false(fv_view_display(v, &eye));
     assert_null(fv_view_gaze_path(v));
+    /* quad.ply is a flat quad: its up axis is guessed as its normal's axis, and the default
+     * camera frames it with that up. */
     fv_camera a, b;
+    fv_vec3 lo, hi;
+    fv_scene_bounds(s, &lo, &hi);
+    fv_vec3 up = fv_view_up_axis(v);
+    fv_vec3 guess = fv_up_axis_guess(lo, hi);
+    assert_vec3(up, guess.x, guess.y, guess.z, 0);
     fv_view_camera(v, s, 0.0, 16, 16, &a);
-    fv_view_camera(NULL, s, 0.0, 16, 16, &b);
+    fv_camera_frame(lo, hi, up, FV_FRAME_THREE_QUARTER, 16, 16, &b);
     assert_memory_equal(&a, &b, sizeof a);
     assert_float_equal(a.fov_y, 45.0f, 0.0f);
     fv_view_destroy(v);
@@ -270,7 +338,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_framing),        cmocka_unit_test(test_camera_path), cmocka_unit_test(test_display),
-        cmocka_unit_test(test_gaze_ownership), cmocka_unit_test(test_loaders),
+        cmocka_unit_test(test_gaze_ownership), cmocka_unit_test(test_loaders), cmocka_unit_test(test_up_guess),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -144,19 +144,29 @@ int fv_cli_check_method(const char *cmd, const char *method)
     return fv_cli_fail(cmd, s, err.msg);
 }
 
-int fv_cli_open_scene(const char *cmd, const char *name, const fv_log *log, int nlights, const float (*lights)[6], fv_scene **scene,
-                      fv_view **view)
+int fv_cli_open_scene(const char *cmd, const char *name, const fv_log *log, const fv_cli_scene_opts *o, fv_scene **scene, fv_view **view)
 {
     fv_error err;
     fv_error_clear(&err);
     *scene = NULL;
     *view = NULL;
+    fv_cli_scene_opts none;
+    memset(&none, 0, sizeof none);
+    if (!o) o = &none;
     fv_status s = fv_scene_open(name, log, scene, view, &err);
-    for (int i = 0; i < nlights && s == FV_OK; i++) {
-        const float *v = lights[i];
+    for (int i = 0; i < o->nlights && s == FV_OK; i++) {
+        const float *v = o->lights[i];
         fv_light_desc l = {FV_LIGHT_POINT, fv_v3(v[0], v[1], v[2]), fv_v3(0, -1, 0), fv_v3(v[3], v[4], v[5]), 0, 0};
         s = fv_scene_add_light(*scene, &l, &err);
     }
+    if (s == FV_OK && o->has_env) {
+        fv_env_desc e = fv_env_uniform(fv_v3(o->env[0], o->env[1], o->env[2]));
+        fv_env_desc had;
+        if (fv_scene_env(*scene, &had)) e.up = had.up;
+        s = fv_scene_set_env(*scene, &e, &err);
+    }
+    if (s == FV_OK && o->has_frame) fv_view_set_frame(*view, o->frame);
+    if (s == FV_OK && !o->no_default_light) s = fv_scene_add_default_lighting(*scene, *view, log, NULL, &err);
     if (s == FV_OK && (s = fv_scene_commit(*scene, log, &err)) != FV_OK) fv_error_prefix(&err, "%s: ", name);
     if (s == FV_OK) return 0;
     fv_scene_destroy(*scene);
@@ -164,6 +174,22 @@ int fv_cli_open_scene(const char *cmd, const char *name, const fv_log *log, int 
     *scene = NULL;
     *view = NULL;
     return fv_cli_fail(cmd, s, err.msg);
+}
+
+int fv_cli_opt_env(const char *cmd, const char *arg, fv_cli_scene_opts *o)
+{
+    if (!fv_cli_parse_floats(arg, 3, o->env) || o->env[0] < 0 || o->env[1] < 0 || o->env[2] < 0)
+        return fv_cli_usage_error(cmd, "--env %s: expected R,G,B radiances >= 0", arg);
+    o->has_env = true;
+    return 0;
+}
+
+int fv_cli_opt_frame_view(const char *cmd, const char *arg, fv_cli_scene_opts *o)
+{
+    if (!fv_frame_view_from_name(arg, &o->frame))
+        return fv_cli_usage_error(cmd, "--frame-view %s: expected front, back, left, right, top or three-quarter", arg);
+    o->has_frame = true;
+    return 0;
 }
 
 int fv_cli_opt_size(const char *cmd, const char *arg, int *w, int *h)

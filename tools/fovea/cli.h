@@ -45,11 +45,25 @@ void fv_cli_progress_done(fv_cli_progress *p);
 /* The method check every rendering command makes before loading anything: an unknown name fails
  * with the library's message listing the methods. Returns 0 or the exit code (message printed). */
 int fv_cli_check_method(const char *cmd, const char *method);
-/* Opens a scene (built-in name or file), adds point lights (x,y,z,r,g,b each; may be none) and
- * commits it, with the messages `fovea render` prints. Returns 0 or the exit code; on failure
- * whatever was opened is released and *scene, *view are NULL. */
-int fv_cli_open_scene(const char *cmd, const char *name, const fv_log *log, int nlights, const float (*lights)[6], fv_scene **scene,
-                      fv_view **view);
+/* What the command line adds to a scene as it opens it. */
+typedef struct fv_cli_scene_opts {
+    int nlights;
+    const float (*lights)[6];  /* --point-light x,y,z,r,g,b each */
+    bool has_env;              /* --env R,G,B: a uniform environment */
+    float env[3];
+    bool no_default_light;     /* --no-default-light */
+    bool has_frame;            /* --frame-view NAME */
+    fv_frame_view frame;
+} fv_cli_scene_opts;
+
+/* Opens a scene (built-in name or file), adds what o asks (NULL: nothing), then the default
+ * lighting when the scene still has no light (unless o->no_default_light), and commits it, with
+ * the messages `fovea render` prints. Returns 0 or the exit code; on failure whatever was opened
+ * is released and *scene, *view are NULL. */
+int fv_cli_open_scene(const char *cmd, const char *name, const fv_log *log, const fv_cli_scene_opts *o, fv_scene **scene, fv_view **view);
+/* --env and --frame-view's parsing, with their one-line messages: 0 or the exit code. */
+int fv_cli_opt_env(const char *cmd, const char *arg, fv_cli_scene_opts *o);
+int fv_cli_opt_frame_view(const char *cmd, const char *arg, fv_cli_scene_opts *o);
 
 /* Subcommands. */
 int fv_cmd_render(int argc, char **argv);

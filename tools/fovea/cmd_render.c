@@ -18,7 +18,8 @@ static void help(void)
     printf("usage: fovea render [SCENE] [options]\n"
            "  SCENE                 built-in name (fovea scenes) or a .json/.obj/.gltf/.glb/.ply file [cornell]\n"
            "  --method NAME         rendering method (fovea methods) [pt]\n"
-           "  --spp N               samples per pixel (sets the method's spp parameter)\n"
+           "  --spp N               samples per pixel: sets the method's own parameter for it (an error names\n"
+           "                        what to use instead for a method without one)\n"
            "  --size WxH            image size [512x512]\n"
            "  --frames N            number of frames; >1 writes numbered files OUT_0000.ext ... [1]\n"
            "  --fps F               frames per second of scene time [30]\n"
@@ -30,6 +31,10 @@ static void help(void)
            "  --camera-pos x,y,z    camera position      --camera-look x,y,z  point looked at\n"
            "  --camera-up x,y,z     camera up vector     --fov DEG            vertical field of view\n"
            "  --point-light x,y,z,r,g,b  add a point light (intensity W/sr), repeatable\n"
+           "  --env R,G,B           a uniform environment light of that radiance (replaces the scene's)\n"
+           "  --no-default-light    a file without lights gets no sky and key light (docs/scene-format.md)\n"
+           "  --frame-view NAME     frame the scene from three-quarter, front, back, left, right or top\n"
+           "                        (replaces the scene's camera) [the scene's camera, else three-quarter]\n"
            "  --gaze X,Y            gaze point in normalised screen coordinates [the scene's gaze, or 0.5,0.5]\n"
            "  --gaze-trace FILE     gaze over time from a CSV trace (docs/gaze.md)\n"
            "  --camera-trace FILE   camera over time from a CSV trace (docs/gaze.md)\n"
@@ -67,19 +72,20 @@ typedef struct render_opts {
     float pos[3], look[3], up[3], fov, gaze[2];
     int nlights;
     float lights[MAX_LIGHTS][6];
+    fv_cli_scene_opts scene_opts;  /* --env, --no-default-light, --frame-view */
 } render_opts;
 
 static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
     enum { O_METHOD = 256, O_SPP, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
-           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP };
+           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP, O_ENV, O_NO_DEFAULT_LIGHT, O_FRAME_VIEW };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
         {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
         {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE},
         {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"help", 0, 0, O_HELP},
-        {0, 0, 0, 0}};
+        {"env", 1, 0, O_ENV}, {"no-default-light", 0, 0, O_NO_DEFAULT_LIGHT}, {"frame-view", 1, 0, O_FRAME_VIEW}, {0, 0, 0, 0}};
     const char *cmd = "render";
     long l;
     double d;
@@ -161,6 +167,13 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
         case O_PARAM:
             if (fv_params_parse(params, optarg, &err) != FV_OK) return fv_cli_fail(cmd, err.status, err.msg);
             break;
+        case O_ENV:
+            if ((rc = fv_cli_opt_env(cmd, optarg, &o->scene_opts))) return rc;
+            break;
+        case O_NO_DEFAULT_LIGHT: o->scene_opts.no_default_light = true; break;
+        case O_FRAME_VIEW:
+            if ((rc = fv_cli_opt_frame_view(cmd, optarg, &o->scene_opts))) return rc;
+            break;
         case O_QUIET: o->quiet = true; break;
         case O_STATS: o->show_stats = true; break;
         case O_HELP:
@@ -222,15 +235,16 @@ int fv_cmd_render(int argc, char **argv)
         goto done;
     }
     if ((rc = fv_cli_check_method(cmd, o.method)) != 0) goto done;
-    if (o.spp > 0) {
-        char v[32];
-        snprintf(v, sizeof v, "%d", o.spp);
-        fv_params_set(params, "spp", v, &err);
+    if (o.spp > 0 && (s = fv_technique_set_spp(o.method, params, o.spp, &err)) != FV_OK) {
+        rc = fv_cli_fail(cmd, s, err.msg);
+        goto done;
     }
 
     bool quiet = o.quiet;
     fv_log log = fv_cli_log(&quiet);
-    if ((rc = fv_cli_open_scene(cmd, o.scene, &log, o.nlights, (const float(*)[6])o.lights, &scene, &view)) != 0) goto done;
+    o.scene_opts.nlights = o.nlights;
+    o.scene_opts.lights = (const float(*)[6])o.lights;
+    if ((rc = fv_cli_open_scene(cmd, o.scene, &log, &o.scene_opts, &scene, &view)) != 0) goto done;
     if ((s = fv_technique_create(o.method, scene, params, &log, &tech, &err)) != FV_OK) {
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;

@@ -15,7 +15,10 @@ void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_r
     out->albedo = fv_v3s(0.0f);
     for (int depth = 0; depth <= max_depth; depth++) {
         fv_hit h;
-        if (!fv_scene_intersect(s, FV_TRACE_ALL, o, d, INFINITY, &h)) return;
+        if (!fv_scene_intersect(s, FV_TRACE_ALL, o, d, INFINITY, &h)) { /* escaped: the environment, if any */
+            out->emitted = fv_add(out->emitted, fv_mul(out->weight, fv_light_env_radiance(s, d)));
+            return;
+        }
         const fv_material *m = fv_scene_material(s, h.mat);
         fv_vec3 wo = fv_neg(d);
         if (depth == 0) {

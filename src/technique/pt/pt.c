@@ -122,4 +122,5 @@ const fv_technique_class fv_technique_pt = {
     .test_params = "spp=64",
     .furnace_radiance = 0.998046875,
     .furnace_tolerance = 0.02,
+    .spp_param = "spp",
 };

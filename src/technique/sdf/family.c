@@ -88,6 +88,9 @@ static fv_status create_method(fv_sdf_method m, const fv_scene *scene, fv_params
     if (meshes > 0)
         fv_log_warn(log, "%d mesh object%s not sphere-traced: this method sees only the signed distance fields (pt renders both)",
                    meshes, meshes == 1 ? " is" : "s are");
+    fv_env_desc env;
+    if (fv_scene_env(scene, &env))
+        fv_log_warn(log, "the environment light is not shaded: this method shades point and spot lights only (ambient=A adds a constant term; pt sees it)");
     family_state *st = calloc(1, sizeof *st);
     if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if ((s = fv_sdf_pipeline_create(scene, &o, &st->pipe, err)) != FV_OK) {
@@ -131,7 +134,7 @@ static fv_status create_fipr(const fv_scene *s, fv_params *p, const fv_log *l, v
 #define SDF_CLASS(id, nm, sum, help, fn)                                                                              \
     const fv_technique_class id = {.name = nm, .summary = sum, .params_help = COMMON_HELP help, .create = fn, .render = render, \
                                    .destroy = destroy, .sdf_only = true, .test_params = "spp=1", .furnace_radiance = 1.0,      \
-                                   .furnace_tolerance = 0.01}
+                                   .furnace_tolerance = 0.01, .spp_param = "spp"}
 
 SDF_CLASS(fv_technique_sdf_gt, "sdf-gt", "sphere tracing of every target sample from the camera (ground truth of ipr/fipr)",
           "show=image|steps (image): the image, or steps per ray from blue (1) to red (256)\n", create_gt);

@@ -28,7 +28,7 @@ fv_vec3 fv_vpl_direct_irradiance(const fv_scene *s, fv_vec3 p, fv_vec3 n, fv_vec
     for (int k = 0; k < area_samples; k++) {
         float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), u2 = fv_rng_next(rng);
         fv_light_sample ls;
-        if (!fv_light_sample_li(s, p, u0, u1, u2, &ls) || ls.delta || !(ls.pdf > 0.0f)) continue;
+        if (!fv_light_sample_li_area(s, p, u0, u1, u2, &ls) || !(ls.pdf > 0.0f)) continue;
         float c = fv_dot(n, ls.wi);
         if (c <= 0.0f) continue;
         (*rays)++;

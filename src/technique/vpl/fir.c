@@ -822,4 +822,5 @@ const fv_technique_class fv_technique_fir = {
     .furnace_params = "vpls=1000,resolution=32,cube_size=32,area_samples=16",
     .furnace_radiance = 0.9375,
     .furnace_tolerance = 0.08,
+    .spp_instead = FV_VPL_SPP_INSTEAD,
 };

@@ -40,6 +40,7 @@ static void gb_fill(const fv_scene *s, fv_vec3 d, const fv_hit *h, bool ok, fv_g
         memset(g, 0, sizeof *g);
         g->t = INFINITY;
         g->obj = -1;
+        g->emit = fv_light_env_radiance(s, d); /* the environment, if any, seen past everything */
         return;
     }
     const fv_material *m = fv_hit_material(s, h);

@@ -23,7 +23,7 @@ typedef struct fv_gpixel {
     fv_vec3 n;      /* unit shading normal, turned towards the camera */
     fv_vec3 ng;     /* unit geometric normal, turned towards the camera */
     fv_vec3 albedo; /* the material's diffuse albedo */
-    fv_vec3 emit;   /* radiance the surface emits towards the camera */
+    fv_vec3 emit;   /* radiance the surface emits towards the camera (a miss: the environment's) */
     float t;        /* distance along the ray; +inf on a miss */
     int obj;        /* object id, -1 on a miss */
 } fv_gpixel;

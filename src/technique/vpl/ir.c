@@ -197,6 +197,7 @@ const fv_technique_class fv_technique_ir = {
     .furnace_params = "vpls=2000,area_samples=16",
     .furnace_radiance = 1.0,
     .furnace_tolerance = 0.03,
+    .spp_instead = FV_VPL_SPP_INSTEAD,
 };
 
 const fv_technique_class fv_technique_ir_low = {
@@ -212,4 +213,5 @@ const fv_technique_class fv_technique_ir_low = {
     .furnace_params = "vpls=2000,area_samples=16,cube_size=32",
     .furnace_radiance = 1.0,
     .furnace_tolerance = 0.03,
+    .spp_instead = FV_VPL_SPP_INSTEAD,
 };

@@ -155,6 +155,8 @@ void fv_vpl_compose(const fv_gbuffer *gb, const fv_vec3 *direct, const fv_vec3 *
             if (indirect) e = fv_add(e, indirect[i]);
             L = fv_scale(fv_mul(g->albedo, e), 1.0f / (float)M_PI);
             if (emitted) L = fv_add(L, g->emit);
+        } else if (emitted) {
+            L = g->emit;
         }
         L = fv_kit_guard(L, dropped);
         rgb[3 * i] = L.x;

@@ -22,7 +22,7 @@
 
 typedef struct fv_vp_opts {
     fv_space_opts space;
-    fv_path_opts pt;            /* spp 1, max_depth = 1 + bounces */
+    fv_path_opts pt;            /* spp paths per grid sample, max_depth = 1 + bounces */
     fv_vp_order order;
     bool skip_offscreen;
     bool kill;                 /* linear fall-off launch (screen grid only) */

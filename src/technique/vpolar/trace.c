@@ -78,6 +78,10 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
         fv_path_first_hit first;
         memset(&first, 0, sizeof first);
         fv_vec3 L = fv_kit_guard(fv_path_trace_from(j->scene, &j->pt, j->cam.pos, dir[k], &hits[k], ok[k], &rng[k], &first, &rays), &bad);
+        /* spp > 1: more paths through the same camera ray (its hit is shared), averaged. */
+        for (int n = 1; n < j->pt.spp; n++)
+            L = fv_add(L, fv_kit_guard(fv_path_trace_from(j->scene, &j->pt, j->cam.pos, dir[k], &hits[k], ok[k], &rng[k], NULL, &rays), &bad));
+        if (j->pt.spp > 1) L = fv_scale(L, 1.0f / (float)j->pt.spp);
         g->color[3 * i] = L.x, g->color[3 * i + 1] = L.y, g->color[3 * i + 2] = L.z;
         if (first.hit) {
             g->albedo[3 * i] = first.albedo.x, g->albedo[3 * i + 1] = first.albedo.y, g->albedo[3 * i + 2] = first.albedo.z;

@@ -54,7 +54,7 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
     int bounces, order, offscreen, sh;
     double blur_fovea_def = kind == K_LINEAR_FALLOFF ? 10.0 : 5.79;
     bool blur_def = kind == K_VPOLAR || kind == K_LINEAR_FALLOFF;
-    if ((s = fv_params_int(p, "bounces", 1, 0, 64, &bounces, err)) ||
+    if ((s = fv_params_int(p, "bounces", 1, 0, 64, &bounces, err)) || (s = fv_params_int(p, "spp", 1, 1, 1 << 16, &o->pt.spp, err)) ||
         (s = fv_params_choice(p, "order", 0, k_orders, &order, err)) ||
         (s = fv_params_choice(p, "offscreen", 0, k_offscreen, &offscreen, err)) ||
         (s = fv_params_choice(p, "show", 0, k_show, &sh, err)) || (s = fv_params_bool(p, "denoise", true, &o->denoise, err)) ||
@@ -113,7 +113,6 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
     case K_CARTESIAN_FULL:
         break;
     }
-    o->pt.spp = 1;
     o->pt.max_depth = 1 + bounces;
     o->pt.rr_depth = 1 << 20; /* Sec. 3.1: a fixed path length, no Russian roulette */
     o->order = (fv_vp_order)order;
@@ -253,6 +252,7 @@ static fv_status create_logpolar(const fv_scene *s, fv_params *p, const fv_log *
 
 #define COMMON_HELP                                                                                                      \
     "bounces=int (1): indirect bounces per path (Sec. 3.1: one)\n"                                                       \
+    "spp=int (1): paths averaged per sample of the grid (Sec. 3.1: one)\n"                                               \
     "denoise=bool (true): SVGF in the sample space\n"                                                                    \
     "svgf_iterations=int (5), svgf_alpha=float (0.2), sigma_lum=float (4), sigma_normal=float (128), sigma_depth=float (1)\n" \
     "blur_sigma=float (6.8): blur sigma in pixels at blur_ramp_deg, for 1280 pixels wide (scaled with the width)\n"     \
@@ -269,7 +269,7 @@ const fv_technique_class fv_technique_vpolar = {
                 "fit_degree=int (6): degree of the polynomial inverse of Eq. 2\n"
                 "blur=bool (true): foveated blur (blur_fovea_deg default 5.79, stretched with the space)\n",
     create_vpolar, vp_render, vp_destroy,
-    FURNACE_TEST,
+    FURNACE_TEST, .spp_param = "spp",
 };
 
 const fv_technique_class fv_technique_cartesian = {
@@ -278,7 +278,7 @@ const fv_technique_class fv_technique_cartesian = {
     COMMON_HELP "reduction=float (0.61): share of screen pixels not sampled, in (0,1)\n"
                 "blur=bool (false)\n",
     create_cartesian, vp_render, vp_destroy,
-    FURNACE_TEST,
+    FURNACE_TEST, .spp_param = "spp",
 };
 
 const fv_technique_class fv_technique_cartesian_full = {
@@ -286,7 +286,7 @@ const fv_technique_class fv_technique_cartesian_full = {
     "1 spp at full resolution with SVGF: the cost reference of Visual-Polar Fig. 12",
     COMMON_HELP "blur=bool (false)\n",
     create_cartesian_full, vp_render, vp_destroy,
-    FURNACE_TEST,
+    FURNACE_TEST, .spp_param = "spp",
 };
 
 const fv_technique_class fv_technique_linear_falloff = {
@@ -296,7 +296,7 @@ const fv_technique_class fv_technique_linear_falloff = {
                 "falloff_probability=float (0.2)\n"
                 "blur=bool (true): foveated blur (blur_fovea_deg default 10)\n",
     create_linear_falloff, vp_render, vp_destroy,
-    FURNACE_TEST,
+    FURNACE_TEST, .spp_param = "spp",
 };
 
 const fv_technique_class fv_technique_logpolar = {
@@ -306,5 +306,5 @@ const fv_technique_class fv_technique_logpolar = {
                 "alpha=float (4): kernel exponent\n"
                 "blur=bool (false)\n",
     create_logpolar, vp_render, vp_destroy,
-    FURNACE_TEST,
+    FURNACE_TEST, .spp_param = "spp",
 };

@@ -1,0 +1,58 @@
+/* fovea — the default lighting of a scene without any light (fv_scene_add_default_lighting in
+ * fovea/scene.h): what users of model viewers expect when they open a mesh file that carries none.
+ *
+ * A point light somewhere inside the bounds would sit inside any closed model (a box, a scanned
+ * animal) and light nothing anyone sees, so the light comes from outside: a sky-gradient
+ * environment about the model's up axis lights every side softly, and a key light above and to
+ * the left of the default camera, outside the bounding sphere, gives shape and shadows. Both scale
+ * with the scene: the environment is at infinity, the key light's intensity is set so that it
+ * gives a fixed irradiance at the centre of the bounds.
+ */
+#include "scene/scene_impl.h"
+#include "scene/view_impl.h"
+
+/* The sky: a blue-grey zenith, a light grey horizon and a dark ground (radiance); the key light's
+ * irradiance at the bounds' centre (W/m^2), about what the sky gives an upward-facing surface. */
+static const fv_vec3 k_zenith = {0.40f, 0.50f, 0.65f}, k_horizon = {0.55f, 0.55f, 0.55f}, k_ground = {0.20f, 0.19f, 0.18f};
+static const float k_key_irradiance = 2.0f;
+
+static bool has_light(const fv_scene *s)
+{
+    if (s->ndelta > 0 || s->has_env) return true;
+    for (int i = 0; i < s->nobj; i++)
+        for (int t = 0; t < s->objs[i].nt; t++)
+            if (fv_max3(s->mats[s->objs[i].mat[t]].emission) > 0.0f) return true;
+    return false;
+}
+
+fv_status fv_scene_add_default_lighting(fv_scene *s, const fv_view *view, const fv_log *log, bool *added, fv_error *err)
+{
+    if (added) *added = false;
+    if (s->committed) return fv_error_set(err, FV_ERR_INTERNAL, "scene already committed: it cannot be changed");
+    if (s->nobj == 0 || has_light(s)) return FV_OK;
+    fv_vec3 lo, hi;
+    fv_scene_world_bounds(s, &lo, &hi);
+    float R = 0.5f * fv_length(fv_sub(hi, lo));
+    if (!(R > 0.0f) || !isfinite(R)) return FV_OK; /* fv_scene_commit says what is wrong */
+    fv_vec3 c = fv_scale(fv_add(lo, hi), 0.5f), up = fv_view_up_axis(view);
+    fv_camera cam;
+    fv_view_frame_bounds(view, lo, hi, 512, 512, &cam);
+    fv_vec3 to_cam = fv_sub(cam.pos, c);
+    float D = fv_length(to_cam);
+    to_cam = D > 0.0f ? fv_scale(to_cam, 1.0f / D) : fv_v3(0, 0, 1);
+    fv_vec3 right = fv_cross(fv_neg(to_cam), up);
+    right = fv_length(right) > 1e-4f ? fv_normalize(right) : fv_v3(1, 0, 0);
+    /* above the camera and to its left, at least 2.5 radii out */
+    float dist = fv_maxf(D, 2.5f * R);
+    fv_vec3 key_dir = fv_normalize(fv_add(to_cam, fv_add(fv_scale(up, 0.9f), fv_scale(right, -0.35f))));
+    fv_light_desc key = {FV_LIGHT_POINT, fv_madd(c, key_dir, dist), fv_neg(key_dir), fv_v3s(k_key_irradiance * dist * dist), 0, 0};
+    fv_env_desc env = {k_zenith, k_horizon, k_ground, up};
+    fv_status st;
+    if ((st = fv_scene_set_env(s, &env, err)) != FV_OK || (st = fv_scene_add_light(s, &key, err)) != FV_OK) return st;
+    fv_log_warn(log,
+                "scene has no lights: added a sky environment (up %g,%g,%g) and a key point light at (%g, %g, %g) of intensity %g "
+                "(--env R,G,B sets the environment, --no-default-light turns this off)",
+                up.x, up.y, up.z, key.pos.x, key.pos.y, key.pos.z, key.intensity.x);
+    if (added) *added = true;
+    return FV_OK;
+}
