@@ -29,6 +29,7 @@ sed 's/^fovea render:/fovea view:/' "$TMP/render.err" | cmp -s - "$TMP/err" || f
 expect 2 "unknown parameter 'foo'" -- "$VIEW" cornell --method vpolar --param foo=1
 expect 2 "no display" -- env -u DISPLAY -u SDL_VIDEODRIVER -u WAYLAND_DISPLAY "$VIEW" cornell --method vpolar
 expect 2 "unknown or incomplete command 'jump'" -- "$VIEW" --script /dev/stdin <<<"0 jump"
+expect 2 "--frame-view sideways: expected front" -- "$VIEW" --frame-view sideways
 expect 2 "move needs R U F" -- "$VIEW" --script /dev/stdin <<<"0 move 1 nan 2"
 expect 2 "look needs YAW PITCH" -- "$VIEW" --script /dev/stdin <<<"0 look 400 0"
 

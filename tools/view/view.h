@@ -11,6 +11,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include "fovea/fovea.h"
+#include "cli.h"
 
 /* The driver's clock: frame index i is at time i / FV_VW_FPS, so the index is the animation
  * clock in milliseconds (2^31 ms is 24 days of viewing). */
@@ -25,6 +26,7 @@ typedef struct fv_vw_args {
     bool has_gaze;
     float gaze[2];
     fv_params *params; /* the --param bag, for the method named on the command line */
+    fv_cli_scene_opts scene_opts; /* --env, --no-default-light, --frame-view, as fovea render's */
 } fv_vw_args;
 /* 0: go on; < 0: --help printed, exit 0; > 0: exit code (message printed). */
 int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a);

@@ -36,7 +36,7 @@ static int prepare(fv_vw_app *app, fv_vw_script *script)
     if ((rc = fv_cli_check_method(k_cmd, a->method)) != 0) return rc;
     if (a->script && (s = fv_vw_script_load(a->script, script, &err)) != FV_OK) return fv_cli_fail(k_cmd, s, err.msg);
     if (a->gaze_trace && (s = fv_gaze_path_load_csv(a->gaze_trace, &app->gaze_trace, &err)) != FV_OK) return fv_cli_fail(k_cmd, s, err.msg);
-    if ((rc = fv_cli_open_scene(k_cmd, a->scene, &app->log, NULL, &app->scene, &app->view)) != 0) return rc;
+    if ((rc = fv_cli_open_scene(k_cmd, a->scene, &app->log, &a->scene_opts, &app->scene, &app->view)) != 0) return rc;
     app->user_method = fv_technique_index(a->method);
     if ((s = fv_vw_slot_create(&app->main, app->scene, app->user_method, -1, a->params, &app->log, &err)) != FV_OK)
         return fv_cli_fail(k_cmd, s, err.msg);
