@@ -2,7 +2,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <omp.h>
 #include "core/alloc.h"
+#include "core/parallel.h"
 #include "technique/photon/photon_map.h"
 
 void fv_photon_map_init(fv_photon_map *m) { memset(m, 0, sizeof *m); }
@@ -12,6 +14,8 @@ void fv_photon_map_free(fv_photon_map *m)
     free(m->p);
     free(m->start);
     free(m->scratch);
+    free(m->px);
+    free(m->key);
     memset(m, 0, sizeof *m);
 }
 
@@ -45,7 +49,41 @@ static inline uint32_t cell_hash(int x, int y, int z, uint32_t mask)
     return h & mask;
 }
 
-fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err)
+static inline uint32_t photon_bucket(const fv_photon_map *m, fv_vec3 p)
+{
+    return cell_hash(cell_coord(p.x, m->inv_cell), cell_coord(p.y, m->inv_cell), cell_coord(p.z, m->inv_cell), m->mask);
+}
+
+/* Room for the sorted copy, the SoA positions (padded: a block may read past the last photon)
+ * and the bucket of each photon. */
+static fv_status reserve(fv_photon_map *m, fv_error *err)
+{
+    int n = m->n ? m->n : 1;
+    if (m->scratch_cap < n) {
+        fv_photon *s = realloc(m->scratch, (size_t)n * sizeof *s);
+        if (!s) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+        m->scratch = s;
+        m->scratch_cap = n;
+    }
+    if (m->key_cap < n) {
+        uint32_t *k = realloc(m->key, (size_t)n * sizeof *k);
+        if (!k) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+        m->key = k;
+        m->key_cap = n;
+    }
+    if (m->soa_cap < n) {
+        float *a = realloc(m->px, 3 * ((size_t)n + FV_PHOTON_BLOCK) * sizeof *a);
+        if (!a) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+        m->px = a;
+        m->soa_cap = n;
+    }
+    size_t stride = (size_t)m->soa_cap + FV_PHOTON_BLOCK;
+    m->py = m->px + stride;
+    m->pz = m->py + stride;
+    return FV_OK;
+}
+
+fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_error *err)
 {
     if (!(cell > 0.0f) || !isfinite(cell)) return fv_error_set(err, FV_ERR_INVALID, "photon grid: cell size %g must be positive", cell);
     m->cell = cell;
@@ -56,45 +94,74 @@ fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err)
     uint32_t *start = realloc(m->start, ((size_t)nb + 1) * sizeof *start);
     if (!start) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
     m->start = start;
-    if (m->scratch_cap < m->n) {
-        fv_photon *s = realloc(m->scratch, (size_t)(m->n ? m->n : 1) * sizeof *s);
-        if (!s) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
-        m->scratch = s;
-        m->scratch_cap = m->n;
-    }
+    fv_status rc = reserve(m, err);
+    if (rc != FV_OK) return rc;
     m->mask = nb - 1;
     m->nbuckets = nb;
-    memset(start, 0, ((size_t)nb + 1) * sizeof *start);
-    /* Counting sort by bucket: count, prefix sum, scatter. */
-    for (int i = 0; i < m->n; i++) {
-        const fv_vec3 p = m->p[i].pos;
-        start[cell_hash(cell_coord(p.x, m->inv_cell), cell_coord(p.y, m->inv_cell), cell_coord(p.z, m->inv_cell), m->mask) + 1]++;
+    /* A stable counting sort by bucket, in parallel: each thread counts the buckets of its own
+     * contiguous share of the photons, every (bucket, thread) pair gets its offset in bucket-major,
+     * thread-minor order, and each thread scatters its share in order. So the photons of a bucket
+     * stay in the order they were stored, whatever the thread count. */
+    int nt = fv_thread_count(threads);
+    if (nt > 1 && m->n < 65536) nt = 1; /* not worth waking threads */
+    uint32_t *count = fv_calloc_array((size_t)nb * (size_t)nt, sizeof *count);
+    if (!count) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+    const int n = m->n;
+    #pragma omp parallel num_threads(nt)
+    {
+        const int t = omp_get_thread_num(), T = omp_get_num_threads();
+        const int i0 = (int)((int64_t)n * t / T), i1 = (int)((int64_t)n * (t + 1) / T);
+        uint32_t *cnt = count + (size_t)t * nb;
+        for (int i = i0; i < i1; i++) cnt[m->key[i] = photon_bucket(m, m->p[i].pos)]++;
+        #pragma omp barrier
+        #pragma omp single
+        {
+            uint32_t sum = 0;
+            for (uint32_t b = 0; b < nb; b++) {
+                start[b] = sum;
+                for (int k = 0; k < T; k++) {
+                    uint32_t c = count[(size_t)k * nb + b];
+                    count[(size_t)k * nb + b] = sum;
+                    sum += c;
+                }
+            }
+            start[nb] = sum;
+        }
+        for (int i = i0; i < i1; i++) {
+            uint32_t d = cnt[m->key[i]]++;
+            const fv_photon *ph = &m->p[i];
+            m->scratch[d] = *ph;
+            m->px[d] = ph->pos.x;
+            m->py[d] = ph->pos.y;
+            m->pz[d] = ph->pos.z;
+        }
     }
-    for (uint32_t b = 0; b < nb; b++) start[b + 1] += start[b];
-    for (int i = 0; i < m->n; i++) {
-        const fv_vec3 p = m->p[i].pos;
-        uint32_t b = cell_hash(cell_coord(p.x, m->inv_cell), cell_coord(p.y, m->inv_cell), cell_coord(p.z, m->inv_cell), m->mask);
-        m->scratch[start[b]++] = m->p[i];
-    }
-    /* start[b] now holds the end of bucket b: shift back to the starts. */
-    for (uint32_t b = nb; b > 0; b--) start[b] = start[b - 1];
-    start[0] = 0;
-    fv_photon *t = m->p;
+    free(count);
+    /* Padding far away: a block reading past the last photon never accepts it. */
+    for (int k = 0; k < FV_PHOTON_BLOCK; k++) m->px[n + k] = m->py[n + k] = m->pz[n + k] = INFINITY;
+    fv_photon *tp = m->p;
     int tc = m->cap;
     m->p = m->scratch;
     m->cap = m->scratch_cap;
-    m->scratch = t;
+    m->scratch = tp;
     m->scratch_cap = tc;
     return FV_OK;
 }
 
-/* Visits every bucket holding cells that overlap the box [x - r, x + r]^3 once (two cells hashed
- * to one bucket must not count its photons twice), calling visit on each photon within r. */
-#define MAX_CELLS 343 /* 7^3: r up to 3 cells */
-typedef bool (*bucket_fn)(void *ctx, const fv_photon *ph, uint32_t index, float d2);
+fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err) { return fv_photon_map_build_mt(m, cell, 0, err); }
 
-static void visit_box(const fv_photon_map *m, fv_vec3 x, float r, bucket_fn fn, void *ctx)
+/* The ranges of p to test: every bucket holding cells that overlap the box [x - r, x + r]^3,
+ * once (two cells hashed to one bucket must not count its photons twice), in the order the cells
+ * are first met, z then y then x. */
+void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x, float r)
 {
+    q->m = m;
+    q->x = x;
+    q->r2 = r * r;
+    q->nranges = 0;
+    q->range = 0;
+    q->i = 0;
+    if (m->nbuckets == 0 || m->n == 0) return;
     int lo[3], hi[3];
     const float c[3] = {x.x, x.y, x.z};
     for (int a = 0; a < 3; a++) {
@@ -102,9 +169,8 @@ static void visit_box(const fv_photon_map *m, fv_vec3 x, float r, bucket_fn fn, 
         hi[a] = cell_coord(c[a] + r, m->inv_cell);
         if (hi[a] - lo[a] > 6) hi[a] = lo[a] + 6; /* callers keep r <= 3 cells */
     }
-    uint32_t seen[MAX_CELLS];
+    uint32_t seen[FV_PHOTON_MAX_CELLS];
     int nseen = 0;
-    float r2 = r * r;
     for (int z = lo[2]; z <= hi[2]; z++)
         for (int y = lo[1]; y <= hi[1]; y++)
             for (int xx = lo[0]; xx <= hi[0]; xx++) {
@@ -113,48 +179,74 @@ static void visit_box(const fv_photon_map *m, fv_vec3 x, float r, bucket_fn fn, 
                 for (int j = 0; j < nseen && !dup; j++) dup = seen[j] == b;
                 if (dup) continue;
                 seen[nseen++] = b;
-                for (uint32_t i = m->start[b]; i < m->start[b + 1]; i++) {
-                    fv_vec3 d = fv_sub(m->p[i].pos, x);
-                    float d2 = fv_dot(d, d);
-                    if (d2 <= r2 && !fn(ctx, &m->p[i], i, d2)) return;
-                }
+                if (m->start[b] == m->start[b + 1]) continue;
+                q->lo[q->nranges] = m->start[b];
+                q->hi[q->nranges++] = m->start[b + 1];
             }
+    if (q->nranges > 0) q->i = q->lo[0];
 }
 
-typedef struct query_ctx {
-    fv_photon_fn fn;
-    void *ctx;
-} query_ctx;
-
-static bool query_visit(void *ctx, const fv_photon *ph, uint32_t index, float d2)
+int fv_photon_query_next(fv_photon_query *q, uint32_t *idx, int cap)
 {
-    (void)index;
-    query_ctx *q = ctx;
-    q->fn(q->ctx, ph, d2);
-    return true;
+    const fv_photon_map *m = q->m;
+    const float x = q->x.x, y = q->x.y, z = q->x.z, r2 = q->r2;
+    int n = 0;
+    while (q->range < q->nranges && n + FV_PHOTON_BLOCK <= cap) {
+        const uint32_t i = q->i, end = q->hi[q->range];
+        /* The distance test of FV_PHOTON_BLOCK photons at once (the compiler vectorises this loop;
+         * the arithmetic is the scalar d = p - x, d.d of before, so the same photons pass). */
+        float d2[FV_PHOTON_BLOCK];
+        for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
+            float dx = m->px[i + k] - x, dy = m->py[i + k] - y, dz = m->pz[i + k] - z;
+            d2[k] = dx * dx + dy * dy + dz * dz;
+        }
+        const int len = end - i < FV_PHOTON_BLOCK ? (int)(end - i) : FV_PHOTON_BLOCK;
+        for (int k = 0; k < len; k++) {
+            idx[n] = i + (uint32_t)k;
+            n += d2[k] <= r2;
+        }
+        if (i + (uint32_t)len < end) {
+            q->i = i + (uint32_t)len;
+        } else if (++q->range < q->nranges) {
+            q->i = q->lo[q->range];
+        }
+    }
+    return n;
+}
+
+static inline float photon_d2(const fv_photon_map *m, uint32_t i, fv_vec3 x)
+{
+    float dx = m->px[i] - x.x, dy = m->py[i] - x.y, dz = m->pz[i] - x.z;
+    return dx * dx + dy * dy + dz * dz;
 }
 
 void fv_photon_map_query(const fv_photon_map *m, fv_vec3 x, float r, fv_photon_fn fn, void *ctx)
 {
-    if (m->nbuckets == 0 || m->n == 0) return;
-    query_ctx q = {fn, ctx};
-    visit_box(m, x, r, query_visit, &q);
+    fv_photon_query q;
+    uint32_t idx[64];
+    int k;
+    fv_photon_query_begin(&q, m, x, r);
+    while ((k = fv_photon_query_next(&q, idx, 64)) > 0)
+        for (int j = 0; j < k; j++) fn(ctx, &m->p[idx[j]], photon_d2(m, idx[j], x));
 }
 
-typedef struct nearest_ctx {
-    fv_vec3 n;
-    float best;
-    int index;
-} nearest_ctx;
-
-static bool nearest_visit(void *ctx, const fv_photon *ph, uint32_t index, float d2)
+/* The nearest photon in query order (ties: the first met). */
+static int nearest_within(const fv_photon_map *m, fv_vec3 x, fv_vec3 n, float r, float *best)
 {
-    nearest_ctx *c = ctx;
-    if (d2 < c->best && fv_dot(ph->n, c->n) > 0.5f) {
-        c->best = d2;
-        c->index = (int)index;
-    }
-    return true;
+    fv_photon_query q;
+    uint32_t idx[64];
+    int k, index = -1;
+    *best = INFINITY;
+    fv_photon_query_begin(&q, m, x, r);
+    while ((k = fv_photon_query_next(&q, idx, 64)) > 0)
+        for (int j = 0; j < k; j++) {
+            float d2 = photon_d2(m, idx[j], x);
+            if (d2 < *best && fv_dot(m->p[idx[j]].n, n) > 0.5f) {
+                *best = d2;
+                index = (int)idx[j];
+            }
+        }
+    return index;
 }
 
 int fv_photon_map_nearest(const fv_photon_map *m, fv_vec3 x, fv_vec3 n, float r, float *d2_out)
@@ -162,15 +254,12 @@ int fv_photon_map_nearest(const fv_photon_map *m, fv_vec3 x, fv_vec3 n, float r,
     if (m->nbuckets == 0 || m->n == 0) return -1;
     /* The nearest photon is usually close: look within a small radius first; a hit there is the
      * nearest overall because every photon within that radius was examined. */
-    nearest_ctx c = {n, INFINITY, -1};
+    float best;
     float r0 = fminf(r, 0.25f * m->cell);
-    visit_box(m, x, r0, nearest_visit, &c);
-    if (c.index < 0 && r > r0) {
-        c.best = INFINITY;
-        visit_box(m, x, r, nearest_visit, &c);
-    }
-    if (d2_out) *d2_out = c.best;
-    return c.index;
+    int index = nearest_within(m, x, n, r0, &best);
+    if (index < 0 && r > r0) index = nearest_within(m, x, n, r, &best);
+    if (d2_out) *d2_out = best;
+    return index;
 }
 
 float fv_photon_radius_eq8(fv_vec3 lo, fv_vec3 hi, int width, int height)

@@ -29,9 +29,31 @@ typedef struct fv_photon_map {
     uint32_t mask;         /* buckets - 1 */
     uint32_t *start;       /* buckets + 1 offsets into p */
     uint32_t nbuckets;
+    /* The positions of p again, one array per axis (SoA) and padded by FV_PHOTON_BLOCK: a query
+     * tests distances a block at a time without loading the rest of each photon. */
+    float *px, *py, *pz;
+    int soa_cap;
     fv_photon *scratch;
     int scratch_cap;
+    uint32_t *key;         /* build scratch: each photon's bucket */
+    int key_cap;
 } fv_photon_map;
+
+/* Photons a query tests at once (one pass of the distance test over the SoA positions). */
+#define FV_PHOTON_BLOCK 8
+/* Cells a query may visit: 7^3 (r up to 3 cells). */
+#define FV_PHOTON_MAX_CELLS 343
+
+/* A query in progress: the index ranges of p to test, in the order they are summed, and how far
+ * the test has got. */
+typedef struct fv_photon_query {
+    const fv_photon_map *m;
+    fv_vec3 x;
+    float r2;
+    int nranges, range;
+    uint32_t i;
+    uint32_t lo[FV_PHOTON_MAX_CELLS], hi[FV_PHOTON_MAX_CELLS];
+} fv_photon_query;
 
 void fv_photon_map_init(fv_photon_map *m);
 void fv_photon_map_free(fv_photon_map *m);
@@ -40,8 +62,20 @@ void fv_photon_map_clear(fv_photon_map *m);
 fv_status fv_photon_map_push(fv_photon_map *m, const fv_photon *ph, fv_error *err);
 fv_status fv_photon_map_append(fv_photon_map *m, const fv_photon *ph, int count, fv_error *err);
 /* Sorts the photons into the grid of cell size `cell` (queries may reach up to 3 cells; about the
- * gather radius is best). O(n). */
+ * gather radius is best). O(n), on up to `threads` threads (fv_thread_count; fv_photon_map_build:
+ * all); the result does not depend on the thread count. */
+fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_error *err);
 fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err);
+
+/* Every photon within radius r (r <= 3 cells) of x, in a fixed order (the order sums over them
+ * are taken in), without callbacks:
+ *     fv_photon_query q;  uint32_t idx[64];  int k;
+ *     fv_photon_query_begin(&q, m, x, r);
+ *     while ((k = fv_photon_query_next(&q, idx, 64)) > 0) ... m->p[idx[j]] for j < k ...
+ * next fills idx with up to cap (>= FV_PHOTON_BLOCK) indices into m->p and returns how many; 0 once
+ * all are found. */
+void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x, float r);
+int fv_photon_query_next(fv_photon_query *q, uint32_t *idx, int cap);
 
 /* Calls fn for every photon within radius r (r <= 3 cell) of x. */
 typedef void (*fv_photon_fn)(void *ctx, const fv_photon *ph, float d2);
