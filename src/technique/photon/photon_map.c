@@ -193,20 +193,25 @@ int fv_photon_query_next(fv_photon_query *q, uint32_t *idx, int cap)
     int n = 0;
     while (q->range < q->nranges && n + FV_PHOTON_BLOCK <= cap) {
         const uint32_t i = q->i, end = q->hi[q->range];
+        const float *X = m->px + i, *Y = m->py + i, *Z = m->pz + i;
         /* The distance test of FV_PHOTON_BLOCK photons at once (the compiler vectorises this loop;
-         * the arithmetic is the scalar d = p - x, d.d of before, so the same photons pass). */
+         * the arithmetic is the scalar d = p - x, d.d of before, so the same photons pass), as a
+         * bit mask whose set bits are then listed in order. */
         float d2[FV_PHOTON_BLOCK];
         for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
-            float dx = m->px[i + k] - x, dy = m->py[i + k] - y, dz = m->pz[i + k] - z;
+            float dx = X[k] - x, dy = Y[k] - y, dz = Z[k] - z;
             d2[k] = dx * dx + dy * dy + dz * dz;
         }
-        const int len = end - i < FV_PHOTON_BLOCK ? (int)(end - i) : FV_PHOTON_BLOCK;
-        for (int k = 0; k < len; k++) {
-            idx[n] = i + (uint32_t)k;
-            n += d2[k] <= r2;
+        unsigned pass = 0;
+        for (int k = 0; k < FV_PHOTON_BLOCK; k++) pass |= (unsigned)(d2[k] <= r2) << k;
+        const uint32_t len = end - i < FV_PHOTON_BLOCK ? end - i : FV_PHOTON_BLOCK;
+        pass &= (1u << len) - 1u;
+        while (pass) {
+            idx[n++] = i + (uint32_t)__builtin_ctz(pass);
+            pass &= pass - 1u;
         }
-        if (i + (uint32_t)len < end) {
-            q->i = i + (uint32_t)len;
+        if (i + len < end) {
+            q->i = i + len;
         } else if (++q->range < q->nranges) {
             q->i = q->lo[q->range];
         }
