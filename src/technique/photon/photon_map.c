@@ -1,4 +1,4 @@
-/* fovea — photon maps in a hashed, sorted uniform grid (see photon_map.h). */
+/* fovea — photon maps in a dense, sorted uniform grid (see photon_map.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,7 +22,7 @@ void fv_photon_map_free(fv_photon_map *m)
 void fv_photon_map_clear(fv_photon_map *m)
 {
     m->n = 0;
-    m->nbuckets = 0;
+    m->ncells = 0;
 }
 
 fv_status fv_photon_map_append(fv_photon_map *m, const fv_photon *ph, int count, fv_error *err)
@@ -32,26 +32,35 @@ fv_status fv_photon_map_append(fv_photon_map *m, const fv_photon *ph, int count,
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory storing %d photons", m->n + count);
     memcpy(m->p + m->n, ph, (size_t)count * sizeof *ph);
     m->n += count;
-    m->nbuckets = 0; /* the grid is stale until the next build */
+    m->ncells = 0; /* the grid is stale until the next build */
     return FV_OK;
 }
 
 fv_status fv_photon_map_push(fv_photon_map *m, const fv_photon *ph, fv_error *err) { return fv_photon_map_append(m, ph, 1, err); }
 
-static inline int cell_coord(float v, float inv) { return (int)floorf(v * inv); }
-
-static inline uint32_t cell_hash(int x, int y, int z, uint32_t mask)
+/* The cell of coordinate v; clamped so that no position, however far (or NaN), overflows an int. */
+static inline int cell_coord(float v, float inv)
 {
-    uint32_t h = (uint32_t)x * 73856093u ^ (uint32_t)y * 19349663u ^ (uint32_t)z * 83492791u;
-    h ^= h >> 13;
-    h *= 0x5bd1e995u;
-    h ^= h >> 15;
-    return h & mask;
+    float c = floorf(v * inv);
+    return (int)fminf(fmaxf(c, -1073741824.0f), 1073741824.0f);
 }
 
-static inline uint32_t photon_bucket(const fv_photon_map *m, fv_vec3 p)
+/* Where the cells c of one axis are stored: c - org, modulo dim on a wrapped axis. */
+static inline long long axis_slot(const fv_photon_map *m, int a, long long c)
 {
-    return cell_hash(cell_coord(p.x, m->inv_cell), cell_coord(p.y, m->inv_cell), cell_coord(p.z, m->inv_cell), m->mask);
+    long long r = c - m->org[a];
+    if (m->wrap[a]) {
+        r %= m->dim[a];
+        if (r < 0) r += m->dim[a];
+    }
+    return r;
+}
+
+static inline uint32_t photon_cell(const fv_photon_map *m, fv_vec3 p)
+{
+    long long x = axis_slot(m, 0, cell_coord(p.x, m->inv_cell)), y = axis_slot(m, 1, cell_coord(p.y, m->inv_cell)),
+              z = axis_slot(m, 2, cell_coord(p.z, m->inv_cell));
+    return (uint32_t)((z * m->dim[1] + y) * m->dim[0] + x);
 }
 
 /* Room for the sorted copy, the SoA positions (padded: a block may read past the last photon)
@@ -83,49 +92,88 @@ static fv_status reserve(fv_photon_map *m, fv_error *err)
     return FV_OK;
 }
 
+/* The grid's extent: the cells the photons occupy; axes wrap while there are more than `limit`
+ * cells (the memory of the old hashed grid, about two buckets per photon). */
+static void grid_extent(fv_photon_map *m, int nt)
+{
+    int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+    const int n = m->n;
+    #pragma omp parallel num_threads(nt)
+    {
+        int l[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, h[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+        #pragma omp for schedule(static) nowait
+        for (int i = 0; i < n; i++) {
+            const int c[3] = {cell_coord(m->p[i].pos.x, m->inv_cell), cell_coord(m->p[i].pos.y, m->inv_cell),
+                              cell_coord(m->p[i].pos.z, m->inv_cell)};
+            for (int a = 0; a < 3; a++) {
+                if (c[a] < l[a]) l[a] = c[a];
+                if (c[a] > h[a]) h[a] = c[a];
+            }
+        }
+        #pragma omp critical
+        for (int a = 0; a < 3; a++) {
+            if (l[a] < lo[a]) lo[a] = l[a];
+            if (h[a] > hi[a]) hi[a] = h[a];
+        }
+    }
+    long long d[3];
+    for (int a = 0; a < 3; a++) {
+        if (n == 0) lo[a] = hi[a] = 0;
+        m->org[a] = lo[a];
+        d[a] = (long long)hi[a] - lo[a] + 1;
+        m->wrap[a] = false;
+    }
+    const long long limit = n < 512 ? 1024 : n < (1 << 25) ? 2LL * n : 1LL << 26;
+    while (d[0] * d[1] * d[2] > limit) {
+        int a = d[0] >= d[1] && d[0] >= d[2] ? 0 : d[1] >= d[2] ? 1 : 2;
+        if (d[a] <= 7) break;
+        d[a] = d[a] / 2 > 7 ? d[a] / 2 : 7;
+        m->wrap[a] = true;
+    }
+    for (int a = 0; a < 3; a++) m->dim[a] = (int)d[a];
+}
+
 fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_error *err)
 {
     if (!(cell > 0.0f) || !isfinite(cell)) return fv_error_set(err, FV_ERR_INVALID, "photon grid: cell size %g must be positive", cell);
     m->cell = cell;
     m->inv_cell = 1.0f / cell;
-    /* About two buckets per photon keeps chains short; at least 1024. */
-    uint32_t nb = 1024;
-    while (nb < (uint32_t)m->n * 2u && nb < (1u << 26)) nb <<= 1;
-    uint32_t *start = realloc(m->start, ((size_t)nb + 1) * sizeof *start);
+    m->ncells = 0;
+    int nt = fv_thread_count(threads);
+    if (nt > 1 && m->n < 65536) nt = 1; /* not worth waking threads */
+    grid_extent(m, nt);
+    const uint32_t nc = (uint32_t)m->dim[0] * (uint32_t)m->dim[1] * (uint32_t)m->dim[2];
+    uint32_t *start = realloc(m->start, ((size_t)nc + 1) * sizeof *start);
     if (!start) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
     m->start = start;
     fv_status rc = reserve(m, err);
     if (rc != FV_OK) return rc;
-    m->mask = nb - 1;
-    m->nbuckets = nb;
-    /* A stable counting sort by bucket, in parallel: each thread counts the buckets of its own
-     * contiguous share of the photons, every (bucket, thread) pair gets its offset in bucket-major,
-     * thread-minor order, and each thread scatters its share in order. So the photons of a bucket
+    /* A stable counting sort by cell, in parallel: each thread counts the cells of its own
+     * contiguous share of the photons, every (cell, thread) pair gets its offset in cell-major,
+     * thread-minor order, and each thread scatters its share in order. So the photons of a cell
      * stay in the order they were stored, whatever the thread count. */
-    int nt = fv_thread_count(threads);
-    if (nt > 1 && m->n < 65536) nt = 1; /* not worth waking threads */
-    uint32_t *count = fv_calloc_array((size_t)nb * (size_t)nt, sizeof *count);
+    uint32_t *count = fv_calloc_array((size_t)nc * (size_t)nt, sizeof *count);
     if (!count) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
     const int n = m->n;
     #pragma omp parallel num_threads(nt)
     {
         const int t = omp_get_thread_num(), T = omp_get_num_threads();
         const int i0 = (int)((int64_t)n * t / T), i1 = (int)((int64_t)n * (t + 1) / T);
-        uint32_t *cnt = count + (size_t)t * nb;
-        for (int i = i0; i < i1; i++) cnt[m->key[i] = photon_bucket(m, m->p[i].pos)]++;
+        uint32_t *cnt = count + (size_t)t * nc;
+        for (int i = i0; i < i1; i++) cnt[m->key[i] = photon_cell(m, m->p[i].pos)]++;
         #pragma omp barrier
         #pragma omp single
         {
             uint32_t sum = 0;
-            for (uint32_t b = 0; b < nb; b++) {
+            for (uint32_t b = 0; b < nc; b++) {
                 start[b] = sum;
                 for (int k = 0; k < T; k++) {
-                    uint32_t c = count[(size_t)k * nb + b];
-                    count[(size_t)k * nb + b] = sum;
+                    uint32_t c = count[(size_t)k * nc + b];
+                    count[(size_t)k * nc + b] = sum;
                     sum += c;
                 }
             }
-            start[nb] = sum;
+            start[nc] = sum;
         }
         for (int i = i0; i < i1; i++) {
             uint32_t d = cnt[m->key[i]]++;
@@ -145,14 +193,25 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
     m->cap = m->scratch_cap;
     m->scratch = tp;
     m->scratch_cap = tc;
+    m->ncells = nc;
     return FV_OK;
 }
 
 fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err) { return fv_photon_map_build_mt(m, cell, 0, err); }
 
-/* The ranges of p to test: every bucket holding cells that overlap the box [x - r, x + r]^3,
- * once (two cells hashed to one bucket must not count its photons twice), in the order the cells
- * are first met, z then y then x. */
+/* The slots of the cells lo..hi of axis a that the grid holds, in order; their count. */
+static int axis_slots(const fv_photon_map *m, int a, int lo, int hi, int *out)
+{
+    int k = 0;
+    for (long long c = lo; c <= hi; c++) {
+        long long r = axis_slot(m, a, c);
+        if (r >= 0 && r < m->dim[a]) out[k++] = (int)r;
+    }
+    return k;
+}
+
+/* The ranges of p to test: the cells overlapping the box [x - r, x + r]^3, z then y then x, a row
+ * of consecutive slots along x being one contiguous range of p. */
 void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x, float r)
 {
     q->m = m;
@@ -161,7 +220,7 @@ void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x
     q->nranges = 0;
     q->range = 0;
     q->i = 0;
-    if (m->nbuckets == 0 || m->n == 0) return;
+    if (m->ncells == 0 || m->n == 0) return;
     int lo[3], hi[3];
     const float c[3] = {x.x, x.y, x.z};
     for (int a = 0; a < 3; a++) {
@@ -169,20 +228,22 @@ void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x
         hi[a] = cell_coord(c[a] + r, m->inv_cell);
         if (hi[a] - lo[a] > 6) hi[a] = lo[a] + 6; /* callers keep r <= 3 cells */
     }
-    uint32_t seen[FV_PHOTON_MAX_CELLS];
-    int nseen = 0;
-    for (int z = lo[2]; z <= hi[2]; z++)
-        for (int y = lo[1]; y <= hi[1]; y++)
-            for (int xx = lo[0]; xx <= hi[0]; xx++) {
-                uint32_t b = cell_hash(xx, y, z, m->mask);
-                bool dup = false;
-                for (int j = 0; j < nseen && !dup; j++) dup = seen[j] == b;
-                if (dup) continue;
-                seen[nseen++] = b;
-                if (m->start[b] == m->start[b + 1]) continue;
-                q->lo[q->nranges] = m->start[b];
-                q->hi[q->nranges++] = m->start[b + 1];
+    int sx[7], sy[7], sz[7];
+    const int nx = axis_slots(m, 0, lo[0], hi[0], sx), ny = axis_slots(m, 1, lo[1], hi[1], sy), nz = axis_slots(m, 2, lo[2], hi[2], sz);
+    for (int k = 0; k < nz; k++)
+        for (int j = 0; j < ny; j++) {
+            const uint32_t row = ((uint32_t)sz[k] * (uint32_t)m->dim[1] + (uint32_t)sy[j]) * (uint32_t)m->dim[0];
+            for (int i = 0; i < nx;) {
+                int e = i + 1;
+                while (e < nx && sx[e] == sx[e - 1] + 1) e++; /* a run of consecutive slots */
+                const uint32_t b = m->start[row + (uint32_t)sx[i]], f = m->start[row + (uint32_t)sx[e - 1] + 1];
+                if (b < f) {
+                    q->lo[q->nranges] = b;
+                    q->hi[q->nranges++] = f;
+                }
+                i = e;
             }
+        }
     if (q->nranges > 0) q->i = q->lo[0];
 }
 
@@ -256,7 +317,7 @@ static int nearest_within(const fv_photon_map *m, fv_vec3 x, fv_vec3 n, float r,
 
 int fv_photon_map_nearest(const fv_photon_map *m, fv_vec3 x, fv_vec3 n, float r, float *d2_out)
 {
-    if (m->nbuckets == 0 || m->n == 0) return -1;
+    if (m->ncells == 0 || m->n == 0) return -1;
     /* The nearest photon is usually close: look within a small radius first; a hit there is the
      * nearest overall because every photon within that radius was examined. */
     float best;

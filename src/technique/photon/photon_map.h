@@ -3,13 +3,15 @@
  * Foveated Photon Mapping (Sec. 3) keeps four maps (light/foveated x static/dynamic); a photon
  * has a direction, a signed RGB flux and a position (and the map remembers the surface normal to
  * keep photons from leaking through thin walls). The paper stores maps in sorted uniform grids
- * rather than kd-trees because they rebuild in linear time; so do we: cells are hashed into a
- * table of 2^k buckets (memory independent of the scene's extent), photons are counting-sorted by
- * bucket, and a query visits the neighbouring cells.
+ * rather than kd-trees because they rebuild in linear time; so do we: photons are counting-sorted
+ * by cell into a dense grid over their bounding box (at most about two cells per photon: axes wrap
+ * beyond that), positions are also kept apart (SoA) for the distance test, and a query tests the
+ * photons of its neighbouring cells, one contiguous range per row of cells along x.
  */
 #ifndef FV_PHOTON_MAP_H
 #define FV_PHOTON_MAP_H
 
+#include <stdbool.h>
 #include <stdint.h>
 #include "fovea/math.h"
 #include "fovea/status.h"
@@ -22,13 +24,17 @@ typedef struct fv_photon {
 } fv_photon;
 
 typedef struct fv_photon_map {
-    fv_photon *p;          /* after fv_photon_map_build: sorted by grid bucket */
+    fv_photon *p;          /* after fv_photon_map_build: sorted by grid cell */
     int n, cap;
-    /* grid */
+    /* grid: cell (i, j, k) covers [i, i + 1) x [j, j + 1) x [k, k + 1) times `cell`; the cells
+     * from org to org + dim - 1 are stored densely, x fastest. An axis whose extent would make the
+     * grid too big wraps: it keeps dim (>= 7) cells and cell c is stored at (c - org) mod dim, so
+     * the up to 7 cells a query spans on it stay distinct. */
     float cell, inv_cell;
-    uint32_t mask;         /* buckets - 1 */
-    uint32_t *start;       /* buckets + 1 offsets into p */
-    uint32_t nbuckets;
+    int org[3], dim[3];
+    bool wrap[3];
+    uint32_t *start;       /* ncells + 1 offsets into p */
+    uint32_t ncells;       /* 0: not built */
     /* The positions of p again, one array per axis (SoA) and padded by FV_PHOTON_BLOCK: a query
      * tests distances a block at a time without loading the rest of each photon. */
     float *px, *py, *pz;
@@ -41,8 +47,9 @@ typedef struct fv_photon_map {
 
 /* Photons a query tests at once (one pass of the distance test over the SoA positions). */
 #define FV_PHOTON_BLOCK 8
-/* Cells a query may visit: 7^3 (r up to 3 cells). */
-#define FV_PHOTON_MAX_CELLS 343
+/* Index ranges a query may test: a row of up to 7 cells along x is one range (two where x wraps),
+ * for each of up to 7 x 7 rows (r up to 3 cells). */
+#define FV_PHOTON_MAX_RANGES 98
 
 /* A query in progress: the index ranges of p to test, in the order they are summed, and how far
  * the test has got. */
@@ -52,7 +59,7 @@ typedef struct fv_photon_query {
     float r2;
     int nranges, range;
     uint32_t i;
-    uint32_t lo[FV_PHOTON_MAX_CELLS], hi[FV_PHOTON_MAX_CELLS];
+    uint32_t lo[FV_PHOTON_MAX_RANGES], hi[FV_PHOTON_MAX_RANGES];
 } fv_photon_query;
 
 void fv_photon_map_init(fv_photon_map *m);
