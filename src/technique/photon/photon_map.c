@@ -3,6 +3,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <omp.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "technique/photon/photon_map.h"
@@ -247,36 +250,54 @@ void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x
     if (q->nranges > 0) q->i = q->lo[0];
 }
 
-int fv_photon_query_next(fv_photon_query *q, uint32_t *idx, int cap)
+/* Bit k set when photon i + k lies within the query (d2 <= r2), for k < FV_PHOTON_BLOCK. The
+ * arithmetic is the scalar one, (dx dx + dy dy) + dz dz per photon, so the same photons pass
+ * whichever branch compiles; SSE2 (every x86-64) tests four at a time. */
+static inline unsigned block_mask(const fv_photon_map *m, uint32_t i, float x, float y, float z, float r2)
+{
+    const float *X = m->px + i, *Y = m->py + i, *Z = m->pz + i;
+#if defined(__SSE2__)
+    const __m128 vx = _mm_set1_ps(x), vy = _mm_set1_ps(y), vz = _mm_set1_ps(z), vr = _mm_set1_ps(r2);
+    unsigned mask = 0;
+    for (int k = 0; k < FV_PHOTON_BLOCK; k += 4) {
+        __m128 dx = _mm_sub_ps(_mm_loadu_ps(X + k), vx), dy = _mm_sub_ps(_mm_loadu_ps(Y + k), vy), dz = _mm_sub_ps(_mm_loadu_ps(Z + k), vz);
+        __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+        mask |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(d2, vr)) << k;
+    }
+    return mask;
+#else
+    unsigned mask = 0;
+    for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
+        float dx = X[k] - x, dy = Y[k] - y, dz = Z[k] - z;
+        mask |= (unsigned)(dx * dx + dy * dy + dz * dz <= r2) << k;
+    }
+    return mask;
+#endif
+}
+
+int fv_photon_query_next(fv_photon_query *q, uint32_t *restrict idx, int cap)
 {
     const fv_photon_map *m = q->m;
     const float x = q->x.x, y = q->x.y, z = q->x.z, r2 = q->r2;
-    int n = 0;
-    while (q->range < q->nranges && n + FV_PHOTON_BLOCK <= cap) {
-        const uint32_t i = q->i, end = q->hi[q->range];
-        const float *X = m->px + i, *Y = m->py + i, *Z = m->pz + i;
-        /* The distance test of FV_PHOTON_BLOCK photons at once (the compiler vectorises this loop;
-         * the arithmetic is the scalar d = p - x, d.d of before, so the same photons pass), as a
-         * bit mask whose set bits are then listed in order. */
-        float d2[FV_PHOTON_BLOCK];
-        for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
-            float dx = X[k] - x, dy = Y[k] - y, dz = Z[k] - z;
-            d2[k] = dx * dx + dy * dy + dz * dz;
+    int n = 0, range = q->range;
+    uint32_t i = q->i;
+    while (range < q->nranges) {
+        const uint32_t end = q->hi[range];
+        while (i < end) {
+            if (n + FV_PHOTON_BLOCK > cap) goto full;
+            const uint32_t len = end - i < FV_PHOTON_BLOCK ? end - i : FV_PHOTON_BLOCK;
+            unsigned pass = block_mask(m, i, x, y, z, r2) & ((1u << len) - 1u);
+            while (pass) { /* the passing photons, in order */
+                idx[n++] = i + (uint32_t)__builtin_ctz(pass);
+                pass &= pass - 1u;
+            }
+            i += len;
         }
-        unsigned pass = 0;
-        for (int k = 0; k < FV_PHOTON_BLOCK; k++) pass |= (unsigned)(d2[k] <= r2) << k;
-        const uint32_t len = end - i < FV_PHOTON_BLOCK ? end - i : FV_PHOTON_BLOCK;
-        pass &= (1u << len) - 1u;
-        while (pass) {
-            idx[n++] = i + (uint32_t)__builtin_ctz(pass);
-            pass &= pass - 1u;
-        }
-        if (i + len < end) {
-            q->i = i + len;
-        } else if (++q->range < q->nranges) {
-            q->i = q->lo[q->range];
-        }
+        if (++range < q->nranges) i = q->lo[range];
     }
+full:
+    q->range = range;
+    q->i = i;
     return n;
 }
 

@@ -82,7 +82,7 @@ fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err);
  * next fills idx with up to cap (>= FV_PHOTON_BLOCK) indices into m->p and returns how many; 0 once
  * all are found. */
 void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x, float r);
-int fv_photon_query_next(fv_photon_query *q, uint32_t *idx, int cap);
+int fv_photon_query_next(fv_photon_query *q, uint32_t *restrict idx, int cap);
 
 /* Calls fn for every photon within radius r (r <= 3 cell) of x. */
 typedef void (*fv_photon_fn)(void *ctx, const fv_photon *ph, float d2);
