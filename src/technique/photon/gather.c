@@ -73,22 +73,16 @@ fv_vec3 fv_pm_gather(const fv_scene *s, const fv_photon_map *m, const fv_pm_hit 
     uint32_t idx[128];
     int k;
     fv_photon_query_begin(&q, m, x->p, r);
+    /* Photons on another surface (the other side of a thin wall, a nearby perpendicular face)
+     * would leak light: keep those whose surface faces the same way, arriving from above (wi's z
+     * in the shading frame > 0). The query makes both tests; then the sums, each a loop of its
+     * own (short dependency chains, few registers). */
+    fv_photon_query_facing(&q, sh.n);
     while ((k = fv_photon_query_next(&q, idx, 128)) > 0) {
-        /* Photons on another surface (the other side of a thin wall, a nearby perpendicular face)
-         * would leak light: keep those whose surface faces the same way, arriving from above. The
-         * survivors go back into idx, in order; then the sums, each a loop of its own (short
-         * dependency chains, few registers). */
-        int kept = 0;
-        for (int j = 0; j < k; j++) {
-            const fv_photon *ph = &m->p[idx[j]];
-            if (fv_dot(ph->n, sh.n) <= 0.5f) continue;
-            if (fv_dot(fv_neg(ph->dir), sh.n) <= 0.0f) continue; /* wi's z in the shading frame */
-            idx[kept++] = idx[j];
-        }
         if (diffuse) {
-            for (int j = 0; j < kept; j++) sum = fv_add(sum, fv_mul(f_diffuse, m->p[idx[j]].flux));
+            for (int j = 0; j < k; j++) sum = fv_add(sum, fv_mul(f_diffuse, m->p[idx[j]].flux));
         } else {
-            for (int j = 0; j < kept; j++) {
+            for (int j = 0; j < k; j++) {
                 const fv_photon *ph = &m->p[idx[j]];
                 float pdf;
                 fv_vec3 f = fv_bsdf_eval(mat, sh.wo, fv_shading_to_local(&sh, fv_neg(ph->dir)), &pdf);
@@ -96,7 +90,7 @@ fv_vec3 fv_pm_gather(const fv_scene *s, const fv_photon_map *m, const fv_pm_hit 
             }
         }
         if (u_sum)
-            for (int j = 0; j < kept; j++) u += max_abs3(m->p[idx[j]].flux);
+            for (int j = 0; j < k; j++) u += max_abs3(m->p[idx[j]].flux);
     }
     if (u_sum) *u_sum += u;
     return sum;

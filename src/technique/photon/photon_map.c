@@ -84,14 +84,14 @@ static fv_status reserve(fv_photon_map *m, fv_error *err)
         m->key_cap = n;
     }
     if (m->soa_cap < n) {
-        float *a = realloc(m->px, 3 * ((size_t)n + FV_PHOTON_BLOCK) * sizeof *a);
+        float *a = realloc(m->px, 9 * ((size_t)n + FV_PHOTON_BLOCK) * sizeof *a);
         if (!a) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
         m->px = a;
         m->soa_cap = n;
     }
     size_t stride = (size_t)m->soa_cap + FV_PHOTON_BLOCK;
-    m->py = m->px + stride;
-    m->pz = m->py + stride;
+    float **arr[9] = {&m->px, &m->py, &m->pz, &m->nx, &m->ny, &m->nz, &m->wx, &m->wy, &m->wz};
+    for (int k = 1; k < 9; k++) *arr[k] = m->px + (size_t)k * stride;
     return FV_OK;
 }
 
@@ -185,11 +185,20 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
             m->px[d] = ph->pos.x;
             m->py[d] = ph->pos.y;
             m->pz[d] = ph->pos.z;
+            m->nx[d] = ph->n.x;
+            m->ny[d] = ph->n.y;
+            m->nz[d] = ph->n.z;
+            m->wx[d] = -ph->dir.x;
+            m->wy[d] = -ph->dir.y;
+            m->wz[d] = -ph->dir.z;
         }
     }
     free(count);
     /* Padding far away: a block reading past the last photon never accepts it. */
-    for (int k = 0; k < FV_PHOTON_BLOCK; k++) m->px[n + k] = m->py[n + k] = m->pz[n + k] = INFINITY;
+    for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
+        m->px[n + k] = m->py[n + k] = m->pz[n + k] = INFINITY;
+        m->nx[n + k] = m->ny[n + k] = m->nz[n + k] = m->wx[n + k] = m->wy[n + k] = m->wz[n + k] = 0.0f;
+    }
     fv_photon *tp = m->p;
     int tc = m->cap;
     m->p = m->scratch;
@@ -220,6 +229,7 @@ void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x
     q->m = m;
     q->x = x;
     q->r2 = r * r;
+    q->facing = false;
     q->nranges = 0;
     q->range = 0;
     q->i = 0;
@@ -250,11 +260,19 @@ void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x
     if (q->nranges > 0) q->i = q->lo[0];
 }
 
-/* Bit k set when photon i + k lies within the query (d2 <= r2), for k < FV_PHOTON_BLOCK. The
- * arithmetic is the scalar one, (dx dx + dy dy) + dz dz per photon, so the same photons pass
- * whichever branch compiles; SSE2 (every x86-64) tests four at a time. */
-static inline unsigned block_mask(const fv_photon_map *m, uint32_t i, float x, float y, float z, float r2)
+void fv_photon_query_facing(fv_photon_query *q, fv_vec3 n)
 {
+    q->facing = true;
+    q->n = n;
+}
+
+/* Bit k set when photon i + k passes the query: d2 <= r2, and with q->facing !(n . N <= 0.5) and
+ * !(w . N <= 0) (w = -dir), the comparisons of the scalar gather, NaN included. The arithmetic is
+ * the scalar one too, (a x b x + a y b y) + a z b z, so the same photons pass whichever branch
+ * compiles; SSE2 (every x86-64) tests four at a time. */
+static inline unsigned block_mask(const fv_photon_map *m, const fv_photon_query *q, uint32_t i)
+{
+    const float x = q->x.x, y = q->x.y, z = q->x.z, r2 = q->r2;
     const float *X = m->px + i, *Y = m->py + i, *Z = m->pz + i;
 #if defined(__SSE2__)
     const __m128 vx = _mm_set1_ps(x), vy = _mm_set1_ps(y), vz = _mm_set1_ps(z), vr = _mm_set1_ps(r2);
@@ -264,12 +282,29 @@ static inline unsigned block_mask(const fv_photon_map *m, uint32_t i, float x, f
         __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
         mask |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(d2, vr)) << k;
     }
+    if (q->facing && mask) {
+        const __m128 Nx = _mm_set1_ps(q->n.x), Ny = _mm_set1_ps(q->n.y), Nz = _mm_set1_ps(q->n.z);
+        const __m128 half = _mm_set1_ps(0.5f), zero = _mm_setzero_ps();
+        unsigned face = 0;
+        for (int k = 0; k < FV_PHOTON_BLOCK; k += 4) {
+            __m128 nd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(m->nx + i + k), Nx), _mm_mul_ps(_mm_loadu_ps(m->ny + i + k), Ny)),
+                                   _mm_mul_ps(_mm_loadu_ps(m->nz + i + k), Nz));
+            __m128 wd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(m->wx + i + k), Nx), _mm_mul_ps(_mm_loadu_ps(m->wy + i + k), Ny)),
+                                   _mm_mul_ps(_mm_loadu_ps(m->wz + i + k), Nz));
+            face |= (unsigned)_mm_movemask_ps(_mm_and_ps(_mm_cmpnle_ps(nd, half), _mm_cmpnle_ps(wd, zero))) << k;
+        }
+        mask &= face;
+    }
     return mask;
 #else
     unsigned mask = 0;
     for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
         float dx = X[k] - x, dy = Y[k] - y, dz = Z[k] - z;
-        mask |= (unsigned)(dx * dx + dy * dy + dz * dz <= r2) << k;
+        bool pass = dx * dx + dy * dy + dz * dz <= r2;
+        if (q->facing)
+            pass = pass && !(m->nx[i + k] * q->n.x + m->ny[i + k] * q->n.y + m->nz[i + k] * q->n.z <= 0.5f) &&
+                   !(m->wx[i + k] * q->n.x + m->wy[i + k] * q->n.y + m->wz[i + k] * q->n.z <= 0.0f);
+        mask |= (unsigned)pass << k;
     }
     return mask;
 #endif
@@ -278,7 +313,6 @@ static inline unsigned block_mask(const fv_photon_map *m, uint32_t i, float x, f
 int fv_photon_query_next(fv_photon_query *q, uint32_t *restrict idx, int cap)
 {
     const fv_photon_map *m = q->m;
-    const float x = q->x.x, y = q->x.y, z = q->x.z, r2 = q->r2;
     int n = 0, range = q->range;
     uint32_t i = q->i;
     while (range < q->nranges) {
@@ -286,7 +320,7 @@ int fv_photon_query_next(fv_photon_query *q, uint32_t *restrict idx, int cap)
         while (i < end) {
             if (n + FV_PHOTON_BLOCK > cap) goto full;
             const uint32_t len = end - i < FV_PHOTON_BLOCK ? end - i : FV_PHOTON_BLOCK;
-            unsigned pass = block_mask(m, i, x, y, z, r2) & ((1u << len) - 1u);
+            unsigned pass = block_mask(m, q, i) & ((1u << len) - 1u);
             while (pass) { /* the passing photons, in order */
                 idx[n++] = i + (uint32_t)__builtin_ctz(pass);
                 pass &= pass - 1u;

@@ -35,9 +35,10 @@ typedef struct fv_photon_map {
     bool wrap[3];
     uint32_t *start;       /* ncells + 1 offsets into p */
     uint32_t ncells;       /* 0: not built */
-    /* The positions of p again, one array per axis (SoA) and padded by FV_PHOTON_BLOCK: a query
-     * tests distances a block at a time without loading the rest of each photon. */
-    float *px, *py, *pz;
+    /* Position, normal and -dir (where the photon came from) of p again, one array per component
+     * (SoA), padded by FV_PHOTON_BLOCK: a query tests a block of photons at a time without
+     * loading the rest of each. */
+    float *px, *py, *pz, *nx, *ny, *nz, *wx, *wy, *wz;
     int soa_cap;
     fv_photon *scratch;
     int scratch_cap;
@@ -57,6 +58,8 @@ typedef struct fv_photon_query {
     const fv_photon_map *m;
     fv_vec3 x;
     float r2;
+    bool facing;           /* fv_photon_query_facing was called */
+    fv_vec3 n;
     int nranges, range;
     uint32_t i;
     uint32_t lo[FV_PHOTON_MAX_RANGES], hi[FV_PHOTON_MAX_RANGES];
@@ -83,6 +86,9 @@ fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err);
  * all are found. */
 void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x, float r);
 int fv_photon_query_next(fv_photon_query *q, uint32_t *restrict idx, int cap);
+/* After begin: keep only the photons on a surface facing like n (n_photon . n > 0.5) that arrived
+ * from above it (-dir . n > 0), the gather's tests, made a block at a time. */
+void fv_photon_query_facing(fv_photon_query *q, fv_vec3 n);
 
 /* Calls fn for every photon within radius r (r <= 3 cell) of x. */
 typedef void (*fv_photon_fn)(void *ctx, const fv_photon *ph, float d2);
