@@ -5,8 +5,9 @@
  * keep photons from leaking through thin walls). The paper stores maps in sorted uniform grids
  * rather than kd-trees because they rebuild in linear time; so do we: photons are counting-sorted
  * by cell into a dense grid over their bounding box (at most about two cells per photon: axes wrap
- * beyond that), positions are also kept apart (SoA) for the distance test, and a query tests the
- * photons of its neighbouring cells, one contiguous range per row of cells along x.
+ * beyond that), positions, normals and directions are also kept apart (SoA) for the tests, and a
+ * query tests the photons of its neighbouring cells a block at a time, one contiguous range per
+ * row of cells along x (docs/photon-mapping.md, "The grid and the gather").
  */
 #ifndef FV_PHOTON_MAP_H
 #define FV_PHOTON_MAP_H
@@ -42,11 +43,11 @@ typedef struct fv_photon_map {
     int soa_cap;
     fv_photon *scratch;
     int scratch_cap;
-    uint32_t *key;         /* build scratch: each photon's bucket */
+    uint32_t *key;         /* build scratch: each photon's cell */
     int key_cap;
 } fv_photon_map;
 
-/* Photons a query tests at once (one pass of the distance test over the SoA positions). */
+/* Photons a query tests at once (one pass of the tests over the SoA arrays). */
 #define FV_PHOTON_BLOCK 8
 /* Index ranges a query may test: a row of up to 7 cells along x is one range (two where x wraps),
  * for each of up to 7 x 7 rows (r up to 3 cells). */
