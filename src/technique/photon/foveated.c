@@ -407,8 +407,8 @@ fv_status fv_foveated_trace(fv_foveated *f, const fv_scene *s, const fv_camera *
     for (int id = 0; id < f->cap && rc == FV_OK; id++)
         for (int k = 0; k < f->len[id] && rc == FV_OK; k++) rc = fv_photon_map_push(&f->fs, &f->pool[(size_t)id * f->max_depth + k].p, err);
     if (st) st->photons_static = f->fs.n;
-    if (rc == FV_OK) rc = fv_photon_map_build(&f->fs, cell, err);
-    if (rc == FV_OK) rc = fv_photon_map_build(&f->fd, cell, err);
+    if (rc == FV_OK) rc = fv_photon_map_build_mt(&f->fs, cell, threads, err);
+    if (rc == FV_OK) rc = fv_photon_map_build_mt(&f->fd, cell, threads, err);
     return rc;
 }
 

@@ -52,36 +52,49 @@ void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_r
     }
 }
 
-typedef struct gather_ctx {
-    const fv_material *m;
-    fv_shading sh;
-    fv_vec3 sum;
-    double u;
-} gather_ctx;
-
-static void gather_one(void *user, const fv_photon *ph, float d2)
+/* max(|r|, |g|, |b|) as fmax(fabs(.), ...) of the flux's components: the same value without
+ * libm calls (NaN components lose to the others, as in fmax). */
+static inline float max_abs3(fv_vec3 v)
 {
-    (void)d2;
-    gather_ctx *c = user;
-    /* Photons on another surface (the other side of a thin wall, a nearby perpendicular face)
-     * would leak light: keep those whose surface faces the same way. */
-    if (fv_dot(ph->n, c->sh.n) <= 0.5f) return;
-    fv_vec3 wi_l = fv_shading_to_local(&c->sh, fv_neg(ph->dir));
-    if (wi_l.z <= 0.0f) return;
-    float pdf;
-    fv_vec3 f = fv_bsdf_eval(c->m, c->sh.wo, wi_l, &pdf);
-    c->sum = fv_add(c->sum, fv_mul(f, ph->flux));
-    c->u += fmax(fabs(ph->flux.x), fmax(fabs(ph->flux.y), fabs(ph->flux.z)));
+    float a = fabsf(v.x), b = fabsf(v.y), c = fabsf(v.z);
+    float bc = c > b || isnan(b) ? c : b;
+    return bc > a || isnan(a) ? bc : a;
 }
 
 fv_vec3 fv_pm_gather(const fv_scene *s, const fv_photon_map *m, const fv_pm_hit *x, float r, double *u_sum)
 {
-    gather_ctx c;
-    c.m = fv_scene_material(s, x->mat);
-    fv_shading_make(c.m, x->ng, x->n, x->wo, &c.sh);
-    c.sum = fv_v3s(0.0f);
-    c.u = 0.0;
-    fv_photon_map_query(m, x->p, r, gather_one, &c);
-    if (u_sum) *u_sum += c.u;
-    return c.sum;
+    const fv_material *mat = fv_scene_material(s, x->mat);
+    fv_shading sh;
+    fv_shading_make(mat, x->ng, x->n, x->wo, &sh);
+    /* A diffuse surface's f_r is albedo / pi for every photon arriving from above (the shading
+     * keeps wo above it): fv_bsdf_eval's value, taken once. */
+    const bool diffuse = mat->type == FV_MAT_DIFFUSE;
+    const fv_vec3 f_diffuse = fv_scale(mat->albedo, FV_INV_PI);
+    fv_vec3 sum = fv_v3s(0.0f);
+    double u = 0.0;
+    fv_photon_query q;
+    uint32_t idx[128];
+    int k;
+    fv_photon_query_begin(&q, m, x->p, r);
+    /* Photons on another surface (the other side of a thin wall, a nearby perpendicular face)
+     * would leak light: keep those whose surface faces the same way, arriving from above (wi's z
+     * in the shading frame > 0). The query makes both tests; then the sums, each a loop of its
+     * own (short dependency chains, few registers). */
+    fv_photon_query_facing(&q, sh.n);
+    while ((k = fv_photon_query_next(&q, idx, 128)) > 0) {
+        if (diffuse) {
+            for (int j = 0; j < k; j++) sum = fv_add(sum, fv_mul(f_diffuse, m->p[idx[j]].flux));
+        } else {
+            for (int j = 0; j < k; j++) {
+                const fv_photon *ph = &m->p[idx[j]];
+                float pdf;
+                fv_vec3 f = fv_bsdf_eval(mat, sh.wo, fv_shading_to_local(&sh, fv_neg(ph->dir)), &pdf);
+                sum = fv_add(sum, fv_mul(f, ph->flux));
+            }
+        }
+        if (u_sum)
+            for (int j = 0; j < k; j++) u += max_abs3(m->p[idx[j]].flux);
+    }
+    if (u_sum) *u_sum += u;
+    return sum;
 }

@@ -1,8 +1,13 @@
-/* fovea — photon maps in a hashed, sorted uniform grid (see photon_map.h). */
+/* fovea — photon maps in a dense, sorted uniform grid (see photon_map.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <omp.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include "core/alloc.h"
+#include "core/parallel.h"
 #include "technique/photon/photon_map.h"
 
 void fv_photon_map_init(fv_photon_map *m) { memset(m, 0, sizeof *m); }
@@ -12,13 +17,15 @@ void fv_photon_map_free(fv_photon_map *m)
     free(m->p);
     free(m->start);
     free(m->scratch);
+    free(m->px);
+    free(m->key);
     memset(m, 0, sizeof *m);
 }
 
 void fv_photon_map_clear(fv_photon_map *m)
 {
     m->n = 0;
-    m->nbuckets = 0;
+    m->ncells = 0;
 }
 
 fv_status fv_photon_map_append(fv_photon_map *m, const fv_photon *ph, int count, fv_error *err)
@@ -28,73 +35,210 @@ fv_status fv_photon_map_append(fv_photon_map *m, const fv_photon *ph, int count,
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory storing %d photons", m->n + count);
     memcpy(m->p + m->n, ph, (size_t)count * sizeof *ph);
     m->n += count;
-    m->nbuckets = 0; /* the grid is stale until the next build */
+    m->ncells = 0; /* the grid is stale until the next build */
     return FV_OK;
 }
 
 fv_status fv_photon_map_push(fv_photon_map *m, const fv_photon *ph, fv_error *err) { return fv_photon_map_append(m, ph, 1, err); }
 
-static inline int cell_coord(float v, float inv) { return (int)floorf(v * inv); }
-
-static inline uint32_t cell_hash(int x, int y, int z, uint32_t mask)
+/* The cell of coordinate v; clamped so that no position, however far (or NaN), overflows an int. */
+static inline int cell_coord(float v, float inv)
 {
-    uint32_t h = (uint32_t)x * 73856093u ^ (uint32_t)y * 19349663u ^ (uint32_t)z * 83492791u;
-    h ^= h >> 13;
-    h *= 0x5bd1e995u;
-    h ^= h >> 15;
-    return h & mask;
+    float c = floorf(v * inv);
+    if (!(c >= -1073741824.0f)) c = -1073741824.0f; /* NaN too */
+    if (c > 1073741824.0f) c = 1073741824.0f;
+    return (int)c;
 }
 
-fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err)
+/* Where the cells c of one axis are stored: c - org, modulo dim on a wrapped axis. */
+static inline long long axis_slot(const fv_photon_map *m, int a, long long c)
+{
+    long long r = c - m->org[a];
+    if (m->wrap[a]) {
+        r %= m->dim[a];
+        if (r < 0) r += m->dim[a];
+    }
+    return r;
+}
+
+static inline uint32_t photon_cell(const fv_photon_map *m, fv_vec3 p)
+{
+    long long x = axis_slot(m, 0, cell_coord(p.x, m->inv_cell)), y = axis_slot(m, 1, cell_coord(p.y, m->inv_cell)),
+              z = axis_slot(m, 2, cell_coord(p.z, m->inv_cell));
+    return (uint32_t)((z * m->dim[1] + y) * m->dim[0] + x);
+}
+
+/* Room for the sorted copy, the SoA positions (padded: a block may read past the last photon)
+ * and the bucket of each photon. */
+static fv_status reserve(fv_photon_map *m, fv_error *err)
+{
+    int n = m->n ? m->n : 1;
+    if (m->scratch_cap < n) {
+        fv_photon *s = realloc(m->scratch, (size_t)n * sizeof *s);
+        if (!s) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+        m->scratch = s;
+        m->scratch_cap = n;
+    }
+    if (m->key_cap < n) {
+        uint32_t *k = realloc(m->key, (size_t)n * sizeof *k);
+        if (!k) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+        m->key = k;
+        m->key_cap = n;
+    }
+    if (m->soa_cap < n) {
+        float *a = realloc(m->px, 9 * ((size_t)n + FV_PHOTON_BLOCK) * sizeof *a);
+        if (!a) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+        m->px = a;
+        m->soa_cap = n;
+    }
+    size_t stride = (size_t)m->soa_cap + FV_PHOTON_BLOCK;
+    float **arr[9] = {&m->px, &m->py, &m->pz, &m->nx, &m->ny, &m->nz, &m->wx, &m->wy, &m->wz};
+    for (int k = 1; k < 9; k++) *arr[k] = m->px + (size_t)k * stride;
+    return FV_OK;
+}
+
+/* The grid's extent: the cells the photons occupy; axes wrap while there are more than `limit`
+ * cells (the memory of the old hashed grid, about two buckets per photon). */
+static void grid_extent(fv_photon_map *m, int nt)
+{
+    int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+    const int n = m->n;
+    #pragma omp parallel num_threads(nt)
+    {
+        int l[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, h[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+        #pragma omp for schedule(static) nowait
+        for (int i = 0; i < n; i++) {
+            const int c[3] = {cell_coord(m->p[i].pos.x, m->inv_cell), cell_coord(m->p[i].pos.y, m->inv_cell),
+                              cell_coord(m->p[i].pos.z, m->inv_cell)};
+            for (int a = 0; a < 3; a++) {
+                if (c[a] < l[a]) l[a] = c[a];
+                if (c[a] > h[a]) h[a] = c[a];
+            }
+        }
+        #pragma omp critical
+        for (int a = 0; a < 3; a++) {
+            if (l[a] < lo[a]) lo[a] = l[a];
+            if (h[a] > hi[a]) hi[a] = h[a];
+        }
+    }
+    long long d[3];
+    for (int a = 0; a < 3; a++) {
+        if (n == 0) lo[a] = hi[a] = 0;
+        m->org[a] = lo[a];
+        d[a] = (long long)hi[a] - lo[a] + 1;
+        m->wrap[a] = false;
+    }
+    const long long limit = n < 512 ? 1024 : n < (1 << 25) ? 2LL * n : 1LL << 26;
+    while (d[0] * d[1] * d[2] > limit) {
+        int a = d[0] >= d[1] && d[0] >= d[2] ? 0 : d[1] >= d[2] ? 1 : 2;
+        if (d[a] <= 7) break;
+        d[a] = d[a] / 2 > 7 ? d[a] / 2 : 7;
+        m->wrap[a] = true;
+    }
+    for (int a = 0; a < 3; a++) m->dim[a] = (int)d[a];
+}
+
+fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_error *err)
 {
     if (!(cell > 0.0f) || !isfinite(cell)) return fv_error_set(err, FV_ERR_INVALID, "photon grid: cell size %g must be positive", cell);
     m->cell = cell;
     m->inv_cell = 1.0f / cell;
-    /* About two buckets per photon keeps chains short; at least 1024. */
-    uint32_t nb = 1024;
-    while (nb < (uint32_t)m->n * 2u && nb < (1u << 26)) nb <<= 1;
-    uint32_t *start = realloc(m->start, ((size_t)nb + 1) * sizeof *start);
+    m->ncells = 0;
+    int nt = fv_thread_count(threads);
+    if (nt > 1 && m->n < 65536) nt = 1; /* not worth waking threads */
+    grid_extent(m, nt);
+    const uint32_t nc = (uint32_t)m->dim[0] * (uint32_t)m->dim[1] * (uint32_t)m->dim[2];
+    uint32_t *start = realloc(m->start, ((size_t)nc + 1) * sizeof *start);
     if (!start) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
     m->start = start;
-    if (m->scratch_cap < m->n) {
-        fv_photon *s = realloc(m->scratch, (size_t)(m->n ? m->n : 1) * sizeof *s);
-        if (!s) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
-        m->scratch = s;
-        m->scratch_cap = m->n;
+    fv_status rc = reserve(m, err);
+    if (rc != FV_OK) return rc;
+    /* A stable counting sort by cell, in parallel: each thread counts the cells of its own
+     * contiguous share of the photons, every (cell, thread) pair gets its offset in cell-major,
+     * thread-minor order, and each thread scatters its share in order. So the photons of a cell
+     * stay in the order they were stored, whatever the thread count. */
+    uint32_t *count = fv_calloc_array((size_t)nc * (size_t)nt, sizeof *count);
+    if (!count) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+    const int n = m->n;
+    #pragma omp parallel num_threads(nt)
+    {
+        const int t = omp_get_thread_num(), T = omp_get_num_threads();
+        const int i0 = (int)((int64_t)n * t / T), i1 = (int)((int64_t)n * (t + 1) / T);
+        uint32_t *cnt = count + (size_t)t * nc;
+        for (int i = i0; i < i1; i++) cnt[m->key[i] = photon_cell(m, m->p[i].pos)]++;
+        #pragma omp barrier
+        #pragma omp single
+        {
+            uint32_t sum = 0;
+            for (uint32_t b = 0; b < nc; b++) {
+                start[b] = sum;
+                for (int k = 0; k < T; k++) {
+                    uint32_t c = count[(size_t)k * nc + b];
+                    count[(size_t)k * nc + b] = sum;
+                    sum += c;
+                }
+            }
+            start[nc] = sum;
+        }
+        for (int i = i0; i < i1; i++) m->scratch[cnt[m->key[i]]++] = m->p[i];
+        #pragma omp barrier
+        /* The SoA copies from the sorted records: sequential reads and writes (scattering ten
+         * arrays at once would miss the cache ten times per photon). */
+        #pragma omp for schedule(static)
+        for (int d = 0; d < n; d++) {
+            const fv_photon *ph = &m->scratch[d];
+            m->px[d] = ph->pos.x;
+            m->py[d] = ph->pos.y;
+            m->pz[d] = ph->pos.z;
+            m->nx[d] = ph->n.x;
+            m->ny[d] = ph->n.y;
+            m->nz[d] = ph->n.z;
+            m->wx[d] = -ph->dir.x;
+            m->wy[d] = -ph->dir.y;
+            m->wz[d] = -ph->dir.z;
+        }
     }
-    m->mask = nb - 1;
-    m->nbuckets = nb;
-    memset(start, 0, ((size_t)nb + 1) * sizeof *start);
-    /* Counting sort by bucket: count, prefix sum, scatter. */
-    for (int i = 0; i < m->n; i++) {
-        const fv_vec3 p = m->p[i].pos;
-        start[cell_hash(cell_coord(p.x, m->inv_cell), cell_coord(p.y, m->inv_cell), cell_coord(p.z, m->inv_cell), m->mask) + 1]++;
+    free(count);
+    /* Padding far away: a block reading past the last photon never accepts it. */
+    for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
+        m->px[n + k] = m->py[n + k] = m->pz[n + k] = INFINITY;
+        m->nx[n + k] = m->ny[n + k] = m->nz[n + k] = m->wx[n + k] = m->wy[n + k] = m->wz[n + k] = 0.0f;
     }
-    for (uint32_t b = 0; b < nb; b++) start[b + 1] += start[b];
-    for (int i = 0; i < m->n; i++) {
-        const fv_vec3 p = m->p[i].pos;
-        uint32_t b = cell_hash(cell_coord(p.x, m->inv_cell), cell_coord(p.y, m->inv_cell), cell_coord(p.z, m->inv_cell), m->mask);
-        m->scratch[start[b]++] = m->p[i];
-    }
-    /* start[b] now holds the end of bucket b: shift back to the starts. */
-    for (uint32_t b = nb; b > 0; b--) start[b] = start[b - 1];
-    start[0] = 0;
-    fv_photon *t = m->p;
+    fv_photon *tp = m->p;
     int tc = m->cap;
     m->p = m->scratch;
     m->cap = m->scratch_cap;
-    m->scratch = t;
+    m->scratch = tp;
     m->scratch_cap = tc;
+    m->ncells = nc;
     return FV_OK;
 }
 
-/* Visits every bucket holding cells that overlap the box [x - r, x + r]^3 once (two cells hashed
- * to one bucket must not count its photons twice), calling visit on each photon within r. */
-#define MAX_CELLS 343 /* 7^3: r up to 3 cells */
-typedef bool (*bucket_fn)(void *ctx, const fv_photon *ph, uint32_t index, float d2);
+fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err) { return fv_photon_map_build_mt(m, cell, 0, err); }
 
-static void visit_box(const fv_photon_map *m, fv_vec3 x, float r, bucket_fn fn, void *ctx)
+/* The slots of the cells lo..hi of axis a that the grid holds, in order; their count. */
+static int axis_slots(const fv_photon_map *m, int a, int lo, int hi, int *out)
 {
+    int k = 0;
+    for (long long c = lo; c <= hi; c++) {
+        long long r = axis_slot(m, a, c);
+        if (r >= 0 && r < m->dim[a]) out[k++] = (int)r;
+    }
+    return k;
+}
+
+/* The ranges of p to test: the cells overlapping the box [x - r, x + r]^3, z then y then x, a row
+ * of consecutive slots along x being one contiguous range of p. */
+void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x, float r)
+{
+    q->m = m;
+    q->x = x;
+    q->r2 = r * r;
+    q->facing = false;
+    q->nranges = 0;
+    q->range = 0;
+    q->i = 0;
+    if (m->ncells == 0 || m->n == 0) return;
     int lo[3], hi[3];
     const float c[3] = {x.x, x.y, x.z};
     for (int a = 0; a < 3; a++) {
@@ -102,75 +246,146 @@ static void visit_box(const fv_photon_map *m, fv_vec3 x, float r, bucket_fn fn, 
         hi[a] = cell_coord(c[a] + r, m->inv_cell);
         if (hi[a] - lo[a] > 6) hi[a] = lo[a] + 6; /* callers keep r <= 3 cells */
     }
-    uint32_t seen[MAX_CELLS];
-    int nseen = 0;
-    float r2 = r * r;
-    for (int z = lo[2]; z <= hi[2]; z++)
-        for (int y = lo[1]; y <= hi[1]; y++)
-            for (int xx = lo[0]; xx <= hi[0]; xx++) {
-                uint32_t b = cell_hash(xx, y, z, m->mask);
-                bool dup = false;
-                for (int j = 0; j < nseen && !dup; j++) dup = seen[j] == b;
-                if (dup) continue;
-                seen[nseen++] = b;
-                for (uint32_t i = m->start[b]; i < m->start[b + 1]; i++) {
-                    fv_vec3 d = fv_sub(m->p[i].pos, x);
-                    float d2 = fv_dot(d, d);
-                    if (d2 <= r2 && !fn(ctx, &m->p[i], i, d2)) return;
+    int sx[7], sy[7], sz[7];
+    const int nx = axis_slots(m, 0, lo[0], hi[0], sx), ny = axis_slots(m, 1, lo[1], hi[1], sy), nz = axis_slots(m, 2, lo[2], hi[2], sz);
+    for (int k = 0; k < nz; k++)
+        for (int j = 0; j < ny; j++) {
+            const uint32_t row = ((uint32_t)sz[k] * (uint32_t)m->dim[1] + (uint32_t)sy[j]) * (uint32_t)m->dim[0];
+            for (int i = 0; i < nx;) {
+                int e = i + 1;
+                while (e < nx && sx[e] == sx[e - 1] + 1) e++; /* a run of consecutive slots */
+                const uint32_t b = m->start[row + (uint32_t)sx[i]], f = m->start[row + (uint32_t)sx[e - 1] + 1];
+                if (b < f) {
+                    q->lo[q->nranges] = b;
+                    q->hi[q->nranges++] = f;
                 }
+                i = e;
             }
+        }
+    if (q->nranges > 0) q->i = q->lo[0];
 }
 
-typedef struct query_ctx {
-    fv_photon_fn fn;
-    void *ctx;
-} query_ctx;
-
-static bool query_visit(void *ctx, const fv_photon *ph, uint32_t index, float d2)
+void fv_photon_query_facing(fv_photon_query *q, fv_vec3 n)
 {
-    (void)index;
-    query_ctx *q = ctx;
-    q->fn(q->ctx, ph, d2);
-    return true;
+    q->facing = true;
+    q->n = n;
+}
+
+/* Bit k set when photon i + k passes the query: d2 <= r2, and with q->facing !(n . N <= 0.5) and
+ * !(w . N <= 0) (w = -dir), the comparisons of the scalar gather, NaN included. The arithmetic is
+ * the scalar one too, (a x b x + a y b y) + a z b z, so the same photons pass whichever branch
+ * compiles; SSE2 (every x86-64) tests four at a time. */
+static inline unsigned block_mask(const fv_photon_map *m, const fv_photon_query *q, uint32_t i)
+{
+    const float x = q->x.x, y = q->x.y, z = q->x.z, r2 = q->r2;
+    const float *X = m->px + i, *Y = m->py + i, *Z = m->pz + i;
+#if defined(__SSE2__)
+    const __m128 vx = _mm_set1_ps(x), vy = _mm_set1_ps(y), vz = _mm_set1_ps(z), vr = _mm_set1_ps(r2);
+    unsigned mask = 0;
+    for (int k = 0; k < FV_PHOTON_BLOCK; k += 4) {
+        __m128 dx = _mm_sub_ps(_mm_loadu_ps(X + k), vx), dy = _mm_sub_ps(_mm_loadu_ps(Y + k), vy), dz = _mm_sub_ps(_mm_loadu_ps(Z + k), vz);
+        __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+        mask |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(d2, vr)) << k;
+    }
+    if (q->facing && mask) {
+        const __m128 Nx = _mm_set1_ps(q->n.x), Ny = _mm_set1_ps(q->n.y), Nz = _mm_set1_ps(q->n.z);
+        const __m128 half = _mm_set1_ps(0.5f), zero = _mm_setzero_ps();
+        unsigned face = 0;
+        for (int k = 0; k < FV_PHOTON_BLOCK; k += 4) {
+            __m128 nd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(m->nx + i + k), Nx), _mm_mul_ps(_mm_loadu_ps(m->ny + i + k), Ny)),
+                                   _mm_mul_ps(_mm_loadu_ps(m->nz + i + k), Nz));
+            __m128 wd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(m->wx + i + k), Nx), _mm_mul_ps(_mm_loadu_ps(m->wy + i + k), Ny)),
+                                   _mm_mul_ps(_mm_loadu_ps(m->wz + i + k), Nz));
+            face |= (unsigned)_mm_movemask_ps(_mm_and_ps(_mm_cmpnle_ps(nd, half), _mm_cmpnle_ps(wd, zero))) << k;
+        }
+        mask &= face;
+    }
+    return mask;
+#else
+    unsigned mask = 0;
+    for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
+        float dx = X[k] - x, dy = Y[k] - y, dz = Z[k] - z;
+        bool pass = dx * dx + dy * dy + dz * dz <= r2;
+        if (q->facing)
+            pass = pass && !(m->nx[i + k] * q->n.x + m->ny[i + k] * q->n.y + m->nz[i + k] * q->n.z <= 0.5f) &&
+                   !(m->wx[i + k] * q->n.x + m->wy[i + k] * q->n.y + m->wz[i + k] * q->n.z <= 0.0f);
+        mask |= (unsigned)pass << k;
+    }
+    return mask;
+#endif
+}
+
+int fv_photon_query_next(fv_photon_query *q, uint32_t *restrict idx, int cap)
+{
+    const fv_photon_map *m = q->m;
+    int n = 0, range = q->range;
+    uint32_t i = q->i;
+    while (range < q->nranges) {
+        const uint32_t end = q->hi[range];
+        while (i < end) {
+            if (n + FV_PHOTON_BLOCK > cap) goto full;
+            const uint32_t len = end - i < FV_PHOTON_BLOCK ? end - i : FV_PHOTON_BLOCK;
+            unsigned pass = block_mask(m, q, i) & ((1u << len) - 1u);
+            while (pass) { /* the passing photons, in order */
+                idx[n++] = i + (uint32_t)__builtin_ctz(pass);
+                pass &= pass - 1u;
+            }
+            i += len;
+        }
+        if (++range < q->nranges) i = q->lo[range];
+    }
+full:
+    q->range = range;
+    q->i = i;
+    return n;
+}
+
+static inline float photon_d2(const fv_photon_map *m, uint32_t i, fv_vec3 x)
+{
+    float dx = m->px[i] - x.x, dy = m->py[i] - x.y, dz = m->pz[i] - x.z;
+    return dx * dx + dy * dy + dz * dz;
 }
 
 void fv_photon_map_query(const fv_photon_map *m, fv_vec3 x, float r, fv_photon_fn fn, void *ctx)
 {
-    if (m->nbuckets == 0 || m->n == 0) return;
-    query_ctx q = {fn, ctx};
-    visit_box(m, x, r, query_visit, &q);
+    fv_photon_query q;
+    uint32_t idx[64];
+    int k;
+    fv_photon_query_begin(&q, m, x, r);
+    while ((k = fv_photon_query_next(&q, idx, 64)) > 0)
+        for (int j = 0; j < k; j++) fn(ctx, &m->p[idx[j]], photon_d2(m, idx[j], x));
 }
 
-typedef struct nearest_ctx {
-    fv_vec3 n;
-    float best;
-    int index;
-} nearest_ctx;
-
-static bool nearest_visit(void *ctx, const fv_photon *ph, uint32_t index, float d2)
+/* The nearest photon in query order (ties: the first met). */
+static int nearest_within(const fv_photon_map *m, fv_vec3 x, fv_vec3 n, float r, float *best)
 {
-    nearest_ctx *c = ctx;
-    if (d2 < c->best && fv_dot(ph->n, c->n) > 0.5f) {
-        c->best = d2;
-        c->index = (int)index;
-    }
-    return true;
+    fv_photon_query q;
+    uint32_t idx[64];
+    int k, index = -1;
+    *best = INFINITY;
+    fv_photon_query_begin(&q, m, x, r);
+    while ((k = fv_photon_query_next(&q, idx, 64)) > 0)
+        for (int j = 0; j < k; j++) {
+            float d2 = photon_d2(m, idx[j], x);
+            if (d2 < *best && fv_dot(m->p[idx[j]].n, n) > 0.5f) {
+                *best = d2;
+                index = (int)idx[j];
+            }
+        }
+    return index;
 }
 
 int fv_photon_map_nearest(const fv_photon_map *m, fv_vec3 x, fv_vec3 n, float r, float *d2_out)
 {
-    if (m->nbuckets == 0 || m->n == 0) return -1;
+    if (m->ncells == 0 || m->n == 0) return -1;
     /* The nearest photon is usually close: look within a small radius first; a hit there is the
      * nearest overall because every photon within that radius was examined. */
-    nearest_ctx c = {n, INFINITY, -1};
+    float best;
     float r0 = fminf(r, 0.25f * m->cell);
-    visit_box(m, x, r0, nearest_visit, &c);
-    if (c.index < 0 && r > r0) {
-        c.best = INFINITY;
-        visit_box(m, x, r, nearest_visit, &c);
-    }
-    if (d2_out) *d2_out = c.best;
-    return c.index;
+    int index = nearest_within(m, x, n, r0, &best);
+    if (index < 0 && r > r0) index = nearest_within(m, x, n, r, &best);
+    if (d2_out) *d2_out = best;
+    return index;
 }
 
 float fv_photon_radius_eq8(fv_vec3 lo, fv_vec3 hi, int width, int height)

@@ -337,7 +337,7 @@ static fv_status light_tracing(pm_state *st, const fv_frame *frame, float cell, 
         fv_photon_map_clear(&st->all);
         job.count = (int64_t)n_light;
         job.stream = 100 + (uint64_t)pass;
-        if ((rc = fv_photon_trace_lights(&job, FV_TRACE_ALL, &st->all, &rays, err)) == FV_OK) rc = fv_photon_map_build(&st->all, cell, err);
+        if ((rc = fv_photon_trace_lights(&job, FV_TRACE_ALL, &st->all, &rays, err)) == FV_OK) rc = fv_photon_map_build_mt(&st->all, cell, frame->threads, err);
         fv_stats_add_count(stats, "light_photons", st->all.n);
     } else {
         bool dyn = fv_scene_dynamic_object_count(s) > 0;
@@ -354,7 +354,7 @@ static fv_status light_tracing(pm_state *st, const fv_frame *frame, float cell, 
             if (!st->ls_done) fv_photon_map_clear(&st->ls); /* a cancelled trace must not leave half a map */
             job.frame = frame->index;
         }
-        if (rc == FV_OK && (fresh || st->ls.cell != cell)) rc = fv_photon_map_build(&st->ls, cell, err);
+        if (rc == FV_OK && (fresh || st->ls.cell != cell)) rc = fv_photon_map_build_mt(&st->ls, cell, frame->threads, err);
         fv_photon_map_clear(&st->ld);
         if (rc == FV_OK && n_ld >= 1.0) {
             if ((rc = fv_dyn_dirs_build(st->dirs, s, err)) == FV_OK) {
@@ -363,7 +363,7 @@ static fv_status light_tracing(pm_state *st, const fv_frame *frame, float cell, 
                 rc = fv_photon_trace_dynamic(&job, st->dirs, &st->ld, &rays, err);
             }
         }
-        if (rc == FV_OK) rc = fv_photon_map_build(&st->ld, cell, err);
+        if (rc == FV_OK) rc = fv_photon_map_build_mt(&st->ld, cell, frame->threads, err);
         fv_stats_add_count(stats, "light_photons", st->ls.n + st->ld.n);
         fv_stats_add_count(stats, "dynamic_photons", st->ld.n);
     }
