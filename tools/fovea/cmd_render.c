@@ -331,7 +331,7 @@ int fv_cmd_render(int argc, char **argv)
             fputc('\n', stderr);
             if (o.show_stats) {
                 fprintf(stderr, "  counters:");
-                for (int i = 0; i < stats.n_counters; i++) fprintf(stderr, " %s=%.0f", stats.counter[i].name, stats.counter[i].value);
+                for (int i = 0; i < stats.n_counters; i++) fprintf(stderr, " %s=%.10g", stats.counter[i].name, stats.counter[i].value);
                 fputc('\n', stderr);
             }
         }
