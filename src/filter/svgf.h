@@ -40,6 +40,7 @@
 #ifndef FV_FILTER_SVGF_H
 #define FV_FILTER_SVGF_H
 
+#include <stdbool.h>
 #include <stdint.h>
 #include "filter/grid.h"
 #include "fovea/status.h"
@@ -66,6 +67,13 @@ typedef struct fv_svgf fv_svgf;
 
 fv_status fv_svgf_create(const fv_grid *grid, const fv_svgf_opts *o, fv_svgf **out, fv_error *err);
 void fv_svgf_destroy(fv_svgf *f);
+/* Which build of the hot sweeps runs: AUTO (the default) picks AVX2 when the CPU has it, else the
+ * baseline x86-64 (SSE2) build; both give the same bits, so this only matters for speed and for
+ * the tests that compare them. False (nothing changes) when AVX2 is asked for and the CPU lacks it.
+ * The environment variable FOVEA_SVGF_ISA=baseline, read by fv_svgf_create, forces the baseline. */
+typedef enum fv_svgf_isa { FV_SVGF_ISA_AUTO = 0, FV_SVGF_ISA_BASELINE, FV_SVGF_ISA_AVX2 } fv_svgf_isa;
+bool fv_svgf_set_isa(fv_svgf *f, fv_svgf_isa isa);
+
 /* Forgets the history (the next frame starts a new sequence). */
 void fv_svgf_reset(fv_svgf *f);
 
