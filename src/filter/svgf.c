@@ -278,7 +278,7 @@ static void sweep_accumulate(fv_svgf *f, const fv_svgf_frame *fr, bool history, 
             size_t p = (size_t)y * w + x;
             const float *np = &fr->normal[3 * p];
             uint8_t k = KIND_NONE;
-            if (y < fv_grid_col_h(g, x)) {
+            if (y < fv_grid_col_h(g, x) && (!fr->active || fr->active[p])) {
                 if (fr->sampled && !fr->sampled[p]) {
                     k = KIND_HOLE;
                 } else if (np[0] != 0.0f || np[1] != 0.0f || np[2] != 0.0f) {

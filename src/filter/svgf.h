@@ -26,8 +26,8 @@
  *     what the next frame reprojects (the paper's choice);
  *  5. remodulate by the albedo.
  *
- * Pixels without a surface (zero normal, e.g. the background) and rows beyond a column's height are
- * left as they are and never used as taps. Pixels marked 0 in `sampled` (no path this frame: linear
+ * Pixels without a surface (zero normal, e.g. the background), rows beyond a column's height and
+ * pixels marked 0 in `active` are left as they are and never used as taps. Pixels marked 0 in `sampled` (no path this frame: linear
  * fall-off's killed rays) have no colour and no features and keep no history: after the last pass
  * each takes the B3-kernel-weighted average (no edge-stopping: its own features are unknown) of the
  * filtered sampled surface pixels among its 5x5 taps 1 apart, or if there are none 2 apart, then
@@ -88,6 +88,10 @@ typedef struct fv_svgf_frame {
     const float *prev_coord;   /* 2 per pixel: (X, V) in the previous frame's grid, NaN when the
                                   point was not seen then; NULL: no history for this frame */
     const uint8_t *sampled;    /* NULL: every pixel was sampled; else 0 where no path was traced */
+    const uint8_t *active;     /* NULL: every pixel; else 0 where the pixel is out of the picture
+                                  (a polar grid's cells off the screen): treated like rows beyond
+                                  a column's height, never filtered, never a tap, no history, its
+                                  colour left as it is; its buffers are not read */
 } fv_svgf_frame;
 
 /* Statistics of the last frame, for the technique's counters. */

@@ -16,6 +16,7 @@
 
 #define MAX_MIP_LEVELS 12
 #define LUT_STEP 0.5f /* pixels between the entries of the per-frame radial tables */
+#define MASK_REACH_PX 6.0f /* see the off-screen mask in fv_vp_pipeline_render */
 
 struct fv_vp_pipeline {
     const fv_scene *scene;
@@ -28,6 +29,8 @@ struct fv_vp_pipeline {
     fv_vp_gbuf g;
     float *prev_coord;
     float *sigma;           /* per screen pixel */
+    uint8_t *onscreen;      /* polar spaces: per grid cell, fv_space_onscreen_mask of mask_view */
+    float mask_gx, mask_gy; /* the gaze onscreen was computed for (NaN: not yet) */
     float *lut;             /* per frame, per radius step: column X, mip level, blur sigma */
     int nlut;
     uint32_t *perm;
@@ -57,7 +60,8 @@ static void free_buffers(fv_vp_pipeline *p)
     fv_svgf_destroy(p->svgf);
     fv_phi_mips_destroy(p->mips);
     free(p->g.color), free(p->g.albedo), free(p->g.normal), free(p->g.depth), free(p->g.position), free(p->g.id);
-    free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm), free(p->lut);
+    free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm), free(p->lut), free(p->onscreen);
+    p->onscreen = NULL;
     memset(&p->g, 0, sizeof p->g);
     p->space = NULL, p->svgf = NULL, p->mips = NULL, p->prev_coord = NULL, p->sigma = NULL, p->perm = NULL, p->lut = NULL;
     p->sw = p->sh = 0;
@@ -106,6 +110,13 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
     memset(p->g.id, 0, n * sizeof(uint32_t));
     memset(p->g.sampled, 0, n);
     for (size_t i = 0; i < n; i++) p->g.depth[i] = INFINITY;
+    if (fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
+        if (!(p->onscreen = fv_alloc_array(n, 1))) {
+            free_buffers(p);
+            return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d sample grid", g->w, g->h);
+        }
+        p->mask_gx = p->mask_gy = NAN;
+    }
     if (p->o.denoise && (s = fv_svgf_create(g, &p->o.svgf, &p->svgf, err)) != FV_OK) {
         free_buffers(p);
         return s;
@@ -139,7 +150,7 @@ static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
     for (int64_t i = b; i < e; i++) {
         float *pc = &p->prev_coord[2 * i];
         pc[0] = pc[1] = NAN;
-        if (!p->g.sampled[i] || p->g.id[i] == 0) continue;
+        if (!p->g.sampled[i] || p->g.id[i] == 0 || (p->onscreen && !p->onscreen[i])) continue;
         fv_vec3 x = fv_v3(p->g.position[3 * i], p->g.position[3 * i + 1], p->g.position[3 * i + 2]);
         float px, py;
         if (!fv_camera_project(&p->prev_cam, x, &px, &py)) continue;
@@ -244,6 +255,16 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     const fv_grid *g = fv_space_grid(p->space);
     fv_space_view view = fv_space_view_at(p->space, gaze);
 
+    /* The cells of a polar grid that no screen pixel can see (its corners reach beyond the screen
+     * wherever the gaze is): the trace skips them with offscreen=skip, the denoiser always (they
+     * would only cost time and pull the edge's samples towards values nobody sees). The reach
+     * covers the map stage's trilinear φ-mip lookup (two levels, one texel each way, a level's
+     * texel about one pixel along φ). Kept while the gaze stays. */
+    if (p->onscreen && !(view.gx == p->mask_gx && view.gy == p->mask_gy)) {
+        fv_space_onscreen_mask(&view, MASK_REACH_PX, p->onscreen);
+        p->mask_gx = view.gx, p->mask_gy = view.gy;
+    }
+
     /* 1. trace */
     fv_vp_trace_job job;
     memset(&job, 0, sizeof job);
@@ -257,6 +278,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     job.perm = p->perm;
     job.nperm = p->nperm;
     job.skip_offscreen = p->o.skip_offscreen;
+    job.onscreen = p->onscreen;
     job.kill = p->o.kill;
     job.kill_e0 = p->o.kill_e0, job.kill_e1 = p->o.kill_e1, job.kill_p = p->o.kill_p;
     job.px_per_deg = p->ppd;
@@ -287,7 +309,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
             fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
         }
         fv_svgf_frame fr = {p->g.color, p->g.albedo, p->g.normal, p->g.depth, p->g.position, p->g.id,
-                            hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL};
+                            hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
         fv_svgf_info info;
         if ((s = fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err)) != FV_OK) return s;
         fv_stats_add_count(stats, "history_fraction", info.history_fraction);

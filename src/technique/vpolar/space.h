@@ -22,6 +22,7 @@
 #ifndef FV_TECHNIQUE_VPOLAR_SPACE_H
 #define FV_TECHNIQUE_VPOLAR_SPACE_H
 
+#include <stdint.h>
 #include "filter/grid.h"
 #include "fovea/gaze.h"
 #include "fovea/status.h"
@@ -83,6 +84,14 @@ void fv_space_to_screen(const fv_space_view *v, float X, float V, float *px, flo
 void fv_space_from_screen(const fv_space_view *v, float px, float py, float *X, float *V, float *phi_per_px);
 /* Screen radius (pixels from the gaze) of column coordinate X. */
 float fv_space_radius(const fv_space_view *v, float X);
+
+/* For every grid cell (storage w * h, rows beyond a column's height 0): 1 when some point of the
+ * cell lies within reach_px of the screen, reach_px plus the cell's own size (a bilinear lookup
+ * from the screen reaches the neighbouring cells), 0 when the whole cell is farther off screen.
+ * The test is conservative: a cell marked 0 is never read by a lookup from the screen whose
+ * footprint stays within reach_px. Cartesian spaces: every cell is 1. Returns the count of 1s.
+ * About ten flops per cell (per-column radii and a per-row angle table for full-height columns). */
+long fv_space_onscreen_mask(const fv_space_view *v, float reach_px, uint8_t *mask);
 
 /* The cumulative acuity of Eq. 2 continued as pi e^2 inside 5.79 degrees (they meet there): the
  * area-weighted acuity within e planar degrees of the gaze. Exposed for the tests. */
