@@ -51,13 +51,25 @@ void SVGF_ISA(variance)(fv_svgf *f, int nt)
             /* Every pixel's depth gradient (each reads only its neighbours' depths) and temporal
              * variance; the 7x7 estimate below replaces the variance of the young ones. */
             bool young = false;
+            /* The four neighbours are plain offsets (the rows above and below wrapped once per row)
+             * between full-height columns away from the clamped edge, and inside a screen grid;
+             * elsewhere fv_grid_tap works them out. */
+            const int xa = g->wrap ? imax(f->full_from + 1, 1) : 1;
+            const bool rows_in = g->wrap || (y >= 1 && y + 1 < h);
+            const long up = (long)(y > 0 ? y - 1 : h - 1) * w, down = (long)(y + 1 < h ? y + 1 : 0) * w;
             for (int k = 0; k < nc; k++) {
                 size_t p = p0 + k;
                 if (kind[p] != KIND_SURFACE) continue;
                 const int x = x0 + k;
                 const float zc = f->z[0][p];
-                float gx = axis_gradient(f, fv_grid_tap(g, x, y, -1, 0), fv_grid_tap(g, x, y, 1, 0), zc);
-                float gy = axis_gradient(f, fv_grid_tap(g, x, y, 0, -1), fv_grid_tap(g, x, y, 0, 1), zc);
+                float gx, gy;
+                if (rows_in && x >= xa && x + 1 < w) {
+                    gx = axis_gradient(f, (long)p - 1, (long)p + 1, zc);
+                    gy = axis_gradient(f, up + x, down + x, zc);
+                } else {
+                    gx = axis_gradient(f, fv_grid_tap(g, x, y, -1, 0), fv_grid_tap(g, x, y, 1, 0), zc);
+                    gy = axis_gradient(f, fv_grid_tap(g, x, y, 0, -1), fv_grid_tap(g, x, y, 0, 1), zc);
+                }
                 grad[p] = gx > gy ? gx : gy;
                 float tv = m2[p] - m1[p] * m1[p];
                 var[p] = tv > 0.0f ? tv : 0.0f;

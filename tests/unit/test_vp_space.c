@@ -370,6 +370,34 @@ static void test_bad_options(void **st)
     expect_invalid(b, W, H, "reduction");
 }
 
+/* fv_space_turns against the exact angle: within 3e-7 turns all round (a million directions, the
+ * axes, the diagonals and the octant fold at tan(pi/8) included), in [0, 1), and atan2's
+ * conventions at the axes (0 for +x, 1/4 for +y, 1/2 for -x, 3/4 for -y). */
+static void test_turns(void **st)
+{
+    (void)st;
+    double worst = 0.0;
+    for (int i = 0; i < 1000000; i++) {
+        double a = 2.0 * M_PI * (i + 0.37) / 1000000.0, r = 1.0 + 700.0 * fmod(i * 0.618034, 1.0);
+        float dx = (float)(r * cos(a)), dy = (float)(r * sin(a));
+        double exact = atan2((double)dy, (double)dx) / (2.0 * M_PI);
+        exact = exact < 0.0 ? exact + 1.0 : exact;
+        float v = fv_space_turns(dx, dy);
+        assert_true(v >= 0.0f && v < 1.0f);
+        double d = fabs(v - exact);
+        d = d > 0.5 ? 1.0 - d : d;
+        worst = d > worst ? d : worst;
+    }
+    assert_true(worst < 3e-7);
+    assert_float_equal(fv_space_turns(3.0f, 0.0f), 0.0f, 0.0);
+    assert_float_equal(fv_space_turns(0.0f, 2.0f), 0.25f, 1e-7);
+    assert_float_equal(fv_space_turns(-5.0f, 0.0f), 0.5f, 1e-7);
+    assert_float_equal(fv_space_turns(0.0f, -1.0f), 0.75f, 1e-7);
+    assert_float_equal(fv_space_turns(1.0f, 1.0f), 0.125f, 1e-7);
+    assert_float_equal(fv_space_turns(1.0f, 0.41421356f), 0.0625f, 1e-7);
+    assert_float_equal(fv_space_turns(0.0f, 0.0f), 0.0f, 0.0);
+}
+
 /* The level-0 rows [*lo, *hi] (unwrapped: may run below 0 or past the column's height) that feed
  * row j of level k of column x: each level's row averages the rows of the level below that overlap
  * its angles (phi_mips.h). */
@@ -450,6 +478,7 @@ int main(void)
         cmocka_unit_test(test_phi_wrap),        cmocka_unit_test(test_fit_error),
         cmocka_unit_test(test_logpolar),        cmocka_unit_test(test_cartesian),
         cmocka_unit_test(test_bad_options),     cmocka_unit_test(test_onscreen_mask),
+        cmocka_unit_test(test_turns),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -189,54 +189,89 @@ static void build_radial_lut(fv_vp_pipeline *p, const fv_space_view *view)
 
 /* Screen pixel colours from the sample space (Sec. 3.4), the film's first-hit buffers from the
  * nearest sample, and the blur's sigma (Sec. 3.5). */
+/* Row y's pixels [x0, x0 + n) on a polar space: column X, angle V and mip level from the radial
+ * table, and the blur's sigma. One vectorised loop: a gather from the table and fv_space_turns,
+ * no call per pixel. */
+static void map_coords(const map_ctx *c, int64_t y, int x0, int n, float *X, float *V, float *level)
+{
+    const fv_vp_pipeline *p = c->p;
+    const float inv_step = 1.0f / LUT_STEP, gx = c->view->gx, gy = c->view->gy;
+    const float *lut = p->lut;
+    const int last = p->nlut - 2;
+    float sigma[64]; /* n <= 64 (map_rows's span) */
+    const float dy = (float)y + 0.5f - gy;
+    #pragma omp simd
+    for (int k = 0; k < n; k++) {
+        float dx = (float)(x0 + k) + 0.5f - gx;
+        float t = sqrtf(dx * dx + dy * dy) * inv_step;
+        int i = (int)t;
+        i = i < last ? i : last;
+        float f = t - (float)i;
+        X[k] = lut[3 * i] + f * (lut[3 * i + 3] - lut[3 * i]);
+        level[k] = lut[3 * i + 1] + f * (lut[3 * i + 4] - lut[3 * i + 1]);
+        V[k] = fv_space_turns(dx, dy);
+        sigma[k] = lut[3 * i + 2] + f * (lut[3 * i + 5] - lut[3 * i + 2]);
+    }
+    if (p->o.blur) memcpy(&p->sigma[(size_t)y * p->sw + x0], sigma, (size_t)n * sizeof(float));
+}
+
+/* The film's first-hit buffers of screen pixel pix from grid cell near. */
+static void store_aux(const map_ctx *c, size_t pix, long near)
+{
+    const fv_vp_gbuf *g = &c->p->g;
+    bool hit = g->id[near] != 0;
+    fv_film_store_first_hit(&c->out, pix, hit, g->depth[near],
+                            fv_v3(g->position[3 * near], g->position[3 * near + 1], g->position[3 * near + 2]),
+                            fv_v3(g->normal[3 * near], g->normal[3 * near + 1], g->normal[3 * near + 2]),
+                            fv_v3(g->albedo[3 * near], g->albedo[3 * near + 1], g->albedo[3 * near + 2]),
+                            hit ? (int)g->id[near] - 1 : 0);
+}
+
 static void map_rows(void *ctx, int64_t b, int64_t e, int thread)
 {
     map_ctx *c = ctx;
     fv_vp_pipeline *p = c->p;
     const fv_grid *g = fv_space_grid(p->space);
     const bool aux = c->out.depth || c->out.normal || c->out.albedo || c->out.position || c->out.id;
-    const float inv_step = 1.0f / LUT_STEP, inv_2pi = 1.0f / (2.0f * FV_PI);
+    enum { SPAN = 64 };
+    float X[SPAN], V[SPAN], level[SPAN];
     for (int64_t y = b; y < e; y++)
-        for (int x = 0; x < p->sw; x++) {
-            size_t pix = (size_t)y * p->sw + x;
-            float dx = (float)x + 0.5f - c->view->gx, dy = (float)y + 0.5f - c->view->gy;
-            float t = sqrtf(dx * dx + dy * dy) * inv_step;
-            int i = (int)t;
-            i = i < p->nlut - 2 ? i : p->nlut - 2;
-            float f = t - (float)i;
-            const float *l0 = &p->lut[3 * i], *l1 = l0 + 3;
-            if (p->o.blur) p->sigma[pix] = l0[2] + f * (l1[2] - l0[2]);
-            long near;
-            if (c->identity) {
-                near = (long)pix;
-                memcpy(&c->out.color[3 * pix], &p->g.color[3 * pix], 3 * sizeof(float));
+        for (int x0 = 0; x0 < p->sw; x0 += SPAN) {
+            const int n = p->sw - x0 < SPAN ? p->sw - x0 : SPAN;
+            if (c->polar) {
+                map_coords(c, y, x0, n, X, V, level);
             } else {
-                float X, V, level = 0.0f;
-                if (c->polar) {
-                    X = l0[0] + f * (l1[0] - l0[0]);
-                    level = l0[1] + f * (l1[1] - l0[1]);
-                    V = atan2f(dy, dx) * inv_2pi;
-                    V = V < 0.0f ? V + 1.0f : V;
-                    V = V < 1.0f ? V : 0.0f;
-                } else {
-                    fv_space_from_screen(c->view, (float)x + 0.5f, (float)y + 0.5f, &X, &V, NULL);
+                /* The Cartesian grid: no blur (its sigma, if any, from the table) and level 0. */
+                for (int k = 0; k < n; k++) {
+                    const float px = (float)(x0 + k) + 0.5f, py = (float)y + 0.5f;
+                    if (p->o.blur) {
+                        float dx = px - c->view->gx, dy = py - c->view->gy, t = sqrtf(dx * dx + dy * dy) / LUT_STEP;
+                        int i = (int)t;
+                        i = i < p->nlut - 2 ? i : p->nlut - 2;
+                        float f = t - (float)i;
+                        const float *l0 = &p->lut[3 * i], *l1 = l0 + 3;
+                        p->sigma[(size_t)y * p->sw + x0 + k] = l0[2] + f * (l1[2] - l0[2]);
+                    }
+                    level[k] = 0.0f;
+                    if (!c->identity) fv_space_from_screen(c->view, px, py, &X[k], &V[k], NULL);
                 }
-                fv_phi_mips_sample(p->mips, X, V, level, &c->out.color[3 * pix]);
-                if (!aux) continue;
-                int gx = (int)X;
-                gx = gx < 0 ? 0 : (gx >= g->w ? g->w - 1 : gx);
-                int n = fv_grid_col_h(g, gx);
-                int gy = (int)(V * (float)n);
-                gy = gy < 0 ? 0 : (gy >= n ? n - 1 : gy);
-                near = (long)gy * g->w + gx;
             }
-            if (!aux) continue;
-            bool hit = p->g.id[near] != 0;
-            fv_film_store_first_hit(&c->out, pix, hit, p->g.depth[near],
-                                    fv_v3(p->g.position[3 * near], p->g.position[3 * near + 1], p->g.position[3 * near + 2]),
-                                    fv_v3(p->g.normal[3 * near], p->g.normal[3 * near + 1], p->g.normal[3 * near + 2]),
-                                    fv_v3(p->g.albedo[3 * near], p->g.albedo[3 * near + 1], p->g.albedo[3 * near + 2]),
-                                    hit ? (int)p->g.id[near] - 1 : 0);
+            for (int k = 0; k < n; k++) {
+                const size_t pix = (size_t)y * p->sw + x0 + k;
+                if (c->identity) {
+                    memcpy(&c->out.color[3 * pix], &p->g.color[3 * pix], 3 * sizeof(float));
+                    if (aux) store_aux(c, pix, (long)pix);
+                    continue;
+                }
+                fv_phi_mips_sample(p->mips, X[k], V[k], level[k], &c->out.color[3 * pix]);
+                if (!aux) continue;
+                int gx = (int)X[k];
+                gx = gx < 0 ? 0 : (gx >= g->w ? g->w - 1 : gx);
+                int nr = fv_grid_col_h(g, gx);
+                int gy = (int)(V[k] * (float)nr);
+                gy = gy < 0 ? 0 : (gy >= nr ? nr - 1 : gy);
+                store_aux(c, pix, (long)gy * g->w + gx);
+            }
         }
 }
 
