@@ -56,6 +56,7 @@
 #include "filter/svgf_impl.h"
 
 #define SVGF_ISA(name) fv_svgf_##name##_base
+#define SVGF_VW 4 /* floats per SSE vector */
 #include "filter/svgf_sweeps.h"
 #undef SVGF_ISA
 

@@ -13,6 +13,7 @@
 #pragma GCC target("avx2")
 #include "filter/svgf_impl.h"
 #define SVGF_ISA(name) fv_svgf_##name##_avx2
+#define SVGF_VW 8 /* floats per AVX2 vector */
 #include "filter/svgf_sweeps.h"
 #pragma GCC pop_options
 #else

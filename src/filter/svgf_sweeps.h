@@ -77,11 +77,17 @@ void SVGF_ISA(variance)(fv_svgf *f, int nt)
             }
             int s0, s1;
             if (!young || !surface_span(kind, p0, x0, x1, &s0, &s1)) continue;
+            float zs[CHUNK], ze[CHUNK];
+            #pragma omp simd
             for (int k = 0; k < nc; k++) {
                 size_t p = p0 + k;
-                float zs = sd * grad[p], ze = depth_eps(f->z[0][p]);
-                for (int c = 0; c < 9; c++) rz[c][k] = 1.0f / (zs * dist[c] + ze);
+                zs[k] = sd * grad[p], ze[k] = depth_eps(f->z[0][p]);
                 a1[k] = m1[p], a2[k] = m2[p], aw[k] = 1.0f; /* the centre, weight 1 */
+            }
+            for (int c = 0; c < 9; c++) {
+                const float dc = dist[c];
+                #pragma omp simd
+                for (int k = 0; k < nc; k++) rz[c][k] = 1.0f / (zs[k] * dc + ze[k]);
             }
             cc.ready = false;
             for (int t = 0; t < NTAP7; t++) {
@@ -204,6 +210,57 @@ TAP_INLINE void atrous_tap(const pass_src *s, size_t p, int q, int k, float kw, 
     acc->w[k] += wt;
 }
 
+/* SVGF_VW pixels at a time with every tap inner (the pixels whose 24 taps are all plain shifts):
+ * the sums and the centre pixels' features stay in registers across the taps, where the per-tap
+ * loops above load and store them once per tap. The arithmetic is atrous_tap's, operation for
+ * operation in the same order (GCC vector extensions, no FMA), so the bits are the same. */
+typedef float vfw __attribute__((vector_size(4 * SVGF_VW)));
+typedef int32_t viw __attribute__((vector_size(4 * SVGF_VW)));
+typedef float vfw_u __attribute__((vector_size(4 * SVGF_VW), aligned(4), may_alias));
+#define LDW(ptr) (*(const vfw_u *)(const void *)(ptr))
+#define STW(ptr, v) (*(vfw_u *)(void *)(ptr) = (v))
+
+TAP_INLINE vfw fabs_w(vfw x) { return (vfw)((viw)x & 0x7fffffff); }
+
+/* exp_neg, lane by lane the same operations. */
+TAP_INLINE vfw exp_neg_w(vfw x)
+{
+    const union { float f; int32_t i; } lim = {87.0f};
+    viw u = (viw)x;
+    const viw in = u < lim.i; /* -1 or 0 */
+    u = (u & in) | (lim.i & ~in);
+    const vfw t = -(vfw)u * 1.44269504f;
+    const viw i = __builtin_convertvector(t - 0.5f, viw);
+    const vfw a = (t - __builtin_convertvector(i, vfw)) * 0.693147181f, a2 = a * a;
+    const vfw p = (1.0f + a) + a2 * ((1.0f / 2 + a * (1.0f / 6)) + a2 * (1.0f / 24 + a * (1.0f / 120)));
+    const viw scale = ((i + 127) * (1 << 23)) & in;
+    return p * (vfw)scale;
+}
+
+TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const long *off, const float *kw, const int *cls,
+                             pass_acc *acc)
+{
+    const vfw nxp = LDW(&s->nx[p]), nyp = LDW(&s->ny[p]), nzp = LDW(&s->nz[p]), zp = LDW(&s->z[p]), lp = LDW(&s->l[p]);
+    const vfw il = LDW(&acc->inv_l[k]);
+    vfw rz[5];
+    for (int c = 0; c < 5; c++) rz[c] = LDW(&acc->rz[c][k]);
+    vfw ar = LDW(&acc->r[k]), ag = LDW(&acc->g[k]), ab = LDW(&acc->b[k]), av = LDW(&acc->v[k]), aw = LDW(&acc->w[k]);
+    for (int t = 0; t < NTAP; t++) {
+        const long q = off[t] + x;
+        vfw c = nxp * LDW(&s->nx[q]) + nyp * LDW(&s->ny[q]) + nzp * LDW(&s->nz[q]);
+        c = 0.5f * (c + fabs_w(c));
+        for (int i = 0; i < SQ_DEFAULT; i++) c *= c;
+        const vfw e = fabs_w(zp - LDW(&s->z[q])) * rz[cls[t]] + fabs_w(lp - LDW(&s->l[q])) * il;
+        const vfw wt = kw[t] * c * exp_neg_w(e);
+        ar += wt * LDW(&s->r[q]);
+        ag += wt * LDW(&s->g[q]);
+        ab += wt * LDW(&s->b[q]);
+        av += wt * wt * LDW(&s->v[q]);
+        aw += wt;
+    }
+    STW(&acc->r[k], ar), STW(&acc->g[k], ag), STW(&acc->b[k], ab), STW(&acc->v[k], av), STW(&acc->w[k], aw);
+}
+
 /* One pass with taps `step` apart from val[src] to val[1 - src]; the first also writes the history. */
 void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
 {
@@ -244,40 +301,65 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
                 for (int c = 0; c < NVAL; c++) memset(&dst[c][p0], 0, (size_t)nc * sizeof(float));
                 continue;
             }
+            /* Per-pixel terms, one vectorised loop per term (the divisions dominate). */
+            float zs[CHUNK], ze[CHUNK];
+            #pragma omp simd
             for (int k = 0; k < nc; k++) {
                 size_t p = p0 + k;
                 acc.inv_l[k] = 1.0f / (sl * sqrtf(gvar[p]) + LUM_EPS);
-                /* 1 / (sigma_depth |grad z| |p - q| + eps) for the five distances. */
-                float zs = sd * grad[p] * (float)step, ze = depth_eps(s.z[p]);
-                for (int c = 0; c < 5; c++) acc.rz[c][k] = 1.0f / (zs * dist[c] + ze);
+                zs[k] = sd * grad[p] * (float)step, ze[k] = depth_eps(s.z[p]);
                 acc.r[k] = wc * s.r[p], acc.g[k] = wc * s.g[p], acc.b[k] = wc * s.b[p];
                 acc.v[k] = wc * wc * s.v[p], acc.w[k] = wc;
             }
+            /* 1 / (sigma_depth |grad z| |p - q| + eps) for the five distances. */
+            for (int c = 0; c < 5; c++) {
+                const float dc = dist[c];
+                #pragma omp simd
+                for (int k = 0; k < nc; k++) acc.rz[c][k] = 1.0f / (zs[k] * dc + ze[k]);
+            }
             cc.ready = false;
-            for (int t = 0; t < NTAP; t++) {
-                int a, b;
-                long off;
-                tap_run(f, y, di[t], dj[t], s0, s1, &a, &b, &off);
-                const float *rz = acc.rz[cls[t]];
-                if (sq == SQ_DEFAULT) {
-                    #pragma omp simd
-                    for (int x = a; x < b; x++)
-                        atrous_tap(&s, p0 + (x - x0), (int)off + x, x - x0, kw[t], rz, SQ_DEFAULT, sn, &acc);
-                } else {
-                    for (int x = a; x < b; x++) atrous_tap(&s, p0 + (x - x0), (int)off + x, x - x0, kw[t], rz, sq, sn, &acc);
+            /* [va, vb): the pixels whose taps are all plain shifts, a whole number of vectors,
+             * filtered by atrous_block; the per-tap loops do the rest of the span. */
+            int va = s0, vb = s0;
+            long offs[NTAP];
+            if (sq == SQ_DEFAULT) {
+                int lo = s0, hi = s1;
+                for (int t = 0; t < NTAP && lo < hi; t++) {
+                    int a, b;
+                    tap_run(f, y, di[t], dj[t], s0, s1, &a, &b, &offs[t]);
+                    lo = imax(lo, a), hi = imin(hi, b);
                 }
-                if (!g->wrap || (a == s0 && b == s1)) continue;
-                if (!cc.ready) chunk_columns(g, y, x0, nc, step, 5, &cc);
-                fallback_taps(g, &cc, di[t] / step + 2, dj[t], x0, s0, s1, a, b, fq);
-                for (int r = 0; r < 2; r++) {
-                    const int lo = r ? b : s0, hi = r ? s1 : a;
+                if (lo < hi) va = lo, vb = lo + (hi - lo) / SVGF_VW * SVGF_VW;
+                for (int x = va; x < vb; x += SVGF_VW) atrous_block(&s, p0 + (x - x0), x, x - x0, offs, kw, cls, &acc);
+            }
+            for (int part = 0; part < 2; part++) {
+                const int u0 = part ? vb : s0, u1 = part ? s1 : va;
+                if (u0 >= u1) continue;
+                for (int t = 0; t < NTAP; t++) {
+                    int a, b;
+                    long off;
+                    tap_run(f, y, di[t], dj[t], u0, u1, &a, &b, &off);
+                    const float *rz = acc.rz[cls[t]];
                     if (sq == SQ_DEFAULT) {
                         #pragma omp simd
-                        for (int x = lo; x < hi; x++)
-                            atrous_tap(&s, p0 + (x - x0), fq[x - x0], x - x0, kw[t], rz, SQ_DEFAULT, sn, &acc);
+                        for (int x = a; x < b; x++)
+                            atrous_tap(&s, p0 + (x - x0), (int)off + x, x - x0, kw[t], rz, SQ_DEFAULT, sn, &acc);
                     } else {
-                        for (int x = lo; x < hi; x++)
-                            atrous_tap(&s, p0 + (x - x0), fq[x - x0], x - x0, kw[t], rz, sq, sn, &acc);
+                        for (int x = a; x < b; x++) atrous_tap(&s, p0 + (x - x0), (int)off + x, x - x0, kw[t], rz, sq, sn, &acc);
+                    }
+                    if (!g->wrap || (a == u0 && b == u1)) continue;
+                    if (!cc.ready) chunk_columns(g, y, x0, nc, step, 5, &cc);
+                    fallback_taps(g, &cc, di[t] / step + 2, dj[t], x0, u0, u1, a, b, fq);
+                    for (int r = 0; r < 2; r++) {
+                        const int lo = r ? b : u0, hi = r ? u1 : a;
+                        if (sq == SQ_DEFAULT) {
+                            #pragma omp simd
+                            for (int x = lo; x < hi; x++)
+                                atrous_tap(&s, p0 + (x - x0), fq[x - x0], x - x0, kw[t], rz, SQ_DEFAULT, sn, &acc);
+                        } else {
+                            for (int x = lo; x < hi; x++)
+                                atrous_tap(&s, p0 + (x - x0), fq[x - x0], x - x0, kw[t], rz, sq, sn, &acc);
+                        }
                     }
                 }
             }
