@@ -178,6 +178,8 @@ fv_status fv_svgf_create(const fv_grid *grid, const fv_svgf_opts *o, fv_svgf **o
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for SVGF buffers of a %dx%d grid", grid->w, grid->h);
     }
     fv_svgf_set_isa(f, FV_SVGF_ISA_AUTO);
+    f->periph_x = f->pass_cut = grid->w;
+    f->periph_passes = o->iterations;
     /* For end-to-end comparisons (docs/filters.md): FOVEA_SVGF_ISA=baseline forces the baseline
      * build in every filter created while it is set. */
     const char *isa = getenv("FOVEA_SVGF_ISA");
@@ -201,6 +203,12 @@ bool fv_svgf_set_isa(fv_svgf *f, fv_svgf_isa isa)
     if (isa == FV_SVGF_ISA_AVX2 && !can) return false;
     f->avx2 = isa == FV_SVGF_ISA_AVX2 || (isa == FV_SVGF_ISA_AUTO && can);
     return true;
+}
+
+void fv_svgf_set_periphery(fv_svgf *f, int x_from, int passes)
+{
+    f->periph_x = x_from < 0 ? 0 : (x_from > f->g.w ? f->g.w : x_from);
+    f->periph_passes = passes < 0 ? 0 : passes;
 }
 
 void fv_svgf_destroy(fv_svgf *f)
@@ -411,6 +419,7 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
         fv_svgf_variance_base(f, nt);
     int cur = 0;
     for (int it = 0; it < f->o.iterations; it++) {
+        f->pass_cut = it < f->periph_passes ? f->g.w : f->periph_x;
         if (f->avx2) {
             fv_svgf_prefilter_avx2(f, f->val[cur][V_VAR], nt);
             fv_svgf_atrous_avx2(f, 1 << it, cur, it == 0, nt);

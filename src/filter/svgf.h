@@ -74,6 +74,13 @@ void fv_svgf_destroy(fv_svgf *f);
 typedef enum fv_svgf_isa { FV_SVGF_ISA_AUTO = 0, FV_SVGF_ISA_BASELINE, FV_SVGF_ISA_AVX2 } fv_svgf_isa;
 bool fv_svgf_set_isa(fv_svgf *f, fv_svgf_isa isa);
 
+/* Fewer À-Trous passes in the periphery (Visual-Polar Sec. 3.5: where the foveated blur will
+ * average over the same scales anyway): the columns from x_from on take part only in the first
+ * `passes` passes; in the later ones their values go through unchanged (and still serve as taps
+ * for the columns that are filtered). passes >= iterations or x_from >= w: every column gets every
+ * pass (the default). Takes effect from the next frame; may change every frame. */
+void fv_svgf_set_periphery(fv_svgf *f, int x_from, int passes);
+
 /* Forgets the history (the next frame starts a new sequence). */
 void fv_svgf_reset(fv_svgf *f);
 

@@ -144,7 +144,8 @@ void SVGF_ISA(prefilter)(fv_svgf *f, const float *var, int nt)
         float av[CHUNK], aw[CHUNK];
         int fq[CHUNK];
         chunk_cols cc;
-        for (int x0 = 0; x0 < w; x0 += CHUNK) {
+        /* Only the columns this pass filters need their prefiltered variance. */
+        for (int x0 = 0; x0 < f->pass_cut; x0 += CHUNK) {
             const int x1 = imin(x0 + CHUNK, w), nc = x1 - x0;
             const size_t p0 = (size_t)y * w + x0;
             int s0, s1;
@@ -296,9 +297,22 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
         for (int x0 = 0; x0 < w; x0 += CHUNK) {
             const int x1 = imin(x0 + CHUNK, w), nc = x1 - x0;
             const size_t p0 = (size_t)y * w + x0;
+            /* Columns from pass_cut on sit this pass out (fv_svgf_set_periphery): their values go
+             * through unchanged, and still serve as taps. */
+            const int xe = imin(x1, f->pass_cut), ne = xe > x0 ? xe - x0 : 0;
+            if (xe < x1) {
+                const int xc = imax(x0, xe);
+                const size_t pc = p0 + (size_t)(xc - x0), m = (size_t)(x1 - xc);
+                for (int c = 0; c < NVAL; c++) memcpy(&dst[c][pc], &f->val[src][c][pc], m * sizeof(float));
+                if (write_hist)
+                    for (size_t p = pc; p < pc + m; p++)
+                        if (kind[p] == KIND_SURFACE)
+                            for (int c = 0; c < 3; c++) f->hist_illum[3 * p + c] = f->val[src][V_R + c][p];
+            }
+            if (!ne) continue;
             int s0, s1;
-            if (!surface_span(kind, p0, x0, x1, &s0, &s1)) {
-                for (int c = 0; c < NVAL; c++) memset(&dst[c][p0], 0, (size_t)nc * sizeof(float));
+            if (!surface_span(kind, p0, x0, xe, &s0, &s1)) {
+                for (int c = 0; c < NVAL; c++) memset(&dst[c][p0], 0, (size_t)ne * sizeof(float));
                 continue;
             }
             /* Per-pixel terms, one vectorised loop per term (the divisions dominate). */
@@ -363,7 +377,7 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
                     }
                 }
             }
-            for (int k = 0; k < nc; k++) {
+            for (int k = 0; k < ne; k++) {
                 size_t p = p0 + k;
                 if (kind[p] != KIND_SURFACE) {
                     for (int c = 0; c < NVAL; c++) dst[c][p] = 0.0f;

@@ -6,6 +6,7 @@
  * bilinearly. Static geometry reprojects exactly; a moving object's samples fail the denoiser's
  * position test and restart their history (no motion vectors).
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
@@ -166,6 +167,21 @@ typedef struct map_ctx {
     bool identity, polar;
 } map_ctx;
 
+/* Visual-Polar stretches its profile (and so its fovea) from the centre gaze's largest ρ to this
+ * gaze's; the blur's fovea follows: screen distances are multiplied by this before they become
+ * degrees of the blur's profile. */
+static double blur_scale(const fv_vp_pipeline *p, const fv_space_view *view)
+{
+    if (!p->o.blur_follows_space) return 1.0;
+    return 0.5 * sqrt((double)p->sw * p->sw + (double)p->sh * p->sh) / view->rho_max;
+}
+
+/* The screen distance from the gaze beyond which the blur has its full sigma (Sec. 3.5). */
+static double blur_full_radius(const fv_vp_pipeline *p, const fv_space_view *view)
+{
+    return p->o.blur_ramp_deg * p->ppd / blur_scale(p, view);
+}
+
 /* Everything the map stage needs that depends only on the distance from the gaze, tabulated for
  * this frame every LUT_STEP pixels: the column X, the φ-mip level (log2 of the rows one pixel spans
  * along φ) and the blur's sigma (Sec. 3.5). The per-pixel work is then a square root, an arc
@@ -173,10 +189,7 @@ typedef struct map_ctx {
 static void build_radial_lut(fv_vp_pipeline *p, const fv_space_view *view)
 {
     double sigma_px = p->o.blur_sigma * (double)p->sw / 1280.0;
-    /* Visual-Polar stretches its profile (and so its fovea) from the centre gaze's largest ρ to
-     * this gaze's; the blur's fovea follows. */
-    double scale = 1.0;
-    if (p->o.blur_follows_space) scale = 0.5 * sqrt((double)p->sw * p->sw + (double)p->sh * p->sh) / view->rho_max;
+    const double scale = blur_scale(p, view);
     for (int i = 0; i < p->nlut; i++) {
         float r = (float)i * LUT_STEP, X, V, rows;
         fv_space_from_screen(view, view->gx + r, view->gy, &X, &V, &rows);
@@ -345,6 +358,12 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
         }
         fv_svgf_frame fr = {p->g.color, p->g.albedo, p->g.normal, p->g.depth, p->g.position, p->g.id,
                             hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
+        if (p->o.blur && p->o.periphery_passes < p->o.svgf.iterations && fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
+            /* The columns wholly beyond the radius where the blur reaches its full sigma. */
+            float X, V;
+            fv_space_from_screen(&view, view.gx + (float)blur_full_radius(p, &view), view.gy, &X, &V, NULL);
+            fv_svgf_set_periphery(p->svgf, (int)ceilf(X), p->o.periphery_passes);
+        }
         fv_svgf_info info;
         if ((s = fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err)) != FV_OK) return s;
         fv_stats_add_count(stats, "history_fraction", info.history_fraction);
