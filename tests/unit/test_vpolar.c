@@ -98,14 +98,15 @@ static double expected_falloff_share(void)
     return sum / (W * H);
 }
 
-/* Each method traces what its distribution says: vpolar its grid (39% of the pixels, fewer when
- * off-screen samples are skipped), cartesian the same count, cartesian-full every pixel,
+/* Each method traces what its distribution says: vpolar its grid (39% of the pixels; fewer when
+ * off-screen samples are skipped, the default), cartesian the same count, cartesian-full every pixel,
  * linear-falloff the expected survivors, log-polar (W/1.8)(H/1.8). */
 static void test_sample_counts(void **st)
 {
     (void)st;
     fv_stats s;
-    free(render("vpolar", NULL, 1, 2, k_centre, &s));
+    const char *trace[] = {"offscreen=trace", NULL};
+    free(render("vpolar", trace, 1, 2, k_centre, &s));
     double grid = fv_stats_get_count(&s, "grid_samples");
     assert_float_equal(fv_stats_get_count(&s, "samples"), grid, 0.0);
     assert_true(fabs(grid / (W * H) - 0.39) < 0.01);

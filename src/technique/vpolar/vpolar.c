@@ -57,7 +57,7 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
     bool blur_def = kind == K_VPOLAR || kind == K_LINEAR_FALLOFF;
     if ((s = fv_params_int(p, "bounces", 1, 0, 64, &bounces, err)) ||
         (s = fv_params_choice(p, "order", 0, k_orders, &order, err)) ||
-        (s = fv_params_choice(p, "offscreen", 0, k_offscreen, &offscreen, err)) ||
+        (s = fv_params_choice(p, "offscreen", 1, k_offscreen, &offscreen, err)) ||
         (s = fv_params_choice(p, "show", 0, k_show, &sh, err)) || (s = fv_params_bool(p, "denoise", true, &o->denoise, err)) ||
         (s = fv_params_int(p, "svgf_iterations", o->svgf.iterations, 0, 10, &o->svgf.iterations, err)))
         return s;
@@ -260,7 +260,7 @@ static fv_status create_logpolar(const fv_scene *s, fv_params *p, const fv_log *
     "blur_sigma=float (6.8): blur sigma in pixels at blur_ramp_deg, for 1280 pixels wide (scaled with the width)\n"     \
     "blur_fovea_deg=float, blur_ramp_deg=float (30): the blur is 0 inside the first, rises linearly to the second\n"    \
     "order=grid|random (grid): launch order of the samples (random: Sec. 6's incoherent launch)\n"                       \
-    "offscreen=trace|skip (trace): trace the samples of the polar grids that fall off the screen, or not\n"              \
+    "offscreen=trace|skip (skip): trace the polar grids' cells no screen pixel sees, or not (same image either way)\n"   \
     "show=screen|space|density (screen): the image, the sample-space image, or samples per pixel\n"
 
 const fv_technique_class fv_technique_vpolar = {
