@@ -19,7 +19,10 @@
  * same order either way, so the two paths give the same bits. The normal weight's cosine^128 is
  * seven squarings, unrolled and vectorised; other powers of two are squarings in a plain loop, other
  * exponents powf. The exponential is an inline approximation (exp_neg). Spans of a chunk with no
- * surface (background, rows beyond short columns) are skipped.
+ * surface (background, rows beyond short columns) are skipped. In the À-Trous pass the pixels whose
+ * 24 taps are all shifts go 4 or 8 at a time with every tap inner, the sums in registers
+ * (atrous_block). B and C live in svgf_sweeps.h, built here for the baseline x86-64 and in
+ * svgf_avx2.c for AVX2; fv_svgf_set_isa picks one (issue 16: same bits, twice the lanes).
  *
  * Choices the paper leaves open, and why:
  *  - Depth gradient: per axis (along the column and across columns, through the grid's own taps) the

@@ -18,6 +18,7 @@
 #define MAX_MIP_LEVELS 12
 #define LUT_STEP 0.5f /* pixels between the entries of the per-frame radial tables */
 #define MASK_REACH_PX 6.0f /* see the off-screen mask in fv_vp_pipeline_render */
+#define MAP_SPAN 64        /* screen pixels of a row the map stage takes at a time (at most) */
 
 struct fv_vp_pipeline {
     const fv_scene *scene;
@@ -30,7 +31,7 @@ struct fv_vp_pipeline {
     fv_vp_gbuf g;
     float *prev_coord;
     float *sigma;           /* per screen pixel */
-    uint8_t *onscreen;      /* polar spaces: per grid cell, fv_space_onscreen_mask of mask_view */
+    uint8_t *onscreen;      /* polar spaces: per grid cell, fv_space_onscreen_mask at (mask_gx, mask_gy) */
     float mask_gx, mask_gy; /* the gaze onscreen was computed for (NaN: not yet) */
     float *lut;             /* per frame, per radius step: column X, mip level, blur sigma */
     int nlut;
@@ -200,8 +201,6 @@ static void build_radial_lut(fv_vp_pipeline *p, const fv_space_view *view)
     }
 }
 
-/* Screen pixel colours from the sample space (Sec. 3.4), the film's first-hit buffers from the
- * nearest sample, and the blur's sigma (Sec. 3.5). */
 /* Row y's pixels [x0, x0 + n) on a polar space: column X, angle V and mip level from the radial
  * table, and the blur's sigma. One vectorised loop: a gather from the table and fv_space_turns,
  * no call per pixel. */
@@ -211,7 +210,7 @@ static void map_coords(const map_ctx *c, int64_t y, int x0, int n, float *X, flo
     const float inv_step = 1.0f / LUT_STEP, gx = c->view->gx, gy = c->view->gy;
     const float *lut = p->lut;
     const int last = p->nlut - 2;
-    float sigma[64]; /* n <= 64 (map_rows's span) */
+    float sigma[MAP_SPAN];
     const float dy = (float)y + 0.5f - gy;
     #pragma omp simd
     for (int k = 0; k < n; k++) {
@@ -240,17 +239,18 @@ static void store_aux(const map_ctx *c, size_t pix, long near)
                             hit ? (int)g->id[near] - 1 : 0);
 }
 
+/* Screen pixel colours from the sample space (Sec. 3.4), the film's first-hit buffers from the
+ * nearest sample, and the blur's sigma (Sec. 3.5), MAP_SPAN pixels of a row at a time. */
 static void map_rows(void *ctx, int64_t b, int64_t e, int thread)
 {
     map_ctx *c = ctx;
     fv_vp_pipeline *p = c->p;
     const fv_grid *g = fv_space_grid(p->space);
     const bool aux = c->out.depth || c->out.normal || c->out.albedo || c->out.position || c->out.id;
-    enum { SPAN = 64 };
-    float X[SPAN], V[SPAN], level[SPAN];
+    float X[MAP_SPAN], V[MAP_SPAN], level[MAP_SPAN];
     for (int64_t y = b; y < e; y++)
-        for (int x0 = 0; x0 < p->sw; x0 += SPAN) {
-            const int n = p->sw - x0 < SPAN ? p->sw - x0 : SPAN;
+        for (int x0 = 0; x0 < p->sw; x0 += MAP_SPAN) {
+            const int n = p->sw - x0 < MAP_SPAN ? p->sw - x0 : MAP_SPAN;
             if (c->polar) {
                 map_coords(c, y, x0, n, X, V, level);
             } else {
