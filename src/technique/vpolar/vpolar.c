@@ -32,7 +32,7 @@ typedef struct vp_state {
 typedef enum vp_kind { K_VPOLAR, K_CARTESIAN, K_CARTESIAN_FULL, K_LINEAR_FALLOFF, K_LOGPOLAR } vp_kind;
 
 static const char *const k_orders[] = {"grid", "random", NULL};
-static const char *const k_offscreen[] = {"trace", "skip", NULL};
+static const char *const k_offscreen[] = {"skip", "trace", NULL}; /* skip first: the default */
 static const char *const k_show[] = {"screen", "space", "density", NULL};
 
 /* A float parameter that must lie strictly inside (lo, hi). */
@@ -57,7 +57,7 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
     bool blur_def = kind == K_VPOLAR || kind == K_LINEAR_FALLOFF;
     if ((s = fv_params_int(p, "bounces", 1, 0, 64, &bounces, err)) ||
         (s = fv_params_choice(p, "order", 0, k_orders, &order, err)) ||
-        (s = fv_params_choice(p, "offscreen", 1, k_offscreen, &offscreen, err)) ||
+        (s = fv_params_choice(p, "offscreen", 0, k_offscreen, &offscreen, err)) ||
         (s = fv_params_choice(p, "show", 0, k_show, &sh, err)) || (s = fv_params_bool(p, "denoise", true, &o->denoise, err)) ||
         (s = fv_params_int(p, "svgf_iterations", o->svgf.iterations, 0, 10, &o->svgf.iterations, err)))
         return s;
@@ -119,7 +119,7 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
     o->pt.max_depth = 1 + bounces;
     o->pt.rr_depth = 1 << 20; /* Sec. 3.1: a fixed path length, no Russian roulette */
     o->order = (fv_vp_order)order;
-    o->skip_offscreen = offscreen == 1;
+    o->skip_offscreen = offscreen == 0;
     *show = (vp_show)sh;
     return FV_OK;
 }
