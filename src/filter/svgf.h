@@ -26,8 +26,8 @@
  *     what the next frame reprojects (the paper's choice);
  *  5. remodulate by the albedo.
  *
- * Pixels without a surface (zero normal, e.g. the background) and rows beyond a column's height are
- * left as they are and never used as taps. Pixels marked 0 in `sampled` (no path this frame: linear
+ * Pixels without a surface (zero normal, e.g. the background), rows beyond a column's height and
+ * pixels marked 0 in `active` are left as they are and never used as taps. Pixels marked 0 in `sampled` (no path this frame: linear
  * fall-off's killed rays) have no colour and no features and keep no history: after the last pass
  * each takes the B3-kernel-weighted average (no edge-stopping: its own features are unknown) of the
  * filtered sampled surface pixels among its 5x5 taps 1 apart, or if there are none 2 apart, then
@@ -40,6 +40,7 @@
 #ifndef FV_FILTER_SVGF_H
 #define FV_FILTER_SVGF_H
 
+#include <stdbool.h>
 #include <stdint.h>
 #include "filter/grid.h"
 #include "fovea/status.h"
@@ -66,6 +67,20 @@ typedef struct fv_svgf fv_svgf;
 
 fv_status fv_svgf_create(const fv_grid *grid, const fv_svgf_opts *o, fv_svgf **out, fv_error *err);
 void fv_svgf_destroy(fv_svgf *f);
+/* Which build of the hot sweeps runs: AUTO (the default) picks AVX2 when the CPU has it, else the
+ * baseline x86-64 (SSE2) build; both give the same bits, so this only matters for speed and for
+ * the tests that compare them. False (nothing changes) when AVX2 is asked for and the CPU lacks it.
+ * The environment variable FOVEA_SVGF_ISA=baseline, read by fv_svgf_create, forces the baseline. */
+typedef enum fv_svgf_isa { FV_SVGF_ISA_AUTO = 0, FV_SVGF_ISA_BASELINE, FV_SVGF_ISA_AVX2 } fv_svgf_isa;
+bool fv_svgf_set_isa(fv_svgf *f, fv_svgf_isa isa);
+
+/* Fewer À-Trous passes in the periphery (Visual-Polar Sec. 3.5: where the foveated blur will
+ * average over the same scales anyway): the columns from x_from on take part only in the first
+ * `passes` passes; in the later ones their values go through unchanged (and still serve as taps
+ * for the columns that are filtered). passes >= iterations or x_from >= w: every column gets every
+ * pass (the default). Takes effect from the next frame; may change every frame. */
+void fv_svgf_set_periphery(fv_svgf *f, int x_from, int passes);
+
 /* Forgets the history (the next frame starts a new sequence). */
 void fv_svgf_reset(fv_svgf *f);
 
@@ -80,6 +95,10 @@ typedef struct fv_svgf_frame {
     const float *prev_coord;   /* 2 per pixel: (X, V) in the previous frame's grid, NaN when the
                                   point was not seen then; NULL: no history for this frame */
     const uint8_t *sampled;    /* NULL: every pixel was sampled; else 0 where no path was traced */
+    const uint8_t *active;     /* NULL: every pixel; else 0 where the pixel is out of the picture
+                                  (a polar grid's cells off the screen): treated like rows beyond
+                                  a column's height, never filtered, never a tap, no history, its
+                                  colour left as it is; its buffers are not read */
 } fv_svgf_frame;
 
 /* Statistics of the last frame, for the technique's counters. */

@@ -75,7 +75,7 @@ static void img_free(img *m)
 
 static fv_svgf_frame frame_of(img *m, bool history)
 {
-    fv_svgf_frame fr = {m->color, m->albedo, m->normal, m->depth, m->position, m->id, history ? m->prev : NULL, m->sampled};
+    fv_svgf_frame fr = {m->color, m->albedo, m->normal, m->depth, m->position, m->id, history ? m->prev : NULL, m->sampled, NULL};
     return fr;
 }
 

@@ -2,7 +2,8 @@
  * by hand, the grid's sample count against the reduction, forward/inverse round trips, a grid that
  * reaches the farthest corner from any gaze with the same samples, a fovea of at least one sample
  * per pixel with a constant density, a periphery whose density follows the acuity, the φ wrap, the
- * fit error, log-polar and Cartesian maps worked by hand, and refused options. */
+ * fit error, log-polar and Cartesian maps worked by hand, refused options, and an off-screen mask
+ * that no screen pixel's trilinear φ-mip lookup ever reads past. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -10,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
+#include "filter/phi_mips.h"
 #include "technique/vpolar/space.h"
 
 #define W 1280
@@ -368,6 +370,105 @@ static void test_bad_options(void **st)
     expect_invalid(b, W, H, "reduction");
 }
 
+/* fv_space_turns against the exact angle: within 3e-7 turns all round (a million directions, the
+ * axes, the diagonals and the octant fold at tan(pi/8) included), in [0, 1), and atan2's
+ * conventions at the axes (0 for +x, 1/4 for +y, 1/2 for -x, 3/4 for -y). */
+static void test_turns(void **st)
+{
+    (void)st;
+    double worst = 0.0;
+    for (int i = 0; i < 1000000; i++) {
+        double a = 2.0 * M_PI * (i + 0.37) / 1000000.0, r = 1.0 + 700.0 * fmod(i * 0.618034, 1.0);
+        float dx = (float)(r * cos(a)), dy = (float)(r * sin(a));
+        double exact = atan2((double)dy, (double)dx) / (2.0 * M_PI);
+        exact = exact < 0.0 ? exact + 1.0 : exact;
+        float v = fv_space_turns(dx, dy);
+        assert_true(v >= 0.0f && v < 1.0f);
+        double d = fabs(v - exact);
+        d = d > 0.5 ? 1.0 - d : d;
+        worst = d > worst ? d : worst;
+    }
+    assert_true(worst < 3e-7);
+    assert_float_equal(fv_space_turns(3.0f, 0.0f), 0.0f, 0.0);
+    assert_float_equal(fv_space_turns(0.0f, 2.0f), 0.25f, 1e-7);
+    assert_float_equal(fv_space_turns(-5.0f, 0.0f), 0.5f, 1e-7);
+    assert_float_equal(fv_space_turns(0.0f, -1.0f), 0.75f, 1e-7);
+    assert_float_equal(fv_space_turns(1.0f, 1.0f), 0.125f, 1e-7);
+    assert_float_equal(fv_space_turns(1.0f, 0.41421356f), 0.0625f, 1e-7);
+    assert_float_equal(fv_space_turns(0.0f, 0.0f), 0.0f, 0.0);
+}
+
+/* The level-0 rows [*lo, *hi] (unwrapped: may run below 0 or past the column's height) that feed
+ * row j of level k of column x: each level's row averages the rows of the level below that overlap
+ * its angles (phi_mips.h). */
+static void mip_rows(const fv_phi_mips *m, int k, int x, int j, long *lo, long *hi)
+{
+    long a = j, b = j;
+    for (; k > 0; k--) {
+        long nk = fv_grid_col_h(fv_phi_mips_grid(m, k), x), nb = fv_grid_col_h(fv_phi_mips_grid(m, k - 1), x);
+        a = (long)floor((double)a * nb / nk);
+        b = (long)ceil((double)(b + 1) * nb / nk) - 1;
+    }
+    *lo = a, *hi = b;
+}
+
+/* Every screen pixel's lookup (the pipeline's map stage: bilinear in the two mip levels around
+ * log2 of the rows per pixel, fv_phi_mips_sample) reads only cells the off-screen mask keeps, for
+ * gazes at the centre, a corner, an edge and off-centre, in Visual-Polar and log-polar space; and
+ * the mask drops a real share of the grid (the farthest circles' arcs off the screen). */
+static void test_onscreen_mask(void **st)
+{
+    (void)st;
+    const fv_gaze gazes[4] = {{0.5f, 0.5f}, {0.0f, 0.0f}, {1.0f, 0.4f}, {0.3f, 0.8f}};
+    const fv_space_kind kinds[2] = {FV_SPACE_VPOLAR, FV_SPACE_LOGPOLAR};
+    for (int ki = 0; ki < 2; ki++) {
+        fv_space *s = make(kinds[ki], 0.61);
+        const fv_grid *g = fv_space_grid(s);
+        fv_phi_mips *m = NULL;
+        fv_error err;
+        assert_int_equal(fv_phi_mips_create(g, 12, &m, &err), FV_OK);
+        const int nlev = fv_phi_mips_levels(m);
+        uint8_t *mask = malloc((size_t)g->w * g->h);
+        for (int gi = 0; gi < 4; gi++) {
+            fv_space_view v = fv_space_view_at(s, gazes[gi]);
+            long on = fv_space_onscreen_mask(&v, 6.0f, mask), count = 0;
+            for (size_t i = 0; i < (size_t)g->w * g->h; i++) count += mask[i];
+            assert_int_equal(on, count);
+            assert_true(on < fv_space_sample_count(s));
+            if (gi == 0 && ki == 0) assert_true(on < 0.95 * (double)fv_space_sample_count(s));
+            long bad = 0;
+            for (int y = 0; y < H; y += 1 + (ki == 1))
+                for (int x = 0; x < W; x += 1 + (ki == 1)) {
+                    float X, V, rows;
+                    fv_space_from_screen(&v, (float)x + 0.5f, (float)y + 0.5f, &X, &V, &rows);
+                    float level = rows > 1.0f ? log2f(rows) : 0.0f;
+                    int k0 = (int)level < nlev - 1 ? (int)level : nlev - 1;
+                    int k1 = level > (float)k0 && k0 + 1 < nlev ? k0 + 1 : k0; /* the second level only when blended */
+                    for (int k = k0; k <= k1; k++) {
+                        long idx[4];
+                        float wt[4];
+                        const fv_grid *gk = fv_phi_mips_grid(m, k);
+                        fv_grid_bilinear(gk, X, V, idx, wt);
+                        for (int t = 0; t < 4; t++) {
+                            int cx = (int)(idx[t] % gk->w), j = (int)(idx[t] / gk->w);
+                            long lo, hi;
+                            mip_rows(m, k, cx, j, &lo, &hi);
+                            long n0 = fv_grid_col_h(g, cx);
+                            for (long r = lo; r <= hi; r++) {
+                                long rr = ((r % n0) + n0) % n0;
+                                bad += !mask[rr * g->w + cx];
+                            }
+                        }
+                    }
+                }
+            assert_int_equal(bad, 0);
+        }
+        free(mask);
+        fv_phi_mips_destroy(m);
+        fv_space_destroy(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -376,7 +477,8 @@ int main(void)
         cmocka_unit_test(test_fovea_density),   cmocka_unit_test(test_periphery_follows_acuity),
         cmocka_unit_test(test_phi_wrap),        cmocka_unit_test(test_fit_error),
         cmocka_unit_test(test_logpolar),        cmocka_unit_test(test_cartesian),
-        cmocka_unit_test(test_bad_options),
+        cmocka_unit_test(test_bad_options),     cmocka_unit_test(test_onscreen_mask),
+        cmocka_unit_test(test_turns),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

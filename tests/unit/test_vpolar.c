@@ -98,14 +98,15 @@ static double expected_falloff_share(void)
     return sum / (W * H);
 }
 
-/* Each method traces what its distribution says: vpolar its grid (39% of the pixels, fewer when
- * off-screen samples are skipped), cartesian the same count, cartesian-full every pixel,
+/* Each method traces what its distribution says: vpolar its grid (39% of the pixels; fewer when
+ * off-screen samples are skipped, the default), cartesian the same count, cartesian-full every pixel,
  * linear-falloff the expected survivors, log-polar (W/1.8)(H/1.8). */
 static void test_sample_counts(void **st)
 {
     (void)st;
     fv_stats s;
-    free(render("vpolar", NULL, 1, 2, k_centre, &s));
+    const char *trace[] = {"offscreen=trace", NULL};
+    free(render("vpolar", trace, 1, 2, k_centre, &s));
     double grid = fv_stats_get_count(&s, "grid_samples");
     assert_float_equal(fv_stats_get_count(&s, "samples"), grid, 0.0);
     assert_true(fabs(grid / (W * H) - 0.39) < 0.01);
@@ -114,8 +115,10 @@ static void test_sample_counts(void **st)
     assert_true(fv_stats_get_count(&s, "rays") >= 2.0 * grid);
     const char *skip[] = {"offscreen=skip", NULL};
     free(render("vpolar", skip, 1, 2, k_centre, &s));
-    /* the centre gaze's farthest circles leave the screen: 9% of the samples */
-    assert_true(fv_stats_get_count(&s, "samples") < 0.95 * grid);
+    /* the centre gaze's farthest circles leave the screen: 9% of the samples at 1280x1440; at this
+     * size the cells are larger against the screen and the mask, which keeps every cell a screen
+     * pixel's lookup can reach (fv_space_onscreen_mask), drops 4% */
+    assert_true(fv_stats_get_count(&s, "samples") < 0.98 * grid);
     free(render("vpolar", skip, 1, 2, (fv_gaze){0.0f, 0.0f}, &s));
     assert_true(fv_stats_get_count(&s, "samples") < 0.6 * grid);
     free(render("cartesian", NULL, 1, 2, k_centre, &s));
@@ -128,6 +131,24 @@ static void test_sample_counts(void **st)
     assert_true(expect < 0.9);
     free(render("log-polar", NULL, 1, 2, k_centre, &s));
     assert_float_equal(fv_stats_get_count(&s, "samples"), 71.0 * 80.0, 0.0);
+}
+
+/* Skipping the off-screen samples changes nothing on the screen: the denoiser ignores those cells
+ * in either mode and no screen pixel's lookup reads them (test_vp_space checks the mask), so the
+ * images are the same bits, for a centred and an off-centre gaze, over frames with a history. */
+static void test_offscreen_skip_same_image(void **st)
+{
+    (void)st;
+    const char *trace[] = {"offscreen=trace", NULL}, *skip[] = {"offscreen=skip", NULL};
+    const fv_gaze gazes[2] = {{0.5f, 0.5f}, {0.15f, 0.8f}};
+    for (int i = 0; i < 2; i++) {
+        fv_stats a, b;
+        float *i1 = render("vpolar", trace, 2, 2, gazes[i], &a);
+        float *i2 = render("vpolar", skip, 2, 2, gazes[i], &b);
+        assert_memory_equal(i1, i2, sizeof(float) * 3 * W * H);
+        assert_true(fv_stats_get_count(&b, "samples") < fv_stats_get_count(&a, "samples"));
+        free(i1), free(i2);
+    }
 }
 
 /* With a still camera and gaze the denoiser's history grows and the fovea converges towards the
@@ -276,7 +297,8 @@ static void test_bad_params(void **st)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_order_and_threads), cmocka_unit_test(test_sample_counts), cmocka_unit_test(test_converges),
+        cmocka_unit_test(test_order_and_threads), cmocka_unit_test(test_sample_counts),
+        cmocka_unit_test(test_offscreen_skip_same_image), cmocka_unit_test(test_converges),
         cmocka_unit_test(test_show_modes),        cmocka_unit_test(test_stereo),        cmocka_unit_test(test_bad_params),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

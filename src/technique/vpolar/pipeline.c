@@ -6,6 +6,7 @@
  * bilinearly. Static geometry reprojects exactly; a moving object's samples fail the denoiser's
  * position test and restart their history (no motion vectors).
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
@@ -16,6 +17,8 @@
 
 #define MAX_MIP_LEVELS 12
 #define LUT_STEP 0.5f /* pixels between the entries of the per-frame radial tables */
+#define MASK_REACH_PX 6.0f /* see the off-screen mask in fv_vp_pipeline_render */
+#define MAP_SPAN 64        /* screen pixels of a row the map stage takes at a time (at most) */
 
 struct fv_vp_pipeline {
     const fv_scene *scene;
@@ -28,6 +31,8 @@ struct fv_vp_pipeline {
     fv_vp_gbuf g;
     float *prev_coord;
     float *sigma;           /* per screen pixel */
+    uint8_t *onscreen;      /* polar spaces: per grid cell, fv_space_onscreen_mask at (mask_gx, mask_gy) */
+    float mask_gx, mask_gy; /* the gaze onscreen was computed for (NaN: not yet) */
     float *lut;             /* per frame, per radius step: column X, mip level, blur sigma */
     int nlut;
     uint32_t *perm;
@@ -57,7 +62,8 @@ static void free_buffers(fv_vp_pipeline *p)
     fv_svgf_destroy(p->svgf);
     fv_phi_mips_destroy(p->mips);
     free(p->g.color), free(p->g.albedo), free(p->g.normal), free(p->g.depth), free(p->g.position), free(p->g.id);
-    free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm), free(p->lut);
+    free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm), free(p->lut), free(p->onscreen);
+    p->onscreen = NULL;
     memset(&p->g, 0, sizeof p->g);
     p->space = NULL, p->svgf = NULL, p->mips = NULL, p->prev_coord = NULL, p->sigma = NULL, p->perm = NULL, p->lut = NULL;
     p->sw = p->sh = 0;
@@ -106,6 +112,13 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
     memset(p->g.id, 0, n * sizeof(uint32_t));
     memset(p->g.sampled, 0, n);
     for (size_t i = 0; i < n; i++) p->g.depth[i] = INFINITY;
+    if (fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
+        if (!(p->onscreen = fv_alloc_array(n, 1))) {
+            free_buffers(p);
+            return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d sample grid", g->w, g->h);
+        }
+        p->mask_gx = p->mask_gy = NAN;
+    }
     if (p->o.denoise && (s = fv_svgf_create(g, &p->o.svgf, &p->svgf, err)) != FV_OK) {
         free_buffers(p);
         return s;
@@ -139,7 +152,7 @@ static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
     for (int64_t i = b; i < e; i++) {
         float *pc = &p->prev_coord[2 * i];
         pc[0] = pc[1] = NAN;
-        if (!p->g.sampled[i] || p->g.id[i] == 0) continue;
+        if (!p->g.sampled[i] || p->g.id[i] == 0 || (p->onscreen && !p->onscreen[i])) continue;
         fv_vec3 x = fv_v3(p->g.position[3 * i], p->g.position[3 * i + 1], p->g.position[3 * i + 2]);
         float px, py;
         if (!fv_camera_project(&p->prev_cam, x, &px, &py)) continue;
@@ -155,6 +168,21 @@ typedef struct map_ctx {
     bool identity, polar;
 } map_ctx;
 
+/* Visual-Polar stretches its profile (and so its fovea) from the centre gaze's largest ρ to this
+ * gaze's; the blur's fovea follows: screen distances are multiplied by this before they become
+ * degrees of the blur's profile. */
+static double blur_scale(const fv_vp_pipeline *p, const fv_space_view *view)
+{
+    if (!p->o.blur_follows_space) return 1.0;
+    return 0.5 * sqrt((double)p->sw * p->sw + (double)p->sh * p->sh) / view->rho_max;
+}
+
+/* The screen distance from the gaze beyond which the blur has its full sigma (Sec. 3.5). */
+static double blur_full_radius(const fv_vp_pipeline *p, const fv_space_view *view)
+{
+    return p->o.blur_ramp_deg * p->ppd / blur_scale(p, view);
+}
+
 /* Everything the map stage needs that depends only on the distance from the gaze, tabulated for
  * this frame every LUT_STEP pixels: the column X, the φ-mip level (log2 of the rows one pixel spans
  * along φ) and the blur's sigma (Sec. 3.5). The per-pixel work is then a square root, an arc
@@ -162,10 +190,7 @@ typedef struct map_ctx {
 static void build_radial_lut(fv_vp_pipeline *p, const fv_space_view *view)
 {
     double sigma_px = p->o.blur_sigma * (double)p->sw / 1280.0;
-    /* Visual-Polar stretches its profile (and so its fovea) from the centre gaze's largest ρ to
-     * this gaze's; the blur's fovea follows. */
-    double scale = 1.0;
-    if (p->o.blur_follows_space) scale = 0.5 * sqrt((double)p->sw * p->sw + (double)p->sh * p->sh) / view->rho_max;
+    const double scale = blur_scale(p, view);
     for (int i = 0; i < p->nlut; i++) {
         float r = (float)i * LUT_STEP, X, V, rows;
         fv_space_from_screen(view, view->gx + r, view->gy, &X, &V, &rows);
@@ -176,56 +201,90 @@ static void build_radial_lut(fv_vp_pipeline *p, const fv_space_view *view)
     }
 }
 
+/* Row y's pixels [x0, x0 + n) on a polar space: column X, angle V and mip level from the radial
+ * table, and the blur's sigma. One vectorised loop: a gather from the table and fv_space_turns,
+ * no call per pixel. */
+static void map_coords(const map_ctx *c, int64_t y, int x0, int n, float *X, float *V, float *level)
+{
+    const fv_vp_pipeline *p = c->p;
+    const float inv_step = 1.0f / LUT_STEP, gx = c->view->gx, gy = c->view->gy;
+    const float *lut = p->lut;
+    const int last = p->nlut - 2;
+    float sigma[MAP_SPAN];
+    const float dy = (float)y + 0.5f - gy;
+    #pragma omp simd
+    for (int k = 0; k < n; k++) {
+        float dx = (float)(x0 + k) + 0.5f - gx;
+        float t = sqrtf(dx * dx + dy * dy) * inv_step;
+        int i = (int)t;
+        i = i < last ? i : last;
+        float f = t - (float)i;
+        X[k] = lut[3 * i] + f * (lut[3 * i + 3] - lut[3 * i]);
+        level[k] = lut[3 * i + 1] + f * (lut[3 * i + 4] - lut[3 * i + 1]);
+        V[k] = fv_space_turns(dx, dy);
+        sigma[k] = lut[3 * i + 2] + f * (lut[3 * i + 5] - lut[3 * i + 2]);
+    }
+    if (p->o.blur) memcpy(&p->sigma[(size_t)y * p->sw + x0], sigma, (size_t)n * sizeof(float));
+}
+
+/* The film's first-hit buffers of screen pixel pix from grid cell near. */
+static void store_aux(const map_ctx *c, size_t pix, long near)
+{
+    const fv_vp_gbuf *g = &c->p->g;
+    bool hit = g->id[near] != 0;
+    fv_film_store_first_hit(&c->out, pix, hit, g->depth[near],
+                            fv_v3(g->position[3 * near], g->position[3 * near + 1], g->position[3 * near + 2]),
+                            fv_v3(g->normal[3 * near], g->normal[3 * near + 1], g->normal[3 * near + 2]),
+                            fv_v3(g->albedo[3 * near], g->albedo[3 * near + 1], g->albedo[3 * near + 2]),
+                            hit ? (int)g->id[near] - 1 : 0);
+}
+
 /* Screen pixel colours from the sample space (Sec. 3.4), the film's first-hit buffers from the
- * nearest sample, and the blur's sigma (Sec. 3.5). */
+ * nearest sample, and the blur's sigma (Sec. 3.5), MAP_SPAN pixels of a row at a time. */
 static void map_rows(void *ctx, int64_t b, int64_t e, int thread)
 {
     map_ctx *c = ctx;
     fv_vp_pipeline *p = c->p;
     const fv_grid *g = fv_space_grid(p->space);
     const bool aux = c->out.depth || c->out.normal || c->out.albedo || c->out.position || c->out.id;
-    const float inv_step = 1.0f / LUT_STEP, inv_2pi = 1.0f / (2.0f * FV_PI);
+    float X[MAP_SPAN], V[MAP_SPAN], level[MAP_SPAN];
     for (int64_t y = b; y < e; y++)
-        for (int x = 0; x < p->sw; x++) {
-            size_t pix = (size_t)y * p->sw + x;
-            float dx = (float)x + 0.5f - c->view->gx, dy = (float)y + 0.5f - c->view->gy;
-            float t = sqrtf(dx * dx + dy * dy) * inv_step;
-            int i = (int)t;
-            i = i < p->nlut - 2 ? i : p->nlut - 2;
-            float f = t - (float)i;
-            const float *l0 = &p->lut[3 * i], *l1 = l0 + 3;
-            if (p->o.blur) p->sigma[pix] = l0[2] + f * (l1[2] - l0[2]);
-            long near;
-            if (c->identity) {
-                near = (long)pix;
-                memcpy(&c->out.color[3 * pix], &p->g.color[3 * pix], 3 * sizeof(float));
+        for (int x0 = 0; x0 < p->sw; x0 += MAP_SPAN) {
+            const int n = p->sw - x0 < MAP_SPAN ? p->sw - x0 : MAP_SPAN;
+            if (c->polar) {
+                map_coords(c, y, x0, n, X, V, level);
             } else {
-                float X, V, level = 0.0f;
-                if (c->polar) {
-                    X = l0[0] + f * (l1[0] - l0[0]);
-                    level = l0[1] + f * (l1[1] - l0[1]);
-                    V = atan2f(dy, dx) * inv_2pi;
-                    V = V < 0.0f ? V + 1.0f : V;
-                    V = V < 1.0f ? V : 0.0f;
-                } else {
-                    fv_space_from_screen(c->view, (float)x + 0.5f, (float)y + 0.5f, &X, &V, NULL);
+                /* The Cartesian grid: no blur (its sigma, if any, from the table) and level 0. */
+                for (int k = 0; k < n; k++) {
+                    const float px = (float)(x0 + k) + 0.5f, py = (float)y + 0.5f;
+                    if (p->o.blur) {
+                        float dx = px - c->view->gx, dy = py - c->view->gy, t = sqrtf(dx * dx + dy * dy) / LUT_STEP;
+                        int i = (int)t;
+                        i = i < p->nlut - 2 ? i : p->nlut - 2;
+                        float f = t - (float)i;
+                        const float *l0 = &p->lut[3 * i], *l1 = l0 + 3;
+                        p->sigma[(size_t)y * p->sw + x0 + k] = l0[2] + f * (l1[2] - l0[2]);
+                    }
+                    level[k] = 0.0f;
+                    if (!c->identity) fv_space_from_screen(c->view, px, py, &X[k], &V[k], NULL);
                 }
-                fv_phi_mips_sample(p->mips, X, V, level, &c->out.color[3 * pix]);
-                if (!aux) continue;
-                int gx = (int)X;
-                gx = gx < 0 ? 0 : (gx >= g->w ? g->w - 1 : gx);
-                int n = fv_grid_col_h(g, gx);
-                int gy = (int)(V * (float)n);
-                gy = gy < 0 ? 0 : (gy >= n ? n - 1 : gy);
-                near = (long)gy * g->w + gx;
             }
-            if (!aux) continue;
-            bool hit = p->g.id[near] != 0;
-            fv_film_store_first_hit(&c->out, pix, hit, p->g.depth[near],
-                                    fv_v3(p->g.position[3 * near], p->g.position[3 * near + 1], p->g.position[3 * near + 2]),
-                                    fv_v3(p->g.normal[3 * near], p->g.normal[3 * near + 1], p->g.normal[3 * near + 2]),
-                                    fv_v3(p->g.albedo[3 * near], p->g.albedo[3 * near + 1], p->g.albedo[3 * near + 2]),
-                                    hit ? (int)p->g.id[near] - 1 : 0);
+            for (int k = 0; k < n; k++) {
+                const size_t pix = (size_t)y * p->sw + x0 + k;
+                if (c->identity) {
+                    memcpy(&c->out.color[3 * pix], &p->g.color[3 * pix], 3 * sizeof(float));
+                    if (aux) store_aux(c, pix, (long)pix);
+                    continue;
+                }
+                fv_phi_mips_sample(p->mips, X[k], V[k], level[k], &c->out.color[3 * pix]);
+                if (!aux) continue;
+                int gx = (int)X[k];
+                gx = gx < 0 ? 0 : (gx >= g->w ? g->w - 1 : gx);
+                int nr = fv_grid_col_h(g, gx);
+                int gy = (int)(V[k] * (float)nr);
+                gy = gy < 0 ? 0 : (gy >= nr ? nr - 1 : gy);
+                store_aux(c, pix, (long)gy * g->w + gx);
+            }
         }
 }
 
@@ -244,6 +303,16 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     const fv_grid *g = fv_space_grid(p->space);
     fv_space_view view = fv_space_view_at(p->space, gaze);
 
+    /* The cells of a polar grid that no screen pixel can see (its corners reach beyond the screen
+     * wherever the gaze is): the trace skips them with offscreen=skip, the denoiser always (they
+     * would only cost time and pull the edge's samples towards values nobody sees). The reach
+     * covers the map stage's trilinear φ-mip lookup (two levels, one texel each way, a level's
+     * texel about one pixel along φ). Kept while the gaze stays. */
+    if (p->onscreen && !(view.gx == p->mask_gx && view.gy == p->mask_gy)) {
+        fv_space_onscreen_mask(&view, MASK_REACH_PX, p->onscreen);
+        p->mask_gx = view.gx, p->mask_gy = view.gy;
+    }
+
     /* 1. trace */
     fv_vp_trace_job job;
     memset(&job, 0, sizeof job);
@@ -257,6 +326,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     job.perm = p->perm;
     job.nperm = p->nperm;
     job.skip_offscreen = p->o.skip_offscreen;
+    job.onscreen = p->onscreen;
     job.kill = p->o.kill;
     job.kill_e0 = p->o.kill_e0, job.kill_e1 = p->o.kill_e1, job.kill_p = p->o.kill_p;
     job.px_per_deg = p->ppd;
@@ -287,7 +357,13 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
             fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
         }
         fv_svgf_frame fr = {p->g.color, p->g.albedo, p->g.normal, p->g.depth, p->g.position, p->g.id,
-                            hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL};
+                            hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
+        if (p->o.blur && p->o.periphery_passes < p->o.svgf.iterations && fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
+            /* The columns wholly beyond the radius where the blur reaches its full sigma. */
+            float X, V;
+            fv_space_from_screen(&view, view.gx + (float)blur_full_radius(p, &view), view.gy, &X, &V, NULL);
+            fv_svgf_set_periphery(p->svgf, (int)ceilf(X), p->o.periphery_passes);
+        }
         fv_svgf_info info;
         if ((s = fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err)) != FV_OK) return s;
         fv_stats_add_count(stats, "history_fraction", info.history_fraction);

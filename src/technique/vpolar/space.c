@@ -309,6 +309,64 @@ float fv_space_radius(const fv_space_view *v, float X)
     return 0.0f;
 }
 
+long fv_space_onscreen_mask(const fv_space_view *v, float reach_px, uint8_t *mask)
+{
+    const fv_space *s = v->space;
+    const fv_grid *g = &s->grid;
+    const int w = g->w, h = g->h;
+    if (s->o.kind == FV_SPACE_CARTESIAN) {
+        memset(mask, 1, (size_t)w * h);
+        return (long)w * h;
+    }
+    /* Column x spans the radii [r(x), r(x + 1)]; a cell of an n-row column spans 2 pi / n of angle,
+     * so every point of it is within (r1 - r0) / 2 + pi r1 / n of its centre (radial half-width
+     * plus the arc, which is longer than the chord). That bound, doubled for the neighbouring cells a
+     * bilinear tap reaches, is how far the centre may be off the screen widened by reach_px. */
+    float *cs = fv_alloc_array((size_t)h, 2 * sizeof(float));
+    const float lo_x = -reach_px, lo_y = -reach_px, hi_x = (float)s->sw + reach_px, hi_y = (float)s->sh + reach_px;
+    long on = 0;
+    if (cs)
+        for (int y = 0; y < h; y++) {
+            float phi = 2.0f * FV_PI * ((float)y + 0.5f) / (float)h;
+            cs[2 * y] = cosf(phi), cs[2 * y + 1] = sinf(phi);
+        }
+    float r0 = fv_space_radius(v, 0.0f);
+    for (int x = 0; x < w; x++) {
+        const float r1 = fv_space_radius(v, (float)x + 1.0f), rm = fv_space_radius(v, (float)x + 0.5f);
+        const int n = fv_grid_col_h(g, x);
+        const float bound = 2.0f * (0.5f * (r1 - r0) + FV_PI * r1 / (float)n);
+        const float b2 = bound * bound;
+        /* Every cell centre of the column (radius rm) within the widened screen: all on. */
+        bool all = v->gx - rm >= lo_x && v->gy - rm >= lo_y && v->gx + rm <= hi_x && v->gy + rm <= hi_y;
+        for (int y = 0; y < h; y++) {
+            size_t p = (size_t)y * w + x;
+            if (y >= n) {
+                mask[p] = 0;
+                continue;
+            }
+            bool in = all;
+            if (!in) {
+                float c, sn;
+                if (n == h && cs) {
+                    c = cs[2 * y], sn = cs[2 * y + 1];
+                } else {
+                    float phi = 2.0f * FV_PI * ((float)y + 0.5f) / (float)n;
+                    c = cosf(phi), sn = sinf(phi);
+                }
+                float px = v->gx + rm * c, py = v->gy + rm * sn;
+                float dx = px < lo_x ? lo_x - px : (px > hi_x ? px - hi_x : 0.0f);
+                float dy = py < lo_y ? lo_y - py : (py > hi_y ? py - hi_y : 0.0f);
+                in = dx * dx + dy * dy <= b2;
+            }
+            mask[p] = in;
+            on += in;
+        }
+        r0 = r1;
+    }
+    free(cs);
+    return on;
+}
+
 void fv_space_to_screen(const fv_space_view *v, float X, float V, float *px, float *py)
 {
     const fv_space *s = v->space;

@@ -54,8 +54,7 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
         float V = ((float)y + fv_rng_next(&rng[k])) / (float)fv_grid_col_h(c->grid, x);
         float px, py;
         fv_space_to_screen(&j->view, X, V, &px, &py);
-        bool on = px >= -1.0f && py >= -1.0f && px <= (float)j->screen_w + 1.0f && py <= (float)j->screen_h + 1.0f;
-        bool go = !(j->skip_offscreen && !on);
+        bool go = !(j->skip_offscreen && j->onscreen && !j->onscreen[i]);
         if (go && j->kill) {
             fv_rng kr = fv_rng_stream(j->frame->seed, FV_STREAM_KILL, (uint64_t)i * 2 + (uint64_t)j->frame->eye, 0, (uint64_t)j->frame->index);
             go = fv_rng_next(&kr) < (float)fv_vp_survival(&j->view, px, py, j->px_per_deg, j->kill_e0, j->kill_e1, j->kill_p);

@@ -40,7 +40,8 @@ typedef struct fv_vp_trace_job {
     fv_vp_order order;
     const uint32_t *perm;  /* random order: the grid's valid pixel indices, permuted */
     long nperm;
-    bool skip_offscreen;   /* samples whose screen position is more than a pixel off screen are not traced */
+    bool skip_offscreen;   /* the cells marked 0 in onscreen are not traced */
+    const uint8_t *onscreen; /* per grid cell (fv_space_onscreen_mask); NULL: every cell is on screen */
     bool kill;             /* linear fall-off: survival 1 up to kill_e0, kill_p from kill_e1 on */
     double kill_e0, kill_e1, kill_p, px_per_deg;
     const fv_frame *frame;     /* seed, index, eye, threads */

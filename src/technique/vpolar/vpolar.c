@@ -32,7 +32,7 @@ typedef struct vp_state {
 typedef enum vp_kind { K_VPOLAR, K_CARTESIAN, K_CARTESIAN_FULL, K_LINEAR_FALLOFF, K_LOGPOLAR } vp_kind;
 
 static const char *const k_orders[] = {"grid", "random", NULL};
-static const char *const k_offscreen[] = {"trace", "skip", NULL};
+static const char *const k_offscreen[] = {"skip", "trace", NULL}; /* skip first: the default */
 static const char *const k_show[] = {"screen", "space", "density", NULL};
 
 /* A float parameter that must lie strictly inside (lo, hi). */
@@ -47,6 +47,7 @@ static fv_status open_range(fv_params *p, const char *key, double def, double lo
 static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *show, fv_error *err)
 {
     memset(o, 0, sizeof *o);
+    o->periphery_passes = 10; /* off: every column gets every pass */
     fv_space_kind sk = kind == K_VPOLAR ? FV_SPACE_VPOLAR : (kind == K_LOGPOLAR ? FV_SPACE_LOGPOLAR : FV_SPACE_CARTESIAN);
     fv_space_opts_default(sk, &o->space);
     fv_svgf_opts_default(&o->svgf);
@@ -84,6 +85,7 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
             (s = fv_params_int(p, "fit_degree", 6, 2, 10, &o->space.fit_degree, err)))
             return s;
         o->blur_follows_space = true;
+        if ((s = fv_params_int(p, "periphery_passes", o->svgf.iterations, 0, 10, &o->periphery_passes, err))) return s;
         break;
     case K_CARTESIAN:
         if ((s = open_range(p, "reduction", 0.61, 0.0, 1.0, &o->space.reduction, err))) return s;
@@ -116,7 +118,7 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
     o->pt.max_depth = 1 + bounces;
     o->pt.rr_depth = 1 << 20; /* Sec. 3.1: a fixed path length, no Russian roulette */
     o->order = (fv_vp_order)order;
-    o->skip_offscreen = offscreen == 1;
+    o->skip_offscreen = offscreen == 0;
     *show = (vp_show)sh;
     return FV_OK;
 }
@@ -258,7 +260,7 @@ static fv_status create_logpolar(const fv_scene *s, fv_params *p, const fv_log *
     "blur_sigma=float (6.8): blur sigma in pixels at blur_ramp_deg, for 1280 pixels wide (scaled with the width)\n"     \
     "blur_fovea_deg=float, blur_ramp_deg=float (30): the blur is 0 inside the first, rises linearly to the second\n"    \
     "order=grid|random (grid): launch order of the samples (random: Sec. 6's incoherent launch)\n"                       \
-    "offscreen=trace|skip (trace): trace the samples of the polar grids that fall off the screen, or not\n"              \
+    "offscreen=trace|skip (skip): trace the polar grids' cells no screen pixel sees, or not (same image either way)\n"   \
     "show=screen|space|density (screen): the image, the sample-space image, or samples per pixel\n"
 
 const fv_technique_class fv_technique_vpolar = {
@@ -267,7 +269,8 @@ const fv_technique_class fv_technique_vpolar = {
     COMMON_HELP "reduction=float (0.61): share of screen pixels not sampled, in (0,1) (the paper: 0.61, 0.71, 0.88)\n"
                 "fovea_deg=float (5.79): radius of the linear, clipped fovea in planar degrees\n"
                 "fit_degree=int (6): degree of the polynomial inverse of Eq. 2\n"
-                "blur=bool (true): foveated blur (blur_fovea_deg default 5.79, stretched with the space)\n",
+                "blur=bool (true): foveated blur (blur_fovea_deg default 5.79, stretched with the space)\n"
+                "periphery_passes=int (svgf_iterations: off): SVGF passes for the columns beyond blur_ramp_deg, where the blur is widest\n",
     create_vpolar, vp_render, vp_destroy,
     FURNACE_TEST, .spp_param = "spp",
 };

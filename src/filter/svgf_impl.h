@@ -1,0 +1,209 @@
+/* fovea — SVGF internals shared by svgf.c and the sweeps it builds twice (svgf_sweeps.h: for the
+ * baseline x86-64 in svgf.c, for AVX2 in svgf_avx2.c). Private to src/filter/svgf*.c. */
+#ifndef FV_FILTER_SVGF_IMPL_H
+#define FV_FILTER_SVGF_IMPL_H
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <string.h>
+#include "filter/svgf.h"
+
+#define LEN_MAX 256.0f
+#define MIN_ALBEDO 1e-3f
+#define HIST_MIN_WEIGHT 0.01f
+#define HIST_COS 0.9f           /* normals within ~25 degrees */
+#define HIST_POS_REL 0.05f      /* position tolerance, fraction of the depth */
+#define HIST_DEPTH_MIN 1e-3f
+#define HIST_POS_ULP 1e-5f      /* plus this fraction of the coordinates' size: float rounding */
+#define DEPTH_EPS_REL 1e-4f     /* depth differences this small relative to the depth are free */
+#define LUM_EPS 1e-10f
+#define VAR_TEMPORAL_LEN 4.0f
+#define CHUNK 64
+#define NTAP 24                 /* taps of the 5x5 kernel besides the centre */
+#define NTAP7 48                /* the same for the 7x7 moments */
+#define SQ_DEFAULT 7            /* sigma_normal 128 = 2^7: the case compiled with a constant */
+/* Rows are dealt to the threads in interleaved blocks (still a static schedule): the fovea's short
+ * columns make the first rows of a polar grid heavier, and halves would leave one thread waiting. */
+#define ROWS_PER_BLOCK 8
+
+/* The per-tap functions must be inlined into the loops marked omp simd, or nothing vectorises. */
+#if defined(__GNUC__)
+#define TAP_INLINE static inline __attribute__((always_inline))
+#else
+#define TAP_INLINE static inline
+#endif
+
+enum { KIND_NONE = 0, KIND_SURFACE = 1, KIND_HOLE = 2 };
+enum { V_R, V_G, V_B, V_VAR, V_LUM, NVAL };
+
+static const float k_b3[5] = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
+static const float k_g3[3] = {0.25f, 0.5f, 0.25f};
+
+struct fv_svgf {
+    fv_grid g;
+    fv_svgf_opts o;
+    int normal_squarings;   /* sigma_normal = 2^k, k <= 16: k; else -1 (powf) */
+    int full_from;          /* polar grids: columns from here on all hold h rows */
+    bool have_history;
+    size_t n;
+    uint8_t *kind;
+    float *surf;            /* 1 on a surface pixel, else 0 (the variance prefilter's weights) */
+    float *nx[2], *ny[2], *nz[2], *z[2]; /* normal and depth; [0] this frame, [1] the history */
+    float *val[2][NVAL];    /* demodulated rgb, variance, luminance; ping-pong over the passes */
+    float *gvar;            /* variance after the 3x3 prefilter, for the current pass */
+    float *grad;            /* depth gradient magnitude */
+    float *m1[2], *m2[2];   /* luminance moments; [0] this frame, [1] the history */
+    float *len[2];          /* history length; 0: not a surface pixel (cannot serve as history) */
+    float *hist_illum;      /* rgb after the first pass, for the next frame */
+    float *hist_pos;        /* xyz */
+    uint32_t *hist_id;
+    long *row_surface, *row_hist, *row_holes;
+    double *row_len;
+    bool avx2;              /* the sweeps' AVX2 build (svgf_avx2.c), else the baseline one */
+    int periph_x, periph_passes; /* fv_svgf_set_periphery (w, iterations: off) */
+    int pass_cut;           /* the current pass filters the columns [0, pass_cut) */
+};
+
+/* ---- small helpers */
+
+static inline int imin(int a, int b) { return a < b ? a : b; }
+static inline int imax(int a, int b) { return a > b ? a : b; }
+
+static inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
+
+static inline float demod_albedo(float a) { return a < MIN_ALBEDO ? 1.0f : a; }
+
+/* The denominator's floor of the depth term: differences below 1e-4 of the depth are rounding. */
+static inline float depth_eps(float z) { return DEPTH_EPS_REL * fabsf(z) + 1e-30f; }
+
+/* e^-x for x >= 0, inline (a call to expf per tap was a quarter of the frame): 2^t with
+ * t = -x log2(e) split into an integer i and a fraction whose e^a, a in [-ln2 / 2, ln2 / 2], comes
+ * from its Taylor series to the 5th power (truncation error below 2.5e-6, evaluated in Estrin's
+ * form: half the dependent operations of Horner's), and 2^i through the exponent bits. Relative
+ * error below 4e-6 for x < 10 and 5e-6 up to 87; exactly 1 at 0; exactly 0 from 87 on (where expf
+ * is below 2e-38), for +inf and NaN. Branch-free, with the selects on integers (for x >= 0 the
+ * bits order like the values), so that loops over taps vectorise. */
+TAP_INLINE float exp_neg(float x)
+{
+    union { float f; int32_t i; } u = {x}, lim = {87.0f}, scale;
+    int32_t in = u.i < lim.i;
+    u.i = in ? u.i : lim.i;
+    float t = -u.f * 1.44269504f;
+    int32_t i = (int32_t)(t - 0.5f); /* t <= 0: truncation rounds t - 0.5 up, i in [-125, 0] */
+    float a = (t - (float)i) * 0.693147181f, a2 = a * a;
+    float p = (1.0f + a) + a2 * ((1.0f / 2 + a * (1.0f / 6)) + a2 * (1.0f / 24 + a * (1.0f / 120)));
+    scale.i = in ? (i + 127) * (1 << 23) : 0;
+    return p * scale.f;
+}
+
+/* max(0, c)^sigma_normal: sq squarings when sigma_normal = 2^sq, else powf. Called with the literal
+ * SQ_DEFAULT in the hot loops so that the squarings unroll and the loop vectorises. (c + |c|) / 2
+ * is max(c, 0) exactly in a form that vectorises. */
+TAP_INLINE float normal_pow(float c, int sq, float sn)
+{
+    c = 0.5f * (c + fabsf(c));
+    if (sq < 0) return powf(c, sn);
+    for (int k = 0; k < sq; k++) c *= c;
+    return c;
+}
+
+/* For the pixels [x0, x1) of row y: the run [*a, *b) whose tap (dx, dy) is the pixel x + *off (a
+ * plain shift: fv_grid_tap reduces to it there). Pixels outside the run need fv_grid_tap on a polar
+ * grid; on a screen grid their tap lies outside the image. An empty run is returned as a = b = x1.
+ * (x0, x1 here are any span of a row, not necessarily a whole chunk.) */
+static inline void tap_run(const fv_svgf *f, int y, int dx, int dy, int x0, int x1, int *a, int *b, long *off)
+{
+    const fv_grid *g = &f->g;
+    int row, lo, hi;
+    if (!g->wrap) {
+        row = y + dy;
+        lo = imax(x0, -dx);
+        hi = imin(x1, g->w - dx);
+        if (row < 0 || row >= g->h) lo = hi = x1;
+    } else {
+        /* Both columns full height: no remapping between heights, the row wraps modulo h. */
+        row = fv_grid_wrap_row(y + dy, g->h);
+        lo = imax(imax(x0, f->full_from), imax(f->full_from - dx, -dx));
+        hi = imin(x1, g->w - dx);
+    }
+    if (lo >= hi) lo = hi = x1;
+    *a = lo;
+    *b = hi;
+    *off = (long)row * g->w + dx;
+}
+
+/* The span [*lo, *hi) of the chunk [x0, x1) (pixel x0 at index p0) from its first to its last
+ * surface pixel; false when the chunk has none. Only the span is filtered (the fovea's short columns leave most of a chunk's row
+ * beyond their heights, and a background stays out of the loops). */
+static inline bool surface_span(const uint8_t *kind, size_t p0, int x0, int x1, int *lo, int *hi)
+{
+    int a = x0, b = x1;
+    while (a < b && kind[p0 + (a - x0)] != KIND_SURFACE) a++;
+    while (b > a && kind[p0 + (b - 1 - x0)] != KIND_SURFACE) b--;
+    *lo = a, *hi = b;
+    return a < b;
+}
+
+/* The pixels of a chunk that are not in a tap's run (polar grids: short columns, clamped edges) take
+ * their taps through this table: for each column offset, where fv_grid_tap(x, y, dx, .) starts. The
+ * same-angle mapping between columns of different heights is an integer division, done once per
+ * column offset here rather than once per tap. */
+typedef struct chunk_cols {
+    int x[7][CHUNK], row[7][CHUNK], n[7][CHUNK];
+    bool ready;     /* built for the current chunk (only chunks that need it build it) */
+} chunk_cols;
+
+static void chunk_columns(const fv_grid *g, int y, int x0, int nc, int step, int ncols, chunk_cols *cc)
+{
+    const int half = ncols / 2;
+    for (int i = 0; i < ncols; i++)
+        for (int k = 0; k < nc; k++) {
+            int x = x0 + k, xx = x + (i - half) * step;
+            xx = xx < 0 ? 0 : (xx >= g->w ? g->w - 1 : xx);
+            int hs = fv_grid_col_h(g, x), hd = fv_grid_col_h(g, xx), row = y;
+            if (hs != hd) row = (int)(((long)y * 2 + 1) * hd / (2L * hs));
+            cc->x[i][k] = xx, cc->row[i][k] = row, cc->n[i][k] = hd;
+        }
+    cc->ready = true;
+}
+
+/* fv_grid_tap(g, x0 + k, y, (ci - ncols / 2) * step, dy) on a polar grid, from the table. */
+static inline int chunk_tap(const fv_grid *g, const chunk_cols *cc, int ci, int k, int dy)
+{
+    int n = cc->n[ci][k], yy = cc->row[ci][k] + dy;
+    if (yy < 0 || yy >= n) yy = fv_grid_wrap_row(yy, n);
+    return yy * g->w + cc->x[ci][k];
+}
+
+/* Fills fq[x - x0] for the pixels of [s0, s1) outside the run [a, b): their taps. Their centres may
+ * be no surface: the tap is then still a valid pixel and weighs 0. */
+static inline void fallback_taps(const fv_grid *g, const chunk_cols *cc, int ci, int dy, int x0, int s0, int s1, int a,
+                                 int b, int *fq)
+{
+    for (int x = s0; x < a; x++) fq[x - x0] = chunk_tap(g, cc, ci, x - x0, dy);
+    for (int x = b; x < s1; x++) fq[x - x0] = chunk_tap(g, cc, ci, x - x0, dy);
+}
+
+/* ---- B. depth gradient and variance */
+
+/* Along one axis: the smaller one-sided difference to a surface neighbour (see the top of the file). */
+static inline float axis_gradient(const fv_svgf *f, long qm, long qp, float zc)
+{
+    const float *z = f->z[0];
+    float dm = qm >= 0 && f->kind[qm] == KIND_SURFACE ? fabsf(zc - z[qm]) : INFINITY;
+    float dp = qp >= 0 && f->kind[qp] == KIND_SURFACE ? fabsf(z[qp] - zc) : INFINITY;
+    float d = fminf(dm, dp);
+    return isfinite(d) ? d : 0.0f;
+}
+
+/* The two builds of svgf_sweeps.h: B. depth gradient and variance; C. the variance prefilter and
+ * one À-Trous pass. The _avx2 ones need an AVX2 CPU. */
+void fv_svgf_variance_base(fv_svgf *f, int nt);
+void fv_svgf_prefilter_base(fv_svgf *f, const float *var, int nt);
+void fv_svgf_atrous_base(fv_svgf *f, int step, int src, bool write_hist, int nt);
+void fv_svgf_variance_avx2(fv_svgf *f, int nt);
+void fv_svgf_prefilter_avx2(fv_svgf *f, const float *var, int nt);
+void fv_svgf_atrous_avx2(fv_svgf *f, int step, int src, bool write_hist, int nt);
+
+#endif

@@ -1,0 +1,396 @@
+/* fovea — the SVGF sweeps that dominate a frame (variance, prefilter, À-Trous passes), written once
+ * and built twice: by svgf.c for the baseline x86-64 (SSE2) and by svgf_avx2.c for AVX2, each
+ * defining SVGF_ISA(name) to name its copies. Neither build enables FMA and every loop keeps its
+ * order, so the two give the same bits (tests/unit/test_svgf_isa.c forces each). Included only
+ * by those two files, after filter/svgf_impl.h. */
+
+/* One tap of the 7x7 moments estimate, pixel p (chunk slot k) taking pixel q. */
+TAP_INLINE void moments_tap(const fv_svgf *f, size_t p, int q, int k, float rz, int sq, float sn, float *a1, float *a2,
+                               float *aw)
+{
+    const float *nx = f->nx[0], *ny = f->ny[0], *nz = f->nz[0], *z = f->z[0];
+    float wn = normal_pow(nx[p] * nx[q] + ny[p] * ny[q] + nz[p] * nz[q], sq, sn);
+    float wt = wn * exp_neg(fabsf(z[p] - z[q]) * rz);
+    a1[k] += wt * f->m1[0][q];
+    a2[k] += wt * f->m2[0][q];
+    aw[k] += wt;
+}
+
+void SVGF_ISA(variance)(fv_svgf *f, int nt)
+{
+    const fv_grid *g = &f->g;
+    const int w = g->w, h = g->h;
+    const uint8_t *kind = f->kind;
+    const float sd = f->o.sigma_depth, sn = f->o.sigma_normal;
+    const int sq = f->normal_squarings;
+    float *var = f->val[0][V_VAR], *grad = f->grad;
+    const float *m1 = f->m1[0], *m2 = f->m2[0], *len = f->len[0];
+    /* The 48 taps of the 7x7 window, the distance classes of their squared distances
+     * (1, 2, 4, 5, 8, 9, 10, 13, 18). */
+    int di[NTAP7], dj[NTAP7], cls[NTAP7];
+    const int d2s[9] = {1, 2, 4, 5, 8, 9, 10, 13, 18};
+    float dist[9];
+    for (int c = 0; c < 9; c++) dist[c] = sqrtf((float)d2s[c]);
+    for (int j = 0, t = 0; j < 7; j++)
+        for (int i = 0; i < 7; i++) {
+            if (i == 3 && j == 3) continue;
+            int d2 = (i - 3) * (i - 3) + (j - 3) * (j - 3);
+            di[t] = i - 3, dj[t] = j - 3;
+            for (int c = 0; c < 9; c++)
+                if (d2s[c] == d2) cls[t] = c;
+            t++;
+        }
+    #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
+    for (int y = 0; y < h; y++) {
+        float a1[CHUNK], a2[CHUNK], aw[CHUNK], rz[9][CHUNK];
+        int fq[CHUNK];
+        chunk_cols cc;
+        for (int x0 = 0; x0 < w; x0 += CHUNK) {
+            const int x1 = imin(x0 + CHUNK, w), nc = x1 - x0;
+            const size_t p0 = (size_t)y * w + x0;
+            /* Every pixel's depth gradient (each reads only its neighbours' depths) and temporal
+             * variance; the 7x7 estimate below replaces the variance of the young ones. */
+            bool young = false;
+            /* The four neighbours are plain offsets (the rows above and below wrapped once per row)
+             * between full-height columns away from the clamped edge, and inside a screen grid;
+             * elsewhere fv_grid_tap works them out. */
+            const int xa = g->wrap ? imax(f->full_from + 1, 1) : 1;
+            const bool rows_in = g->wrap || (y >= 1 && y + 1 < h);
+            const long up = (long)(y > 0 ? y - 1 : h - 1) * w, down = (long)(y + 1 < h ? y + 1 : 0) * w;
+            for (int k = 0; k < nc; k++) {
+                size_t p = p0 + k;
+                if (kind[p] != KIND_SURFACE) continue;
+                const int x = x0 + k;
+                const float zc = f->z[0][p];
+                float gx, gy;
+                if (rows_in && x >= xa && x + 1 < w) {
+                    gx = axis_gradient(f, (long)p - 1, (long)p + 1, zc);
+                    gy = axis_gradient(f, up + x, down + x, zc);
+                } else {
+                    gx = axis_gradient(f, fv_grid_tap(g, x, y, -1, 0), fv_grid_tap(g, x, y, 1, 0), zc);
+                    gy = axis_gradient(f, fv_grid_tap(g, x, y, 0, -1), fv_grid_tap(g, x, y, 0, 1), zc);
+                }
+                grad[p] = gx > gy ? gx : gy;
+                float tv = m2[p] - m1[p] * m1[p];
+                var[p] = tv > 0.0f ? tv : 0.0f;
+                young = young || len[p] < VAR_TEMPORAL_LEN;
+            }
+            int s0, s1;
+            if (!young || !surface_span(kind, p0, x0, x1, &s0, &s1)) continue;
+            float zs[CHUNK], ze[CHUNK];
+            #pragma omp simd
+            for (int k = 0; k < nc; k++) {
+                size_t p = p0 + k;
+                zs[k] = sd * grad[p], ze[k] = depth_eps(f->z[0][p]);
+                a1[k] = m1[p], a2[k] = m2[p], aw[k] = 1.0f; /* the centre, weight 1 */
+            }
+            for (int c = 0; c < 9; c++) {
+                const float dc = dist[c];
+                #pragma omp simd
+                for (int k = 0; k < nc; k++) rz[c][k] = 1.0f / (zs[k] * dc + ze[k]);
+            }
+            cc.ready = false;
+            for (int t = 0; t < NTAP7; t++) {
+                int a, b;
+                long off;
+                tap_run(f, y, di[t], dj[t], s0, s1, &a, &b, &off);
+                const float *rzc = rz[cls[t]];
+                if (sq == SQ_DEFAULT) {
+                    #pragma omp simd
+                    for (int x = a; x < b; x++)
+                        moments_tap(f, p0 + (x - x0), (int)off + x, x - x0, rzc[x - x0], SQ_DEFAULT, sn, a1, a2, aw);
+                } else {
+                    for (int x = a; x < b; x++)
+                        moments_tap(f, p0 + (x - x0), (int)off + x, x - x0, rzc[x - x0], sq, sn, a1, a2, aw);
+                }
+                if (!g->wrap || (a == s0 && b == s1)) continue;
+                if (!cc.ready) chunk_columns(g, y, x0, nc, 1, 7, &cc);
+                fallback_taps(g, &cc, di[t] + 3, dj[t], x0, s0, s1, a, b, fq);
+                for (int r = 0; r < 2; r++) {
+                    const int lo = r ? b : s0, hi = r ? s1 : a;
+                    if (sq == SQ_DEFAULT) {
+                        #pragma omp simd
+                        for (int x = lo; x < hi; x++)
+                            moments_tap(f, p0 + (x - x0), fq[x - x0], x - x0, rzc[x - x0], SQ_DEFAULT, sn, a1, a2, aw);
+                    } else {
+                        for (int x = lo; x < hi; x++)
+                            moments_tap(f, p0 + (x - x0), fq[x - x0], x - x0, rzc[x - x0], sq, sn, a1, a2, aw);
+                    }
+                }
+            }
+            for (int k = 0; k < nc; k++) {
+                size_t p = p0 + k;
+                if (kind[p] != KIND_SURFACE || len[p] >= VAR_TEMPORAL_LEN) continue;
+                float mean1 = a1[k] / aw[k], mean2 = a2[k] / aw[k], sv = mean2 - mean1 * mean1;
+                var[p] = sv > 0.0f ? sv : 0.0f;
+            }
+        }
+    }
+}
+
+/* ---- C. the À-Trous passes */
+
+/* The variance that guides the luminance weight, prefiltered with a 3x3 Gaussian over the surface
+ * neighbours (Sec. 4.3: one pixel's variance estimate is itself noisy). */
+void SVGF_ISA(prefilter)(fv_svgf *f, const float *var, int nt)
+{
+    const fv_grid *g = &f->g;
+    const int w = g->w, h = g->h;
+    const uint8_t *kind = f->kind;
+    const float *surf = f->surf;
+    float *gvar = f->gvar;
+    #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
+    for (int y = 0; y < h; y++) {
+        float av[CHUNK], aw[CHUNK];
+        int fq[CHUNK];
+        chunk_cols cc;
+        /* Only the columns this pass filters need their prefiltered variance. */
+        for (int x0 = 0; x0 < f->pass_cut; x0 += CHUNK) {
+            const int x1 = imin(x0 + CHUNK, w), nc = x1 - x0;
+            const size_t p0 = (size_t)y * w + x0;
+            int s0, s1;
+            if (!surface_span(kind, p0, x0, x1, &s0, &s1)) {
+                memset(&gvar[p0], 0, (size_t)nc * sizeof(float));
+                continue;
+            }
+            for (int k = 0; k < nc; k++) av[k] = aw[k] = 0.0f;
+            cc.ready = false;
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++) {
+                    const float kk = k_g3[i] * k_g3[j];
+                    int a, b;
+                    long off;
+                    tap_run(f, y, i - 1, j - 1, s0, s1, &a, &b, &off);
+                    #pragma omp simd
+                    for (int x = a; x < b; x++) {
+                        av[x - x0] += kk * var[off + x];
+                        aw[x - x0] += kk * surf[off + x];
+                    }
+                    if (!g->wrap || (a == s0 && b == s1)) continue;
+                    if (!cc.ready) chunk_columns(g, y, x0, nc, 1, 3, &cc);
+                    fallback_taps(g, &cc, i, j - 1, x0, s0, s1, a, b, fq);
+                    for (int r = 0; r < 2; r++) {
+                        const int lo = r ? b : s0, hi = r ? s1 : a;
+                        #pragma omp simd
+                        for (int x = lo; x < hi; x++) {
+                            av[x - x0] += kk * var[fq[x - x0]];
+                            aw[x - x0] += kk * surf[fq[x - x0]];
+                        }
+                    }
+                }
+            /* Not a surface: aw may be 0 (no surface around), and the value is never read. */
+            for (int k = 0; k < nc; k++) gvar[p0 + k] = kind[p0 + k] == KIND_SURFACE ? av[k] / aw[k] : 0.0f;
+        }
+    }
+}
+
+/* The sums of one pass over a chunk, and the per-pixel terms of its weights. */
+typedef struct pass_acc {
+    float r[CHUNK], g[CHUNK], b[CHUNK], v[CHUNK], w[CHUNK];
+    float inv_l[CHUNK];
+    float rz[5][CHUNK];
+} pass_acc;
+
+/* The buffers a pass reads. */
+typedef struct pass_src {
+    const float *nx, *ny, *nz, *z;
+    const float *r, *g, *b, *v, *l;
+} pass_src;
+
+/* One tap of a pass, pixel p (chunk slot k) taking pixel q with kernel weight kw. */
+TAP_INLINE void atrous_tap(const pass_src *s, size_t p, int q, int k, float kw, const float *rz, int sq, float sn,
+                              pass_acc *acc)
+{
+    float wn = normal_pow(s->nx[p] * s->nx[q] + s->ny[p] * s->ny[q] + s->nz[p] * s->nz[q], sq, sn);
+    float e = fabsf(s->z[p] - s->z[q]) * rz[k] + fabsf(s->l[p] - s->l[q]) * acc->inv_l[k];
+    float wt = kw * wn * exp_neg(e);
+    acc->r[k] += wt * s->r[q];
+    acc->g[k] += wt * s->g[q];
+    acc->b[k] += wt * s->b[q];
+    acc->v[k] += wt * wt * s->v[q];
+    acc->w[k] += wt;
+}
+
+/* SVGF_VW pixels at a time with every tap inner (the pixels whose 24 taps are all plain shifts):
+ * the sums and the centre pixels' features stay in registers across the taps, where the per-tap
+ * loops above load and store them once per tap. The arithmetic is atrous_tap's, operation for
+ * operation in the same order (GCC vector extensions, no FMA), so the bits are the same. */
+typedef float vfw __attribute__((vector_size(4 * SVGF_VW)));
+typedef int32_t viw __attribute__((vector_size(4 * SVGF_VW)));
+typedef float vfw_u __attribute__((vector_size(4 * SVGF_VW), aligned(4), may_alias));
+#define LDW(ptr) (*(const vfw_u *)(const void *)(ptr))
+#define STW(ptr, v) (*(vfw_u *)(void *)(ptr) = (v))
+
+TAP_INLINE vfw fabs_w(vfw x) { return (vfw)((viw)x & 0x7fffffff); }
+
+/* exp_neg, lane by lane the same operations. */
+TAP_INLINE vfw exp_neg_w(vfw x)
+{
+    const union { float f; int32_t i; } lim = {87.0f};
+    viw u = (viw)x;
+    const viw in = u < lim.i; /* -1 or 0 */
+    u = (u & in) | (lim.i & ~in);
+    const vfw t = -(vfw)u * 1.44269504f;
+    const viw i = __builtin_convertvector(t - 0.5f, viw);
+    const vfw a = (t - __builtin_convertvector(i, vfw)) * 0.693147181f, a2 = a * a;
+    const vfw p = (1.0f + a) + a2 * ((1.0f / 2 + a * (1.0f / 6)) + a2 * (1.0f / 24 + a * (1.0f / 120)));
+    const viw scale = ((i + 127) * (1 << 23)) & in;
+    return p * (vfw)scale;
+}
+
+TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const long *off, const float *kw, const int *cls,
+                             pass_acc *acc)
+{
+    const vfw nxp = LDW(&s->nx[p]), nyp = LDW(&s->ny[p]), nzp = LDW(&s->nz[p]), zp = LDW(&s->z[p]), lp = LDW(&s->l[p]);
+    const vfw il = LDW(&acc->inv_l[k]);
+    vfw rz[5];
+    for (int c = 0; c < 5; c++) rz[c] = LDW(&acc->rz[c][k]);
+    vfw ar = LDW(&acc->r[k]), ag = LDW(&acc->g[k]), ab = LDW(&acc->b[k]), av = LDW(&acc->v[k]), aw = LDW(&acc->w[k]);
+    for (int t = 0; t < NTAP; t++) {
+        const long q = off[t] + x;
+        vfw c = nxp * LDW(&s->nx[q]) + nyp * LDW(&s->ny[q]) + nzp * LDW(&s->nz[q]);
+        c = 0.5f * (c + fabs_w(c));
+        for (int i = 0; i < SQ_DEFAULT; i++) c *= c;
+        const vfw e = fabs_w(zp - LDW(&s->z[q])) * rz[cls[t]] + fabs_w(lp - LDW(&s->l[q])) * il;
+        const vfw wt = kw[t] * c * exp_neg_w(e);
+        ar += wt * LDW(&s->r[q]);
+        ag += wt * LDW(&s->g[q]);
+        ab += wt * LDW(&s->b[q]);
+        av += wt * wt * LDW(&s->v[q]);
+        aw += wt;
+    }
+    STW(&acc->r[k], ar), STW(&acc->g[k], ag), STW(&acc->b[k], ab), STW(&acc->v[k], av), STW(&acc->w[k], aw);
+}
+
+/* One pass with taps `step` apart from val[src] to val[1 - src]; the first also writes the history. */
+void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
+{
+    const fv_grid *g = &f->g;
+    const int w = g->w, h = g->h;
+    const uint8_t *kind = f->kind;
+    const float sd = f->o.sigma_depth, sn = f->o.sigma_normal, sl = f->o.sigma_lum;
+    const int sq = f->normal_squarings;
+    float *const *dst = f->val[1 - src];
+    const float *grad = f->grad, *gvar = f->gvar;
+    const pass_src s = {f->nx[0], f->ny[0], f->nz[0], f->z[0], f->val[src][V_R], f->val[src][V_G],
+                        f->val[src][V_B], f->val[src][V_VAR], f->val[src][V_LUM]};
+    /* The taps around the centre: kernel weight, offsets, and the distance class (1, sqrt 2, 2,
+     * sqrt 5, sqrt 8 times the step). */
+    float kw[NTAP];
+    int cls[NTAP], di[NTAP], dj[NTAP];
+    const float dist[5] = {1.0f, sqrtf(2.0f), 2.0f, sqrtf(5.0f), sqrtf(8.0f)};
+    for (int j = 0, t = 0; j < 5; j++)
+        for (int i = 0; i < 5; i++) {
+            if (i == 2 && j == 2) continue;
+            int d2 = (i - 2) * (i - 2) + (j - 2) * (j - 2);
+            kw[t] = k_b3[i] * k_b3[j];
+            cls[t] = d2 == 1 ? 0 : d2 == 2 ? 1 : d2 == 4 ? 2 : d2 == 5 ? 3 : 4;
+            di[t] = (i - 2) * step, dj[t] = (j - 2) * step;
+            t++;
+        }
+    const float wc = k_b3[2] * k_b3[2];
+    #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
+    for (int y = 0; y < h; y++) {
+        pass_acc acc;
+        int fq[CHUNK];
+        chunk_cols cc;
+        for (int x0 = 0; x0 < w; x0 += CHUNK) {
+            const int x1 = imin(x0 + CHUNK, w), nc = x1 - x0;
+            const size_t p0 = (size_t)y * w + x0;
+            /* Columns from pass_cut on sit this pass out (fv_svgf_set_periphery): their values go
+             * through unchanged, and still serve as taps. */
+            const int xe = imin(x1, f->pass_cut), ne = xe > x0 ? xe - x0 : 0;
+            if (xe < x1) {
+                const int xc = imax(x0, xe);
+                const size_t pc = p0 + (size_t)(xc - x0), m = (size_t)(x1 - xc);
+                for (int c = 0; c < NVAL; c++) memcpy(&dst[c][pc], &f->val[src][c][pc], m * sizeof(float));
+                if (write_hist)
+                    for (size_t p = pc; p < pc + m; p++)
+                        if (kind[p] == KIND_SURFACE)
+                            for (int c = 0; c < 3; c++) f->hist_illum[3 * p + c] = f->val[src][V_R + c][p];
+            }
+            if (!ne) continue;
+            int s0, s1;
+            if (!surface_span(kind, p0, x0, xe, &s0, &s1)) {
+                for (int c = 0; c < NVAL; c++) memset(&dst[c][p0], 0, (size_t)ne * sizeof(float));
+                continue;
+            }
+            /* Per-pixel terms, one vectorised loop per term (the divisions dominate). */
+            float zs[CHUNK], ze[CHUNK];
+            #pragma omp simd
+            for (int k = 0; k < nc; k++) {
+                size_t p = p0 + k;
+                acc.inv_l[k] = 1.0f / (sl * sqrtf(gvar[p]) + LUM_EPS);
+                zs[k] = sd * grad[p] * (float)step, ze[k] = depth_eps(s.z[p]);
+                acc.r[k] = wc * s.r[p], acc.g[k] = wc * s.g[p], acc.b[k] = wc * s.b[p];
+                acc.v[k] = wc * wc * s.v[p], acc.w[k] = wc;
+            }
+            /* 1 / (sigma_depth |grad z| |p - q| + eps) for the five distances. */
+            for (int c = 0; c < 5; c++) {
+                const float dc = dist[c];
+                #pragma omp simd
+                for (int k = 0; k < nc; k++) acc.rz[c][k] = 1.0f / (zs[k] * dc + ze[k]);
+            }
+            cc.ready = false;
+            /* [va, vb): the pixels whose taps are all plain shifts, a whole number of vectors,
+             * filtered by atrous_block; the per-tap loops do the rest of the span. */
+            int va = s0, vb = s0;
+            long offs[NTAP];
+            if (sq == SQ_DEFAULT) {
+                int lo = s0, hi = s1;
+                for (int t = 0; t < NTAP && lo < hi; t++) {
+                    int a, b;
+                    tap_run(f, y, di[t], dj[t], s0, s1, &a, &b, &offs[t]);
+                    lo = imax(lo, a), hi = imin(hi, b);
+                }
+                if (lo < hi) va = lo, vb = lo + (hi - lo) / SVGF_VW * SVGF_VW;
+                for (int x = va; x < vb; x += SVGF_VW) atrous_block(&s, p0 + (x - x0), x, x - x0, offs, kw, cls, &acc);
+            }
+            for (int part = 0; part < 2; part++) {
+                const int u0 = part ? vb : s0, u1 = part ? s1 : va;
+                if (u0 >= u1) continue;
+                for (int t = 0; t < NTAP; t++) {
+                    int a, b;
+                    long off;
+                    tap_run(f, y, di[t], dj[t], u0, u1, &a, &b, &off);
+                    const float *rz = acc.rz[cls[t]];
+                    if (sq == SQ_DEFAULT) {
+                        #pragma omp simd
+                        for (int x = a; x < b; x++)
+                            atrous_tap(&s, p0 + (x - x0), (int)off + x, x - x0, kw[t], rz, SQ_DEFAULT, sn, &acc);
+                    } else {
+                        for (int x = a; x < b; x++) atrous_tap(&s, p0 + (x - x0), (int)off + x, x - x0, kw[t], rz, sq, sn, &acc);
+                    }
+                    if (!g->wrap || (a == u0 && b == u1)) continue;
+                    if (!cc.ready) chunk_columns(g, y, x0, nc, step, 5, &cc);
+                    fallback_taps(g, &cc, di[t] / step + 2, dj[t], x0, u0, u1, a, b, fq);
+                    for (int r = 0; r < 2; r++) {
+                        const int lo = r ? b : u0, hi = r ? u1 : a;
+                        if (sq == SQ_DEFAULT) {
+                            #pragma omp simd
+                            for (int x = lo; x < hi; x++)
+                                atrous_tap(&s, p0 + (x - x0), fq[x - x0], x - x0, kw[t], rz, SQ_DEFAULT, sn, &acc);
+                        } else {
+                            for (int x = lo; x < hi; x++)
+                                atrous_tap(&s, p0 + (x - x0), fq[x - x0], x - x0, kw[t], rz, sq, sn, &acc);
+                        }
+                    }
+                }
+            }
+            for (int k = 0; k < ne; k++) {
+                size_t p = p0 + k;
+                if (kind[p] != KIND_SURFACE) {
+                    for (int c = 0; c < NVAL; c++) dst[c][p] = 0.0f;
+                    continue;
+                }
+                /* Divisions, not a reciprocal: a mean of equal values then comes out exactly equal. */
+                float ws = acc.w[k], r = acc.r[k] / ws, gg = acc.g[k] / ws, b = acc.b[k] / ws;
+                dst[V_R][p] = r, dst[V_G][p] = gg, dst[V_B][p] = b;
+                dst[V_VAR][p] = acc.v[k] / (ws * ws);
+                dst[V_LUM][p] = luminance(r, gg, b);
+                if (write_hist) f->hist_illum[3 * p] = r, f->hist_illum[3 * p + 1] = gg, f->hist_illum[3 * p + 2] = b;
+            }
+        }
+    }
+}
+
