@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "fovea/drive.h"
+#include "fovea/limits.h"
 
 struct fv_driver {
     fv_scene *scene;
@@ -29,6 +30,13 @@ fv_status fv_driver_create(fv_scene *scene, const fv_view *view, const fv_drive_
     if (!isfinite(opts->time0)) return fv_error_set(err, FV_ERR_INVALID, "driver: start time must be finite");
     if (!(opts->eye_separation >= 0.0f) || !isfinite(opts->eye_separation))
         return fv_error_set(err, FV_ERR_INVALID, "driver: eye separation %g must be >= 0", opts->eye_separation);
+    /* Each eye sits half the separation beside the camera: bounded like any coordinate. */
+    double sep = opts->eye_separation;
+    if ((s = fv_limit_coords("driver: eye separation", &sep, 1, err)) != FV_OK) return s;
+    if (((opts->camera_set & FV_DRIVE_POS) && (s = fv_limit_vec3("driver: camera position", opts->pos, err)) != FV_OK) ||
+        ((opts->camera_set & FV_DRIVE_LOOK) && (s = fv_limit_vec3("driver: camera look-at point", opts->look, err)) != FV_OK) ||
+        ((opts->camera_set & FV_DRIVE_UP) && (s = fv_limit_vec3("driver: camera up vector", opts->up, err)) != FV_OK))
+        return s;
     if (opts->threads < 0) return fv_error_set(err, FV_ERR_INVALID, "driver: thread count %d must be >= 0", opts->threads);
     fv_driver *d = calloc(1, sizeof *d);
     if (!d) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");

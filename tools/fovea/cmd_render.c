@@ -127,15 +127,15 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             o->exposure = d;
             break;
         case O_POS:
-            if (!fv_cli_parse_floats(optarg, 3, o->pos)) return fv_cli_usage_error(cmd, "--camera-pos %s: expected x,y,z", optarg);
+            if ((rc = fv_cli_opt_vec3(cmd, "--camera-pos", optarg, o->pos))) return rc;
             o->has_pos = true;
             break;
         case O_LOOK:
-            if (!fv_cli_parse_floats(optarg, 3, o->look)) return fv_cli_usage_error(cmd, "--camera-look %s: expected x,y,z", optarg);
+            if ((rc = fv_cli_opt_vec3(cmd, "--camera-look", optarg, o->look))) return rc;
             o->has_look = true;
             break;
         case O_UP:
-            if (!fv_cli_parse_floats(optarg, 3, o->up)) return fv_cli_usage_error(cmd, "--camera-up %s: expected x,y,z", optarg);
+            if ((rc = fv_cli_opt_vec3(cmd, "--camera-up", optarg, o->up))) return rc;
             o->has_up = true;
             break;
         case O_FOV:
@@ -145,7 +145,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             break;
         case O_LIGHT:
             if (o->nlights >= MAX_LIGHTS) return fv_cli_usage_error(cmd, "--point-light: at most %d lights", MAX_LIGHTS);
-            if (!fv_cli_parse_floats(optarg, 6, o->lights[o->nlights])) return fv_cli_usage_error(cmd, "--point-light %s: expected x,y,z,r,g,b", optarg);
+            if ((rc = fv_cli_opt_light(cmd, optarg, o->lights[o->nlights]))) return rc;
             o->nlights++;
             break;
         case O_GAZE:
