@@ -392,7 +392,10 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
         char full[8192];
         snprintf(full, sizeof full, "%s%s%s", o->valuestring[0] == '/' ? "" : dir, o->valuestring[0] == '/' ? "" : "/", o->valuestring);
         fv_camera base = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 45.0f, s->width, s->height};
-        if ((st = fv_camera_path_load_csv(full, &base, &s->cam_keys, &s->ncam_keys, err)) != FV_OK) return st;
+        if ((st = fv_camera_path_load_csv(full, &base, &s->cam_keys, &s->ncam_keys, err)) != FV_OK) {
+            fv_error_prefix(err, "%s: camera_path: ", file);
+            return st;
+        }
     } else if (o && (st = parse_camera_path(o, file, s, err))) {
         return st;
     }

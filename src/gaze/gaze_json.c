@@ -56,7 +56,9 @@ fv_status fv_gaze_json_path(const cJSON *o, const char *file, const char *where,
         if ((st = fv_json_string(o, "trace", file, where, &p, err)) != FV_OK) return st;
         char full[4096];
         snprintf(full, sizeof full, "%s%s%s", p[0] == '/' ? "" : dir, p[0] == '/' ? "" : "/", p);
-        return fv_gaze_path_load_csv(full, out, err);
+        st = fv_gaze_path_load_csv(full, out, err);
+        if (st != FV_OK) fv_error_prefix(err, "%s: %s.trace: ", file, where);
+        return st;
     }
     int n = cJSON_GetArraySize(keys_);
     if (!cJSON_IsArray(keys_) || n < 1)

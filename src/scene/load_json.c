@@ -676,8 +676,8 @@ fv_status fv_load_json(const char *path, fv_scene *scene, fv_view *view, const f
         fv_view_camera(view, scene, 0.0, 512, 512, &base);
         fv_camera_key *k = NULL;
         int n = 0;
-        if ((st = fv_camera_path_load_csv(full, &base, &k, &n, err)) == FV_OK && (st = fv_view_set_camera_path(view, k, n, err)) != FV_OK)
-            fv_error_prefix(err, "%s: ", path);
+        if ((st = fv_camera_path_load_csv(full, &base, &k, &n, err)) != FV_OK || (st = fv_view_set_camera_path(view, k, n, err)) != FV_OK)
+            fv_error_prefix(err, "%s: camera_path: ", path);
         fv_camera_keys_free(k);
         if (st != FV_OK) goto done;
     } else if (it) {
