@@ -10,6 +10,7 @@ struct fv_driver {
     const fv_view *view;
     fv_drive_opts o;
     fv_eye_model eye;
+    fv_eye_model eye_whole; /* eye widened to the whole screen: FV_GAZE_MISSING_WIDEN's frames */
 };
 
 void fv_drive_opts_init(fv_drive_opts *o)
@@ -57,6 +58,7 @@ fv_status fv_driver_create(fv_scene *scene, const fv_view *view, const fv_drive_
         }
     }
     d->o.eye_model = &d->eye;
+    fv_eye_model_whole_screen(&d->eye, &d->eye_whole);
     *out = d;
     return FV_OK;
 }
@@ -102,7 +104,14 @@ void fv_driver_views(const fv_driver *d, int index, fv_frame_views *out)
     const fv_gaze_path *gp = o->gaze_path ? o->gaze_path : d->view ? fv_view_gaze_path(d->view) : NULL;
     fv_gaze g = o->fixed_gaze ? o->gaze : (fv_gaze){0.5f, 0.5f};
     out->gaze[0] = out->gaze[1] = g;
-    if (!o->fixed_gaze && gp) fv_gaze_path_eval(gp, t, &out->gaze[0], &out->gaze[1]);
+    out->gaze_known = true;
+    out->eye_model = &d->eye;
+    if (!o->fixed_gaze && gp) out->gaze_known = fv_gaze_path_eval(gp, t, &out->gaze[0], &out->gaze[1]);
+    fv_gaze_missing policy = o->gaze_missing != FV_GAZE_MISSING_PATH ? o->gaze_missing : gp ? fv_gaze_path_missing(gp) : FV_GAZE_MISSING_HOLD;
+    if (!out->gaze_known && policy == FV_GAZE_MISSING_WIDEN) {
+        out->gaze[0] = out->gaze[1] = (fv_gaze){0.5f, 0.5f};
+        out->eye_model = &d->eye_whole;
+    }
 }
 
 /* Progress of one eye -> progress of the whole frame. */
@@ -141,7 +150,7 @@ fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool contin
         fr.prev_camera = has_prev ? &pv.camera[e] : NULL;
         fr.left_camera = e == 1 ? &v.camera[0] : NULL;
         fr.gaze = v.gaze[e];
-        fr.eye_model = &d->eye;
+        fr.eye_model = v.eye_model;
         if (progress) {
             ep.eye = e;
             fr.progress = on_eye_progress;

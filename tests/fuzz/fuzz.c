@@ -354,7 +354,7 @@ static void load_seeds(kind *k, const char *src)
 {
     for (int d = 0; d < 3 && k->seed_dirs[d]; d++) {
         char dir[3800];
-        snprintf(dir, sizeof dir, "%s/%s", src, k->seed_dirs[d]);
+        if (snprintf(dir, sizeof dir, "%s/%s", src, k->seed_dirs[d]) >= (int)sizeof dir) continue;
         DIR *dp = opendir(dir);
         if (!dp) continue;
         struct dirent *e;
@@ -367,7 +367,7 @@ static void load_seeds(kind *k, const char *src)
         qsort(names, (size_t)n, 256, (int (*)(const void *, const void *))strcmp);
         for (int i = 0; i < n && k->nseeds < MAX_SEEDS; i++) {
             char p[4400];
-            snprintf(p, sizeof p, "%s/%s", dir, names[i]);
+            if (snprintf(p, sizeof p, "%s/%s", dir, names[i]) >= (int)sizeof p) continue;
             if (read_file(p, &k->seeds[k->nseeds])) k->nseeds++;
         }
     }

@@ -207,7 +207,9 @@ static void test_gaze_csv(void **st)
         {"0,0.5,0.5\n1,0.5,0.5,0.5,0.5\n", "columns"},
         {"0,0.5,abc\n", ":1:"},
         {"# only a comment\n", "no samples"},
-        {"0,nan,0.5\n", ":1:"},
+        {"0,nan,0.5\n", "every sample of the left eye is missing"},
+        {"0,,\n1,nan,nan\n", "every sample"},
+        {"0,0.5,0.5\n1,0.5,abc\n", ":2:"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         path = write_tmp(bad[i].text);
