@@ -147,6 +147,33 @@ FV_API fv_gaze_missing fv_gaze_path_missing(const fv_gaze_path *p);
 /* "hold" or "widen" -> the policy; false for any other name. */
 FV_API bool fv_gaze_missing_from_name(const char *name, fv_gaze_missing *out);
 
+/* ---- importing eye-tracker recordings (docs/gaze.md, "Importing") ---- */
+
+typedef enum fv_gaze_format {
+    FV_GAZE_FORMAT_AUTO = 0,     /* from the extension: .asc EyeLink, .csv Pupil Labs */
+    FV_GAZE_FORMAT_EYELINK_ASC,  /* EyeLink sample file (edf2asc) */
+    FV_GAZE_FORMAT_PUPIL_CSV     /* Pupil Labs gaze_positions.csv (Pupil Player export) */
+} fv_gaze_format;
+
+typedef struct fv_gaze_import_opts {
+    fv_gaze_format format;
+    double min_confidence; /* Pupil: samples below this confidence are missing [0.6] */
+    int width, height;     /* EyeLink: the screen in pixels, replacing DISPLAY_COORDS (0: from the file) */
+} fv_gaze_import_opts;
+
+typedef struct fv_gaze_import_info {
+    fv_gaze_format format;
+    long samples, missing, dropped; /* written; of those missing; dropped (time not increasing) */
+    double width, height;           /* EyeLink: the screen the coordinates were divided by */
+    bool binocular;
+} fv_gaze_import_info;
+
+FV_API void fv_gaze_import_opts_init(fv_gaze_import_opts *o);
+/* Converts a recording into a gaze trace CSV at out_path (written whole or not at all), missing
+ * samples as empty fields. info (may be NULL) says what was read. Errors name the file. */
+FV_API fv_status fv_gaze_import(const char *in_path, const char *out_path, const fv_gaze_import_opts *opts, fv_gaze_import_info *info,
+                                fv_error *err);
+
 #ifdef __cplusplus
 }
 #endif

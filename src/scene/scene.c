@@ -422,8 +422,10 @@ fv_status fv_scene_commit(fv_scene *s, const fv_log *log, fv_error *err)
     if ((st = build_lights(s, err)) != FV_OK) return st;
     if (s->nlights == 0) {
         fv_vec3 c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
+        /* Within the intensity limit, so a huge scene gets a dim light rather than a refusal that
+         * names a light the user never wrote. */
         fv_light_desc l = {FV_LIGHT_POINT, fv_v3(c.x, s->lo.y + 0.9f * ext.y, c.z), fv_v3(0, -1, 0),
-                           fv_v3s(0.25f * diag * diag), 0, 0};
+                           fv_v3s(fminf(0.25f * diag * diag, (float)FV_INTENSITY_MAX)), 0, 0};
         fv_log_warn(log, "scene has no lights: added a point light at (%g, %g, %g) with intensity %g", l.pos.x, l.pos.y, l.pos.z,
                     l.intensity.x);
         if ((st = fv_scene_add_light(s, &l, err)) != FV_OK) return st;

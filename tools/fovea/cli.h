@@ -64,5 +64,6 @@ int fv_cmd_scenes(int argc, char **argv);
 int fv_cmd_compare(int argc, char **argv);
 int fv_cmd_bench(int argc, char **argv);
 int fv_cmd_view(int argc, char **argv);
+int fv_cmd_gaze(int argc, char **argv);
 
 #endif

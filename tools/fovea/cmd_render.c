@@ -32,6 +32,8 @@ static void help(void)
            "  --point-light x,y,z,r,g,b  add a point light (intensity W/sr), repeatable\n"
            "  --gaze X,Y            gaze point in normalised screen coordinates [the scene's gaze, or 0.5,0.5]\n"
            "  --gaze-trace FILE     gaze over time from a CSV trace (docs/gaze.md)\n"
+           "  --gaze-missing P      while the trace's gaze is missing: hold (the last known gaze) or widen (the fovea\n"
+           "                        to the whole screen) [the trace's own, hold]\n"
            "  --camera-trace FILE   camera over time from a CSV trace (docs/gaze.md)\n"
            "  --stereo SEP          render a stereo pair with eye separation SEP: OUT_left.ext, OUT_right.ext\n"
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
@@ -64,6 +66,7 @@ typedef struct render_opts {
     unsigned long long seed;
     bool quiet, show_stats, has_pos, has_look, has_up, has_fov, has_gaze;
     const char *gaze_trace, *camera_trace;
+    fv_gaze_missing missing;
     float pos[3], look[3], up[3], fov, gaze[2];
     int nlights;
     float lights[MAX_LIGHTS][6];
@@ -72,12 +75,12 @@ typedef struct render_opts {
 static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
     enum { O_METHOD = 256, O_SPP, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
-           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP };
+           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP, O_MISSING };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
         {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
-        {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE},
+        {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE}, {"gaze-missing", 1, 0, O_MISSING},
         {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"help", 0, 0, O_HELP},
         {0, 0, 0, 0}};
     const char *cmd = "render";
@@ -153,6 +156,9 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             o->has_gaze = true;
             break;
         case O_TRACE: o->gaze_trace = optarg; break;
+        case O_MISSING:
+            if (!fv_gaze_missing_from_name(optarg, &o->missing)) return fv_cli_usage_error(cmd, "--gaze-missing %s: expected hold or widen", optarg);
+            break;
         case O_CTRACE: o->camera_trace = optarg; break;
         case O_STEREO:
             if ((rc = fv_cli_opt_stereo(cmd, optarg, &d))) return rc;
@@ -270,6 +276,7 @@ int fv_cmd_render(int argc, char **argv)
     dopt.fixed_gaze = o.has_gaze;
     dopt.gaze = (fv_gaze){o.gaze[0], o.gaze[1]};
     dopt.gaze_path = trace;
+    dopt.gaze_missing = o.missing;
     if ((s = fv_driver_create(scene, view, &dopt, &driver, &err)) != FV_OK) {
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
