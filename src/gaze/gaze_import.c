@@ -46,17 +46,21 @@ static bool on_screen(double x, double y) { return x >= 0.0 && x <= 1.0 && y >= 
 /* One sample (time in seconds; an eye is missing when its coordinates are NaN). */
 static void put_sample(writer *w, double t, double xl, double yl, double xr, double yr)
 {
-    if (!isfinite(t) || (w->any && !(t > w->prev))) {
+    /* The time as written (9 digits) must increase too: a jump to 1e19 s would print equal. */
+    char tt[40];
+    snprintf(tt, sizeof tt, "%.9g", w->any ? t - w->t0 : 0.0);
+    double shown = strtod(tt, NULL);
+    if (!isfinite(t) || !isfinite(shown) || (w->any && !(shown > w->prev))) {
         w->info->dropped++;
         return;
     }
     if (!w->any) w->t0 = t;
     w->any = true;
-    w->prev = t;
+    w->prev = shown;
     bool ml = !on_screen(xl, yl), mr = !on_screen(xr, yr);
     w->info->samples++;
     if (ml || (w->binocular && mr)) w->info->missing++;
-    fprintf(w->f, "%.9g", t - w->t0);
+    fputs(tt, w->f);
     if (ml) fputs(",,", w->f);
     else fprintf(w->f, ",%.6f,%.6f", xl, yl);
     if (w->binocular) {

@@ -117,6 +117,12 @@ grep -q '^0.2,0.900000,0.100000$' "$TMP/pupil2.csv" || fail "a lower threshold k
 expect 0 "" -- $R cornell --gaze-trace "$TMP/mono.csv" --frames 2 --fps 125 --size 8x8 --spp 1 --quiet --out "$TMP/m.png"
 expect 0 "" -- $R cornell --gaze-trace "$TMP/bino.csv" --gaze-missing widen --stereo 10 --size 8x8 --spp 1 --quiet --out "$TMP/b.png"
 expect 2 "--gaze-missing blink" -- $R cornell --gaze-missing blink $small
+# a jump of the clock to 1e19 s: times that would print equal are dropped, the trace still loads
+# (a fuzz finding: the imported trace was refused)
+printf 'gaze_timestamp,confidence,norm_pos_x,norm_pos_y\n100,1,0.5,0.5\n1e19,1,0.5,0.5\n1.0000000001e19,1,0.4,0.4\n' >"$TMP/jump.csv"
+expect 0 "" -- $G "$TMP/jump.csv" --out "$TMP/jump-trace.csv"
+grep -q "2 samples (0 missing, 1 dropped" "$TMP/err" || fail "jump summary: $(cat "$TMP/err")"
+expect 0 "" -- $R cornell --gaze-trace "$TMP/jump-trace.csv" --size 8x8 --spp 1 --quiet --out "$TMP/j.png"
 # bad recordings: one line naming the file, no output
 printf 'MSG\t1 TRIALID\n1\t1\t2\t3\n' >"$TMP/nosize.asc"
 expect 2 "nosize.asc: no usable DISPLAY_COORDS" -- $G "$TMP/nosize.asc" --out "$TMP/x.csv"

@@ -309,6 +309,17 @@ static fv_status run_image(fuzz_ctx *c, const char *path, fv_error *err)
     return st;
 }
 
+/* An eye tracker's recording: imported, and the trace it wrote must load and drive a render. */
+static fv_status run_import(fuzz_ctx *c, const char *path, fv_error *err)
+{
+    fv_status st = fv_gaze_import(path, "trace.csv", NULL, NULL, err);
+    if (st != FV_OK) return st;
+    fv_error e2;
+    if (run_gaze(c, "trace.csv", &e2) != FV_OK && !c->note[0]) snprintf(c->note, sizeof c->note, "imported, then the trace was refused: %s", e2.msg);
+    remove("trace.csv");
+    return c->note[0] ? FV_ERR_INTERNAL : FV_OK;
+}
+
 typedef fv_status (*run_fn)(fuzz_ctx *c, const char *path, fv_error *err);
 
 typedef struct kind {
@@ -331,6 +342,8 @@ static kind k_kinds[] = {
     {"png", ".png", run_image, {"tests/fuzz/seeds", NULL, NULL}, {{0}}, 0},
     {"pfm", ".pfm", run_image, {"tests/fuzz/seeds", NULL, NULL}, {{0}}, 0},
     {"exr", ".exr", run_image, {"tests/fuzz/seeds", NULL, NULL}, {{0}}, 0},
+    {"eyelink", ".asc", run_import, {"tests/data", NULL, NULL}, {{0}}, 0},
+    {"pupil", "gaze_positions.csv", run_import, {"tests/data", NULL, NULL}, {{0}}, 0},
 };
 #define NKINDS ((int)(sizeof k_kinds / sizeof k_kinds[0]))
 
