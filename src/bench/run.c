@@ -481,6 +481,21 @@ static fv_status open_scene(const fv_scenario *sc, const char *path, const fv_lo
 
 /* ---- entry points ---- */
 
+/* The driver options of a scenario's frames: its size, times, camera path, gaze and eye model
+ * (*cpath holds the path the options point to). */
+static void scenario_drive_opts(const fv_scenario *sc, fv_camera_path *cpath, fv_drive_opts *o)
+{
+    *cpath = (fv_camera_path){sc->cam_keys, sc->ncam_keys};
+    fv_drive_opts_init(o);
+    o->width = sc->width;
+    o->height = sc->height;
+    o->time0 = sc->start_time;
+    o->fps = sc->fps;
+    o->camera_path = sc->ncam_keys ? cpath : NULL;
+    o->gaze_path = sc->gaze;
+    o->eye_model = sc->has_eye ? &sc->eye : NULL;
+}
+
 /* Everything a run would refuse, found before anything is rendered or written: the scenario
  * file, its scene with "diffuse" and "animate" applied, every method's parameters (the
  * reference, the extra references, the methods and sweeps, each value a "match" would try) and
@@ -512,16 +527,9 @@ static fv_status validate(const fv_scenario *sc, const char *path, const fv_log 
     }
     /* The frames' cameras, as the driver will make them: a degenerate camera path fails here, not
      * after the reference has rendered for minutes. */
-    fv_camera_path cpath = {sc->cam_keys, sc->ncam_keys};
+    fv_camera_path cpath;
     fv_drive_opts dopt;
-    fv_drive_opts_init(&dopt);
-    dopt.width = sc->width;
-    dopt.height = sc->height;
-    dopt.time0 = sc->start_time;
-    dopt.fps = sc->fps;
-    dopt.camera_path = sc->ncam_keys ? &cpath : NULL;
-    dopt.gaze_path = sc->gaze;
-    dopt.eye_model = sc->has_eye ? &sc->eye : NULL;
+    scenario_drive_opts(sc, &cpath, &dopt);
     fv_driver *d = NULL;
     if (st == FV_OK && (st = fv_driver_create(*scene, *view, &dopt, &d, err)) != FV_OK) fv_error_prefix(err, "%s: ", path);
     for (int i = 0; i < sc->frames && st == FV_OK; i++) {
@@ -586,18 +594,11 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
     if ((st = fv_mkdirs(info.out_dir, err)) || (st = fv_mkdirs(cache_dir, err)) || (st = fv_mkdirs(img_dir, err))) goto done;
     /* The frames: the same driver policy as `fovea render`; the scenario's camera path, gaze and
      * eye model when it has them, else the scene file's. */
-    fv_camera_path cpath = {sc->cam_keys, sc->ncam_keys};
+    fv_camera_path cpath;
     fv_drive_opts dopt;
-    fv_drive_opts_init(&dopt);
-    dopt.width = sc->width;
-    dopt.height = sc->height;
-    dopt.time0 = sc->start_time;
-    dopt.fps = sc->fps;
+    scenario_drive_opts(sc, &cpath, &dopt);
     dopt.seed = sc->seed;
     dopt.threads = opt->threads;
-    dopt.camera_path = sc->ncam_keys ? &cpath : NULL;
-    dopt.gaze_path = sc->gaze;
-    dopt.eye_model = sc->has_eye ? &sc->eye : NULL;
     if ((st = fv_driver_create(scene, view, &dopt, &info.driver, err)) != FV_OK) goto done;
     dopt.seed = fv_seed_reference(sc->seed);
     if ((st = fv_driver_create(scene, view, &dopt, &info.ref_driver, err)) != FV_OK) goto done;
