@@ -43,6 +43,8 @@ cat >"$TMP/point.json" <<'J'
 {"materials": {"w": {}}, "objects": [{"quad": [[0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0]], "material": "w"}]}
 J
 expect 2 "point.json: objects[0]: mesh 'objects[0]': no valid triangles" -- $R "$TMP/point.json" $small
+# an argument with a newline stays on one line
+expect 2 "--camera-pos 1\\n2: expected x,y,z" -- $R cornell --camera-pos "$(printf '1\n2')" $small
 # at the limit it renders
 expect 0 "" -- $R cornell --camera-pos 1e15,273,-800 $small
 rm -f "$OUT"

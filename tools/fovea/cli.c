@@ -26,12 +26,15 @@ int fv_cli_fail(const char *cmd, fv_status s, const char *msg)
 
 int fv_cli_usage_error(const char *cmd, const char *fmt, ...)
 {
+    char msg[FV_ERROR_MSG_MAX];
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "fovea %s: ", cmd);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    /* Through fv_error_set, which escapes control bytes: an argument may hold a newline. */
+    fv_error e;
+    fv_error_set(&e, FV_ERR_INVALID, "%s", msg);
+    fprintf(stderr, "fovea %s: %s\n", cmd, e.msg);
     return FV_EXIT_USAGE;
 }
 
