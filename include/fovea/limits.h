@@ -5,9 +5,11 @@
  * --camera-pos 1.8e18,273,-800` renders and 1e19 aborts inside the packet intersector. Every ray
  * fovea traces starts at a camera (a position, moved by at most half the stereo separation), at a
  * point on the scene's geometry or at a light, so bounding all of them bounds every ray origin.
- * FV_COORD_MAX keeps three orders of magnitude below Embree's limit, which also covers what our
- * own float arithmetic does with coordinates: squared distances (12 FV_COORD_MAX^2 = 1.2e31) and
- * the scene's diagonal stay far below FLT_MAX = 3.4e38.
+ * Our own float arithmetic is the tighter bound: a triangle's area test squares the length of the
+ * cross product of two edges, up to (2 sqrt(3) C)^4 = 144 C^4 for coordinates within C, which
+ * must stay below FLT_MAX = 3.4e38, so C <= 1.2e9 (found by the fuzzer: a triangle with edges of
+ * 1e15 was dropped as degenerate). FV_COORD_MAX = 1e9 keeps that, nine orders of magnitude below
+ * Embree's limit; in metres it is a million kilometres, in millimetres a thousand.
  *
  * FV_INTENSITY_MAX bounds a point or spot light's intensity and a material's emission. A light's
  * power (4 pi I) and a path's contribution (I over a squared distance, times a few inverse pdfs,
@@ -29,11 +31,11 @@
 extern "C" {
 #endif
 
-#define FV_COORD_MAX 1.0e15      /* largest |coordinate| of a position, extent or offset */
+#define FV_COORD_MAX 1.0e9       /* largest |coordinate| of a position, extent or offset */
 #define FV_INTENSITY_MAX 1.0e20  /* largest light intensity (W/sr) or emission */
 
 /* Checks n coordinates (finite, |v| <= FV_COORD_MAX). On failure the message reads
- * "<what>: <why>", e.g. "--camera-pos 1e19,273,-800: coordinate 1e+19 is beyond +-1e+15, the
+ * "<what>: <why>", e.g. "--camera-pos 1e19,273,-800: coordinate 1e+19 is beyond +-1e+09, the
  * range the ray kernels take". Readers check the double they parsed, before converting it to
  * float, so 1e39 is reported as itself rather than as inf. */
 FV_API fv_status fv_limit_coords(const char *what, const double *v, int n, fv_error *err);

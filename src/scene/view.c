@@ -82,6 +82,10 @@ static fv_camera framing_camera(const fv_scene *s)
     float r = 0.5f * diag, fov = 45.0f;
     float dist = 1.05f * r / sinf(fv_radians(fov) * 0.5f);
     fv_camera cam = {fv_add(c, fv_v3(0, 0, dist)), c, fv_v3(0, 1, 0), fov, 512, 512};
+    /* A scene reaching the edge of the coordinate range would put its framing camera beyond it
+     * (fovea/limits.h): the camera stops at the edge, looking the same way. */
+    cam.pos.z = fminf(cam.pos.z, (float)FV_COORD_MAX);
+    if (!(cam.pos.z > c.z)) cam.pos.z = fmaxf(c.z - dist, -(float)FV_COORD_MAX); /* the centre is at the edge: from -z */
     return cam;
 }
 

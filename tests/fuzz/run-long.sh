@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The long fuzz run (docs/fuzzing.md): every input kind for COUNT inputs (the OBJ importer, the
 # slowest, for a third of that), in the background-friendly way: nice, one kind after another.
-#   bash tests/fuzz/run-long.sh FUZZ_BINARY [COUNT] [OUTDIR] [SEED]
+#   bash tests/fuzz/run-long.sh FUZZ_BINARY [COUNT] [OUTDIR] [SEED] [KINDS]
+# KINDS (e.g. "obj", to run the slow kind beside the others on a second core): default all.
 # FUZZ_BINARY is build/tests/fovea-fuzz (Release is ~3x faster; build-asan's adds the sanitizers).
 # Exit status 1 when any kind had a finding (listed in OUTDIR/findings.txt).
 set -u
@@ -9,9 +10,10 @@ FUZZ=${1:?usage: run-long.sh FUZZ_BINARY [COUNT] [OUTDIR] [SEED]}
 COUNT=${2:-100000}
 OUT=${3:-fuzz-long}
 SEED=${4:-1}
+KINDS=${5:-}
 mkdir -p "$OUT"
 rc=0
-kinds=$("$FUZZ" --kind list 2>&1 | sed -n 's/^kinds: //p')
+kinds=${KINDS:-$("$FUZZ" --kind list 2>&1 | sed -n 's/^kinds: //p')}
 for k in $kinds; do
   n=$COUNT
   [ "$k" = obj ] && n=$((COUNT / 3))

@@ -14,12 +14,12 @@ static void test_coords(void **st)
     fv_error err;
     double ok[3] = {FV_COORD_MAX, -FV_COORD_MAX, 0.0};
     assert_int_equal(fv_limit_coords("p", ok, 3, &err), FV_OK);
-    /* The float a bound value becomes passes too (float(1e15) rounds below, float(1e20) above). */
+    /* The float a bound value becomes passes too (float(1e9) is exact, float(1e20) above). */
     assert_int_equal(fv_limit_vec3("p", fv_v3((float)FV_COORD_MAX, -(float)FV_COORD_MAX, 0), &err), FV_OK);
     double far[2] = {1.0, 1e19};
     assert_int_equal(fv_limit_coords("--camera-pos 1,1e19", far, 2, &err), FV_ERR_INVALID);
-    assert_string_equal(err.msg, "--camera-pos 1,1e19: coordinate 1e+19 is beyond +-1e+15, the range the ray kernels take");
-    /* Embree's own limit, 1.844e18, is refused with three orders of margin. */
+    assert_string_equal(err.msg, "--camera-pos 1,1e19: coordinate 1e+19 is beyond +-1e+09, the range the ray kernels take");
+    /* Embree's own limit, 1.844e18, is refused with nine orders of margin. */
     double embree = 1.844e18;
     assert_int_equal(fv_limit_coords("x", &embree, 1, &err), FV_ERR_INVALID);
     double nan = NAN;
@@ -48,7 +48,7 @@ static void test_camera_messages(void **st)
     fv_camera_basis b;
     fv_camera c = {{1e38f, 1e38f, 1e38f}, {0, 0, 0}, {0, 1, 0}, 40, 8, 8};
     assert_int_equal(fv_camera_basis_make(&c, &b, &err), FV_ERR_INVALID);
-    assert_string_equal(err.msg, "camera: position: coordinate 1e+38 is beyond +-1e+15, the range the ray kernels take");
+    assert_string_equal(err.msg, "camera: position: coordinate 1e+38 is beyond +-1e+09, the range the ray kernels take");
     c.pos = fv_v3(0, 0, 5);
     c.up = fv_v3(0, 0, 0);
     assert_int_equal(fv_camera_basis_make(&c, &b, &err), FV_ERR_INVALID);
