@@ -443,7 +443,11 @@ static fv_status open_scene(const fv_scenario *sc, const char *path, const fv_lo
 {
     fv_scene *scene = NULL;
     fv_status st = fv_scene_open(sc->scene, log, &scene, view, err);
-    if (st != FV_OK) return st;
+    if (st != FV_OK) {
+        /* A scene file's own errors name it; a missing one is named from the scenario. */
+        if (!strstr(err->msg, path)) fv_error_prefix(err, "%s: scene: ", path);
+        return st;
+    }
     if (sc->diffuse && (st = fv_scene_make_diffuse(scene, err)) != FV_OK) fv_error_prefix(err, "%s: diffuse: ", path);
     for (int i = 0; i < sc->nanimate && st == FV_OK; i++) {
         const fv_bench_animate *a = &sc->animate[i];

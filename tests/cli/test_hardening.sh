@@ -75,7 +75,7 @@ expect 2 "s.json: reference: " -- $B "$TMP/s.json"
 scen cornell '' ', "params": {"bogus": 1}' ''
 expect 2 "unknown parameter 'bogus'" -- $B "$TMP/s.json"
 scen no-such-scene.json '' '' ''
-expect 2 "no-such-scene.json" -- $B "$TMP/s.json"
+expect 2 "s.json: scene: cannot open scene" -- $B "$TMP/s.json"
 scen cornell '' '' ', "camera_path": [{"time": 0, "pos": [0, 0, 0], "look": [0, 0, -1]}, {"time": 1, "pos": [0, 0, 0], "look": [0, 0, 0]}], "frames": 2, "fps": 1'
 expect 2 "s.json: frame 1 (time 1), camera_path: camera: look-at point equals the position" -- $B "$TMP/s.json"
 scen cornell '' '' ', "match": [{"method": "pt", "param": "spp", "values": [-2, 1], "target": "pt"}]'
@@ -102,7 +102,8 @@ printf 'OFF\n4 2 0\n0 0 0' >"$TMP/abort.off"
 expect 2 "abort.off': the mesh importer (assimp): crashed (signal 6" -- $R "$TMP/abort.off" $small
 # a binary PLY with too few bytes: assimp reads out of bounds (a segmentation fault in the child)
 printf 'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\200' >"$TMP/short.ply"
-expect 2 "short.ply': the mesh importer (assimp): crashed" -- $R "$TMP/short.ply" $small
+# (under AddressSanitizer the child reports the fault and exits instead of dying of the signal)
+expect 2 "short.ply': the mesh importer (assimp): " -- $R "$TMP/short.ply" $small
 t1=$(date +%s)
 [ $((t1 - t0)) -lt 30 ] || fail "the runaway meshes took $((t1 - t0)) s"
 [ -e "$OUT" ] && fail "a refused input left $OUT behind"
