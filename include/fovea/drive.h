@@ -10,7 +10,9 @@
  *           field of view);
  *   stereo  two eyes eye_separation apart (fv_camera_stereo), left rendered first;
  *   gaze    a fixed gaze when set, else the options' gaze path, else the view's, else the centre
- *           (a path may give the right eye its own gaze);
+ *           (a path may give the right eye its own gaze); while the path says the gaze is
+ *           unknown (a blink, track loss), the options' policy, else the path's: hold the last
+ *           known gaze, or widen (the gaze at the centre and fv_eye_model_whole_screen);
  *   eye     the options' eye model when given (a scenario's), else the view's display with its
  *           density rescaled to the image width (the regions cover the same part of the view),
  *           else the default model for the image size;
@@ -53,6 +55,7 @@ typedef struct fv_drive_opts {
     bool fixed_gaze;                   /* gaze below for every frame and eye */
     fv_gaze gaze;
     const fv_gaze_path *gaze_path;     /* optional: replaces the view's gaze path */
+    fv_gaze_missing gaze_missing;      /* while the path's gaze is unknown; PATH (0): the path's policy */
     const fv_eye_model *eye_model;     /* optional: replaces the view's display */
 } fv_drive_opts;
 
@@ -73,6 +76,8 @@ typedef struct fv_frame_views {
     int eye_count;
     fv_camera camera[2];
     fv_gaze gaze[2];
+    bool gaze_known;                /* false while the gaze path marks the gaze missing */
+    const fv_eye_model *eye_model;  /* the frame's: the driver's, or its whole-screen widening */
 } fv_frame_views;
 FV_API void fv_driver_views(const fv_driver *d, int index, fv_frame_views *out);
 /* The views a continuing render of frame `index` hands its technique as the previous frame's

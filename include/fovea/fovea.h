@@ -23,5 +23,6 @@
 #include "fovea/metrics.h"
 #include "fovea/bench.h"
 #include "fovea/sdf.h"
+#include "fovea/limits.h"
 
 #endif

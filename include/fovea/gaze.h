@@ -19,6 +19,7 @@
 #define FOVEA_GAZE_H
 
 #include "fovea/export.h"
+#include <stdbool.h>
 #include <stdint.h>
 #include "fovea/math.h"
 #include "fovea/status.h"
@@ -59,6 +60,9 @@ typedef struct fv_eye_model {
 FV_API void fv_eye_model_default(int width, int height, fv_eye_model *out);
 /* Checks every field (positive sizes and densities, 0 < e_f <= e_t < 90, 0 < frac_f <= frac_t). */
 FV_API fv_status fv_eye_model_validate(const fv_eye_model *m, fv_error *err);
+/* m widened so that, with the gaze at the centre (0.5, 0.5), every pixel lies in the fovea: the
+ * model a frame uses while the gaze is unknown under FV_GAZE_MISSING_WIDEN. Same display. */
+FV_API void fv_eye_model_whole_screen(const fv_eye_model *m, fv_eye_model *out);
 
 /* Viewing distance D in pixels. */
 FV_API double fv_eye_view_dist_px(const fv_eye_model *m);
@@ -118,12 +122,57 @@ FV_API fv_status fv_gaze_path_create_fixed(fv_gaze g, fv_gaze_path **out, fv_err
 /* Keys with strictly increasing times, linear interpolation, end keys held. */
 FV_API fv_status fv_gaze_path_create_keys(const fv_gaze_key *keys, int count, fv_gaze_path **out, fv_error *err);
 /* A recorded trace: CSV lines "time,x,y" or "time,xl,yl,xr,yr" (docs/gaze.md); '#' comments
- * and a header line are allowed. Errors name the file and line. */
+ * and a header line are allowed. An empty coordinate or "nan" marks a missing sample (a blink,
+ * track loss); at least one sample of each eye must be known. Errors name the file and line. */
 FV_API fv_status fv_gaze_path_load_csv(const char *path, fv_gaze_path **out, fv_error *err);
 FV_API void fv_gaze_path_destroy(fv_gaze_path *p);
-/* Gaze of each eye at time t. */
-FV_API void fv_gaze_path_eval(const fv_gaze_path *p, double t, fv_gaze *left, fv_gaze *right);
+/* Gaze of each eye at time t. Keys may mark an eye's gaze missing (x and y NaN, as the CSV's
+ * empty fields): from a missing key until the next known one the gaze holds the last known one
+ * (the first known before any), and false is returned (true: both eyes known at t). */
+FV_API bool fv_gaze_path_eval(const fv_gaze_path *p, double t, fv_gaze *left, fv_gaze *right);
 FV_API int fv_gaze_path_key_count(const fv_gaze_path *p);
+
+/* What the sequence driver does while a path says the gaze is unknown (docs/gaze.md):
+ *   HOLD   keep the last known gaze (the default: a blink is shorter than a fixation);
+ *   WIDEN  render as if the whole screen were the fovea (fv_eye_model_whole_screen), so nothing is
+ *          rendered at peripheral quality where the viewer may be looking. */
+typedef enum fv_gaze_missing {
+    FV_GAZE_MISSING_PATH = 0, /* driver option only: the policy of the gaze path in use */
+    FV_GAZE_MISSING_HOLD,
+    FV_GAZE_MISSING_WIDEN
+} fv_gaze_missing;
+/* A path's own policy (HOLD when created; a scene's "gaze" block may say "missing": "widen"). */
+FV_API void fv_gaze_path_set_missing(fv_gaze_path *p, fv_gaze_missing policy);
+FV_API fv_gaze_missing fv_gaze_path_missing(const fv_gaze_path *p);
+/* "hold" or "widen" -> the policy; false for any other name. */
+FV_API bool fv_gaze_missing_from_name(const char *name, fv_gaze_missing *out);
+
+/* ---- importing eye-tracker recordings (docs/gaze.md, "Importing") ---- */
+
+typedef enum fv_gaze_format {
+    FV_GAZE_FORMAT_AUTO = 0,     /* from the extension: .asc EyeLink, .csv Pupil Labs */
+    FV_GAZE_FORMAT_EYELINK_ASC,  /* EyeLink sample file (edf2asc) */
+    FV_GAZE_FORMAT_PUPIL_CSV     /* Pupil Labs gaze_positions.csv (Pupil Player export) */
+} fv_gaze_format;
+
+typedef struct fv_gaze_import_opts {
+    fv_gaze_format format;
+    double min_confidence; /* Pupil: samples below this confidence are missing [0.6] */
+    int width, height;     /* EyeLink: the screen in pixels, replacing DISPLAY_COORDS (0: from the file) */
+} fv_gaze_import_opts;
+
+typedef struct fv_gaze_import_info {
+    fv_gaze_format format;
+    long samples, missing, dropped; /* written; of those missing; dropped (time not increasing) */
+    double width, height;           /* EyeLink: the screen the coordinates were divided by */
+    bool binocular;
+} fv_gaze_import_info;
+
+FV_API void fv_gaze_import_opts_init(fv_gaze_import_opts *o);
+/* Converts a recording into a gaze trace CSV at out_path (written whole or not at all), missing
+ * samples as empty fields. info (may be NULL) says what was read. Errors name the file. */
+FV_API fv_status fv_gaze_import(const char *in_path, const char *out_path, const fv_gaze_import_opts *opts, fv_gaze_import_info *info,
+                                fv_error *err);
 
 #ifdef __cplusplus
 }

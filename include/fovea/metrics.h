@@ -35,6 +35,9 @@ FV_API void fv_metric_opts_default(fv_metric_opts *o);
 typedef struct fv_metric_values {
     double mse, psnr, e, ssim, flip;  /* psnr is +inf when mse is 0 */
     long long pixels;                 /* pixels in the region; the other fields are NaN when none */
+    long long nonfinite;              /* of those, pixels with a NaN or infinite channel in ref or test:
+                                         every metric counts such a channel as black, so callers
+                                         must report this count (fovea compare does) */
 } fv_metric_values;
 
 typedef struct fv_metric_report {

@@ -443,7 +443,11 @@ static fv_status open_scene(const fv_scenario *sc, const char *path, const fv_lo
 {
     fv_scene *scene = NULL;
     fv_status st = fv_scene_open(sc->scene, log, &scene, view, err);
-    if (st != FV_OK) return st;
+    if (st != FV_OK) {
+        /* A scene file's own errors name it; a missing one is named from the scenario. */
+        if (!strstr(err->msg, path)) fv_error_prefix(err, "%s: scene: ", path);
+        return st;
+    }
     if (sc->diffuse && (st = fv_scene_make_diffuse(scene, err)) != FV_OK) fv_error_prefix(err, "%s: diffuse: ", path);
     for (int i = 0; i < sc->nanimate && st == FV_OK; i++) {
         const fv_bench_animate *a = &sc->animate[i];
@@ -483,11 +487,85 @@ static fv_status open_scene(const fv_scenario *sc, const char *path, const fv_lo
 
 /* ---- entry points ---- */
 
+/* The driver options of a scenario's frames: its size, times, camera path, gaze and eye model
+ * (*cpath holds the path the options point to). */
+static void scenario_drive_opts(const fv_scenario *sc, fv_camera_path *cpath, fv_drive_opts *o)
+{
+    *cpath = (fv_camera_path){sc->cam_keys, sc->ncam_keys};
+    fv_drive_opts_init(o);
+    o->width = sc->width;
+    o->height = sc->height;
+    o->time0 = sc->start_time;
+    o->fps = sc->fps;
+    o->camera_path = sc->ncam_keys ? cpath : NULL;
+    o->gaze_path = sc->gaze;
+    o->eye_model = sc->has_eye ? &sc->eye : NULL;
+}
+
+/* Everything a run would refuse, found before anything is rendered or written: the scenario
+ * file, its scene with "diffuse" and "animate" applied, every method's parameters (the
+ * reference, the extra references, the methods and sweeps, each value a "match" would try) and
+ * the camera of every frame. `fovea bench --check` is exactly this. On success the scene and its
+ * view stay open for the run. */
+static fv_status validate(const fv_scenario *sc, const char *path, const fv_log *log, fv_scene **scene, fv_view **view, fv_error *err)
+{
+    fv_status st = open_scene(sc, path, log, scene, view, err);
+    if (st != FV_OK) return st;
+    for (int i = -1 - sc->nextra; i < sc->nmethods && st == FV_OK; i++) {
+        const fv_bench_method *m = i >= 0 ? &sc->methods[i] : i == -1 ? &sc->reference : &sc->extra[-2 - i];
+        fv_technique *t = NULL;
+        if ((st = fv_technique_create(m->method, *scene, m->params, log, &t, err)) != FV_OK) fv_error_prefix(err, "%s: %s: ", path, m->label);
+        fv_technique_destroy(t);
+    }
+    for (int k = 0; k < sc->nmatches && st == FV_OK; k++) {
+        const fv_bench_match *mt = &sc->matches[k];
+        for (int v = 0; v < mt->nvalues && st == FV_OK; v++) {
+            char text[64];
+            snprintf(text, sizeof text, "%.17g", mt->values[v]);
+            fv_params *p = NULL;
+            fv_technique *t = NULL;
+            if ((st = fv_params_clone(mt->base.params, &p, err)) == FV_OK && (st = fv_params_set(p, mt->param, text, err)) == FV_OK)
+                st = fv_technique_create(mt->base.method, *scene, p, log, &t, err);
+            if (st != FV_OK) fv_error_prefix(err, "%s: match[%d] (%s=%s): ", path, k, mt->param, text);
+            fv_technique_destroy(t);
+            fv_params_destroy(p);
+        }
+    }
+    /* The frames' cameras, as the driver will make them: a degenerate camera path fails here, not
+     * after the reference has rendered for minutes. */
+    fv_camera_path cpath;
+    fv_drive_opts dopt;
+    scenario_drive_opts(sc, &cpath, &dopt);
+    fv_driver *d = NULL;
+    if (st == FV_OK && (st = fv_driver_create(*scene, *view, &dopt, &d, err)) != FV_OK) fv_error_prefix(err, "%s: ", path);
+    for (int i = 0; i < sc->frames && st == FV_OK; i++) {
+        fv_frame_views v;
+        fv_driver_views(d, i, &v);
+        fv_camera_basis b;
+        if ((st = fv_camera_basis_make(&v.camera[0], &b, err)) != FV_OK)
+            fv_error_prefix(err, "%s: frame %d (time %g)%s: ", path, i, v.time, sc->ncam_keys ? ", camera_path" : "");
+    }
+    fv_driver_destroy(d);
+    if (st != FV_OK) {
+        fv_scene_destroy(*scene);
+        fv_view_destroy(*view);
+        *scene = NULL;
+        *view = NULL;
+    }
+    return st;
+}
+
 fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err)
 {
     fv_scenario *sc;
     fv_status st = fv_scenario_load(path, mode, &sc, err);
-    fv_scenario_destroy(st == FV_OK ? sc : NULL);
+    if (st != FV_OK) return st;
+    fv_scene *scene = NULL;
+    fv_view *view = NULL;
+    st = validate(sc, path, NULL, &scene, &view, err);
+    fv_scene_destroy(scene);
+    fv_view_destroy(view);
+    fv_scenario_destroy(sc);
     return st;
 }
 
@@ -515,32 +593,18 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
 
     say(opt, "scenario %s: scene %s, %dx%d, %d frame(s), %d method(s)", sc->name, sc->scene, sc->width, sc->height, sc->frames,
         sc->nmethods);
-    if ((st = open_scene(sc, path, opt->log, &scene, &view, err)) != FV_OK) goto done;
-    /* Every method's parameters are checked before anything is rendered. */
-    for (int i = -1 - sc->nextra; i < sc->nmethods && st == FV_OK; i++) {
-        const fv_bench_method *m = i >= 0 ? &sc->methods[i] : i == -1 ? &sc->reference : &sc->extra[-2 - i];
-        fv_technique *t = NULL;
-        if ((st = fv_technique_create(m->method, scene, m->params, opt->log, &t, err)) != FV_OK) fv_error_prefix(err, "%s: %s: ", path, m->label);
-        fv_technique_destroy(t);
-    }
-    if (st != FV_OK) goto done;
+    /* Everything --check checks, before anything is rendered. */
+    if ((st = validate(sc, path, opt->log, &scene, &view, err)) != FV_OK) goto done;
     /* Folders only once the scenario, its scene and every method are known to be good: bad input
      * writes nothing. */
     if ((st = fv_mkdirs(info.out_dir, err)) || (st = fv_mkdirs(cache_dir, err)) || (st = fv_mkdirs(img_dir, err))) goto done;
     /* The frames: the same driver policy as `fovea render`; the scenario's camera path, gaze and
      * eye model when it has them, else the scene file's. */
-    fv_camera_path cpath = {sc->cam_keys, sc->ncam_keys};
+    fv_camera_path cpath;
     fv_drive_opts dopt;
-    fv_drive_opts_init(&dopt);
-    dopt.width = sc->width;
-    dopt.height = sc->height;
-    dopt.time0 = sc->start_time;
-    dopt.fps = sc->fps;
+    scenario_drive_opts(sc, &cpath, &dopt);
     dopt.seed = sc->seed;
     dopt.threads = opt->threads;
-    dopt.camera_path = sc->ncam_keys ? &cpath : NULL;
-    dopt.gaze_path = sc->gaze;
-    dopt.eye_model = sc->has_eye ? &sc->eye : NULL;
     if ((st = fv_driver_create(scene, view, &dopt, &info.driver, err)) != FV_OK) goto done;
     dopt.seed = fv_seed_reference(sc->seed);
     if ((st = fv_driver_create(scene, view, &dopt, &info.ref_driver, err)) != FV_OK) goto done;

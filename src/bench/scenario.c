@@ -11,6 +11,7 @@
 #include "bench/scenario.h"
 #include "core/alloc.h"
 #include "core/json_util.h"
+#include "fovea/limits.h"
 #include "gaze/gaze_json.h"
 #include "scene/anim.h"
 #include "scene/load_impl.h"
@@ -101,9 +102,9 @@ static fv_status parse_camera_path(const cJSON *arr, const char *file, fv_scenar
         if ((st = fv_json_check_keys(e, keys, file, where, err)) != FV_OK || (st = fv_json_require(e, "time", file, where, err)) ||
             (st = fv_json_require(e, "pos", file, where, err)) || (st = fv_json_require(e, "look", file, where, err)) ||
             (st = fv_json_number(e, "time", -1e9, 1e9, file, where, &t, err)) ||
-            (st = fv_json_numbers(e, "pos", 3, -1e30, 1e30, file, where, pos, err)) ||
-            (st = fv_json_numbers(e, "look", 3, -1e30, 1e30, file, where, look, err)) ||
-            (st = fv_json_numbers(e, "up", 3, -1e30, 1e30, file, where, up, err)) ||
+            (st = fv_json_limited(e, "pos", 3, fv_limit_coords, file, where, pos, err)) ||
+            (st = fv_json_limited(e, "look", 3, fv_limit_coords, file, where, look, err)) ||
+            (st = fv_json_limited(e, "up", 3, fv_limit_coords, file, where, up, err)) ||
             (st = fv_json_number(e, "fov", 0.1, 179.9, file, where, &fov, err)))
             break;
         fv_camera_key *k = &s->cam_keys[i];
@@ -391,7 +392,10 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
         char full[8192];
         snprintf(full, sizeof full, "%s%s%s", o->valuestring[0] == '/' ? "" : dir, o->valuestring[0] == '/' ? "" : "/", o->valuestring);
         fv_camera base = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 45.0f, s->width, s->height};
-        if ((st = fv_camera_path_load_csv(full, &base, &s->cam_keys, &s->ncam_keys, err)) != FV_OK) return st;
+        if ((st = fv_camera_path_load_csv(full, &base, &s->cam_keys, &s->ncam_keys, err)) != FV_OK) {
+            fv_error_prefix(err, "%s: camera_path: ", file);
+            return st;
+        }
     } else if (o && (st = parse_camera_path(o, file, s, err))) {
         return st;
     }

@@ -9,7 +9,9 @@
 
 typedef enum fv_csv_kind { FV_CSV_SKIP = 0, FV_CSV_HEADER, FV_CSV_ROW, FV_CSV_BAD } fv_csv_kind;
 
-/* Classifies one line; for a row, the numbers go to v (at most max) and their count to *n.
+/* Classifies one line; for a row, the numbers go to v (at most max) and their count to *n. An
+ * empty field reads as NaN, as does "nan" (strtod): a value the file marks as unknown, which each
+ * reader accepts (a gaze trace's missing sample) or refuses (a camera trace's coordinates).
  * `before_rows` says no sample or header has been seen yet (only then is a header accepted). */
 fv_csv_kind fv_csv_line(const char *line, bool before_rows, double *v, int max, int *n);
 

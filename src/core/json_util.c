@@ -8,6 +8,47 @@
 
 #define FV_JSON_MAX_BYTES (64L << 20)
 
+static int cmp_key(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* cJSON keeps every member of an object and lookups return the first: a key given twice would
+ * silently lose its second value. Every object of the tree is checked (its keys sorted), with
+ * the path of the object in the message. cJSON's nesting limit bounds the recursion. */
+static fv_status check_duplicates(const cJSON *node, const char *file, const char *path, int depth, fv_error *err)
+{
+    if (!cJSON_IsObject(node) && !cJSON_IsArray(node)) return FV_OK;
+    int n = 0;
+    for (const cJSON *it = node->child; it; it = it->next) n++;
+    if (cJSON_IsObject(node) && n > 1) {
+        const char **keys = malloc((size_t)n * sizeof *keys);
+        if (!keys) return fv_error_set(err, FV_ERR_NOMEM, "out of memory reading '%s'", file);
+        int k = 0;
+        for (const cJSON *it = node->child; it; it = it->next) keys[k++] = it->string ? it->string : "";
+        qsort(keys, (size_t)n, sizeof *keys, cmp_key);
+        const char *dup = NULL;
+        for (int i = 1; i < n && !dup; i++)
+            if (strcmp(keys[i - 1], keys[i]) == 0) dup = keys[i];
+        fv_status st = FV_OK;
+        if (dup)
+            st = fv_error_set(err, FV_ERR_INVALID, "%s: %s%sfield '%s' is given twice", file, path[0] ? path : "",
+                              path[0] ? ": " : "", dup);
+        free(keys);
+        if (st != FV_OK) return st;
+    }
+    int i = 0;
+    for (const cJSON *it = node->child; it; it = it->next, i++) {
+        if (!cJSON_IsObject(it) && !cJSON_IsArray(it)) continue;
+        char sub[256];
+        if (cJSON_IsObject(node)) snprintf(sub, sizeof sub, "%s%s%.64s", path, path[0] ? "." : "", it->string ? it->string : "");
+        else snprintf(sub, sizeof sub, "%s[%d]", path, i);
+        fv_status st = check_duplicates(it, file, sub, depth + 1, err);
+        if (st != FV_OK) return st;
+    }
+    return FV_OK;
+}
+
 fv_status fv_json_parse_text(const char *name, const char *text, cJSON **out, fv_error *err)
 {
     const char *end = NULL;
@@ -25,6 +66,11 @@ fv_status fv_json_parse_text(const char *name, const char *text, cJSON **out, fv
         near[k] = '\0';
         if (k == 0) return fv_error_set(err, FV_ERR_INVALID, "%s:%d: malformed JSON (unexpected end of file)", name, line);
         return fv_error_set(err, FV_ERR_INVALID, "%s:%d: malformed JSON near '%s'", name, line, near);
+    }
+    fv_status st = check_duplicates(root, name, "", 0, err);
+    if (st != FV_OK) {
+        cJSON_Delete(root);
+        return st;
     }
     *out = root;
     return FV_OK;
@@ -164,6 +210,24 @@ fv_status fv_json_numbers(const cJSON *obj, const char *key, int n, double lo, d
     }
     for (i = 0; i < n && i < 16; i++) out[i] = tmp[i];
     return FV_OK;
+}
+
+fv_status fv_json_limited(const cJSON *obj, const char *key, int n, fv_json_limit_fn check, const char *file, const char *where,
+                          double *out, fv_error *err)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!it) return FV_OK;
+    double tmp[16];
+    int i = 0;
+    if (cJSON_IsArray(it) && cJSON_GetArraySize(it) == n && n <= 16)
+        for (const cJSON *e = it->child; e && cJSON_IsNumber(e) && isfinite(e->valuedouble); e = e->next) tmp[i++] = e->valuedouble;
+    if (i != n || n > 16)
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s%s%s: expected an array of %d finite numbers", file, w0(where), dot(where), key, n);
+    char what[512];
+    snprintf(what, sizeof what, "%s: %s%s%s", file, w0(where), dot(where), key);
+    fv_status st = check(what, tmp, n, err);
+    if (st == FV_OK) memcpy(out, tmp, (size_t)n * sizeof *out);
+    return st;
 }
 
 bool fv_json_scalar_text(const cJSON *item, char *buf, size_t n)

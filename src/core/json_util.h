@@ -35,6 +35,13 @@ fv_status fv_json_string(const cJSON *obj, const char *key, const char *file, co
 fv_status fv_json_numbers(const cJSON *obj, const char *key, int n, double lo, double hi, const char *file,
                           const char *where, double *out, fv_error *err);
 
+/* An array of exactly n finite numbers, then `check` (fv_limit_coords or fv_limit_intensity of
+ * fovea/limits.h: the range every reader of coordinates and intensities shares), with the
+ * message naming file and where.key. */
+typedef fv_status (*fv_json_limit_fn)(const char *what, const double *v, int n, fv_error *err);
+fv_status fv_json_limited(const cJSON *obj, const char *key, int n, fv_json_limit_fn check, const char *file, const char *where,
+                          double *out, fv_error *err);
+
 /* A scalar (string, number, bool) rendered as text for a parameter bag: numbers print in the
  * shortest form that reads back exactly. False for objects, arrays and null. */
 bool fv_json_scalar_text(const cJSON *item, char *buf, size_t n);

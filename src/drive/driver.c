@@ -3,12 +3,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include "fovea/drive.h"
+#include "fovea/limits.h"
 
 struct fv_driver {
     fv_scene *scene;
     const fv_view *view;
     fv_drive_opts o;
     fv_eye_model eye;
+    fv_eye_model eye_whole; /* eye widened to the whole screen: FV_GAZE_MISSING_WIDEN's frames */
     /* The views of the last frame rendered: the viewer changes the camera between frames
      * (fv_driver_set_camera), so frame i-1's camera can only be known by remembering it, not by
      * deriving it again from today's overrides. */
@@ -34,6 +36,13 @@ fv_status fv_driver_create(fv_scene *scene, const fv_view *view, const fv_drive_
     if (!isfinite(opts->time0)) return fv_error_set(err, FV_ERR_INVALID, "driver: start time must be finite");
     if (!(opts->eye_separation >= 0.0f) || !isfinite(opts->eye_separation))
         return fv_error_set(err, FV_ERR_INVALID, "driver: eye separation %g must be >= 0", opts->eye_separation);
+    /* Each eye sits half the separation beside the camera: bounded like any coordinate. */
+    double sep = opts->eye_separation;
+    if ((s = fv_limit_coords("driver: eye separation", &sep, 1, err)) != FV_OK) return s;
+    if (((opts->camera_set & FV_DRIVE_POS) && (s = fv_limit_vec3("driver: camera position", opts->pos, err)) != FV_OK) ||
+        ((opts->camera_set & FV_DRIVE_LOOK) && (s = fv_limit_vec3("driver: camera look-at point", opts->look, err)) != FV_OK) ||
+        ((opts->camera_set & FV_DRIVE_UP) && (s = fv_limit_vec3("driver: camera up vector", opts->up, err)) != FV_OK))
+        return s;
     if (opts->threads < 0) return fv_error_set(err, FV_ERR_INVALID, "driver: thread count %d must be >= 0", opts->threads);
     fv_driver *d = calloc(1, sizeof *d);
     if (!d) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
@@ -54,6 +63,7 @@ fv_status fv_driver_create(fv_scene *scene, const fv_view *view, const fv_drive_
         }
     }
     d->o.eye_model = &d->eye;
+    fv_eye_model_whole_screen(&d->eye, &d->eye_whole);
     d->last_index = -1;
     *out = d;
     return FV_OK;
@@ -100,7 +110,14 @@ void fv_driver_views(const fv_driver *d, int index, fv_frame_views *out)
     const fv_gaze_path *gp = o->gaze_path ? o->gaze_path : d->view ? fv_view_gaze_path(d->view) : NULL;
     fv_gaze g = o->fixed_gaze ? o->gaze : (fv_gaze){0.5f, 0.5f};
     out->gaze[0] = out->gaze[1] = g;
-    if (!o->fixed_gaze && gp) fv_gaze_path_eval(gp, t, &out->gaze[0], &out->gaze[1]);
+    out->gaze_known = true;
+    out->eye_model = &d->eye;
+    if (!o->fixed_gaze && gp) out->gaze_known = fv_gaze_path_eval(gp, t, &out->gaze[0], &out->gaze[1]);
+    fv_gaze_missing policy = o->gaze_missing != FV_GAZE_MISSING_PATH ? o->gaze_missing : gp ? fv_gaze_path_missing(gp) : FV_GAZE_MISSING_HOLD;
+    if (!out->gaze_known && policy == FV_GAZE_MISSING_WIDEN) {
+        out->gaze[0] = out->gaze[1] = (fv_gaze){0.5f, 0.5f};
+        out->eye_model = &d->eye_whole;
+    }
 }
 
 void fv_driver_prev_views(const fv_driver *d, int index, fv_frame_views *out)
@@ -145,7 +162,7 @@ fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool contin
         fr.prev_camera = has_prev ? &pv.camera[e] : NULL;
         fr.left_camera = e == 1 ? &v.camera[0] : NULL;
         fr.gaze = v.gaze[e];
-        fr.eye_model = &d->eye;
+        fr.eye_model = v.eye_model;
         if (progress) {
             ep.eye = e;
             fr.progress = on_eye_progress;

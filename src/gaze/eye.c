@@ -51,6 +51,17 @@ fv_status fv_eye_model_validate(const fv_eye_model *m, fv_error *err)
     return FV_OK;
 }
 
+void fv_eye_model_whole_screen(const fv_eye_model *m, fv_eye_model *out)
+{
+    /* Radii as fractions of the width: from the centre the farthest pixel centre is half the
+     * diagonal away; one pixel more covers rounding. The transition equals the fovea (nothing is
+     * blended). Capped at the validator's bound of 4 widths (an image 7.9 times taller than wide). */
+    *out = *m;
+    out->mode = FV_FOVEA_WIDTH;
+    double frac = (0.5 * hypot((double)m->width, (double)m->height) + 1.0) / (m->width > 0 ? m->width : 1);
+    out->fovea_frac = out->transition_frac = (float)fmin(frac, 4.0);
+}
+
 double fv_eye_view_dist_px(const fv_eye_model *m)
 {
     if (m->fov_x_deg > 0.0f) return 0.5 * m->width / tan(0.5 * m->fov_x_deg * FV_PI_D / 180.0);

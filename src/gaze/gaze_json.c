@@ -37,11 +37,26 @@ fv_status fv_gaze_json_eye(const cJSON *o, const char *file, const char *where, 
     return st;
 }
 
+static fv_status gaze_json_path(const cJSON *o, const char *file, const char *where, const char *dir, fv_gaze_path **out, fv_error *err);
+
 fv_status fv_gaze_json_path(const cJSON *o, const char *file, const char *where, const char *dir, fv_gaze_path **out, fv_error *err)
 {
-    static const char *const keys[] = {"fixed", "keys", "trace", NULL};
+    static const char *const keys[] = {"fixed", "keys", "trace", "missing", NULL};
     fv_status st = fv_json_check_keys(o, keys, file, where, err);
     if (st != FV_OK) return st;
+    const char *missing = NULL;
+    if ((st = fv_json_string(o, "missing", file, where, &missing, err)) != FV_OK) return st;
+    fv_gaze_missing policy = FV_GAZE_MISSING_HOLD;
+    if (missing && !fv_gaze_missing_from_name(missing, &policy))
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.missing: '%s' is not 'hold' or 'widen'", file, where, missing);
+    st = gaze_json_path(o, file, where, dir, out, err);
+    if (st == FV_OK) fv_gaze_path_set_missing(*out, policy);
+    return st;
+}
+
+static fv_status gaze_json_path(const cJSON *o, const char *file, const char *where, const char *dir, fv_gaze_path **out, fv_error *err)
+{
+    fv_status st;
     const cJSON *fixed = cJSON_GetObjectItemCaseSensitive(o, "fixed"), *keys_ = cJSON_GetObjectItemCaseSensitive(o, "keys"),
                 *trace = cJSON_GetObjectItemCaseSensitive(o, "trace");
     if (!!fixed + !!keys_ + !!trace != 1)
@@ -56,7 +71,9 @@ fv_status fv_gaze_json_path(const cJSON *o, const char *file, const char *where,
         if ((st = fv_json_string(o, "trace", file, where, &p, err)) != FV_OK) return st;
         char full[4096];
         snprintf(full, sizeof full, "%s%s%s", p[0] == '/' ? "" : dir, p[0] == '/' ? "" : "/", p);
-        return fv_gaze_path_load_csv(full, out, err);
+        st = fv_gaze_path_load_csv(full, out, err);
+        if (st != FV_OK) fv_error_prefix(err, "%s: %s.trace: ", file, where);
+        return st;
     }
     int n = cJSON_GetArraySize(keys_);
     if (!cJSON_IsArray(keys_) || n < 1)

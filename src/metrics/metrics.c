@@ -5,6 +5,7 @@
  * of threads.
  */
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
@@ -111,7 +112,7 @@ fv_status fv_metrics_compare(const float *ref, const float *test, int w, int h, 
     size_t n = (size_t)w * h;
     float *a = fv_alloc_array(n, 3 * sizeof(float)), *b = fv_alloc_array(n, 3 * sizeof(float));
     float *ssim = fv_alloc_array(n, sizeof(float)), *flip = flip_map ? flip_map : fv_alloc_array(n, sizeof(float));
-    double *rows = fv_calloc_array((size_t)h * FV_REGION_COUNT * 5, sizeof(double));
+    double *rows = fv_calloc_array((size_t)h * FV_REGION_COUNT * 6, sizeof(double));
     if (!a || !b || !ssim || !flip || !rows) {
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory comparing %dx%d images", w, h);
         goto done;
@@ -136,13 +137,15 @@ fv_status fv_metrics_compare(const float *ref, const float *test, int w, int h, 
         st = fv_metrics_flip_map(a, b, w, h, opts->ppd, flip, err);
     }
     if (st != FV_OK) goto done;
-    /* Per row and region: count, squared error, E, SSIM, FLIP. */
+    /* Per row and region: count, squared error, E, SSIM, FLIP, pixels with a non-finite value. */
     #pragma omp parallel for schedule(static)
     for (int y = 0; y < h; y++) {
-        double *r = rows + (size_t)y * FV_REGION_COUNT * 5;
+        double *r = rows + (size_t)y * FV_REGION_COUNT * 6;
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             double se = 0.0, ae = 0.0;
+            bool bad = false;
+            for (int c = 0; c < 3; c++) bad |= !isfinite(ref[3 * i + c]) || !isfinite(test[3 * i + c]);
             for (int c = 0; c < 3; c++) {
                 double d = (double)a[3 * i + c] - b[3 * i + c];
                 se += d * d;
@@ -151,7 +154,8 @@ fv_status fv_metrics_compare(const float *ref, const float *test, int w, int h, 
             int regs[2] = {FV_REGION_ALL, labels && labels[i] < FV_REGION_ALL ? labels[i] : -1};
             for (int k = 0; k < 2; k++) {
                 if (regs[k] < 0) continue;
-                double *q = r + regs[k] * 5;
+                double *q = r + regs[k] * 6;
+                q[5] += bad;
                 q[0] += 1.0;
                 q[1] += se / 3.0;
                 q[2] += ae / 3.0;
@@ -162,11 +166,12 @@ fv_status fv_metrics_compare(const float *ref, const float *test, int w, int h, 
     }
     memset(out, 0, sizeof *out);
     for (int g = 0; g < FV_REGION_COUNT; g++) {
-        double s[5] = {0, 0, 0, 0, 0};
+        double s[6] = {0, 0, 0, 0, 0, 0};
         for (int y = 0; y < h; y++)
-            for (int k = 0; k < 5; k++) s[k] += rows[((size_t)y * FV_REGION_COUNT + g) * 5 + k];
+            for (int k = 0; k < 6; k++) s[k] += rows[((size_t)y * FV_REGION_COUNT + g) * 6 + k];
         fv_metric_values *v = &out->region[g];
         v->pixels = (long long)s[0];
+        v->nonfinite = (long long)s[5];
         if (s[0] > 0) {
             v->mse = s[1] / s[0];
             v->e = s[2] / s[0];

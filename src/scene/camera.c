@@ -1,16 +1,23 @@
 /* fovea — pinhole camera basis, projection, stereo pairs and camera paths (include/fovea/camera.h). */
 #include "fovea/camera.h"
+#include "fovea/limits.h"
 
 fv_status fv_camera_basis_make(const fv_camera *c, fv_camera_basis *b, fv_error *err)
 {
-    if (!fv_is_finite3(c->pos) || !fv_is_finite3(c->look) || !fv_is_finite3(c->up))
-        return fv_error_set(err, FV_ERR_INVALID, "camera: position, look-at and up must be finite");
+    /* Bounded first: beyond the ray kernels' range Embree aborts, and nearer FLT_MAX the length
+     * of the view direction overflows and would be reported as a parallel up vector. */
+    fv_status s;
+    if ((s = fv_limit_vec3("camera: position", c->pos, err)) != FV_OK ||
+        (s = fv_limit_vec3("camera: look-at point", c->look, err)) != FV_OK ||
+        (s = fv_limit_vec3("camera: up vector", c->up, err)) != FV_OK)
+        return s;
     if (!(c->fov_y > 0.0f && c->fov_y < 180.0f))
         return fv_error_set(err, FV_ERR_INVALID, "camera: field of view %g is outside (0, 180) degrees", c->fov_y);
     if (c->width <= 0 || c->height <= 0)
         return fv_error_set(err, FV_ERR_INVALID, "camera: image size %dx%d must be positive", c->width, c->height);
     fv_vec3 f = fv_sub(c->look, c->pos);
     if (fv_length(f) <= 0.0f) return fv_error_set(err, FV_ERR_INVALID, "camera: look-at point equals the position");
+    if (!(fv_length(c->up) > 0.0f)) return fv_error_set(err, FV_ERR_INVALID, "camera: up vector is zero");
     f = fv_normalize(f);
     fv_vec3 r = fv_cross(f, fv_normalize(c->up));
     if (fv_length(r) < 1e-6f) return fv_error_set(err, FV_ERR_INVALID, "camera: up vector is parallel to the view direction");

@@ -8,6 +8,7 @@
 #include "core/alloc.h"
 #include "core/csv.h"
 #include "fovea/camera.h"
+#include "fovea/limits.h"
 
 typedef struct camera_rows {
     const fv_camera *base;
@@ -19,6 +20,11 @@ static fv_status camera_row(void *ctx, const double *v, int c, const char *path,
 {
     camera_rows *r = ctx;
     if (c != 7 && c != 10 && c != 11) return fv_error_set(err, FV_ERR_INVALID, "%s:%d: expected time,px,py,pz,lx,ly,lz[,ux,uy,uz[,fov]]", path, line);
+    /* Checked as read, before the float conversion turns 1e39 into inf (fovea/limits.h). */
+    char what[4200];
+    snprintf(what, sizeof what, "%s:%d", path, line);
+    fv_status st = fv_limit_coords(what, v + 1, c >= 10 ? 9 : 6, err);
+    if (st != FV_OK) return st;
     fv_camera_key k;
     k.time = v[0];
     k.pos = fv_v3((float)v[1], (float)v[2], (float)v[3]);

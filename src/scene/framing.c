@@ -3,6 +3,7 @@
  */
 #include <string.h>
 #include "fovea/camera.h"
+#include "fovea/limits.h"
 
 static const char *const k_names[] = {"three-quarter", "front", "back", "left", "right", "top"};
 
@@ -43,6 +44,8 @@ static fv_vec3 front_of(fv_vec3 up)
     return fv_normalize(f);
 }
 
+static inline float comp(fv_vec3 v, int k) { return k == 0 ? v.x : k == 1 ? v.y : v.z; }
+
 void fv_camera_frame(fv_vec3 lo, fv_vec3 hi, fv_vec3 up, fv_frame_view view, int width, int height, fv_camera *out)
 {
     up = fv_length(up) > 0.0f ? fv_normalize(up) : fv_v3(0, 1, 0);
@@ -79,6 +82,13 @@ void fv_camera_frame(fv_vec3 lo, fv_vec3 hi, fv_vec3 up, fv_frame_view view, int
         dist = fv_maxf(dist, 0.05f * rad - z); /* in front of the nearest corner */
     }
     if (!(dist > 0.0f)) dist = 1.0f;
+    /* A scene reaching the edge of the coordinate range would put the camera beyond it
+     * (fovea/limits.h): it stops at the edge on its way out from the centre, looking the same way. */
+    for (int k = 0; k < 3; k++) {
+        const float dk = comp(dir, k), ck = comp(c, k);
+        if (dk * dist + ck > (float)FV_COORD_MAX) dist = ((float)FV_COORD_MAX - ck) / dk;
+        if (dk * dist + ck < -(float)FV_COORD_MAX) dist = (-(float)FV_COORD_MAX - ck) / dk;
+    }
     fv_camera cam = {fv_madd(c, dir, dist), c, cam_up, fov, width, height};
     *out = cam;
 }

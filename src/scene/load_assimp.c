@@ -1,5 +1,13 @@
 /* fovea — mesh files through assimp (OBJ/MTL, glTF 2.0, PLY and whatever else assimp reads).
  *
+ * assimp runs in a child process (core/sandbox.h): on malformed files some of its importers
+ * assert and abort, crash, loop, or allocate what a header claims (15 GB for a .off file of a few
+ * bytes). The child imports, flattens and converts; it streams materials, triangle meshes, the
+ * camera and the lights back as plain records, and the parent adds them to the scene. However the
+ * child ends, the parent reports it as a bad file (exit status 2). Before that, counts a PLY or OFF
+ * header declares are checked against the file's size, so the common runaway is refused at once.
+ * The child's cost is one fork per mesh file and one copy of the mesh through a pipe.
+ *
  * The node hierarchy is flattened: each mesh instance becomes one object with its node's
  * transform baked in. Materials map onto ours as documented in docs/scene-format.md (MTL: Kd, Ks,
  * Ns, Ni, d, illum, Ke; glTF: base colour, metallic/roughness, transmission, emissive). A file's
@@ -12,12 +20,18 @@
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <limits.h>
+#include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include "core/alloc.h"
+#include "core/sandbox.h"
 #include "scene/load_impl.h"
 
 bool fv_load_assimp_supports(const char *path)
@@ -112,18 +126,51 @@ static fv_material map_material(const struct aiMaterial *am, int index)
     return m;
 }
 
+/* ---- the child: assimp's scene as records on a pipe ---- */
+
+enum { REC_MATERIAL = 'M', REC_MESH = 'G', REC_CAMERA = 'C', REC_LIGHT = 'L', REC_WARN = 'W', REC_ERROR = 'E', REC_END = 'Z' };
+
+typedef struct mesh_head {
+    char name[FV_NAME_MAX];
+    int material; /* assimp's material index */
+    int nv, nt, has_normals;
+} mesh_head;
+
+typedef struct light_rec {
+    fv_light_desc d;
+    char name[64];
+} light_rec;
+
+typedef struct camera_rec {
+    fv_camera c;
+    char name[64];
+} camera_rec;
+
 typedef struct import_ctx {
-    const struct aiScene *ai;
-    fv_scene *scene;
-    fv_view *view;
-    const fv_import_opts *opts;
-    const fv_log *log;
     const char *path;
-    int *matmap;          /* assimp material index -> ours */
-    int first, count;
-    fv_vec3 *pos, *nrm;
-    uint32_t *idx;
+    const fv_import_opts *opts;
+    const struct aiScene *ai;
+    int fd;
+    bool ok;
 } import_ctx;
+
+static void put(import_ctx *c, char tag, const void *p, size_t n)
+{
+    if (c->ok) c->ok = fv_sandbox_write(c->fd, &tag, 1) && (n == 0 || fv_sandbox_write(c->fd, p, n));
+}
+
+static void put_text(import_ctx *c, char tag, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void put_text(import_ctx *c, char tag, const char *fmt, ...)
+{
+    char msg[FV_ERROR_MSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    int n = (int)strlen(msg);
+    put(c, tag, &n, sizeof n);
+    if (c->ok) c->ok = fv_sandbox_write(c->fd, msg, (size_t)n);
+}
 
 static fv_xform ai_to_xform(const struct aiMatrix4x4 *m)
 {
@@ -144,71 +191,65 @@ static fv_xform xform_mul(const fv_xform *a, const fv_xform *b)
     return r;
 }
 
-static fv_status add_ai_mesh(import_ctx *c, const struct aiMesh *am, const fv_xform *x, fv_error *err)
+/* One mesh instance, its node's transform baked in, as a REC_MESH record. */
+static void put_mesh(import_ctx *c, const struct aiMesh *am, const fv_xform *x)
 {
-    if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || am->mNumVertices == 0) return FV_OK;
-    int nv = (int)am->mNumVertices;
-    c->pos = fv_alloc_array((size_t)nv, sizeof(fv_vec3));
-    c->nrm = am->mNormals ? fv_alloc_array((size_t)nv, sizeof(fv_vec3)) : NULL;
-    c->idx = fv_alloc_array((size_t)am->mNumFaces, 3 * sizeof(uint32_t));
-    if (!c->pos || !c->idx || (am->mNormals && !c->nrm)) return fv_error_set(err, FV_ERR_NOMEM, "%s: out of memory", c->path);
-    fv_xform inv = fv_xform_identity();
-    bool has_inv = fv_xform_inverse(x, &inv);
-    for (int i = 0; i < nv; i++) {
-        const struct aiVector3D *p = &am->mVertices[i];
-        c->pos[i] = fv_xform_point(x, fv_v3(p->x, p->y, p->z));
-        if (c->nrm) {
-            const struct aiVector3D *n = &am->mNormals[i];
-            c->nrm[i] = has_inv ? fv_xform_normal(&inv, fv_v3(n->x, n->y, n->z)) : fv_v3(n->x, n->y, n->z);
+    if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || am->mNumVertices == 0 || am->mNumVertices > INT_MAX ||
+        am->mNumFaces > INT_MAX / 3)
+        return;
+    mesh_head h;
+    memset(&h, 0, sizeof h);
+    snprintf(h.name, sizeof h.name, "%.63s", am->mName.length ? am->mName.data : "mesh");
+    h.material = (int)am->mMaterialIndex;
+    h.nv = (int)am->mNumVertices;
+    h.has_normals = am->mNormals != NULL;
+    for (unsigned f = 0; f < am->mNumFaces; f++) h.nt += am->mFaces[f].mNumIndices == 3;
+    if (h.nt == 0) return;
+    fv_vec3 *pos = fv_alloc_array((size_t)h.nv, sizeof(fv_vec3));
+    fv_vec3 *nrm = h.has_normals ? fv_alloc_array((size_t)h.nv, sizeof(fv_vec3)) : NULL;
+    uint32_t *idx = fv_alloc_array((size_t)h.nt, 3 * sizeof(uint32_t));
+    if (!pos || !idx || (h.has_normals && !nrm)) {
+        put_text(c, REC_ERROR, "out of memory for a mesh of %d vertices", h.nv);
+    } else {
+        fv_xform inv = fv_xform_identity();
+        bool has_inv = fv_xform_inverse(x, &inv);
+        for (int i = 0; i < h.nv; i++) {
+            const struct aiVector3D *p = &am->mVertices[i];
+            pos[i] = fv_xform_point(x, fv_v3(p->x, p->y, p->z));
+            if (nrm) {
+                const struct aiVector3D *n = &am->mNormals[i];
+                nrm[i] = has_inv ? fv_xform_normal(&inv, fv_v3(n->x, n->y, n->z)) : fv_v3(n->x, n->y, n->z);
+            }
         }
-    }
-    int nt = 0;
-    for (unsigned f = 0; f < am->mNumFaces; f++) {
-        const struct aiFace *face = &am->mFaces[f];
-        if (face->mNumIndices != 3) continue;
-        for (int k = 0; k < 3; k++) c->idx[3 * nt + k] = face->mIndices[k];
-        nt++;
-    }
-    fv_status st = FV_OK;
-    if (nt > 0) {
-        char name[FV_NAME_MAX];
-        snprintf(name, sizeof name, "%.31s%.32s", c->opts->prefix, am->mName.length ? am->mName.data : "mesh");
-        fv_mesh_desc d = {name, c->pos, nv, c->nrm, c->idx, nt, NULL,
-                          c->opts->material_override >= 0 ? c->opts->material_override : c->matmap[am->mMaterialIndex]};
-        int id;
-        st = fv_scene_add_mesh(c->scene, &d, c->log, &id, err);
-        if (st == FV_OK) {
-            if (c->count++ == 0) c->first = id;
-        } else if (err && strstr(err->msg, "no valid triangles")) {
-            /* A sub-mesh made only of degenerate or non-finite triangles is dropped like its triangles. */
-            fv_log_warn(c->log, "%s: %s", c->path, err->msg);
-            fv_error_clear(err);
-            st = FV_OK;
+        int t = 0;
+        for (unsigned f = 0; f < am->mNumFaces; f++) {
+            const struct aiFace *face = &am->mFaces[f];
+            if (face->mNumIndices != 3) continue;
+            for (int k = 0; k < 3; k++) idx[3 * t + k] = face->mIndices[k];
+            t++;
         }
+        put(c, REC_MESH, &h, sizeof h);
+        if (c->ok) c->ok = fv_sandbox_write(c->fd, pos, (size_t)h.nv * sizeof *pos);
+        if (c->ok && nrm) c->ok = fv_sandbox_write(c->fd, nrm, (size_t)h.nv * sizeof *nrm);
+        if (c->ok) c->ok = fv_sandbox_write(c->fd, idx, (size_t)h.nt * 3 * sizeof *idx);
     }
-    free(c->pos);
-    free(c->nrm);
-    free(c->idx);
-    c->pos = c->nrm = NULL;
-    c->idx = NULL;
-    return st;
+    free(pos);
+    free(nrm);
+    free(idx);
 }
 
-static fv_status walk(import_ctx *c, const struct aiNode *node, const fv_xform *parent, int depth, fv_error *err)
+static void walk(import_ctx *c, const struct aiNode *node, const fv_xform *parent, int depth)
 {
-    if (depth > 256) return fv_error_set(err, FV_ERR_INVALID, "%s: node hierarchy deeper than 256 levels", c->path);
+    if (depth > 256) {
+        put_text(c, REC_ERROR, "node hierarchy deeper than 256 levels");
+        return;
+    }
     fv_xform local = ai_to_xform(&node->mTransformation), x = xform_mul(parent, &local);
-    for (unsigned i = 0; i < node->mNumMeshes; i++) {
+    for (unsigned i = 0; i < node->mNumMeshes && c->ok; i++) {
         unsigned mi = node->mMeshes[i];
-        if (mi >= c->ai->mNumMeshes) continue;
-        fv_status st = add_ai_mesh(c, c->ai->mMeshes[mi], &x, err);
-        if (st != FV_OK) return st;
+        if (mi < c->ai->mNumMeshes) put_mesh(c, c->ai->mMeshes[mi], &x);
     }
-    for (unsigned i = 0; i < node->mNumChildren; i++) {
-        fv_status st = walk(c, node->mChildren[i], &x, depth + 1, err);
-        if (st != FV_OK) return st;
-    }
-    return FV_OK;
+    for (unsigned i = 0; i < node->mNumChildren && c->ok; i++) walk(c, node->mChildren[i], &x, depth + 1);
 }
 
 /* The world transform of the node called `name` (identity when there is none). */
@@ -246,7 +287,7 @@ static float vertical_fov(const char *path, float h, float aspect)
     return 2.0f * atanf(tanf(h) / aspect);
 }
 
-static void import_camera_and_lights(import_ctx *c, const fv_xform *base, fv_error *err)
+static void put_camera_and_lights(import_ctx *c, const fv_xform *base)
 {
     const struct aiScene *ai = c->ai;
     if (c->opts->import_camera && ai->mNumCameras > 0) {
@@ -261,84 +302,264 @@ static void import_camera_and_lights(import_ctx *c, const fv_xform *base, fv_err
         fv_vec3 p = fv_xform_point(&x, local);
         fv_vec3 dir = fv_xform_vector(&x, fv_v3(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z));
         fv_vec3 up = fv_xform_vector(&x, fv_v3(cam->mUp.x, cam->mUp.y, cam->mUp.z));
-        float aspect = cam->mAspect > 0.0f ? cam->mAspect : 1.0f;
+        float aspect = cam->mAspect > 0.0f && isfinite(cam->mAspect) ? cam->mAspect : 1.0f;
         float fov_y = vertical_fov(c->path, cam->mHorizontalFOV, aspect);
-        fv_camera fc = {p, fv_add(p, fv_normalize(dir)), up, fv_degrees(fov_y), 512, (int)lroundf(512 / aspect)};
-        fv_camera_basis b;
-        fv_error e2;
-        if (fv_is_finite3(fc.look) && fv_camera_basis_make(&fc, &b, &e2) == FV_OK) fv_view_set_camera(c->view, &fc);
-        else fv_log_warn(c->log, "%s: ignoring camera '%s' (%s)", c->path, cam->mName.data, e2.msg);
+        float hgt = 512.0f / aspect;
+        camera_rec r;
+        memset(&r, 0, sizeof r);
+        r.c = (fv_camera){p, fv_add(p, fv_normalize(dir)), up, fv_degrees(fov_y), 512, hgt >= 1.0f && hgt < 1e6f ? (int)lroundf(hgt) : 512};
+        snprintf(r.name, sizeof r.name, "%.63s", cam->mName.data);
+        put(c, REC_CAMERA, &r, sizeof r);
     }
     if (!c->opts->import_lights) return;
-    for (unsigned i = 0; i < ai->mNumLights; i++) {
+    for (unsigned i = 0; i < ai->mNumLights && c->ok; i++) {
         const struct aiLight *l = ai->mLights[i];
         if (l->mType != aiLightSource_POINT && l->mType != aiLightSource_SPOT) {
-            fv_log_warn(c->log, "%s: ignoring light '%s' (only point and spot lights are imported)", c->path, l->mName.data);
+            put_text(c, REC_WARN, "ignoring light '%.63s' (only point and spot lights are imported)", l->mName.data);
             continue;
         }
         fv_xform x = *base;
         find_node(ai->mRootNode, l->mName.data, base, &x, 0);
-        fv_light_desc d;
-        memset(&d, 0, sizeof d);
-        d.type = l->mType == aiLightSource_POINT ? FV_LIGHT_POINT : FV_LIGHT_SPOT;
-        d.pos = fv_xform_point(&x, fv_v3(l->mPosition.x, l->mPosition.y, l->mPosition.z));
-        d.dir = fv_xform_vector(&x, fv_v3(l->mDirection.x, l->mDirection.y, l->mDirection.z));
-        d.intensity = fv_v3(l->mColorDiffuse.r, l->mColorDiffuse.g, l->mColorDiffuse.b);
-        d.outer_deg = fv_degrees(fminf(l->mAngleOuterCone, 1.5f));
-        d.inner_deg = fminf(fv_degrees(l->mAngleInnerCone), d.outer_deg);
-        fv_error e2;
-        if (fv_scene_add_light(c->scene, &d, &e2) != FV_OK) fv_log_warn(c->log, "%s: ignoring light '%s': %s", c->path, l->mName.data, e2.msg);
+        light_rec r;
+        memset(&r, 0, sizeof r);
+        fv_light_desc *d = &r.d;
+        d->type = l->mType == aiLightSource_POINT ? FV_LIGHT_POINT : FV_LIGHT_SPOT;
+        d->pos = fv_xform_point(&x, fv_v3(l->mPosition.x, l->mPosition.y, l->mPosition.z));
+        d->dir = fv_xform_vector(&x, fv_v3(l->mDirection.x, l->mDirection.y, l->mDirection.z));
+        d->intensity = fv_v3(l->mColorDiffuse.r, l->mColorDiffuse.g, l->mColorDiffuse.b);
+        d->outer_deg = fv_degrees(fminf(l->mAngleOuterCone, 1.5f));
+        d->inner_deg = fminf(fv_degrees(l->mAngleInnerCone), d->outer_deg);
+        snprintf(r.name, sizeof r.name, "%.63s", l->mName.data);
+        put(c, REC_LIGHT, &r, sizeof r);
     }
-    (void)err;
 }
 
-fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const fv_import_opts *opts, const fv_log *log,
-                         int *first_object, int *object_count, fv_error *err)
+static int import_child(void *user, int fd)
 {
+    import_ctx *c = user;
+    c->fd = fd;
+    c->ok = true;
     struct aiPropertyStore *props = aiCreatePropertyStore();
     /* Points and lines would only be dropped later; ask assimp not to produce them. */
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const struct aiScene *ai = aiImportFileExWithProperties(
-        path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType, NULL, props);
+        c->path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType, NULL, props);
     aiReleasePropertyStore(props);
+    c->ai = ai;
     if (!ai) {
-        /* Our messages are one line; some of assimp's are not. */
         const char *why = aiGetErrorString();
+        put_text(c, REC_ERROR, "%s", why && why[0] ? why : "assimp could not read it");
+    } else if (!ai->mRootNode || ai->mNumMeshes == 0) {
+        put_text(c, REC_ERROR, "the file holds no meshes");
+    } else {
+        for (unsigned i = 0; c->ok && i < ai->mNumMaterials && c->opts->material_override < 0; i++) {
+            fv_material m = map_material(ai->mMaterials[i], (int)i);
+            put(c, REC_MATERIAL, &m, sizeof m);
+        }
+        fv_xform base = c->opts->xform ? *c->opts->xform : fv_xform_identity();
+        walk(c, ai->mRootNode, &base, 0);
+        put_camera_and_lights(c, &base);
+        put(c, REC_END, NULL, 0);
+    }
+    if (ai) aiReleaseImport(ai);
+    return c->ok ? 0 : 3;
+}
+
+/* ---- before the child: counts a header declares against the file's size ---- */
+
+/* A PLY header must be whole and made of the lines the format has: assimp loops without end on
+ * a header cut short or with a mangled line. Sets *elements to the sum of the element counts. */
+static bool ply_header_ok(const char *head, long double *elements, int *line_no)
+{
+    static const char *const types[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "uint8",
+                                        "int16", "uint16", "int32", "uint32", "float32", "float64", NULL};
+    *elements = 0;
+    int n = 0;
+    for (const char *l = head; *l; n++) {
+        const char *nl = strchr(l, '\n');
+        if (!nl) break; /* no end_header within the first 64 kB */
         char line[256];
-        snprintf(line, sizeof line, "%s", why && why[0] ? why : "assimp could not read it");
-        for (char *ch = line; *ch; ch++)
-            if (*ch == '\n' || *ch == '\r' || *ch == '\t') *ch = ' ';
-        for (size_t n = strlen(line); n > 0 && line[n - 1] == ' '; n--) line[n - 1] = '\0';
-        return fv_error_set(err, FV_ERR_INVALID, "scene '%s': %s", path, line);
+        size_t len = (size_t)(nl - l) < sizeof line - 1 ? (size_t)(nl - l) : sizeof line - 1;
+        memcpy(line, l, len);
+        line[len] = '\0';
+        if (len && line[len - 1] == '\r') line[--len] = '\0';
+        *line_no = n + 1;
+        char a[64], b[64], c[64], d[64], e[64];
+        long double cnt;
+        int k;
+        if (n == 0) {
+            if (strcmp(line, "ply")) return false;
+        } else if (!strcmp(line, "end_header")) {
+            return n > 1;
+        } else if (!strncmp(line, "comment", 7) || !strncmp(line, "obj_info", 8)) {
+        } else if (sscanf(line, "format %63s %63s %n", a, b, &k) == 2) {
+            if (strcmp(a, "ascii") && strcmp(a, "binary_little_endian") && strcmp(a, "binary_big_endian")) return false;
+        } else if (sscanf(line, "element %63s %Lf %n", a, &cnt, &k) == 2 && line[k] == '\0') {
+            if (!(cnt >= 0) || cnt != floorl(cnt)) return false;
+            *elements += cnt;
+        } else if (sscanf(line, "property list %63s %63s %63s %n", a, b, c, &k) == 3 && line[k] == '\0') {
+            bool ta = false, tb = false;
+            for (int t = 0; types[t]; t++) ta |= !strcmp(a, types[t]), tb |= !strcmp(b, types[t]);
+            if (!ta || !tb) return false;
+        } else if (sscanf(line, "property %63s %63s %n", d, e, &k) == 2 && line[k] == '\0') {
+            bool td = false;
+            for (int t = 0; types[t]; t++) td |= !strcmp(d, types[t]);
+            if (!td) return false;
+        } else {
+            return false;
+        }
+        l = nl + 1;
     }
-    import_ctx c;
-    memset(&c, 0, sizeof c);
-    c.ai = ai;
-    c.scene = scene;
-    c.view = view;
-    c.opts = opts;
-    c.log = log;
-    c.path = path;
+    return false;
+}
+
+/* PLY and OFF headers declare element counts: every element takes at least one byte (binary) or
+ * two (text), so a count beyond that is a lie that would make the importer reserve gigabytes.
+ * Other formats are left to the child's limits. */
+static fv_status check_header(const char *path, long long size, fv_error *err)
+{
+    const char *dot = strrchr(path, '.');
+    bool ply = dot && strcasecmp(dot, ".ply") == 0, off = dot && strcasecmp(dot, ".off") == 0;
+    if (!ply && !off) return FV_OK;
+    FILE *f = fopen(path, "rb");
+    if (!f) return FV_OK; /* the importer says why */
+    static const size_t cap = 65536;
+    char *head = malloc(cap);
+    if (!head) {
+        fclose(f);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    }
+    size_t n = fread(head, 1, cap - 1, f);
+    fclose(f);
+    head[n] = '\0';
+    long double total = 0;
+    int per = 2, line = 0;
     fv_status st = FV_OK;
-    if (!ai->mRootNode || ai->mNumMeshes == 0) st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': the file holds no meshes", path);
-    if (st == FV_OK && !(c.matmap = fv_alloc_array(ai->mNumMaterials + 1, sizeof(int))))
-        st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    for (unsigned i = 0; st == FV_OK && i < ai->mNumMaterials && opts->material_override < 0; i++) {
-        fv_material m = map_material(ai->mMaterials[i], (int)i);
-        char name[FV_NAME_MAX];
-        snprintf(name, sizeof name, "%.31s%.32s", opts->prefix, m.name);
-        snprintf(m.name, sizeof m.name, "%s", name);
-        if ((st = fv_scene_add_material(scene, &m, &c.matmap[i], err)) != FV_OK) fv_error_prefix(err, "scene '%s': ", path);
+    if (ply) {
+        per = strstr(head, "format ascii") ? 2 : 1;
+        if (!ply_header_ok(head, &total, &line))
+            st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': PLY header line %d is malformed or the header does not end (end_header)", path,
+                              line ? line : 1);
+    } else {
+        const char *l = head;
+        while (*l == ' ' || *l == '\t') l++;
+        while (*l == 'C' || *l == 'N' || *l == 'S' || *l == 'T' || *l == '4' || *l == 'n') l++; /* COFF, NOFF, STOFF, 4OFF, nOFF */
+        const char *nl = strchr(l, '\n');
+        long double nv, nf;
+        if (nl && sscanf(nl + 1, "%Lf %Lf", &nv, &nf) == 2 && nv > 0 && nf > 0) total = nv + nf;
     }
-    fv_xform base = opts->xform ? *opts->xform : fv_xform_identity();
-    if (st == FV_OK) st = walk(&c, ai->mRootNode, &base, 0, err);
-    if (st == FV_OK && c.count == 0) st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': no usable triangles in the file", path);
-    if (st == FV_OK) import_camera_and_lights(&c, &base, err);
-    free(c.matmap);
-    aiReleaseImport(ai);
-    if (st == FV_OK) {
-        if (first_object) *first_object = c.first;
-        if (object_count) *object_count = c.count;
-    }
+    free(head);
+    if (st == FV_OK && total * per > (long double)size)
+        st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': its header declares %.0Lf elements, more than its %lld bytes can hold", path, total,
+                          size);
     return st;
+}
+
+/* ---- the parent: records into the scene ---- */
+
+fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const fv_import_opts *opts, const fv_log *log,
+                         int *first_object, int *object_count, fv_error *err)
+{
+    struct stat sb;
+    if (stat(path, &sb) != 0) return fv_error_set(err, FV_ERR_IO, "cannot open scene '%s': %s", path, strerror(errno));
+    fv_status st = check_header(path, (long long)sb.st_size, err);
+    if (st != FV_OK) return st;
+    /* Limits for the child: room for meshes many times the file's size, at least 2 GiB (a .gltf
+     * file may name large .bin buffers), and 10 s of CPU time plus 2 s per MB (assimp reads tens of MB a second). */
+    size_t mem = (size_t)2 << 30;
+    if ((size_t)sb.st_size < ((size_t)64 << 30) / 64 && (size_t)sb.st_size * 64 > mem) mem = (size_t)sb.st_size * 64;
+    int cpu = 10 + 2 * (int)(sb.st_size >> 20);
+    import_ctx c = {path, opts, NULL, -1, true};
+    fv_sandbox *box;
+    if ((st = fv_sandbox_start(import_child, &c, mem, cpu, &box, err)) != FV_OK) return st;
+
+    int *matmap = NULL, nmat = 0, cap = 0, first = -1, count = 0;
+    bool ended = false;
+    char tag;
+    while (st == FV_OK && !ended && fv_sandbox_read(box, &tag, 1)) {
+        if (tag == REC_MATERIAL) {
+            fv_material m;
+            if (!fv_sandbox_read(box, &m, sizeof m)) break;
+            char name[FV_NAME_MAX];
+            m.name[FV_NAME_MAX - 1] = '\0';
+            snprintf(name, sizeof name, "%.31s%.32s", opts->prefix, m.name);
+            snprintf(m.name, sizeof m.name, "%s", name);
+            if (fv_grow((void **)&matmap, &cap, nmat + 1, sizeof *matmap)) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+            else if ((st = fv_scene_add_material(scene, &m, &matmap[nmat++], err)) != FV_OK) fv_error_prefix(err, "scene '%s': ", path);
+        } else if (tag == REC_MESH) {
+            mesh_head h;
+            if (!fv_sandbox_read(box, &h, sizeof h)) break;
+            h.name[FV_NAME_MAX - 1] = '\0';
+            if (h.nv < 1 || h.nt < 1 || h.nt > INT_MAX / 3) break; /* not what the child sends: treat as a failed child */
+            fv_vec3 *pos = fv_alloc_array((size_t)h.nv, sizeof *pos), *nrm = h.has_normals ? fv_alloc_array((size_t)h.nv, sizeof *nrm) : NULL;
+            uint32_t *idx = fv_alloc_array((size_t)h.nt, 3 * sizeof *idx);
+            bool got = pos && idx && (!h.has_normals || nrm) && fv_sandbox_read(box, pos, (size_t)h.nv * sizeof *pos) &&
+                       (!nrm || fv_sandbox_read(box, nrm, (size_t)h.nv * sizeof *nrm)) && fv_sandbox_read(box, idx, (size_t)h.nt * 3 * sizeof *idx);
+            if (got) {
+                int mat = opts->material_override;
+                if (mat < 0) mat = h.material >= 0 && h.material < nmat ? matmap[h.material] : -1;
+                char name[FV_NAME_MAX];
+                snprintf(name, sizeof name, "%.31s%.32s", opts->prefix, h.name);
+                fv_mesh_desc d = {name, pos, h.nv, nrm, idx, h.nt, NULL, mat};
+                int id;
+                if (mat < 0) {
+                    st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': mesh '%s' uses material %d, which the file does not define", path,
+                                      name, h.material);
+                } else if ((st = fv_scene_add_mesh(scene, &d, log, &id, err)) == FV_OK) {
+                    if (count++ == 0) first = id;
+                } else if (strstr(err->msg, "no valid triangles")) {
+                    /* A sub-mesh made only of degenerate or non-finite triangles is dropped like its triangles. */
+                    fv_log_warn(log, "%s: %s", path, err->msg);
+                    fv_error_clear(err);
+                    st = FV_OK;
+                } else {
+                    fv_error_prefix(err, "scene '%s': ", path);
+                }
+            } else if (!pos || !idx || (h.has_normals && !nrm)) {
+                st = fv_error_set(err, FV_ERR_NOMEM, "scene '%s': out of memory for a mesh of %d vertices", path, h.nv);
+            }
+            free(pos);
+            free(nrm);
+            free(idx);
+            if (!got && st == FV_OK) break;
+        } else if (tag == REC_CAMERA) {
+            camera_rec r;
+            if (!fv_sandbox_read(box, &r, sizeof r)) break;
+            r.name[sizeof r.name - 1] = '\0';
+            fv_camera_basis b;
+            fv_error e2;
+            if (view && fv_camera_basis_make(&r.c, &b, &e2) == FV_OK) fv_view_set_camera(view, &r.c);
+            else if (view) fv_log_warn(log, "%s: ignoring camera '%s' (%s)", path, r.name, e2.msg);
+        } else if (tag == REC_LIGHT) {
+            light_rec r;
+            if (!fv_sandbox_read(box, &r, sizeof r)) break;
+            r.name[sizeof r.name - 1] = '\0';
+            fv_error e2;
+            if (fv_scene_add_light(scene, &r.d, &e2) != FV_OK) fv_log_warn(log, "%s: ignoring light '%s': %s", path, r.name, e2.msg);
+        } else if (tag == REC_WARN || tag == REC_ERROR) {
+            int n;
+            char msg[FV_ERROR_MSG_MAX];
+            if (!fv_sandbox_read(box, &n, sizeof n) || n < 0 || n >= (int)sizeof msg || !fv_sandbox_read(box, msg, (size_t)n)) break;
+            msg[n] = '\0';
+            /* Our messages are one line (status.c escapes control bytes); drop assimp's trailing ones. */
+            while (n > 0 && (msg[n - 1] == '\n' || msg[n - 1] == '\r' || msg[n - 1] == ' ')) msg[--n] = '\0';
+            if (tag == REC_WARN) fv_log_warn(log, "%s: %s", path, msg);
+            else st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': %s", path, msg);
+        } else if (tag == REC_END) {
+            ended = true;
+        } else {
+            break;
+        }
+    }
+    fv_error e2;
+    char what[4200];
+    snprintf(what, sizeof what, "scene '%s': the mesh importer (assimp)", path);
+    fv_status fin = fv_sandbox_finish(box, what, &e2);
+    free(matmap);
+    if (st != FV_OK) return st;
+    if (!ended) return fin != FV_OK ? fv_error_set(err, fin, "%s", e2.msg) : fv_error_set(err, FV_ERR_INVALID, "%s: stopped early", what);
+    if (count == 0) return fv_error_set(err, FV_ERR_INVALID, "scene '%s': no usable triangles in the file", path);
+    if (first_object) *first_object = first;
+    if (object_count) *object_count = count;
+    return FV_OK;
 }

@@ -11,12 +11,14 @@
 #include <string.h>
 #include "core/alloc.h"
 #include "fovea/film.h"
+#include "fovea/limits.h"
 #include "core/json_util.h"
 #include "gaze/gaze_json.h"
 #include "scene/load_impl.h"
 #include "scene/mesh_gen.h"
 
-#define BIG 1e30
+/* Lengths and coordinates: the ray kernels' range (fovea/limits.h). */
+#define BIG FV_COORD_MAX
 
 typedef struct json_ctx {
     const char *file;
@@ -33,6 +35,18 @@ static fv_status vec3(const cJSON *o, const char *key, double lo, double hi, con
     if (st == FV_OK) *out = fv_v3((float)v[0], (float)v[1], (float)v[2]);
     return st;
 }
+
+/* Coordinates (and intensities) checked against fovea/limits.h with its message. */
+static fv_status limited3(const cJSON *o, const char *key, fv_json_limit_fn check, const json_ctx *c, const char *where, fv_vec3 *out,
+                          fv_error *err)
+{
+    double v[3] = {out->x, out->y, out->z};
+    fv_status st = fv_json_limited(o, key, 3, check, c->file, where, v, err);
+    if (st == FV_OK) *out = fv_v3((float)v[0], (float)v[1], (float)v[2]);
+    return st;
+}
+#define coord3(o, key, c, where, out, err) limited3(o, key, fv_limit_coords, c, where, out, err)
+#define intensity3(o, key, c, where, out, err) limited3(o, key, fv_limit_intensity, c, where, out, err)
 
 static fv_status parse_material(const cJSON *o, const json_ctx *c, fv_error *err)
 {
@@ -54,7 +68,7 @@ static fv_status parse_material(const cJSON *o, const json_ctx *c, fv_error *err
     snprintf(m.name, sizeof m.name, "%s", o->string);
     double rough = m.roughness, ior = m.ior;
     if ((st = vec3(o, "albedo", 0, 1, c, where, &m.albedo, err)) || (st = vec3(o, "specular", 0, 1, c, where, &m.specular, err)) ||
-        (st = vec3(o, "emission", 0, BIG, c, where, &m.emission, err)) ||
+        (st = intensity3(o, "emission", c, where, &m.emission, err)) ||
         (st = fv_json_number(o, "roughness", 0.001, 1, c->file, where, &rough, err)) ||
         (st = fv_json_number(o, "ior", 1.0001, 10, c->file, where, &ior, err)) ||
         (st = fv_json_bool(o, "two_sided", c->file, where, &m.two_sided_emission, err)))
@@ -84,7 +98,7 @@ static fv_status parse_trs(const cJSON *o, const json_ctx *c, const char *where,
     fv_vec3 rot = fv_v3s(0.0f);
     *t = fv_v3s(0.0f);
     *s = fv_v3s(1.0f);
-    if (st || (st = vec3(o, "translate", -BIG, BIG, c, where, t, err)) || (st = vec3(o, "rotate_deg", -1e6, 1e6, c, where, &rot, err)))
+    if (st || (st = coord3(o, "translate", c, where, t, err)) || (st = vec3(o, "rotate_deg", -1e6, 1e6, c, where, &rot, err)))
         return st;
     const cJSON *sc = cJSON_GetObjectItemCaseSensitive(o, "scale");
     if (cJSON_IsNumber(sc)) {
@@ -99,7 +113,7 @@ static fv_status parse_trs(const cJSON *o, const json_ctx *c, const char *where,
         if (cJSON_GetObjectItemCaseSensitive(o, "rotate_deg"))
             return fv_error_set(err, FV_ERR_INVALID, "%s: %s: give rotate_deg or rotate_quat, not both", c->file, where);
         double v[4];
-        if ((st = fv_json_numbers(o, "rotate_quat", 4, -BIG, BIG, c->file, where, v, err))) return st;
+        if ((st = fv_json_numbers(o, "rotate_quat", 4, -1e30, 1e30, c->file, where, v, err))) return st;
         double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]);
         if (!(len > 1e-6) || !isfinite(len))
             return fv_error_set(err, FV_ERR_INVALID, "%s: %s.rotate_quat: not a rotation (length %g)", c->file, where, len);
@@ -125,7 +139,7 @@ static fv_status parse_shape(const cJSON *o, const json_ctx *c, const char *wher
             for (const cJSON *n = cJSON_IsArray(e) ? e->child : NULL; n && k < 4; n = n->next, k++)
                 if (k < 3) v[k] = cJSON_IsNumber(n) && fabs(n->valuedouble) <= BIG ? (float)n->valuedouble : NAN;
             if (k != 3 || !isfinite(v[0]) || !isfinite(v[1]) || !isfinite(v[2]))
-                return fv_error_set(err, FV_ERR_INVALID, "%s: %s[%d]: expected 3 finite numbers", c->file, w2, i);
+                return fv_error_set(err, FV_ERR_INVALID, "%s: %s[%d]: expected 3 finite numbers within +-%g", c->file, w2, i, BIG);
             p[i] = fv_v3(v[0], v[1], v[2]);
         }
         fv_mesh_quad(mb, p[0], p[1], p[2], p[3], mat);
@@ -137,7 +151,7 @@ static fv_status parse_shape(const cJSON *o, const json_ctx *c, const char *wher
         fv_vec3 ce = fv_v3s(0), h = fv_v3s(0.5f);
         double yaw = 0;
         if ((st = fv_json_check_keys(it, keys, c->file, w2, err)) || (st = fv_json_require(it, "half", c->file, w2, err)) ||
-            (st = vec3(it, "center", -BIG, BIG, c, w2, &ce, err)) || (st = vec3(it, "half", 1e-9, BIG, c, w2, &h, err)) ||
+            (st = coord3(it, "center", c, w2, &ce, err)) || (st = vec3(it, "half", 1e-9, BIG, c, w2, &h, err)) ||
             (st = fv_json_number(it, "yaw_deg", -1e6, 1e6, c->file, w2, &yaw, err)))
             return st;
         fv_mesh_box(mb, ce, h, (float)yaw, mat);
@@ -149,7 +163,7 @@ static fv_status parse_shape(const cJSON *o, const json_ctx *c, const char *wher
     fv_vec3 ce = fv_v3s(0);
     double r = 1, seg[2] = {64, 32};
     if ((st = fv_json_check_keys(it, keys, c->file, w2, err)) || (st = fv_json_require(it, "radius", c->file, w2, err)) ||
-        (st = vec3(it, "center", -BIG, BIG, c, w2, &ce, err)) || (st = fv_json_number(it, "radius", 1e-9, BIG, c->file, w2, &r, err)) ||
+        (st = coord3(it, "center", c, w2, &ce, err)) || (st = fv_json_number(it, "radius", 1e-9, BIG, c->file, w2, &r, err)) ||
         (st = fv_json_numbers(it, "segments", 2, 3, 2048, c->file, w2, seg, err)))
         return st;
     fv_mesh_sphere(mb, ce, (float)r, (int)seg[0], (int)seg[1], false, mat);
@@ -223,7 +237,7 @@ static fv_status sdf_num(const cJSON *o, const char *key, bool required, int con
     const cJSON *it = cJSON_GetObjectItemCaseSensitive(o, key);
     if (!it) return required ? fv_error_set(err, FV_ERR_INVALID, "%s: %s: missing '%s'", b->c->file, where, key) : FV_OK;
     if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble) || fabs(it->valuedouble) > BIG)
-        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: expected a finite number", b->c->file, where, key);
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: expected a finite number within +-%g", b->c->file, where, key, BIG);
     double v = it->valuedouble;
     if (cond > 0 && !(v > 0)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: must be > 0", b->c->file, where, key);
     if (cond == 0 && !(v >= 0)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: must be >= 0", b->c->file, where, key);
@@ -244,7 +258,7 @@ static fv_status sdf_vec(const cJSON *o, const char *key, bool required, int con
             if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > BIG) break;
             v[k] = (float)e->valuedouble;
         }
-    if (k != 3) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: expected 3 finite numbers", b->c->file, where, key);
+    if (k != 3) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: expected 3 finite numbers within +-%g", b->c->file, where, key, BIG);
     for (k = 0; k < 3; k++) {
         if (cond > 0 && !(v[k] > 0)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: each must be > 0", b->c->file, where, key);
         if (cond == 0 && !(v[k] >= 0)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.%s: each must be >= 0", b->c->file, where, key);
@@ -570,8 +584,8 @@ static fv_status parse_light(const cJSON *o, const json_ctx *c, int index, fv_er
     d.intensity = fv_v3s(1.0f);
     double inner = 20, outer = 30;
     if (st || (st = fv_json_string(o, "type", c->file, where, &type, err)) || (st = fv_json_require(o, "pos", c->file, where, err)) ||
-        (st = vec3(o, "pos", -BIG, BIG, c, where, &d.pos, err)) || (st = vec3(o, "dir", -BIG, BIG, c, where, &d.dir, err)) ||
-        (st = vec3(o, "intensity", 0, BIG, c, where, &d.intensity, err)) ||
+        (st = coord3(o, "pos", c, where, &d.pos, err)) || (st = coord3(o, "dir", c, where, &d.dir, err)) ||
+        (st = intensity3(o, "intensity", c, where, &d.intensity, err)) ||
         (st = fv_json_number(o, "inner_deg", 0, 89.9, c->file, where, &inner, err)) ||
         (st = fv_json_number(o, "outer_deg", 0.01, 89.9, c->file, where, &outer, err)))
         return st;
@@ -624,8 +638,8 @@ static fv_status parse_camera_key(const cJSON *o, const json_ctx *c, const char 
     double t = 0, fov = 40;
     k->up = fv_v3(0, 1, 0);
     if (st || (st = fv_json_require(o, "pos", c->file, where, err)) || (st = fv_json_require(o, "look", c->file, where, err)) ||
-        (timed && (st = fv_json_require(o, "time", c->file, where, err))) || (st = vec3(o, "pos", -BIG, BIG, c, where, &k->pos, err)) ||
-        (st = vec3(o, "look", -BIG, BIG, c, where, &k->look, err)) || (st = vec3(o, "up", -BIG, BIG, c, where, &k->up, err)) ||
+        (timed && (st = fv_json_require(o, "time", c->file, where, err))) || (st = coord3(o, "pos", c, where, &k->pos, err)) ||
+        (st = coord3(o, "look", c, where, &k->look, err)) || (st = coord3(o, "up", c, where, &k->up, err)) ||
         (st = fv_json_number(o, "fov", 0.01, 179.9, c->file, where, &fov, err)) ||
         (st = fv_json_number(o, "time", -1e9, 1e9, c->file, where, &t, err)))
         return st;
@@ -689,8 +703,8 @@ fv_status fv_load_json(const char *path, fv_scene *scene, fv_view *view, const f
         fv_view_camera(view, scene, 0.0, 512, 512, &base);
         fv_camera_key *k = NULL;
         int n = 0;
-        if ((st = fv_camera_path_load_csv(full, &base, &k, &n, err)) == FV_OK && (st = fv_view_set_camera_path(view, k, n, err)) != FV_OK)
-            fv_error_prefix(err, "%s: ", path);
+        if ((st = fv_camera_path_load_csv(full, &base, &k, &n, err)) != FV_OK || (st = fv_view_set_camera_path(view, k, n, err)) != FV_OK)
+            fv_error_prefix(err, "%s: camera_path: ", path);
         fv_camera_keys_free(k);
         if (st != FV_OK) goto done;
     } else if (it) {

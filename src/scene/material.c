@@ -1,6 +1,7 @@
 /* fovea — material defaults, names and validation (the BSDFs themselves are in bsdf.c). */
 #include <stdio.h>
 #include <string.h>
+#include "fovea/limits.h"
 #include "fovea/scene.h"
 
 static const char *const k_type_names[] = {"diffuse", "mirror", "glossy", "dielectric"};
@@ -47,7 +48,7 @@ fv_status fv_material_validate(const fv_material *m, fv_error *err)
         return fv_error_set(err, FV_ERR_INVALID, "material '%s': roughness %g outside [0.001, 1]", m->name, m->roughness);
     if (m->type == FV_MAT_DIELECTRIC && !(m->ior > 1.0f && m->ior < 10.0f))
         return fv_error_set(err, FV_ERR_INVALID, "material '%s': ior %g outside (1, 10)", m->name, m->ior);
-    if (!fv_is_finite3(m->emission) || fv_min3(m->emission) < 0.0f)
-        return fv_error_set(err, FV_ERR_INVALID, "material '%s': emission must be finite and >= 0", m->name);
-    return FV_OK;
+    char what[FV_NAME_MAX + 32];
+    snprintf(what, sizeof what, "material '%s': emission", m->name);
+    return fv_limit_intensity3(what, m->emission, err);
 }

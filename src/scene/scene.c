@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "fovea/limits.h"
 #include "scene/scene_impl.h"
 
 static void embree_error(void *user, enum RTCError code, const char *str)
@@ -84,11 +85,17 @@ int fv_scene_find_material(const fv_scene *s, const char *name)
     return -1;
 }
 
-/* A triangle is kept when its vertices are finite and it has a non-zero area relative to its
- * edge lengths (collinear vertices give zero area and a NaN normal). */
+/* A triangle is kept when its vertices are finite and within the ray kernels' range
+ * (fovea/limits.h) and it has a non-zero area relative to its edge lengths (collinear vertices
+ * give zero area and a NaN normal). */
+static bool in_range(fv_vec3 p)
+{
+    return fv_limit_vec3("", p, NULL) == FV_OK; /* false for NaN */
+}
+
 static bool triangle_ok(fv_vec3 a, fv_vec3 b, fv_vec3 c)
 {
-    if (!fv_is_finite3(a) || !fv_is_finite3(b) || !fv_is_finite3(c)) return false;
+    if (!in_range(a) || !in_range(b) || !in_range(c)) return false;
     fv_vec3 e1 = fv_sub(b, a), e2 = fv_sub(c, a);
     float cr = fv_length(fv_cross(e1, e2));
     return isfinite(cr) && cr > 1e-7f * fv_length(e1) * fv_length(e2);
@@ -139,9 +146,9 @@ fv_status fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, const fv_log *lo
         free(remap);
         free(o.idx);
         free(o.mat);
-        return fv_error_set(err, FV_ERR_INVALID, "mesh '%s': no valid triangles (%d dropped as degenerate or non-finite)", name, dropped);
+        return fv_error_set(err, FV_ERR_INVALID, "mesh '%s': no valid triangles (%d dropped as degenerate, non-finite or beyond +-%g)", name, dropped, FV_COORD_MAX);
     }
-    if (dropped) fv_log_warn(log, "mesh '%s': dropped %d of %d triangles (degenerate, non-finite or bad index)", name, dropped, m->triangle_count);
+    if (dropped) fv_log_warn(log, "mesh '%s': dropped %d of %d triangles (degenerate, non-finite, beyond +-%g or bad index)", name, dropped, m->triangle_count, FV_COORD_MAX);
 
     /* +1 element: Embree reads vertex buffers with 16-byte loads. */
     o.pos = fv_alloc_array((size_t)o.nv + 1, sizeof(fv_vec3));
@@ -217,12 +224,12 @@ fv_status fv_scene_add_light(fv_scene *s, const fv_light_desc *l, fv_error *err)
     if (st != FV_OK) return st;
     if (l->type != FV_LIGHT_POINT && l->type != FV_LIGHT_SPOT)
         return fv_error_set(err, FV_ERR_INVALID, "light: unknown type %d", (int)l->type);
-    if (!fv_is_finite3(l->pos) || !fv_is_finite3(l->intensity) || fv_min3(l->intensity) < 0.0f)
-        return fv_error_set(err, FV_ERR_INVALID, "light: position and intensity must be finite, intensity >= 0");
+    if ((st = fv_limit_vec3("light: position", l->pos, err)) != FV_OK || (st = fv_limit_intensity3("light: intensity", l->intensity, err)) != FV_OK)
+        return st;
     fv_light_desc c = *l;
     if (l->type == FV_LIGHT_SPOT) {
-        if (!fv_is_finite3(l->dir) || fv_length(l->dir) <= 0.0f)
-            return fv_error_set(err, FV_ERR_INVALID, "spot light: direction must be finite and non-zero");
+        if ((st = fv_limit_vec3("spot light: direction", l->dir, err)) != FV_OK) return st;
+        if (!(fv_length(l->dir) > 0.0f)) return fv_error_set(err, FV_ERR_INVALID, "spot light: direction must be non-zero");
         if (!(l->outer_deg > 0.0f && l->outer_deg < 90.0f && l->inner_deg >= 0.0f && l->inner_deg <= l->outer_deg))
             return fv_error_set(err, FV_ERR_INVALID, "spot light: need 0 <= inner (%g) <= outer (%g) < 90 degrees", l->inner_deg, l->outer_deg);
         c.dir = fv_normalize(l->dir);
@@ -294,21 +301,31 @@ bool fv_scene_env(const fv_scene *s, fv_env_desc *out)
     return s->has_env;
 }
 
+/* One object's world box: as it stands when static, over all its keys when dynamic. */
+static void object_world_bounds(const fv_object *o, fv_vec3 *lo, fv_vec3 *hi)
+{
+    *lo = fv_v3s(FLT_MAX);
+    *hi = fv_v3s(-FLT_MAX);
+    if (!o->dynamic) {
+        bounds_add_box(lo, hi, &o->xf, o->lo, o->hi);
+        return;
+    }
+    for (int k = 0; k < o->anim.nkeys; k++) {
+        fv_xform x = anim_eval(o, o->anim.keys[k].time);
+        bounds_add_box(lo, hi, &x, o->lo, o->hi);
+    }
+}
+
 void fv_scene_world_bounds(const fv_scene *s, fv_vec3 *lo, fv_vec3 *hi)
 {
     /* Static objects as they are, dynamic ones at every key. */
     *lo = fv_v3s(FLT_MAX);
     *hi = fv_v3s(-FLT_MAX);
     for (int i = 0; i < s->nobj; i++) {
-        const fv_object *o = &s->objs[i];
-        if (!o->dynamic) {
-            bounds_add_box(lo, hi, &o->xf, o->lo, o->hi);
-            continue;
-        }
-        for (int k = 0; k < o->anim.nkeys; k++) {
-            fv_xform x = anim_eval(o, o->anim.keys[k].time);
-            bounds_add_box(lo, hi, &x, o->lo, o->hi);
-        }
+        fv_vec3 a, b;
+        object_world_bounds(&s->objs[i], &a, &b);
+        *lo = fv_vmin(*lo, a);
+        *hi = fv_vmax(*hi, b);
     }
 }
 
@@ -442,16 +459,36 @@ fv_status fv_scene_commit(fv_scene *s, const fv_log *log, fv_error *err)
         if (s->objs[i].dynamic) s->ndynamic++;
 
     fv_scene_world_bounds(s, &s->lo, &s->hi);
+    for (int i = 0; i < s->nobj; i++) {
+        fv_vec3 lo, hi;
+        object_world_bounds(&s->objs[i], &lo, &hi);
+        /* Every ray starts at a camera, a light or a point on an object: each object must stay
+         * within the ray kernels' range wherever its animation takes it (fovea/limits.h). */
+        char what[FV_NAME_MAX + 48];
+        snprintf(what, sizeof what, "object '%s'%s: bounds", s->objs[i].name, s->objs[i].dynamic ? " (as animated)" : "");
+        if ((st = fv_limit_vec3(what, lo, err)) != FV_OK || (st = fv_limit_vec3(what, hi, err)) != FV_OK) return st;
+    }
+    for (int i = 0; i < s->ndelta; i++)
+        for (int k = 0; k < s->delta[i].anim.nkeys; k++) {
+            fv_xform x = fv_anim_key_xform(&s->delta[i].anim.keys[k]);
+            char what[64];
+            snprintf(what, sizeof what, "light %d (as animated): position", i);
+            if ((st = fv_limit_vec3(what, fv_xform_point(&x, s->delta[i].desc.pos), err)) != FV_OK) return st;
+        }
     fv_vec3 ext = fv_sub(s->hi, s->lo);
     float diag = fv_length(ext);
-    if (!(diag > 0.0f) || !isfinite(diag)) return fv_error_set(err, FV_ERR_INVALID, "scene has zero or non-finite extent");
+    if (!(diag > 0.0f))
+        return fv_error_set(err, FV_ERR_INVALID, "scene has zero extent: all its geometry is at the single point (%g, %g, %g)", s->lo.x,
+                            s->lo.y, s->lo.z);
     s->eps = 1e-4f * diag;
 
     if ((st = build_lights(s, err)) != FV_OK) return st;
     if (s->nlights == 0) {
         fv_vec3 c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
+        /* Within the intensity limit, so a huge scene gets a dim light rather than a refusal that
+         * names a light the user never wrote. */
         fv_light_desc l = {FV_LIGHT_POINT, fv_v3(c.x, s->lo.y + 0.9f * ext.y, c.z), fv_v3(0, -1, 0),
-                           fv_v3s(0.25f * diag * diag), 0, 0};
+                           fv_v3s(fminf(0.25f * diag * diag, (float)FV_INTENSITY_MAX)), 0, 0};
         fv_log_warn(log, "scene has no lights: added a point light at (%g, %g, %g) with intensity %g", l.pos.x, l.pos.y, l.pos.z,
                     l.intensity.x);
         if ((st = fv_scene_add_light(s, &l, err)) != FV_OK) return st;

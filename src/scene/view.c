@@ -2,9 +2,11 @@
  * from the scene so a scene is only what is rendered and a view only how it is looked at.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "fovea/limits.h"
 #include "fovea/view.h"
 #include "scene/scene_impl.h"
 #include "scene/view_impl.h"
@@ -51,9 +53,14 @@ fv_status fv_view_set_camera_path(fv_view *v, const fv_camera_key *keys, int cou
 {
     if (count < 1) return fv_error_set(err, FV_ERR_INVALID, "camera path: no keys");
     for (int i = 0; i < count; i++) {
-        if (!isfinite(keys[i].time) || !fv_is_finite3(keys[i].pos) || !fv_is_finite3(keys[i].look) || !fv_is_finite3(keys[i].up) ||
-            !(keys[i].fov_y > 0.0f && keys[i].fov_y < 180.0f))
-            return fv_error_set(err, FV_ERR_INVALID, "camera path: key %d has non-finite values or a fov outside (0,180)", i);
+        char what[48];
+        snprintf(what, sizeof what, "camera path: key %d", i);
+        fv_status st;
+        if ((st = fv_limit_vec3(what, keys[i].pos, err)) != FV_OK || (st = fv_limit_vec3(what, keys[i].look, err)) != FV_OK ||
+            (st = fv_limit_vec3(what, keys[i].up, err)) != FV_OK)
+            return st;
+        if (!isfinite(keys[i].time) || !(keys[i].fov_y > 0.0f && keys[i].fov_y < 180.0f))
+            return fv_error_set(err, FV_ERR_INVALID, "camera path: key %d has a non-finite time or a fov outside (0,180)", i);
         if (i > 0 && !(keys[i].time > keys[i - 1].time))
             return fv_error_set(err, FV_ERR_INVALID, "camera path: key times must increase (key %d)", i);
     }

@@ -207,6 +207,88 @@ static void test_bad_options(void **st)
     o.eye_separation = NAN;
     assert_int_equal(fv_driver_create(g_scene, NULL, &o, &d, &err), FV_ERR_INVALID);
     assert_null(d);
+    /* Beyond the ray kernels' range (fovea/limits.h): Embree would abort the process. */
+    fv_drive_opts_init(&o);
+    o.eye_separation = 1e20f;
+    assert_int_equal(fv_driver_create(g_scene, NULL, &o, &d, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "eye separation: coordinate 1e+20 is beyond"));
+    fv_drive_opts_init(&o);
+    o.camera_set = FV_DRIVE_POS;
+    o.pos = fv_v3(1e19f, 273, -800);
+    assert_int_equal(fv_driver_create(g_scene, NULL, &o, &d, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "camera position: coordinate 1e+19 is beyond"));
+    assert_null(d);
+}
+
+/* A trace with a blink: key 1 is missing. Hold keeps the gaze of key 0 until key 2 and the
+ * frame's eye model is the driver's; widen puts the gaze at the centre with a fovea covering the
+ * whole image, for exactly the frames in the gap. */
+static void test_missing_gaze(void **st)
+{
+    (void)st;
+    fv_error err;
+    fv_gaze_key k[3] = {{0.0, {0.2f, 0.3f}, {0.2f, 0.3f}}, {1.0, {NAN, NAN}, {NAN, NAN}}, {2.0, {0.8f, 0.7f}, {0.8f, 0.7f}}};
+    fv_gaze_path *p = NULL;
+    assert_int_equal(fv_gaze_path_create_keys(k, 3, &p, &err), FV_OK);
+    fv_drive_opts o;
+    fv_drive_opts_init(&o);
+    o.width = 32;
+    o.height = 16;
+    o.fps = 2.0; /* frames at t = 0, 0.5, 1, 1.5, 2 */
+    o.gaze_path = p;
+    fv_frame_views fv;
+    fv_driver *d = make(NULL, &o);
+    const fv_eye_model *eye = fv_driver_eye_model(d);
+    fv_driver_views(d, 1, &fv); /* t = 0.5: key 0 known, key 1 missing: held, known */
+    assert_true(fv.gaze_known);
+    assert_float_equal(fv.gaze[0].x, 0.2f, 0.0f);
+    fv_driver_views(d, 3, &fv); /* t = 1.5: in the gap: held, unknown, the driver's model */
+    assert_false(fv.gaze_known);
+    assert_float_equal(fv.gaze[0].x, 0.2f, 0.0f);
+    assert_float_equal(fv.gaze[0].y, 0.3f, 0.0f);
+    assert_ptr_equal(fv.eye_model, eye);
+    fv_driver_views(d, 4, &fv);
+    assert_true(fv.gaze_known);
+    assert_float_equal(fv.gaze[0].x, 0.8f, 0.0f);
+    fv_driver_destroy(d);
+
+    o.gaze_missing = FV_GAZE_MISSING_WIDEN;
+    d = make(NULL, &o);
+    fv_driver_views(d, 3, &fv);
+    assert_false(fv.gaze_known);
+    assert_float_equal(fv.gaze[0].x, 0.5f, 0.0f);
+    assert_float_equal(fv.gaze[1].y, 0.5f, 0.0f);
+    assert_ptr_not_equal(fv.eye_model, fv_driver_eye_model(d));
+    /* Every pixel, the corners included, is in the fovea; the model is still a valid one. */
+    assert_int_equal(fv_eye_model_validate(fv.eye_model, &err), FV_OK);
+    assert_int_equal(fv_eye_region(fv.eye_model, fv.gaze[0], 0, 0), FV_REGION_FOVEA);
+    assert_int_equal(fv_eye_region(fv.eye_model, fv.gaze[0], 31, 15), FV_REGION_FOVEA);
+    /* r_f = (hypot(32, 16) / 2 + 1) px = 18.89 px */
+    assert_float_equal(fv_eye_fovea_radius_px(fv.eye_model), 0.5 * hypot(32.0, 16.0) + 1.0, 1e-4);
+    fv_driver_views(d, 1, &fv); /* outside the gap nothing changes */
+    assert_true(fv.gaze_known);
+    assert_float_equal(fv.gaze[0].x, 0.2f, 0.0f);
+    assert_ptr_equal(fv.eye_model, fv_driver_eye_model(d));
+    fv_driver_destroy(d);
+
+    /* The path's own policy applies when the driver leaves it to the path. */
+    o.gaze_missing = FV_GAZE_MISSING_PATH;
+    fv_gaze_path_set_missing(p, FV_GAZE_MISSING_WIDEN);
+    d = make(NULL, &o);
+    fv_driver_views(d, 3, &fv);
+    assert_float_equal(fv.gaze[0].x, 0.5f, 0.0f);
+    /* ... and a render of a frame in the gap works with the widened model. */
+    fv_technique *t = NULL;
+    fv_film *film = NULL;
+    fv_stats stats;
+    fv_stats_clear(&stats);
+    assert_int_equal(fv_technique_create("pt", g_scene, NULL, NULL, &t, &err), FV_OK);
+    assert_int_equal(fv_film_create(32, 16, 0, &film, &err), FV_OK);
+    assert_int_equal(fv_driver_render(d, t, 3, false, &film, &stats, NULL, NULL, &err), FV_OK);
+    fv_film_destroy(film);
+    fv_technique_destroy(t);
+    fv_driver_destroy(d);
+    fv_gaze_path_destroy(p);
 }
 
 typedef struct progress_log {
@@ -320,6 +402,7 @@ int main(void)
         cmocka_unit_test(test_gaze_precedence), cmocka_unit_test(test_eye_model),
         cmocka_unit_test(test_bad_options),     cmocka_unit_test(test_render_progress_and_cancel),
         cmocka_unit_test(test_set_camera_keeps_the_past),
+        cmocka_unit_test(test_missing_gaze),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

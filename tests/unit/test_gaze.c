@@ -207,7 +207,9 @@ static void test_gaze_csv(void **st)
         {"0,0.5,0.5\n1,0.5,0.5,0.5,0.5\n", "columns"},
         {"0,0.5,abc\n", ":1:"},
         {"# only a comment\n", "no samples"},
-        {"0,nan,0.5\n", ":1:"},
+        {"0,nan,0.5\n", "every sample of the left eye is missing"},
+        {"0,,\n1,nan,nan\n", "every sample"},
+        {"0,0.5,0.5\n1,0.5,abc\n", ":2:"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         path = write_tmp(bad[i].text);
@@ -216,6 +218,30 @@ static void test_gaze_csv(void **st)
         assert_null(p);
         if (!strstr(err.msg, bad[i].needle)) fail_msg("case %zu: '%s' lacks '%s'", i, err.msg, bad[i].needle);
     }
+    /* Missing samples: an empty field or nan, per eye. Left: known at 0 and 3, missing at 1 and
+     * 2 (held at key 0's gaze, not interpolated towards key 3); right eye known throughout. */
+    path = write_tmp("time,xl,yl,xr,yr\n0,0.2,0.2,0.4,0.4\n1,,,0.5,0.5\n2,nan,NaN,0.6,0.6\n3,0.8,0.8,0.7,0.7\n");
+    assert_int_equal(fv_gaze_path_load_csv(path, &p, &err), FV_OK);
+    assert_true(fv_gaze_path_eval(p, 0.5, &l, &r)); /* key 0 known, key 1 missing: hold, known */
+    assert_float_equal(l.x, 0.2f, 0.0f);
+    assert_float_equal(r.x, 0.45f, 1e-6f);
+    assert_false(fv_gaze_path_eval(p, 2.5, &l, &r)); /* in the gap */
+    assert_float_equal(l.x, 0.2f, 0.0f);
+    assert_float_equal(r.x, 0.65f, 1e-6f);
+    assert_true(fv_gaze_path_eval(p, 3.5, &l, NULL));
+    assert_float_equal(l.x, 0.8f, 0.0f);
+    assert_int_equal(fv_gaze_path_missing(p), FV_GAZE_MISSING_HOLD);
+    fv_gaze_path_destroy(p);
+    /* A trace that starts in a blink holds its first known gaze. */
+    path = write_tmp("0,,\n1,0.3,0.6\n");
+    assert_int_equal(fv_gaze_path_load_csv(path, &p, &err), FV_OK);
+    assert_false(fv_gaze_path_eval(p, 0.5, &l, NULL));
+    assert_float_equal(l.y, 0.6f, 0.0f);
+    fv_gaze_path_destroy(p);
+    fv_gaze_missing pol;
+    assert_true(fv_gaze_missing_from_name("widen", &pol));
+    assert_int_equal(pol, FV_GAZE_MISSING_WIDEN);
+    assert_false(fv_gaze_missing_from_name("blink", &pol));
     unlink(path);
     assert_int_equal(fv_gaze_path_load_csv("/nonexistent/trace.csv", &p, &err), FV_ERR_IO);
     assert_non_null(strstr(err.msg, "/nonexistent/trace.csv"));

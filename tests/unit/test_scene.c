@@ -176,19 +176,42 @@ static void test_refusals(void **st)
     assert_int_equal(fv_scene_add_light(s, &l2, &err), FV_ERR_INVALID);
     fv_scene_destroy(s);
 
-    /* An emission that is finite but whose power (pi L A) is not: refused at commit, naming the
-     * material, instead of a NaN light table that switches every light off. A unit quad at
-     * 3e38: pi * 3e38 overflows a float. */
+    /* An emission beyond the intensity limit (fovea/limits.h) is refused when the material is
+     * added, naming it: at 3e38 its power (pi L A) would overflow a float and turn the light
+     * table into NaN, switching every light off. */
     assert_int_equal(fv_scene_create(&s, &err), FV_OK);
     m = fv_material_default(FV_MAT_DIFFUSE);
     snprintf(m.name, sizeof m.name, "sun");
     m.emission = fv_v3s(3e38f);
     int id;
-    assert_int_equal(fv_scene_add_material(s, &m, &id, &err), FV_OK);
-    add_quad(s, id, "lamp");
-    assert_int_equal(fv_scene_commit(s, NULL, &err), FV_ERR_INVALID);
+    assert_int_equal(fv_scene_add_material(s, &m, &id, &err), FV_ERR_INVALID);
     assert_non_null(strstr(err.msg, "'sun'"));
+    assert_non_null(strstr(err.msg, "emission"));
     assert_null(strchr(err.msg, '\n'));
+    /* At the limit it is taken; a point light the same. */
+    m.emission = fv_v3s((float)FV_INTENSITY_MAX);
+    assert_int_equal(fv_scene_add_material(s, &m, &id, &err), FV_OK);
+    fv_light_desc hot = {FV_LIGHT_POINT, {0, 1, 0}, {0, -1, 0}, {3e38f, 1, 1}, 0, 0};
+    assert_int_equal(fv_scene_add_light(s, &hot, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "intensity 3e+38"));
+    fv_light_desc far = {FV_LIGHT_POINT, {1e19f, 1, 0}, {0, -1, 0}, {1, 1, 1}, 0, 0};
+    assert_int_equal(fv_scene_add_light(s, &far, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "light: position: coordinate 1e+19 is beyond"));
+    fv_scene_destroy(s);
+
+    /* Geometry beyond the coordinate range: the triangles are dropped like non-finite ones, and
+     * an object animated out of the range is refused at commit, naming it. */
+    assert_int_equal(fv_scene_create(&s, &err), FV_OK);
+    m = fv_material_default(FV_MAT_DIFFUSE);
+    assert_int_equal(fv_scene_add_material(s, &m, &id, &err), FV_OK);
+    const fv_vec3 far_quad[4] = {{-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {2e9f, 0, 1}};
+    fv_mesh_desc fq = {"far", far_quad, 4, NULL, k_quad_idx, 2, NULL, id};
+    int fid;
+    assert_int_equal(fv_scene_add_mesh(s, &fq, NULL, &fid, &err), FV_OK); /* one of two triangles kept */
+    fv_anim_key keys[2] = {{0, {0, 0, 0}, {0, 0, 0, 1}, {1, 1, 1}}, {1, {1e10f, 0, 0}, {0, 0, 0, 1}, {1, 1, 1}}};
+    assert_int_equal(fv_scene_animate_object(s, fid, keys, 2, &err), FV_OK);
+    assert_int_equal(fv_scene_commit(s, NULL, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "object 'far' (as animated): bounds: coordinate 1e+10 is beyond"));
     fv_scene_destroy(s);
 }
 

@@ -1,5 +1,6 @@
 /* fovea CLI — shared helpers (see cli.h). */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -25,12 +26,15 @@ int fv_cli_fail(const char *cmd, fv_status s, const char *msg)
 
 int fv_cli_usage_error(const char *cmd, const char *fmt, ...)
 {
+    char msg[FV_ERROR_MSG_MAX];
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "fovea %s: ", cmd);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    /* Through fv_error_set, which escapes control bytes: an argument may hold a newline. */
+    fv_error e;
+    fv_error_set(&e, FV_ERR_INVALID, "%s", msg);
+    fprintf(stderr, "fovea %s: %s\n", cmd, e.msg);
     return FV_EXIT_USAGE;
 }
 
@@ -54,15 +58,15 @@ bool fv_cli_parse_float(const char *s, double *out)
     return true;
 }
 
-bool fv_cli_parse_floats(const char *s, int n, float *out)
+bool fv_cli_parse_doubles(const char *s, int n, double *out)
 {
     const char *p = s;
     for (int i = 0; i < n; i++) {
         char *end;
         errno = 0;
         double v = strtod(p, &end);
-        if (errno || end == p || !isfinite(v)) return false;
-        out[i] = (float)v;
+        if (end == p || !isfinite(v) || (errno && fabs(v) > 1.0)) return false; /* underflow to 0 is fine */
+        out[i] = v;
         p = end;
         if (i < n - 1) {
             if (*p != ',') return false;
@@ -70,6 +74,16 @@ bool fv_cli_parse_floats(const char *s, int n, float *out)
         }
     }
     return *p == '\0';
+}
+
+bool fv_cli_parse_floats(const char *s, int n, float *out)
+{
+    double v[16];
+    if (n > 16 || !fv_cli_parse_doubles(s, n, v)) return false;
+    for (int i = 0; i < n; i++)
+        if (fabs(v[i]) > FLT_MAX) return false;
+    for (int i = 0; i < n; i++) out[i] = (float)v[i];
+    return true;
 }
 
 bool fv_cli_parse_size(const char *s, int *w, int *h)
@@ -203,8 +217,39 @@ int fv_cli_opt_gaze(const char *cmd, const char *arg, float xy[2])
     return fv_cli_usage_error(cmd, "--gaze %s: expected X,Y with both in [0,1]", arg);
 }
 
+/* The limit's own message after the option and its value: "--camera-pos 1e19,0,0: coordinate
+ * 1e+19 is beyond +-1e+15, the range the ray kernels take". */
+static int limit_fail(const char *cmd, const char *opt, const char *arg, fv_status (*check)(const char *, const double *, int, fv_error *),
+                      const double *v, int n)
+{
+    char what[256];
+    snprintf(what, sizeof what, "%s %.200s", opt, arg);
+    fv_error err;
+    fv_status s = check(what, v, n, &err);
+    return s == FV_OK ? 0 : fv_cli_fail(cmd, s, err.msg);
+}
+
 int fv_cli_opt_stereo(const char *cmd, const char *arg, double *sep)
 {
-    if (fv_cli_parse_float(arg, sep) && *sep > 0) return 0;
-    return fv_cli_usage_error(cmd, "--stereo %s: expected a positive eye separation", arg);
+    if (!fv_cli_parse_float(arg, sep) || !(*sep > 0)) return fv_cli_usage_error(cmd, "--stereo %s: expected a positive eye separation", arg);
+    return limit_fail(cmd, "--stereo", arg, fv_limit_coords, sep, 1);
+}
+
+int fv_cli_opt_vec3(const char *cmd, const char *opt, const char *arg, float out[3])
+{
+    double v[3];
+    if (!fv_cli_parse_doubles(arg, 3, v)) return fv_cli_usage_error(cmd, "%s %s: expected x,y,z", opt, arg);
+    int rc = limit_fail(cmd, opt, arg, fv_limit_coords, v, 3);
+    for (int i = 0; i < 3 && rc == 0; i++) out[i] = (float)v[i];
+    return rc;
+}
+
+int fv_cli_opt_light(const char *cmd, const char *arg, float out[6])
+{
+    double v[6];
+    if (!fv_cli_parse_doubles(arg, 6, v)) return fv_cli_usage_error(cmd, "--point-light %s: expected x,y,z,r,g,b", arg);
+    int rc = limit_fail(cmd, "--point-light", arg, fv_limit_coords, v, 3);
+    if (rc == 0) rc = limit_fail(cmd, "--point-light", arg, fv_limit_intensity, v + 3, 3);
+    for (int i = 0; i < 6 && rc == 0; i++) out[i] = (float)v[i];
+    return rc;
 }

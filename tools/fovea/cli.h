@@ -20,12 +20,18 @@ int fv_cli_usage_error(const char *cmd, const char *fmt, ...) __attribute__((for
 /* Parsers for option values; false with a message in err when malformed. */
 bool fv_cli_parse_int(const char *s, long lo, long hi, long *out);
 bool fv_cli_parse_float(const char *s, double *out);
-bool fv_cli_parse_floats(const char *s, int n, float *out); /* "x,y,z" with exactly n numbers */
+bool fv_cli_parse_doubles(const char *s, int n, double *out); /* "x,y,z" with exactly n finite numbers */
+bool fv_cli_parse_floats(const char *s, int n, float *out);   /* the same, each within the float range */
 /* The options `fovea render` and `fovea view` both take, read and checked once so both word a bad
  * value alike: 0 when arg is good (the value in *out), else the exit status after the message. */
 int fv_cli_opt_size(const char *cmd, const char *arg, int *w, int *h);
 int fv_cli_opt_gaze(const char *cmd, const char *arg, float xy[2]);
 int fv_cli_opt_stereo(const char *cmd, const char *arg, double *sep);
+/* Coordinates and intensities within the ray kernels' range (fovea/limits.h), as the scene files
+ * and traces check them: an option of three coordinates (--camera-pos, ...), and --point-light
+ * x,y,z,r,g,b. */
+int fv_cli_opt_vec3(const char *cmd, const char *opt, const char *arg, float out[3]);
+int fv_cli_opt_light(const char *cmd, const char *arg, float out[6]);
 bool fv_cli_parse_size(const char *s, int *w, int *h);      /* "WxH" */
 
 /* Warning sink printing "fovea: warning: ..." on stderr (silenced when quiet). */
@@ -72,5 +78,6 @@ int fv_cmd_scenes(int argc, char **argv);
 int fv_cmd_compare(int argc, char **argv);
 int fv_cmd_bench(int argc, char **argv);
 int fv_cmd_view(int argc, char **argv);
+int fv_cmd_gaze(int argc, char **argv);
 
 #endif

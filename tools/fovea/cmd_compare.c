@@ -165,6 +165,15 @@ int fv_cmd_compare(int argc, char **argv)
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
     }
+    /* A NaN or infinite channel counts as black in every metric (two all-NaN images would
+     * otherwise read as identical): say how many pixels that was, per image. */
+    long long bad[2] = {0, 0};
+    const float *img[2] = {ref.rgb, test.rgb};
+    for (int k = 0; k < 2; k++)
+        for (size_t i = 0; i < n; i++) bad[k] += !isfinite(img[k][3 * i]) || !isfinite(img[k][3 * i + 1]) || !isfinite(img[k][3 * i + 2]);
+    if (bad[0] || bad[1])
+        fprintf(stderr, "fovea compare: warning: pixels with NaN or Inf values, counted as black in every metric: %lld of %zu in %s, %lld in %s\n",
+                bad[0], n, ref_path, bad[1], test_path);
     if (heat) {
         float vmax = 1.0f;
         if (strcmp(heat_metric, "flip") != 0) {
@@ -216,11 +225,11 @@ int fv_cmd_compare(int argc, char **argv)
             json_number(v->ssim);
             printf(", \"flip\": ");
             json_number(v->flip);
-            printf("}%s\n", r + 1 < FV_REGION_COUNT ? "," : "");
+            printf(", \"nonfinite\": %lld}%s\n", v->nonfinite, r + 1 < FV_REGION_COUNT ? "," : "");
         }
-        printf("  }\n}\n");
+        printf("  },\n  \"nonfinite_pixels\": {\"ref\": %lld, \"test\": %lld}\n}\n", bad[0], bad[1]);
     } else {
-        printf("%-11s %10s %10s %10s %10s %10s %10s\n", "region", "pixels", "MSE", "PSNR", "E", "SSIM", "FLIP");
+        printf("%-11s %10s %10s %10s %10s %10s %10s %10s\n", "region", "pixels", "MSE", "PSNR", "E", "SSIM", "FLIP", "NaN/Inf");
         for (int r = 0; r < FV_REGION_COUNT; r++) {
             const fv_metric_values *v = &rep.region[r];
             printf("%-11s %10lld", fv_region_name((fv_region)r), v->pixels);
@@ -229,7 +238,7 @@ int fv_cmd_compare(int argc, char **argv)
             print_value(v->e);
             print_value(v->ssim);
             print_value(v->flip);
-            printf("\n");
+            printf(" %10lld\n", v->nonfinite);
         }
     }
 done:

@@ -37,6 +37,8 @@ static void help(void)
            "                        (replaces the scene's camera) [the scene's camera, else three-quarter]\n"
            "  --gaze X,Y            gaze point in normalised screen coordinates [the scene's gaze, or 0.5,0.5]\n"
            "  --gaze-trace FILE     gaze over time from a CSV trace (docs/gaze.md)\n"
+           "  --gaze-missing P      while the trace's gaze is missing: hold (the last known gaze) or widen (the fovea\n"
+           "                        to the whole screen) [the trace's own, hold]\n"
            "  --camera-trace FILE   camera over time from a CSV trace (docs/gaze.md)\n"
            "  --stereo SEP          render a stereo pair with eye separation SEP: OUT_left.ext, OUT_right.ext\n"
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
@@ -69,6 +71,7 @@ typedef struct render_opts {
     unsigned long long seed;
     bool quiet, show_stats, has_pos, has_look, has_up, has_fov, has_gaze;
     const char *gaze_trace, *camera_trace;
+    fv_gaze_missing missing;
     float pos[3], look[3], up[3], fov, gaze[2];
     int nlights;
     float lights[MAX_LIGHTS][6];
@@ -78,12 +81,13 @@ typedef struct render_opts {
 static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
     enum { O_METHOD = 256, O_SPP, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
-           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP, O_ENV, O_NO_DEFAULT_LIGHT, O_FRAME_VIEW };
+           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP, O_ENV, O_NO_DEFAULT_LIGHT, O_FRAME_VIEW,
+           O_MISSING };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
         {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
-        {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE},
+        {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE}, {"gaze-missing", 1, 0, O_MISSING},
         {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"help", 0, 0, O_HELP},
         {"env", 1, 0, O_ENV}, {"no-default-light", 0, 0, O_NO_DEFAULT_LIGHT}, {"frame-view", 1, 0, O_FRAME_VIEW}, {0, 0, 0, 0}};
     const char *cmd = "render";
@@ -133,15 +137,15 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             o->exposure = d;
             break;
         case O_POS:
-            if (!fv_cli_parse_floats(optarg, 3, o->pos)) return fv_cli_usage_error(cmd, "--camera-pos %s: expected x,y,z", optarg);
+            if ((rc = fv_cli_opt_vec3(cmd, "--camera-pos", optarg, o->pos))) return rc;
             o->has_pos = true;
             break;
         case O_LOOK:
-            if (!fv_cli_parse_floats(optarg, 3, o->look)) return fv_cli_usage_error(cmd, "--camera-look %s: expected x,y,z", optarg);
+            if ((rc = fv_cli_opt_vec3(cmd, "--camera-look", optarg, o->look))) return rc;
             o->has_look = true;
             break;
         case O_UP:
-            if (!fv_cli_parse_floats(optarg, 3, o->up)) return fv_cli_usage_error(cmd, "--camera-up %s: expected x,y,z", optarg);
+            if ((rc = fv_cli_opt_vec3(cmd, "--camera-up", optarg, o->up))) return rc;
             o->has_up = true;
             break;
         case O_FOV:
@@ -151,7 +155,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             break;
         case O_LIGHT:
             if (o->nlights >= MAX_LIGHTS) return fv_cli_usage_error(cmd, "--point-light: at most %d lights", MAX_LIGHTS);
-            if (!fv_cli_parse_floats(optarg, 6, o->lights[o->nlights])) return fv_cli_usage_error(cmd, "--point-light %s: expected x,y,z,r,g,b", optarg);
+            if ((rc = fv_cli_opt_light(cmd, optarg, o->lights[o->nlights]))) return rc;
             o->nlights++;
             break;
         case O_GAZE:
@@ -159,6 +163,9 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             o->has_gaze = true;
             break;
         case O_TRACE: o->gaze_trace = optarg; break;
+        case O_MISSING:
+            if (!fv_gaze_missing_from_name(optarg, &o->missing)) return fv_cli_usage_error(cmd, "--gaze-missing %s: expected hold or widen", optarg);
+            break;
         case O_CTRACE: o->camera_trace = optarg; break;
         case O_STEREO:
             if ((rc = fv_cli_opt_stereo(cmd, optarg, &d))) return rc;
@@ -284,6 +291,7 @@ int fv_cmd_render(int argc, char **argv)
     dopt.fixed_gaze = o.has_gaze;
     dopt.gaze = (fv_gaze){o.gaze[0], o.gaze[1]};
     dopt.gaze_path = trace;
+    dopt.gaze_missing = o.missing;
     if ((s = fv_driver_create(scene, view, &dopt, &driver, &err)) != FV_OK) {
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;

@@ -16,6 +16,7 @@ static const fv_command k_commands[] = {
     {"compare", fv_cmd_compare, "error metrics per region between two images"},
     {"bench", fv_cmd_bench, "run a benchmark scenario: timings and errors side by side"},
     {"view", fv_cmd_view, "interactive viewer: the fovea follows the mouse (needs SDL2)"},
+    {"gaze", fv_cmd_gaze, "gaze import: an eye tracker's recording into a gaze trace"},
 };
 
 static void usage(FILE *f)
