@@ -54,6 +54,15 @@ fv_status fv_cubemaps_create(int count, int face_size, fv_cubemaps **out, fv_err
     return FV_OK;
 }
 
+fv_status fv_vpl_cubemaps_create(int count, int face_size, fv_cubemaps **out, fv_error *err)
+{
+    fv_status s = fv_cubemaps_create(count, face_size, out, err);
+    if (s != FV_ERR_NOMEM) return s;
+    const double gb = 6.0 * face_size * (double)face_size * sizeof(float) * count / 1e9;
+    return fv_error_set(err, FV_ERR_INVALID, "parameters vpls=%d, cube_size=%d: the cube maps need %.1f GB, more than can be allocated (lower either)",
+                        count, face_size, gb);
+}
+
 void fv_cubemaps_destroy(fv_cubemaps *m)
 {
     if (!m) return;

@@ -124,6 +124,9 @@ static inline int fv_cube_face_of(fv_vec3 d, float *u, float *v)
  * (*out NULL); no memory -> FV_ERR_NOMEM. */
 fv_status fv_cubemaps_create(int count, int face_size, fv_cubemaps **out, fv_error *err);
 void fv_cubemaps_destroy(fv_cubemaps *maps);
+/* fv_cubemaps_create for a technique's parameters: running out of memory is then the parameters'
+ * fault, refused as FV_ERR_INVALID naming vpls and cube_size and the size they asked for. */
+fv_status fv_vpl_cubemaps_create(int count, int face_size, fv_cubemaps **out, fv_error *err);
 /* The parameter cube_build=auto|raster|rays of the techniques with cube maps, in enum order. */
 extern const char *const fv_cube_build_names[];
 #define FV_CUBE_BUILD_HELP                                                                                             \

@@ -209,8 +209,9 @@ static fv_status fir_create(const fv_scene *scene, fv_params *params, const fv_l
     fv_vec3 lo, hi;
     fv_scene_bounds(scene, &lo, &hi);
     if ((s = fv_density_grid_create(lo, hi, st->density_res, &st->grid, err)) != FV_OK) goto fail;
-    if ((s = fv_cubemaps_create(st->total, st->cube_size, &st->maps, err)) != FV_OK) goto fail;
-    fv_cubemaps_set_build(st->maps, (fv_cube_build)st->cube_build);
+    /* visibility=rays reads no map: none is made */
+    if (st->visibility == 0 && (s = fv_vpl_cubemaps_create(st->total, st->cube_size, &st->maps, err)) != FV_OK) goto fail;
+    if (st->maps) fv_cubemaps_set_build(st->maps, (fv_cube_build)st->cube_build);
     fv_vpl_dirs_make(st->ndirs, &st->dirs);
     for (int o = 0, n = fv_scene_object_count(scene); o < n; o++) st->has_dynamic |= fv_scene_object_dynamic(scene, o);
     const int N = st->total;
@@ -635,7 +636,7 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
         st->build_idx[k] = v->map;
         v->built = st->frames;
     }
-    fv_status status = fv_cubemaps_build_many(st->maps, s, st->build_idx, st->build_pos, st->build_nrm, nb, threads, err);
+    fv_status status = st->maps ? fv_cubemaps_build_many(st->maps, s, st->build_idx, st->build_pos, st->build_nrm, nb, threads, err) : FV_OK;
     st->built_maps = nb;
     double t5 = fv_time_ms();
     st->frames++;

@@ -76,7 +76,7 @@ static fv_status ir_create_common(const fv_scene *scene, fv_params *params, bool
         size_t per_map = 6u * (size_t)st->cube_size * (size_t)st->cube_size * sizeof(float);
         size_t batch = IR_LOW_BATCH_BYTES / per_map;
         st->batch = (int)(batch < 1 ? 1 : batch > (size_t)st->vpls ? (size_t)st->vpls : batch);
-        if ((s = fv_cubemaps_create(st->batch, st->cube_size, &st->maps, err)) != FV_OK) goto fail;
+        if ((s = fv_vpl_cubemaps_create(st->batch, st->cube_size, &st->maps, err)) != FV_OK) goto fail;
         fv_cubemaps_set_build(st->maps, (fv_cube_build)cube_build);
         st->pos = malloc((size_t)st->batch * sizeof *st->pos);
         st->nrm = malloc((size_t)st->batch * sizeof *st->nrm);
