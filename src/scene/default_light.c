@@ -8,6 +8,7 @@
  * with the scene: the environment is at infinity, the key light's intensity is set so that it
  * gives a fixed irradiance at the centre of the bounds.
  */
+#include "fovea/limits.h"
 #include "scene/scene_impl.h"
 #include "scene/view_impl.h"
 
@@ -45,7 +46,17 @@ fv_status fv_scene_add_default_lighting(fv_scene *s, const fv_view *view, const 
     /* above the camera and to its left, at least 2.5 radii out */
     float dist = fv_maxf(D, 2.5f * R);
     fv_vec3 key_dir = fv_normalize(fv_add(to_cam, fv_add(fv_scale(up, 0.9f), fv_scale(right, -0.35f))));
-    fv_light_desc key = {FV_LIGHT_POINT, fv_madd(c, key_dir, dist), fv_neg(key_dir), fv_v3s(k_key_irradiance * dist * dist), 0, 0};
+    /* A scene at the edge of the coordinate range (fovea/limits.h) keeps its key light inside it:
+     * the light stops at the edge on its way out from the centre. A centre beyond the range adds
+     * nothing: fv_scene_commit names the object at fault. */
+    const float kd[3] = {key_dir.x, key_dir.y, key_dir.z}, kc[3] = {c.x, c.y, c.z};
+    for (int k = 0; k < 3; k++) {
+        if (kd[k] * dist + kc[k] > (float)FV_COORD_MAX) dist = ((float)FV_COORD_MAX - kc[k]) / kd[k];
+        if (kd[k] * dist + kc[k] < -(float)FV_COORD_MAX) dist = (-(float)FV_COORD_MAX - kc[k]) / kd[k];
+    }
+    if (!(dist > 0.0f) || fv_limit_vec3("default key light", fv_madd(c, key_dir, dist), NULL) != FV_OK) return FV_OK;
+    const float I = fv_minf(k_key_irradiance * dist * dist, (float)FV_INTENSITY_MAX);
+    fv_light_desc key = {FV_LIGHT_POINT, fv_madd(c, key_dir, dist), fv_neg(key_dir), fv_v3s(I), 0, 0};
     fv_env_desc env = {k_zenith, k_horizon, k_ground, up};
     fv_status st;
     if ((st = fv_scene_set_env(s, &env, err)) != FV_OK || (st = fv_scene_add_light(s, &key, err)) != FV_OK) return st;

@@ -83,7 +83,15 @@ void fv_camera_frame(fv_vec3 lo, fv_vec3 hi, fv_vec3 up, fv_frame_view view, int
     }
     if (!(dist > 0.0f)) dist = 1.0f;
     /* A scene reaching the edge of the coordinate range would put the camera beyond it
-     * (fovea/limits.h): it stops at the edge on its way out from the centre, looking the same way. */
+     * (fovea/limits.h): it moves to the other side on an axis that has room there, else stops at
+     * the edge on its way out from the centre. */
+    float dv[3] = {dir.x, dir.y, dir.z};
+    for (int k = 0; k < 3; k++) {
+        /* beyond the range on this axis: look from the other side along it when that side has room */
+        const float ck = comp(c, k), far = ck + dv[k] * dist, mirrored = ck - dv[k] * dist;
+        if (fabsf(far) > (float)FV_COORD_MAX && fabsf(mirrored) <= (float)FV_COORD_MAX) dv[k] = -dv[k];
+    }
+    dir = fv_v3(dv[0], dv[1], dv[2]); /* a mirrored axis keeps dir apart from cam_up */
     for (int k = 0; k < 3; k++) {
         const float dk = comp(dir, k), ck = comp(c, k);
         if (dk * dist + ck > (float)FV_COORD_MAX) dist = ((float)FV_COORD_MAX - ck) / dk;
