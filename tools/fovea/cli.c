@@ -190,6 +190,16 @@ int fv_cli_open_scene(const char *cmd, const char *name, const fv_log *log, cons
     return fv_cli_fail(cmd, s, err.msg);
 }
 
+int fv_cli_scene_option(const char *cmd, int c, const char *arg, fv_cli_scene_opts *o)
+{
+    switch (c) {
+    case FV_CLI_OPT_ENV: return fv_cli_opt_env(cmd, arg, o);
+    case FV_CLI_OPT_NO_DEFAULT_LIGHT: o->no_default_light = true; return 0;
+    case FV_CLI_OPT_FRAME_VIEW: return fv_cli_opt_frame_view(cmd, arg, o);
+    default: return -1;
+    }
+}
+
 int fv_cli_opt_env(const char *cmd, const char *arg, fv_cli_scene_opts *o)
 {
     if (!fv_cli_parse_floats(arg, 3, o->env) || o->env[0] < 0 || o->env[1] < 0 || o->env[2] < 0)

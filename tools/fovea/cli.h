@@ -67,6 +67,18 @@ typedef struct fv_cli_scene_opts {
  * the messages `fovea render` prints. Returns 0 or the exit code; on failure whatever was opened
  * is released and *scene, *view are NULL. */
 int fv_cli_open_scene(const char *cmd, const char *name, const fv_log *log, const fv_cli_scene_opts *o, fv_scene **scene, fv_view **view);
+/* The scene options every command that opens a scene takes (--env, --no-default-light,
+ * --frame-view): their getopt codes (above any command's own), long options and help lines, and
+ * the handler. fv_cli_scene_option returns -1 when c is not one of them, else 0 or the exit code
+ * (message printed). */
+enum { FV_CLI_OPT_ENV = 1000, FV_CLI_OPT_NO_DEFAULT_LIGHT, FV_CLI_OPT_FRAME_VIEW };
+#define FV_CLI_SCENE_LONGOPTS \
+    {"env", 1, 0, FV_CLI_OPT_ENV}, {"no-default-light", 0, 0, FV_CLI_OPT_NO_DEFAULT_LIGHT}, {"frame-view", 1, 0, FV_CLI_OPT_FRAME_VIEW}
+#define FV_CLI_SCENE_HELP \
+    "  --env R,G,B           a uniform environment light of that radiance (replaces the scene's)\n" \
+    "  --no-default-light    a file without lights gets no sky and key light (docs/scene-format.md)\n" \
+    "  --frame-view NAME     frame the scene from three-quarter, front, back, left, right or top\n"
+int fv_cli_scene_option(const char *cmd, int c, const char *arg, fv_cli_scene_opts *o);
 /* --env and --frame-view's parsing, with their one-line messages: 0 or the exit code. */
 int fv_cli_opt_env(const char *cmd, const char *arg, fv_cli_scene_opts *o);
 int fv_cli_opt_frame_view(const char *cmd, const char *arg, fv_cli_scene_opts *o);

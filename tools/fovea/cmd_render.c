@@ -31,9 +31,7 @@ static void help(void)
            "  --camera-pos x,y,z    camera position      --camera-look x,y,z  point looked at\n"
            "  --camera-up x,y,z     camera up vector     --fov DEG            vertical field of view\n"
            "  --point-light x,y,z,r,g,b  add a point light (intensity W/sr), repeatable\n"
-           "  --env R,G,B           a uniform environment light of that radiance (replaces the scene's)\n"
-           "  --no-default-light    a file without lights gets no sky and key light (docs/scene-format.md)\n"
-           "  --frame-view NAME     frame the scene from three-quarter, front, back, left, right or top\n"
+           FV_CLI_SCENE_HELP
            "                        (replaces the scene's camera) [the scene's camera, else three-quarter]\n"
            "  --gaze X,Y            gaze point in normalised screen coordinates [the scene's gaze, or 0.5,0.5]\n"
            "  --gaze-trace FILE     gaze over time from a CSV trace (docs/gaze.md)\n"
@@ -81,7 +79,7 @@ typedef struct render_opts {
 static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
     enum { O_METHOD = 256, O_SPP, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
-           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP, O_ENV, O_NO_DEFAULT_LIGHT, O_FRAME_VIEW,
+           O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP,
            O_MISSING };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
@@ -89,7 +87,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
         {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE}, {"gaze-missing", 1, 0, O_MISSING},
         {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"help", 0, 0, O_HELP},
-        {"env", 1, 0, O_ENV}, {"no-default-light", 0, 0, O_NO_DEFAULT_LIGHT}, {"frame-view", 1, 0, O_FRAME_VIEW}, {0, 0, 0, 0}};
+        FV_CLI_SCENE_LONGOPTS, {0, 0, 0, 0}};
     const char *cmd = "render";
     long l;
     double d;
@@ -99,6 +97,10 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
     optind = 1;
     int c;
     while ((c = getopt_long(argc, argv, "h", longs, NULL)) != -1) {
+        if ((rc = fv_cli_scene_option(cmd, c, optarg, &o->scene_opts)) >= 0) {
+            if (rc) return rc;
+            continue;
+        }
         switch (c) {
         case O_METHOD: o->method = optarg; break;
         case O_SPP:
@@ -173,13 +175,6 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             break;
         case O_PARAM:
             if (fv_params_parse(params, optarg, &err) != FV_OK) return fv_cli_fail(cmd, err.status, err.msg);
-            break;
-        case O_ENV:
-            if ((rc = fv_cli_opt_env(cmd, optarg, &o->scene_opts))) return rc;
-            break;
-        case O_NO_DEFAULT_LIGHT: o->scene_opts.no_default_light = true; break;
-        case O_FRAME_VIEW:
-            if ((rc = fv_cli_opt_frame_view(cmd, optarg, &o->scene_opts))) return rc;
             break;
         case O_QUIET: o->quiet = true; break;
         case O_STATS: o->show_stats = true; break;

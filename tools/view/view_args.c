@@ -17,9 +17,7 @@ static void help(void)
            "  --gaze-trace FILE     replay a gaze trace (docs/gaze.md) instead of the mouse\n"
            "  --stereo SEP          left and right eye side by side, eye separation SEP\n"
            "  --threads N           worker threads, 0 = all cores [0]\n"
-           "  --env R,G,B           a uniform environment light of that radiance (replaces the scene's)\n"
-           "  --no-default-light    a file without lights gets no sky and key light (docs/scene-format.md)\n"
-           "  --frame-view NAME     frame the scene from three-quarter, front, back, left, right or top\n"
+           FV_CLI_SCENE_HELP
            "  --script FILE         timed commands by frame number (docs/viewer.md)\n"
            "  --fps-log FILE        one CSV line per frame: render and frame milliseconds\n"
            "Keys: Tab/Shift-Tab method, +/- main parameter, V split with the baseline, O overlay, H text,\n"
@@ -29,12 +27,12 @@ static void help(void)
 
 int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
 {
-    enum { O_METHOD = 256, O_PARAM, O_SIZE, O_SCALE, O_GAZE, O_TRACE, O_STEREO, O_THREADS, O_SCRIPT, O_FPSLOG, O_ENV, O_NO_DEFAULT_LIGHT, O_FRAME_VIEW, O_HELP };
+    enum { O_METHOD = 256, O_PARAM, O_SIZE, O_SCALE, O_GAZE, O_TRACE, O_STEREO, O_THREADS, O_SCRIPT, O_FPSLOG, O_HELP };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"param", 1, 0, O_PARAM},   {"size", 1, 0, O_SIZE},       {"scale", 1, 0, O_SCALE},
         {"gaze", 1, 0, O_GAZE},     {"gaze-trace", 1, 0, O_TRACE}, {"stereo", 1, 0, O_STEREO}, {"threads", 1, 0, O_THREADS},
         {"script", 1, 0, O_SCRIPT}, {"fps-log", 1, 0, O_FPSLOG}, {"help", 0, 0, O_HELP},
-        {"env", 1, 0, O_ENV},       {"no-default-light", 0, 0, O_NO_DEFAULT_LIGHT}, {"frame-view", 1, 0, O_FRAME_VIEW}, {0, 0, 0, 0}};
+        FV_CLI_SCENE_LONGOPTS, {0, 0, 0, 0}};
     const char *cmd = "view";
     long l;
     double d;
@@ -44,6 +42,10 @@ int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
     optind = 1;
     int c;
     while ((c = getopt_long(argc, argv, "h", longs, NULL)) != -1) {
+        if ((rc = fv_cli_scene_option(cmd, c, optarg, &a->scene_opts)) >= 0) {
+            if (rc) return rc;
+            continue;
+        }
         switch (c) {
         case O_METHOD: a->method = optarg; break;
         case O_PARAM:
@@ -71,13 +73,6 @@ int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
             break;
         case O_SCRIPT: a->script = optarg; break;
         case O_FPSLOG: a->fps_log = optarg; break;
-        case O_ENV:
-            if ((rc = fv_cli_opt_env(cmd, optarg, &a->scene_opts))) return rc;
-            break;
-        case O_NO_DEFAULT_LIGHT: a->scene_opts.no_default_light = true; break;
-        case O_FRAME_VIEW:
-            if ((rc = fv_cli_opt_frame_view(cmd, optarg, &a->scene_opts))) return rc;
-            break;
         case O_HELP:
         case 'h': help(); return -1;
         default: return fv_cli_usage_error(cmd, "unknown or incomplete option '%s' (see fovea view --help)", argv[optind - 1]);
