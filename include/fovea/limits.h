@@ -44,6 +44,19 @@ FV_API fv_status fv_limit_vec3(const char *what, fv_vec3 v, fv_error *err);
 FV_API fv_status fv_limit_intensity(const char *what, const double *v, int n, fv_error *err);
 FV_API fv_status fv_limit_intensity3(const char *what, fv_vec3 v, fv_error *err);
 
+/* How far along dir, up to dist, a point leaving c stays within +-FV_COORD_MAX on every axis (for
+ * what is placed outside a scene: its framing camera, its default key light). c itself within the
+ * range gives a result >= 0. */
+static inline float fv_limit_reach(fv_vec3 c, fv_vec3 dir, float dist)
+{
+    const float cc[3] = {c.x, c.y, c.z}, dd[3] = {dir.x, dir.y, dir.z}, m = (float)FV_COORD_MAX;
+    for (int k = 0; k < 3; k++) {
+        if (dd[k] * dist + cc[k] > m) dist = (m - cc[k]) / dd[k];
+        if (dd[k] * dist + cc[k] < -m) dist = (-m - cc[k]) / dd[k];
+    }
+    return dist;
+}
+
 #ifdef __cplusplus
 }
 #endif

@@ -49,11 +49,7 @@ fv_status fv_scene_add_default_lighting(fv_scene *s, const fv_view *view, const 
     /* A scene at the edge of the coordinate range (fovea/limits.h) keeps its key light inside it:
      * the light stops at the edge on its way out from the centre. A centre beyond the range adds
      * nothing: fv_scene_commit names the object at fault. */
-    const float kd[3] = {key_dir.x, key_dir.y, key_dir.z}, kc[3] = {c.x, c.y, c.z};
-    for (int k = 0; k < 3; k++) {
-        if (kd[k] * dist + kc[k] > (float)FV_COORD_MAX) dist = ((float)FV_COORD_MAX - kc[k]) / kd[k];
-        if (kd[k] * dist + kc[k] < -(float)FV_COORD_MAX) dist = (-(float)FV_COORD_MAX - kc[k]) / kd[k];
-    }
+    dist = fv_limit_reach(c, key_dir, dist);
     if (!(dist > 0.0f) || fv_limit_vec3("default key light", fv_madd(c, key_dir, dist), NULL) != FV_OK) return FV_OK;
     const float I = fv_minf(k_key_irradiance * dist * dist, (float)FV_INTENSITY_MAX);
     fv_light_desc key = {FV_LIGHT_POINT, fv_madd(c, key_dir, dist), fv_neg(key_dir), fv_v3s(I), 0, 0};

@@ -92,11 +92,7 @@ void fv_camera_frame(fv_vec3 lo, fv_vec3 hi, fv_vec3 up, fv_frame_view view, int
         if (fabsf(far) > (float)FV_COORD_MAX && fabsf(mirrored) <= (float)FV_COORD_MAX) dv[k] = -dv[k];
     }
     dir = fv_v3(dv[0], dv[1], dv[2]); /* a mirrored axis keeps dir apart from cam_up */
-    for (int k = 0; k < 3; k++) {
-        const float dk = comp(dir, k), ck = comp(c, k);
-        if (dk * dist + ck > (float)FV_COORD_MAX) dist = ((float)FV_COORD_MAX - ck) / dk;
-        if (dk * dist + ck < -(float)FV_COORD_MAX) dist = (-(float)FV_COORD_MAX - ck) / dk;
-    }
+    dist = fv_limit_reach(c, dir, dist);
     fv_camera cam = {fv_madd(c, dir, dist), c, cam_up, fov, width, height};
     *out = cam;
 }
