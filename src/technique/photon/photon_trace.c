@@ -97,7 +97,12 @@ static void light_photon(const run_ctx *c, int64_t i, block_out *out)
     const fv_photon_job *job = c->job;
     fv_rng rng = photon_rng(job, i, 0);
     fv_vec3 o, d, flux;
-    if (!fv_light_path_emit(job->scene, &rng, job->count, &o, &d, &flux)) return;
+    if (job->warp) {
+        float u[5], q = job->warp(job->warp_ctx, &rng, u);
+        if (!(q > 0.0f) || !fv_light_path_emit_u(job->scene, u, job->count, &o, &d, &flux)) return;
+        flux = fv_scale(flux, 1.0f / q);
+    } else if (!fv_light_path_emit(job->scene, &rng, job->count, &o, &d, &flux))
+        return;
     fv_light_path_trace(job->scene, c->set, o, d, flux, 0, job->max_depth, &rng, deposit, out, &out->rays);
 }
 

@@ -32,6 +32,11 @@ void fv_dyn_dirs_destroy(fv_dyn_dirs *d);
 fv_status fv_dyn_dirs_build(fv_dyn_dirs *d, const fv_scene *s, fv_error *err);
 int fv_dyn_dirs_count(const fv_dyn_dirs *d);
 
+/* Photon guiding (technique/photon/guide.h): fills the five numbers a photon's emission uses
+ * (fv_light_path_emit_u) from rng and returns their density relative to uniform numbers, by which
+ * the photon's flux is divided so the map stays unbiased; a density <= 0 drops the photon. */
+typedef float (*fv_photon_warp_fn)(const void *ctx, fv_rng *rng, float u[5]);
+
 typedef struct fv_photon_job {
     const fv_scene *scene;
     int64_t count;         /* photons emitted */
@@ -42,6 +47,8 @@ typedef struct fv_photon_job {
     uint64_t stream;       /* distinguishes several maps traced in one frame: FV_STREAM_PHOTONS(stream) */
     fv_kit_progress *progress; /* optional: reported as blocks of photons finish; a cancel stops
                                   the tracing with FV_ERR_CANCELLED */
+    fv_photon_warp_fn warp;     /* fv_photon_trace_lights: NULL for uniform emission */
+    const void *warp_ctx;
 } fv_photon_job;
 
 /* Traces job->count photons from the lights through `set` (FV_TRACE_ALL for plain photon mapping,
