@@ -189,12 +189,6 @@ typedef struct render_ctx {
     fv_kit_progress prog;
 } render_ctx;
 
-static float blend_k(double num, double den)
-{
-    double w = den > 0.0 ? fmin(num / den, 1.0) : (num > 0.0 ? 1.0 : 0.0);
-    return (float)(3.0 * w * w - 2.0 * w * w * w);
-}
-
 /* Plain photon mapping (pm): one map, no blending. */
 static fv_vec3 estimate_plain(const render_ctx *c, const fv_pm_hit *x)
 {
@@ -226,10 +220,10 @@ static void gather_sums(const render_ctx *c, const fv_pm_hit *x, float b, px_sum
 static fv_vec3 estimate_sums(const render_ctx *c, const px_sums *o)
 {
     if (!o->hit) return o->emitted;
-    float kl = blend_k(o->u_ld, o->u_ls);
+    float kl = fv_pmt_blend_k(o->u_ld, o->u_ls);
     fv_vec3 g = fv_scale(fv_madd(o->ls, o->ld, kl), c->norm);
     if (o->b < 1.0f) {
-        float kf = blend_k(o->u_ld + o->u_fd / c->eta, o->u_ls + o->u_fs);
+        float kf = fv_pmt_blend_k(o->u_ld + o->u_fd / c->eta, o->u_ls + o->u_fs);
         fv_vec3 fov = fv_scale(fv_madd(fv_add(o->ls, o->fs), fv_add(o->ld, o->fd), kf), (float)c->eta * c->norm);
         g = fv_add(fv_scale(fov, 1.0f - o->b), fv_scale(g, o->b));
     }

@@ -8,6 +8,7 @@
 #ifndef FV_PHOTON_TEMPORAL_H
 #define FV_PHOTON_TEMPORAL_H
 
+#include <math.h>
 #include <stdbool.h>
 #include "fovea/stats.h"
 #include "technique/photon/photon_trace.h"
@@ -29,5 +30,14 @@ void fv_pmt_maps_free(fv_pmt_maps *m);
  * cancelled trace leaves no half map behind. */
 fv_status fv_pmt_maps_update(fv_pmt_maps *m, const fv_photon_job *job, double n_light, double dyn_fraction, float cell, fv_stats *stats,
                              uint64_t *rays, fv_error *err);
+
+/* Eq. 4's k: how much of M_ld's estimate joins M_ls's at a pixel, from the u sums of the dynamic
+ * (num) and static (den) photons gathered there, W = min(num / den, 1) smoothed as 3W^2 - 2W^3.
+ * The estimate is then sum(M_ls) + k sum(M_ld) (our reading of Eq. 3-5, pm.c). */
+static inline float fv_pmt_blend_k(double num, double den)
+{
+    double w = den > 0.0 ? fmin(num / den, 1.0) : (num > 0.0 ? 1.0 : 0.0);
+    return (float)(3.0 * w * w - 2.0 * w * w * w);
+}
 
 #endif
