@@ -8,19 +8,19 @@
 
 static inline float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-long fv_lattice_fill(float *rgb, const uint8_t *known, const float *normal, const float *position, int w, int h,
-                     const fv_lattice_opts *o, uint8_t *need)
+long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, const float *normal, const float *position, int w,
+                     int h, const fv_lattice_opts *o, uint8_t *need)
 {
-    const int S = o->step > 1 ? o->step : 1;
+    const int S0 = o->step > 1 ? o->step : 1;
     const float inv_s2 = o->sigma_position > 0.0f ? 1.0f / (o->sigma_position * o->sigma_position) : 0.0f;
     long missing = 0;
     #pragma omp parallel for schedule(static) reduction(+ : missing)
     for (int y = 0; y < h; y++) {
-        int y0 = y / S * S;
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             need[i] = 0;
-            if (known[i]) continue;
+            if (known[i] || (skip && skip[i])) continue;
+            const int S = o->level ? S0 << o->level[i] : S0, y0 = y / S * S;
             const float *n = &normal[3 * i], *p = &position[3 * i];
             if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f) { /* no surface: nothing to agree with */
                 need[i] = 1;

@@ -17,17 +17,19 @@
 
 typedef struct fv_lattice_opts {
     int step;             /* lattice spacing in pixels (>= 1); the lattice is x % step == 0 && y % step == 0 */
+    const uint8_t *level; /* optional per pixel: its cell is step << level[i] wide (coarser where acuity is
+                             lower; NULL: level 0 everywhere); its corners are multiples of that */
     float normal_power;   /* weight max(0, n . n_q)^power */
     float sigma_position; /* weight exp(-|p - p_q|^2 / sigma^2), scene units; <= 0: no position term */
 } fv_lattice_opts;
 
-/* Fills every pixel with known[i] == 0 of rgb (w*h*3) from the known pixels at its cell's
- * lattice corners, guided by normal and position (3 floats per pixel; a zero normal marks a
- * pixel without surface, which neither gives nor takes). Each unfilled pixel (no corner with
- * weight) gets need[i] = 1 and keeps its value; the others get need[i] = 0. Returns how many
- * need shading. Known pixels off the lattice are left alone and not used. */
-long fv_lattice_fill(float *rgb, const uint8_t *known, const float *normal, const float *position, int w, int h,
-                     const fv_lattice_opts *o, uint8_t *need);
+/* Fills every pixel with known[i] == 0 and (skip NULL or skip[i] == 0) of rgb (w*h*3) from the
+ * known pixels at its cell's lattice corners, guided by normal and position (3 floats per pixel;
+ * a zero normal marks a pixel without surface, which neither gives nor takes). Each pixel left
+ * unfilled (no corner with weight) gets need[i] = 1 and keeps its value; all others get
+ * need[i] = 0. Returns how many need shading. Known pixels off the lattice are not used. */
+long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, const float *normal, const float *position, int w,
+                     int h, const fv_lattice_opts *o, uint8_t *need);
 
 /* Filters the lattice's known pixels among themselves with the À-Trous filter (filter/atrous.h),
  * as an image of ceil(w/step) x ceil(h/step) pixels, before the fill: the periphery is denoised at

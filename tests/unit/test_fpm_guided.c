@@ -240,8 +240,8 @@ static void test_fill_constant_plane(void **st)
             rgb[3 * i + 1] = known[i] ? 0.5f : -1.0f;
             rgb[3 * i + 2] = known[i] ? 2.0f : -1.0f;
         }
-        fv_lattice_opts o = {step, 8.0f, 1.0f};
-        long missing = fv_lattice_fill(rgb, known, nrm, pos, W, H, &o, need);
+        fv_lattice_opts o = {step, NULL, 8.0f, 1.0f};
+        long missing = fv_lattice_fill(rgb, known, NULL, nrm, pos, W, H, &o, need);
         assert_int_equal(missing, 0);
         for (int i = 0; i < W * H; i++) {
             assert_float_equal(rgb[3 * i], 0.25, 1e-6);
@@ -271,8 +271,8 @@ static void test_fill_edges(void **st)
     }
     const int thin = 5 * W + 6; /* (6, 5) */
     nrm[3 * thin + 2] = -1.0f;
-    fv_lattice_opts o = {S, 8.0f, 0.0f};
-    long missing = fv_lattice_fill(rgb, known, nrm, pos, W, H, &o, need);
+    fv_lattice_opts o = {S, NULL, 8.0f, 0.0f};
+    long missing = fv_lattice_fill(rgb, known, NULL, nrm, pos, W, H, &o, need);
     assert_int_equal(missing, 1);
     assert_int_equal(need[thin], 1);
     assert_float_equal(rgb[3 * thin], -1.0, 0.0);

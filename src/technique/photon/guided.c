@@ -47,7 +47,8 @@ typedef struct gd_opts {
     double pilot_fraction;   /* share of the guided budget spent learning the guide */
     double retrace_overlap;  /* keep M_g while at least this share of the focus cells were guided for */
     int fovea_spp;           /* eye paths per fovea pixel */
-    int periphery_step;      /* lattice spacing of the periphery's gathers */
+    int periphery_step;      /* lattice spacing of the periphery's gathers next to the transition */
+    int acuity_levels;       /* how often the spacing may double further out, as acuity falls */
 } gd_opts;
 
 typedef struct gd_state {
@@ -64,7 +65,7 @@ typedef struct gd_state {
     /* per pixel: first-hit normal and position (filters, fill), albedo and emission of the first
      * surface, the periphery's demodulated reflected light; masks */
     float *nbuf, *pbuf, *alb, *emit, *refl;
-    uint8_t *need, *focus_px, *lattice_px;
+    uint8_t *need, *focus_px, *lattice_px, *level;
     size_t bufn;
 } gd_state;
 
@@ -83,7 +84,8 @@ static fv_status read_opts(fv_params *p, gd_opts *o, fv_error *err)
         (s = fv_params_float(p, "pilot_fraction", 0.125, 0.01, 0.9, &o->pilot_fraction, err)) ||
         (s = fv_params_float(p, "retrace_overlap", 0.75, 0.0, 1.0, &o->retrace_overlap, err)) ||
         (s = fv_params_int(p, "fovea_spp", 4, 1, 256, &o->fovea_spp, err)) ||
-        (s = fv_params_int(p, "periphery_step", 2, 1, 16, &o->periphery_step, err)))
+        (s = fv_params_int(p, "periphery_step", 2, 1, 16, &o->periphery_step, err)) ||
+        (s = fv_params_int(p, "acuity_levels", 1, 0, 3, &o->acuity_levels, err)))
         return s;
     for (int i = 0; i < fv_params_count(p); i++)
         if (strcmp(fv_params_key(p, i), "radius") == 0 && !(o->radius > 0.0))
@@ -102,7 +104,7 @@ static void gd_destroy(void *state)
     fv_focus_cells_destroy(st->mg_focus);
     fv_photon_guide_destroy(st->guide);
     free(st->nbuf), free(st->pbuf), free(st->alb), free(st->emit), free(st->refl);
-    free(st->need), free(st->focus_px), free(st->lattice_px);
+    free(st->need), free(st->focus_px), free(st->lattice_px), free(st->level);
     free(st);
 }
 
@@ -131,7 +133,7 @@ static fv_status ensure_buffers(gd_state *st, size_t n, fv_error *err)
 {
     if (st->bufn == n) return FV_OK;
     free(st->nbuf), free(st->pbuf), free(st->alb), free(st->emit), free(st->refl);
-    free(st->need), free(st->focus_px), free(st->lattice_px);
+    free(st->need), free(st->focus_px), free(st->lattice_px), free(st->level);
     st->nbuf = fv_alloc_array(n, 3 * sizeof(float));
     st->pbuf = fv_alloc_array(n, 3 * sizeof(float));
     st->alb = fv_alloc_array(n, 3 * sizeof(float));
@@ -140,7 +142,8 @@ static fv_status ensure_buffers(gd_state *st, size_t n, fv_error *err)
     st->need = fv_alloc_array(n, 1);
     st->focus_px = fv_alloc_array(n, 1);
     st->lattice_px = fv_alloc_array(n, 1);
-    bool ok = st->nbuf && st->pbuf && st->alb && st->emit && st->refl && st->need && st->focus_px && st->lattice_px;
+    st->level = fv_alloc_array(n, 1);
+    bool ok = st->nbuf && st->pbuf && st->alb && st->emit && st->refl && st->need && st->focus_px && st->lattice_px && st->level;
     st->bufn = ok ? n : 0;
     return ok ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory for fpm-guided's %zu-pixel buffers", n);
 }
@@ -154,6 +157,7 @@ typedef struct gd_ctx {
     const fv_eye_model *eye;
     fv_gaze gaze;
     float gamma, norm;
+    double e_t;               /* eccentricity of the transition's outer edge, degrees */
     float *color;
     fv_film_views out;
     fv_vec3 *focus_pts;       /* focus pass: up to two gather points per sampled pixel (NaN: none) */
@@ -163,14 +167,16 @@ typedef struct gd_ctx {
 
 static inline fv_vec3 nan3(void) { return fv_v3s(NAN); }
 
-/* Eq. 5 with pm-t's blend at gather point x: the static map (M_g in the focus region, M_ls in the
- * periphery) plus k times M_ld, f_r-weighted, divided by pi gamma^2. */
+/* The density estimate at gather point x: the static map (M_g in the focus region, M_ls in the
+ * periphery) plus M_ld, f_r-weighted, divided by pi gamma^2. pm-t weighs M_ld by Eq. 4's k, which
+ * quiets the noise of sparse dynamic photons but leaves part of a moving object's shadow lit (k < 1
+ * wherever M_ld is sparser than M_ls); the plain sum is unbiased, its negative photons cancel the
+ * static light exactly in expectation, so fpm-guided takes it (docs/results.md). */
 static fv_vec3 estimate(const gd_ctx *c, const fv_photon_map *stat, const fv_pm_hit *x)
 {
-    double u_s = 0.0, u_d = 0.0;
-    fv_vec3 s = fv_pm_gather(c->st->scene, stat, x, c->gamma, &u_s);
-    fv_vec3 d = fv_pm_gather(c->st->scene, &c->st->tm.ld, x, c->gamma, &u_d);
-    return fv_scale(fv_madd(s, d, fv_pmt_blend_k(u_d, u_s)), c->norm);
+    fv_vec3 s = fv_pm_gather(c->st->scene, stat, x, c->gamma, NULL);
+    fv_vec3 d = fv_pm_gather(c->st->scene, &c->st->tm.ld, x, c->gamma, NULL);
+    return fv_scale(fv_add(s, d), c->norm);
 }
 
 /* The focus pass: one split eye path at every other pixel of every other row of the focus region,
@@ -222,7 +228,16 @@ static void main_tile(void *ctx, const fv_tile *t)
             memcpy(&st->pbuf[3 * pix], &pos, sizeof pos);
             fv_film_store_first_hit(&c->out, pix, any, h[0].first_t, h[0].first_p, h[0].first_n, h[0].albedo, h[0].first_obj);
             st->focus_px[pix] = b < 1.0f;
-            st->lattice_px[pix] = b >= 1.0f && x % S == 0 && y % S == 0;
+            /* Lattice spacing ~ 1 / acuity (Visual-Polar's Eq. 1, cycles per degree), relative to the
+             * transition's edge, in doublings of periphery_step. */
+            int lv = 0;
+            if (b >= 1.0f && st->o.acuity_levels > 0) {
+                double ratio = fv_acuity_v(c->e_t) / fv_acuity_v(fv_eye_eccentricity_deg(c->eye, c->gaze, x + 0.5, y + 0.5));
+                while (lv < st->o.acuity_levels && ratio >= (double)(2 << lv)) lv++;
+            }
+            st->level[pix] = (uint8_t)lv;
+            const int step = S << lv;
+            st->lattice_px[pix] = b >= 1.0f && x % step == 0 && y % step == 0;
             if (b < 1.0f) {
                 /* Eq. 6's b ramps the paths from fovea_spp in the fovea down to one at the periphery. */
                 int spp = (int)lroundf((float)st->o.fovea_spp * (1.0f - b) + b);
@@ -262,6 +277,7 @@ static void main_tile(void *ctx, const fv_tile *t)
                         gathers++;
                     }
             /* Demodulated by the first surface's colour, so the fill carries light, not texture. */
+            R = fv_kit_guard(R, &bad);
             for (int k = 0; k < 3; k++) {
                 float a = (&A.x)[k];
                 st->alb[3 * pix + k] = a > 1e-3f ? a : 1.0f;
@@ -299,6 +315,7 @@ static void gather_needed(gd_ctx *c, uint64_t *gathers)
                 R = fv_add(R, fv_mul(h[j].weight, estimate(c, &st->tm.ls, &h[j])));
                 g++;
             }
+        if (!fv_is_finite3(R)) R = fv_v3s(0.0f); /* counted when the colour is composed */
         for (int q = 0; q < 3; q++) st->refl[3 * i + q] = (&R.x)[q] / st->alb[3 * i + q];
     }
     *gathers += g;
@@ -389,16 +406,21 @@ static fv_status finish(gd_ctx *c, fv_film *film, fv_stats *stats, fv_error *err
     if (rc != FV_OK) return rc;
     t0 = fv_time_ms();
     /* The fill reads lattice pixels only: focus pixels hold colour, not demodulated light. */
-    fv_lattice_opts lo = {st->o.periphery_step, 8.0f, 2.0f * c->gamma};
-    long missing = fv_lattice_fill(st->refl, st->lattice_px, st->nbuf, st->pbuf, w, h, &lo, st->need);
+    fv_lattice_opts lo = {st->o.periphery_step, st->level, 8.0f, 2.0f * c->gamma};
+    long missing = fv_lattice_fill(st->refl, st->lattice_px, st->focus_px, st->nbuf, st->pbuf, w, h, &lo, st->need);
     uint64_t gathers = 0;
     gather_needed(c, &gathers);
     fv_stats_add_count(stats, "fill_gathered", (double)missing);
     fv_stats_add_count(stats, "gathers", (double)fv_kit_sum(c->counters, FV_KIT_USER0) + (double)gathers);
+    uint64_t bad = 0;
     for (size_t i = 0; i < n; i++) {
         if (st->focus_px[i]) continue;
-        for (int k = 0; k < 3; k++) c->color[3 * i + k] = st->emit[3 * i + k] + st->alb[3 * i + k] * st->refl[3 * i + k];
+        fv_vec3 L;
+        for (int k = 0; k < 3; k++) (&L.x)[k] = st->emit[3 * i + k] + st->alb[3 * i + k] * st->refl[3 * i + k];
+        L = fv_kit_guard(L, &bad);
+        memcpy(&c->color[3 * i], &L, sizeof L);
     }
+    fv_stats_add_count(stats, "nan_samples", (double)bad);
     fv_stats_add_ms(stats, "fill", fv_time_ms() - t0);
     if (!st->o.filter) return FV_OK;
     /* The focus region's bounding box, widened by the filter's reach so its edge pixels see
@@ -461,6 +483,7 @@ static fv_status gd_render(void *state, const fv_frame *frame, fv_film *film, fv
         fv_scene_bounds(st->scene, &lo, &hi);
         c->gamma = st->o.radius > 0.0 ? (float)st->o.radius : fv_photon_radius_eq8(lo, hi, w, h);
         c->norm = 1.0f / (FV_PI * c->gamma * c->gamma);
+        c->e_t = fv_eye_transition_radius_px(c->eye) / fv_eye_px_per_deg(c->eye);
         c->color = fv_film_color(film);
         c->out = fv_film_views_of(film);
         memset(c->color, 0, (size_t)w * h * 3 * sizeof(float));
@@ -469,7 +492,7 @@ static fv_status gd_render(void *state, const fv_frame *frame, fv_film *film, fv
     bool reuse = frame->eye == 1 && st->maps_index == frame->index && st->maps_gamma == c->gamma;
     if (rc == FV_OK && !reuse) rc = update_maps(c, stats, err);
     if (rc == FV_OK) {
-        fv_kit_phase(&c->prog, frame, 0.4, 0.55);
+        fv_kit_phase(&c->prog, frame, 0.4, 0.6);
         double t0 = fv_time_ms();
         if (!fv_parallel_tiles(w, h, frame->threads, main_tile, c, fv_kit_progress_fn, &c->prog))
             rc = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
@@ -502,7 +525,8 @@ const fv_technique_class fv_technique_fpm_guided = {
                    "pilot_fraction=float (0.125): share of the guided budget spent learning where to guide\n"
                    "retrace_overlap=float (0.75): keep the guided map while this share of the focus cells is unchanged\n"
                    "fovea_spp=int (4): eye paths per fovea pixel, ramping to 1 across the transition\n"
-                   "periphery_step=int (2): the periphery gathers every step-th pixel of every step-th row\n",
+                   "periphery_step=int (2): the periphery gathers every step-th pixel of every step-th row\n"
+                   "acuity_levels=int (1): the step doubles up to this many times where acuity falls to 1/2, 1/4, ...\n",
     .create = gd_create,
     .render = gd_render,
     .destroy = gd_destroy,

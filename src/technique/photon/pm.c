@@ -56,6 +56,8 @@ typedef struct pm_opts {
     int passes;           /* pm: independent passes averaged (references) */
     bool filter, tpm;
     int eta_region;       /* fpm: 0 fovea, 1 focus region (Eq. 1's r_i) */
+    int terms;            /* fpm: 0 all, 1 the light photons' term only, 2 the foveated photons' only
+                             (the bias analysis, docs/results.md: eta and k stay those of the whole) */
 } pm_opts;
 
 typedef struct pm_state {
@@ -107,6 +109,8 @@ static fv_status read_opts(pm_mode mode, fv_params *p, pm_opts *o, fv_error *err
             return s;
         static const char *const regions[] = {"fovea", "focus", NULL};
         if ((s = fv_params_choice(p, "eta_region", 0, regions, &o->eta_region, err))) return s;
+        static const char *const terms[] = {"all", "light", "foveated", NULL};
+        if ((s = fv_params_choice(p, "terms", 0, terms, &o->terms, err))) return s;
         if (o->fov_fraction >= 1.0)
             return fv_error_set(err, FV_ERR_INVALID, "parameter fov_fraction=%g: some light photons are needed (use < 1)", o->fov_fraction);
         /* Absolute counts (the paper's Fig. 6 b, c vary one at a fixed other) replace the split. */
@@ -219,15 +223,22 @@ static void gather_sums(const render_ctx *c, const fv_pm_hit *x, float b, px_sum
  * Eq. 3 (all four maps, times eta) in the fovea, linear in b between. */
 static fv_vec3 estimate_sums(const render_ctx *c, const px_sums *o)
 {
-    if (!o->hit) return o->emitted;
+    /* terms=light|foveated: one map pair's share of the same estimate (same eta, same k), the
+     * emission and the periphery's light-photon estimate going to the light term: the two add
+     * up to terms=all. */
+    const int terms = c->st->o.terms;
+    fv_vec3 emitted = terms == 2 ? fv_v3s(0.0f) : o->emitted;
+    if (!o->hit) return emitted;
     float kl = fv_pmt_blend_k(o->u_ld, o->u_ls);
-    fv_vec3 g = fv_scale(fv_madd(o->ls, o->ld, kl), c->norm);
+    fv_vec3 g = terms == 2 ? fv_v3s(0.0f) : fv_scale(fv_madd(o->ls, o->ld, kl), c->norm);
     if (o->b < 1.0f) {
         float kf = fv_pmt_blend_k(o->u_ld + o->u_fd / c->eta, o->u_ls + o->u_fs);
-        fv_vec3 fov = fv_scale(fv_madd(fv_add(o->ls, o->fs), fv_add(o->ld, o->fd), kf), (float)c->eta * c->norm);
+        fv_vec3 zero = fv_v3s(0.0f), ls = terms == 2 ? zero : o->ls, ld = terms == 2 ? zero : o->ld;
+        fv_vec3 fs = terms == 1 ? zero : o->fs, fd = terms == 1 ? zero : o->fd;
+        fv_vec3 fov = fv_scale(fv_madd(fv_add(ls, fs), fv_add(ld, fd), kf), (float)c->eta * c->norm);
         g = fv_add(fv_scale(fov, 1.0f - o->b), fv_scale(g, o->b));
     }
-    return fv_add(o->emitted, fv_mul(o->weight, g));
+    return fv_add(emitted, fv_mul(o->weight, g));
 }
 
 static fv_vec3 shade(const render_ctx *c, const fv_pm_hit *x, float px, float py)
@@ -610,7 +621,8 @@ const fv_technique_class fv_technique_fpm = {
                                "light_photons=int, fov_photons=int: absolute counts instead of photons and fov_fraction\n"
                                "paths_per_pixel=int (from the budget): N foveated paths per focus pixel\n"
                                "tpm=bool (true): temporal photon management (false: retrace all foveated paths)\n"
-                               "eta_region=fovea|focus (fovea): the pixels whose gathered flux Eq. 1 sums (r_i)\n",
+                               "eta_region=fovea|focus (fovea): the pixels whose gathered flux Eq. 1 sums (r_i)\n"
+                               "terms=all|light|foveated (all): the focus region's estimate, or only one map pair's share of it (analysis)\n",
     .create = fpm_create,
     .render = pm_render,
     .destroy = pm_destroy,
