@@ -60,7 +60,7 @@ long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, cons
 }
 
 fv_status fv_lattice_filter(float *rgb, const uint8_t *known, const uint8_t *filter_mask, const float *normal,
-                            const float *position, int w, int h, int step, float sigma_position, fv_error *err)
+                            const float *position, int w, int h, int step, int iterations, float sigma_position, fv_error *err)
 {
     const int S = step > 1 ? step : 1, lw = (w + S - 1) / S, lh = (h + S - 1) / S;
     size_t n = (size_t)lw * lh;
@@ -81,8 +81,7 @@ fv_status fv_lattice_filter(float *rgb, const uint8_t *known, const uint8_t *fil
     fv_atrous_opts ao;
     fv_atrous_opts_default(&ao);
     ao.sigma_position = sigma_position;
-    /* The lattice's pixels are S apart: the same reach in screen space needs fewer passes. */
-    while (ao.iterations > 1 && (1 << (ao.iterations - 1)) * S > (1 << (5 - 1))) ao.iterations--;
+    ao.iterations = iterations;
     fv_status rc = fv_atrous_filter(c, nb, pb, lw, lh, &ao, err);
     if (rc == FV_OK)
         for (int ly = 0; ly < lh; ly++)

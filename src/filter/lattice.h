@@ -31,11 +31,11 @@ typedef struct fv_lattice_opts {
 long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, const float *normal, const float *position, int w,
                      int h, const fv_lattice_opts *o, uint8_t *need);
 
-/* Filters the lattice's known pixels among themselves with the À-Trous filter (filter/atrous.h),
- * as an image of ceil(w/step) x ceil(h/step) pixels, before the fill: the periphery is denoised at
- * the resolution it was estimated at. Only pixels with filter_mask[i] != 0 are written back (others
- * still guide and feed the filter). sigma_position as for fv_atrous_opts. */
+/* Filters the lattice's known pixels among themselves with `iterations` passes of the À-Trous
+ * filter (filter/atrous.h), as an image of ceil(w/step) x ceil(h/step) pixels, before the fill: the
+ * periphery is denoised at the resolution it was estimated at. Only pixels with filter_mask[i] != 0
+ * are written back (others still guide and feed the filter). sigma_position as for fv_atrous_opts. */
 fv_status fv_lattice_filter(float *rgb, const uint8_t *known, const uint8_t *filter_mask, const float *normal,
-                            const float *position, int w, int h, int step, float sigma_position, fv_error *err);
+                            const float *position, int w, int h, int step, int iterations, float sigma_position, fv_error *err);
 
 #endif
