@@ -1,6 +1,6 @@
 /* fpm-guided's parts (technique/photon/guided.c): the focus cell set, photon guiding that stays
  * unbiased while it concentrates photons, eye paths split at the first dielectric (hand-worked
- * Fresnel weights), the sparse periphery fill (exact on a constant plane, never across an edge),
+ * Fresnel weights), kept photon paths refreshed near a moving object equal to a full retrace, the sparse periphery fill (exact on a constant plane, never across an edge),
  * memory flat over 500 moving frames, and parameter checking. */
 #include <malloc.h>
 #include <math.h>
@@ -15,6 +15,7 @@
 #include "filter/lattice.h"
 #include "technique/photon/gather.h"
 #include "technique/photon/guide.h"
+#include "technique/photon/path_store.h"
 #include "testkit.h"
 
 /* ---- the focus cells ---- */
@@ -172,6 +173,67 @@ static void test_guide_unbiased(void **st)
     assert_true(cnt[1][0] >= 3 * cnt[0][0]);
     fv_photon_guide_destroy(g);
     fv_focus_cells_destroy(focus);
+    fv_scene_destroy(s);
+}
+
+/* ---- kept paths, refreshed near the dynamic objects ---- */
+
+/* The room with a dynamic diffuse box moved between two places: at each time the frame's map made
+ * from the kept static paths (those meeting the box's sphere traced again) holds the photons a full
+ * trace of the scene at that time gives, photon for photon (positions within rounding: the static
+ * objects are instanced in the full scene), and some paths, not all, were traced again. */
+static void test_path_store_refresh(void **st)
+{
+    (void)st;
+    fv_scene *s;
+    fv_error err;
+    assert_int_equal(fv_scene_create(&s, &err), FV_OK);
+    fv_material m = fv_material_default(FV_MAT_DIFFUSE), e = fv_material_default(FV_MAT_DIFFUSE);
+    m.albedo = fv_v3s(0.6f);
+    e.albedo = fv_v3s(0.0f);
+    e.emission = fv_v3s(10.0f);
+    int mm, em;
+    assert_int_equal(fv_scene_add_material(s, &m, &mm, &err), FV_OK);
+    assert_int_equal(fv_scene_add_material(s, &e, &em, &err), FV_OK);
+    add_quad(s, "floor", fv_v3(-100, 0, -100), fv_v3(-100, 0, 100), fv_v3(100, 0, 100), fv_v3(100, 0, -100), mm);
+    add_quad(s, "wall", fv_v3(-100, 0, -100), fv_v3(100, 0, -100), fv_v3(100, 200, -100), fv_v3(-100, 200, -100), mm);
+    add_quad(s, "light", fv_v3(-10, 100, -10), fv_v3(10, 100, -10), fv_v3(10, 100, 10), fv_v3(-10, 100, 10), em);
+    fv_vec3 bv[8];
+    for (int k = 0; k < 8; k++) bv[k] = fv_v3(k & 1 ? 10.0f : -10.0f, k & 2 ? 10.0f : -10.0f, k & 4 ? 10.0f : -10.0f);
+    const uint32_t bi[36] = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
+    fv_mesh_desc box = {"box", bv, 8, NULL, bi, 12, NULL, mm};
+    int obj;
+    assert_int_equal(fv_scene_add_mesh(s, &box, NULL, &obj, &err), FV_OK);
+    fv_anim_key keys[2] = {{0.0, {0, 40, 0}, {0, 0, 0, 1}, {1, 1, 1}}, {1.0, {50, 20, 30}, {0, 0, 0, 1}, {1, 1, 1}}};
+    assert_int_equal(fv_scene_animate_object(s, obj, keys, 2, &err), FV_OK);
+    assert_int_equal(fv_scene_commit(s, NULL, &err), FV_OK);
+    fv_path_store *store;
+    fv_dyn_dirs *dirs;
+    assert_int_equal(fv_path_store_create(&store, &err), FV_OK);
+    assert_int_equal(fv_dyn_dirs_create(&dirs, &err), FV_OK);
+    fv_photon_job job = {s, 20000, 5, 0, 6, 0, 1, NULL, NULL, NULL};
+    assert_int_equal(fv_path_store_trace(store, &job, NULL, &err), FV_OK);
+    for (int t = 0; t < 2; t++) {
+        assert_int_equal(fv_scene_set_time(s, (double)t, &err), FV_OK);
+        assert_int_equal(fv_dyn_dirs_build(dirs, s, &err), FV_OK);
+        fv_photon_map frame, full;
+        fv_photon_map_init(&frame);
+        fv_photon_map_init(&full);
+        int64_t again = 0;
+        assert_int_equal(fv_path_store_frame(store, dirs, 0, &frame, &again, NULL, &err), FV_OK);
+        assert_int_equal(fv_photon_trace_lights(&job, FV_TRACE_ALL, &full, NULL, &err), FV_OK);
+        print_message("time %d: %lld of 20000 paths traced again, %d photons (full trace %d)\n", t, (long long)again, frame.n, full.n);
+        assert_true(again > 0 && again < 20000);
+        assert_int_equal(frame.n, full.n);
+        for (int i = 0; i < full.n; i++) {
+            assert_true(fv_length(fv_sub(frame.p[i].pos, full.p[i].pos)) < 1e-2f);
+            assert_float_equal(frame.p[i].flux.y, full.p[i].flux.y, 1e-4 * fabsf(full.p[i].flux.y) + 1e-9);
+        }
+        fv_photon_map_free(&frame);
+        fv_photon_map_free(&full);
+    }
+    fv_dyn_dirs_destroy(dirs);
+    fv_path_store_destroy(store);
     fv_scene_destroy(s);
 }
 
@@ -370,6 +432,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_focus_cells),       cmocka_unit_test(test_guide_unbiased), cmocka_unit_test(test_split_weights),
+        cmocka_unit_test(test_path_store_refresh),
         cmocka_unit_test(test_fill_constant_plane), cmocka_unit_test(test_fill_edges),   cmocka_unit_test(test_bad_params),
         cmocka_unit_test(test_memory_flat),
     };

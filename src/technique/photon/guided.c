@@ -14,10 +14,12 @@
  *     (filter/lattice.h); the full-resolution filter runs only over the focus region;
  *   - photon side: the focus region gathers from M_g, light photons guided towards the grid cells
  *     its gather discs touch, their flux divided by the guiding density so the map stays unbiased
- *     (guide.h), in place of fpm's flux-copying foveated photons; the periphery from pm-t's M_ls;
- *     both with pm-t's M_ld for the dynamic objects (temporal.h). M_g sees only static objects like
- *     M_ls and is kept across frames while the focus region gathers from the same cells (a still or
- *     fixating gaze); when the gaze moves on it is learnt and traced again.
+ *     (guide.h), in place of fpm's flux-copying foveated photons; the periphery from M_ls, plain
+ *     light photons. Both are static photon paths traced once and kept (M_g until the gaze moves
+ *     on to other cells); each frame only the paths that pass a dynamic object are traced again,
+ *     so the maps are what a full trace of the current scene gives (path_store.h) rather than
+ *     pm-t's static map plus negative photons, which leaves light a moving object blocks after a
+ *     bounce and adds noise in its shadow (docs/results.md).
  * Everything else (tracer, grids, gather, filters) is pm's.
  *
  * Stereo: the right eye of a frame reuses the left eye's photon maps (same time, same lights).
@@ -34,14 +36,13 @@
 #include "technique/kit.h"
 #include "technique/photon/gather.h"
 #include "technique/photon/guide.h"
-#include "technique/photon/temporal.h"
+#include "technique/photon/path_store.h"
 
 typedef struct gd_opts {
     int photons;             /* per frame: light photons (M_ls + M_ld) plus guided ones (M_g, with the pilot) */
     double radius;           /* gather radius; 0: Eq. 8 */
     int max_depth, eye_depth;
     bool filter, split;
-    double dyn_fraction;     /* share of the light photons sent towards dynamic objects */
     double guided_fraction;  /* share of the photons that are guided (fpm's foveated share, Sec. 4: 40%) */
     double alpha;            /* share of the guided photons the learnt cells get */
     double pilot_fraction;   /* share of the guided budget spent learning the guide */
@@ -54,8 +55,11 @@ typedef struct gd_opts {
 typedef struct gd_state {
     const fv_scene *scene;
     gd_opts o;
-    fv_pmt_maps tm;
-    fv_photon_map mg;          /* M_g: guided static photons */
+    fv_path_store *ls_store;   /* M_ls's paths, traced once through the static objects */
+    fv_path_store *g_store;    /* M_g's paths: guided, traced again when the focus moves on */
+    fv_dyn_dirs *dirs;         /* the dynamic objects' bounding spheres this frame */
+    bool lights_move;
+    fv_photon_map ls, mg;      /* this frame's maps */
     bool mg_valid;
     fv_focus_cells *focus;     /* this frame's focus cells */
     fv_focus_cells *mg_focus;  /* the cells M_g was guided towards */
@@ -78,7 +82,6 @@ static fv_status read_opts(fv_params *p, gd_opts *o, fv_error *err)
         (s = fv_params_int(p, "max_depth", 8, 1, 64, &o->max_depth, err)) ||
         (s = fv_params_int(p, "eye_depth", 8, 1, 64, &o->eye_depth, err)) || (s = fv_params_bool(p, "filter", true, &o->filter, err)) ||
         (s = fv_params_bool(p, "split", true, &o->split, err)) ||
-        (s = fv_params_float(p, "dyn_fraction", 0.2, 0.0, 0.95, &o->dyn_fraction, err)) ||
         (s = fv_params_float(p, "guided_fraction", 0.4, 0.0, 0.95, &o->guided_fraction, err)) ||
         (s = fv_params_float(p, "alpha", 0.8, 0.0, 0.99, &o->alpha, err)) ||
         (s = fv_params_float(p, "pilot_fraction", 0.125, 0.01, 0.9, &o->pilot_fraction, err)) ||
@@ -98,7 +101,10 @@ static void gd_destroy(void *state)
 {
     gd_state *st = state;
     if (!st) return;
-    fv_pmt_maps_free(&st->tm);
+    fv_path_store_destroy(st->ls_store);
+    fv_path_store_destroy(st->g_store);
+    fv_dyn_dirs_destroy(st->dirs);
+    fv_photon_map_free(&st->ls);
     fv_photon_map_free(&st->mg);
     fv_focus_cells_destroy(st->focus);
     fv_focus_cells_destroy(st->mg_focus);
@@ -114,9 +120,13 @@ static fv_status gd_create(const fv_scene *scene, fv_params *params, const fv_lo
     if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     st->scene = scene;
     st->maps_index = -1;
+    fv_photon_map_init(&st->ls);
     fv_photon_map_init(&st->mg);
+    st->lights_move = fv_scene_lights_move(scene);
     fv_status s = read_opts(params, &st->o, err);
-    if (s == FV_OK) s = fv_pmt_maps_init(&st->tm, scene, err);
+    if (s == FV_OK) s = fv_path_store_create(&st->ls_store, err);
+    if (s == FV_OK) s = fv_path_store_create(&st->g_store, err);
+    if (s == FV_OK) s = fv_dyn_dirs_create(&st->dirs, err);
     if (s == FV_OK) s = fv_focus_cells_create(&st->focus, err);
     if (s == FV_OK) s = fv_focus_cells_create(&st->mg_focus, err);
     if (s == FV_OK) s = fv_photon_guide_create(st->o.alpha, &st->guide, err);
@@ -124,7 +134,7 @@ static fv_status gd_create(const fv_scene *scene, fv_params *params, const fv_lo
         gd_destroy(st);
         return s;
     }
-    if (st->tm.lights_move) fv_log_warn(log, "fpm-guided: the scene's lights move, so its light and guided photons are retraced every frame");
+    if (st->lights_move) fv_log_warn(log, "fpm-guided: the scene's lights move, so its light and guided photons are retraced every frame");
     *state = st;
     return FV_OK;
 }
@@ -167,16 +177,11 @@ typedef struct gd_ctx {
 
 static inline fv_vec3 nan3(void) { return fv_v3s(NAN); }
 
-/* The density estimate at gather point x: the static map (M_g in the focus region, M_ls in the
- * periphery) plus M_ld, f_r-weighted, divided by pi gamma^2. pm-t weighs M_ld by Eq. 4's k, which
- * quiets the noise of sparse dynamic photons but leaves part of a moving object's shadow lit (k < 1
- * wherever M_ld is sparser than M_ls); the plain sum is unbiased, its negative photons cancel the
- * static light exactly in expectation, so fpm-guided takes it (docs/results.md). */
-static fv_vec3 estimate(const gd_ctx *c, const fv_photon_map *stat, const fv_pm_hit *x)
+/* The density estimate at gather point x (Eq. 5 with one map: M_g in the focus region, M_ls in
+ * the periphery), f_r-weighted, divided by pi gamma^2. */
+static fv_vec3 estimate(const gd_ctx *c, const fv_photon_map *m, const fv_pm_hit *x)
 {
-    fv_vec3 s = fv_pm_gather(c->st->scene, stat, x, c->gamma, NULL);
-    fv_vec3 d = fv_pm_gather(c->st->scene, &c->st->tm.ld, x, c->gamma, NULL);
-    return fv_scale(fv_add(s, d), c->norm);
+    return fv_scale(fv_pm_gather(c->st->scene, m, x, c->gamma, NULL), c->norm);
 }
 
 /* The focus pass: one split eye path at every other pixel of every other row of the focus region,
@@ -273,7 +278,7 @@ static void main_tile(void *ctx, const fv_tile *t)
             if (hit && st->lattice_px[pix])
                 for (int j = 0; j < n; j++)
                     if (h[j].hit) {
-                        R = fv_add(R, fv_mul(h[j].weight, estimate(c, &st->tm.ls, &h[j])));
+                        R = fv_add(R, fv_mul(h[j].weight, estimate(c, &st->ls, &h[j])));
                         gathers++;
                     }
             /* Demodulated by the first surface's colour, so the fill carries light, not texture. */
@@ -312,7 +317,7 @@ static void gather_needed(gd_ctx *c, uint64_t *gathers)
         fv_vec3 R = fv_v3s(0.0f);
         for (int j = 0; j < k; j++)
             if (h[j].hit) {
-                R = fv_add(R, fv_mul(h[j].weight, estimate(c, &st->tm.ls, &h[j])));
+                R = fv_add(R, fv_mul(h[j].weight, estimate(c, &st->ls, &h[j])));
                 g++;
             }
         if (!fv_is_finite3(R)) R = fv_v3s(0.0f); /* counted when the colour is composed */
@@ -321,19 +326,33 @@ static void gather_needed(gd_ctx *c, uint64_t *gathers)
     *gathers += g;
 }
 
-/* This frame's maps: pm-t's (light photons), then M_g when the focus cells moved on. */
+/* A store's paths as this frame's map: kept, or traced again where a dynamic object now is. */
+static fv_status frame_map(gd_ctx *c, const fv_path_store *store, fv_photon_map *m, int64_t *retraced, uint64_t *rays, fv_error *err)
+{
+    fv_status rc = fv_path_store_frame(store, c->st->dirs, c->frame->threads, m, retraced, rays, err);
+    return rc == FV_OK ? fv_photon_map_build_mt(m, c->gamma, c->frame->threads, err) : rc;
+}
+
+/* This frame's maps: M_ls (its paths traced once), then M_g, learnt and traced again when the
+ * focus cells moved on; both refreshed near the dynamic objects (path_store.h). */
 static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
 {
     gd_state *st = c->st;
     const fv_frame *f = c->frame;
     const int w = c->cam.width, h = c->cam.height;
     double n_guided = st->o.photons * st->o.guided_fraction, n_light = st->o.photons - n_guided;
-    fv_photon_job job = {st->scene, 0, f->seed, f->index, st->o.max_depth, f->threads, 0, &c->prog, NULL, NULL};
+    /* Paths kept for every frame use frame 0's random numbers, unless the lights move. */
+    const int path_frame = st->lights_move ? f->index : 0;
+    fv_photon_job job = {st->scene, (int64_t)n_light, f->seed, path_frame, st->o.max_depth, f->threads, 1, &c->prog, NULL, NULL};
     uint64_t rays = 0;
+    int64_t again = 0, again_g = 0;
     fv_kit_phase(&c->prog, f, 0.0, 0.2);
     double t0 = fv_time_ms();
-    fv_status rc = fv_pmt_maps_update(&st->tm, &job, n_light, st->o.dyn_fraction, c->gamma, stats, &rays, err);
+    fv_status rc = fv_dyn_dirs_build(st->dirs, st->scene, err);
+    if (rc == FV_OK && (!fv_path_store_ready(st->ls_store) || st->lights_move)) rc = fv_path_store_trace(st->ls_store, &job, &rays, err);
+    if (rc == FV_OK) rc = frame_map(c, st->ls_store, &st->ls, &again, &rays, err);
     fv_stats_add_ms(stats, "light_tracing", fv_time_ms() - t0);
+    fv_stats_add_count(stats, "light_photons", st->ls.n);
 
     /* The cells the focus region gathers from. */
     t0 = fv_time_ms();
@@ -350,37 +369,42 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
     fv_stats_add_count(stats, "focus_cells", fv_focus_cells_count(st->focus));
 
     /* M_g: kept while the focus region gathers from (mostly) the cells it was guided towards. */
-    bool retrace = !st->mg_valid || st->tm.lights_move || st->mg.cell != c->gamma || overlap < st->o.retrace_overlap;
+    bool retrace = !st->mg_valid || st->lights_move || st->mg.cell != c->gamma || overlap < st->o.retrace_overlap;
     fv_kit_phase(&c->prog, f, 0.2, 0.2);
     t0 = fv_time_ms();
     if (rc == FV_OK && retrace) {
         st->mg_valid = false;
-        fv_photon_map_clear(&st->mg);
         int64_t n_pilot = (int64_t)(n_guided * st->o.pilot_fraction);
-        job.count = n_pilot;
-        job.stream = 3;
-        job.frame = f->index;
-        rc = fv_photon_guide_learn(st->guide, &job, FV_TRACE_STATIC, st->focus, &rays, err);
+        fv_photon_job pilot = job;
+        pilot.count = n_pilot;
+        pilot.stream = 3;
+        pilot.frame = f->index;
+        rc = fv_photon_guide_learn(st->guide, &pilot, FV_TRACE_STATIC, st->focus, &rays, err);
         if (rc == FV_OK) {
-            job.count = (int64_t)n_guided - n_pilot;
-            job.stream = 4;
-            job.warp = fv_photon_guide_warp;
-            job.warp_ctx = st->guide;
-            rc = fv_photon_trace_lights(&job, FV_TRACE_STATIC, &st->mg, &rays, err);
+            fv_photon_job gj = job;
+            gj.count = (int64_t)n_guided - n_pilot;
+            gj.stream = 4;
+            gj.frame = f->index;
+            gj.warp = fv_photon_guide_warp;
+            gj.warp_ctx = st->guide;
+            rc = fv_path_store_trace(st->g_store, &gj, &rays, err);
         }
-        if (rc == FV_OK) rc = fv_photon_map_build_mt(&st->mg, c->gamma, f->threads, err);
         if (rc == FV_OK) {
             st->mg_valid = true;
             fv_focus_cells *tmp = st->mg_focus; /* M_g now serves this frame's cells */
             st->mg_focus = st->focus;
             st->focus = tmp;
-        } else {
-            fv_photon_map_clear(&st->mg);
         }
+    }
+    if (rc == FV_OK) rc = frame_map(c, st->g_store, &st->mg, &again_g, &rays, err);
+    if (rc != FV_OK) {
+        st->mg_valid = false;
+        fv_photon_map_clear(&st->mg);
     }
     fv_stats_add_ms(stats, "guided_tracing", fv_time_ms() - t0);
     fv_stats_add_count(stats, "guided_photons", st->mg.n);
     fv_stats_add_count(stats, "guided_retraced", retrace ? 1.0 : 0.0);
+    fv_stats_add_count(stats, "paths_retraced", (double)(again + again_g));
     fv_stats_add_count(stats, "guide_focus_share", fv_photon_guide_focus_share(st->guide));
     fv_stats_add_count(stats, "focus_overlap", overlap);
     fv_stats_add_count(stats, "rays", (double)rays);
@@ -527,7 +551,6 @@ const fv_technique_class fv_technique_fpm_guided = {
                    "eye_depth=int (8): mirror/glass bounces of eye rays\n"
                    "filter=bool (true): lattice filter in the periphery, A-Trous over the focus region\n"
                    "split=bool (true): follow both reflection and refraction at an eye path's first dielectric\n"
-                   "dyn_fraction=float (0.2): share of light photons sent towards dynamic objects each frame\n"
                    "guided_fraction=float (0.4): share of the photons guided towards the focus region\n"
                    "alpha=float (0.8): share of guided photons the learnt cells get (the rest uniform)\n"
                    "pilot_fraction=float (0.125): share of the guided budget spent learning where to guide\n"
