@@ -88,11 +88,15 @@ static fv_rng photon_rng(const fv_photon_job *job, int64_t i, uint64_t sub)
     return fv_rng_stream(job->seed, FV_STREAM_PHOTONS(job->stream), (uint64_t)i, sub, (uint64_t)job->frame);
 }
 
-bool fv_photon_emit(const fv_photon_job *job, int64_t i, fv_rng *rng, fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux)
+bool fv_photon_emit(const fv_photon_job *job, int64_t i, fv_rng *rng, float u[5], fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux)
 {
     *rng = photon_rng(job, i, 0);
-    if (!job->warp) return fv_light_path_emit(job->scene, rng, job->count, o, d, flux);
-    float u[5], q = job->warp(job->warp_ctx, rng, u);
+    if (!job->warp) {
+        /* fv_light_path_emit's five numbers, kept for the caller */
+        for (int k = 0; k < 5; k++) u[k] = fv_rng_next(rng);
+        return fv_light_path_emit_u(job->scene, u, job->count, o, d, flux);
+    }
+    float q = job->warp(job->warp_ctx, rng, u);
     if (!(q > 0.0f) || !fv_light_path_emit_u(job->scene, u, job->count, o, d, flux)) return false;
     *flux = fv_scale(*flux, 1.0f / q);
     return true;
@@ -102,8 +106,9 @@ static void light_photon(const run_ctx *c, int64_t i, block_out *out)
 {
     const fv_photon_job *job = c->job;
     fv_rng rng;
+    float u[5];
     fv_vec3 o, d, flux;
-    if (!fv_photon_emit(job, i, &rng, &o, &d, &flux)) return;
+    if (!fv_photon_emit(job, i, &rng, u, &o, &d, &flux)) return;
     fv_light_path_trace(job->scene, c->set, o, d, flux, 0, job->max_depth, &rng, deposit, out, &out->rays);
 }
 
