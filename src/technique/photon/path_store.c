@@ -1,6 +1,5 @@
 /* fovea — kept static photon paths, refreshed near the dynamic objects (see path_store.h). */
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
@@ -96,6 +95,28 @@ void fv_path_store_destroy(fv_path_store *p)
 
 bool fv_path_store_ready(const fv_path_store *p) { return p->ready; }
 
+typedef struct trace_job {
+    fv_path_store *p;
+    const fv_photon_job *job;
+    blk *b;
+} trace_job;
+
+/* Block k of the paths, recorded into its own output. */
+static void trace_block(void *ctx, int64_t k)
+{
+    const trace_job *t = ctx;
+    const fv_photon_job *job = t->job;
+    blk *o = &t->b[k];
+    o->record = true;
+    int64_t end = (k + 1) * BLOCK < job->count ? (k + 1) * BLOCK : job->count;
+    for (int64_t i = k * BLOCK; i < end; i++) {
+        int np = o->np, ns = o->ns;
+        walk(job, FV_TRACE_STATIC, i, o, t->p->u[i]);
+        o->pn[i - k * BLOCK] = o->np - np;
+        o->sn[i - k * BLOCK] = o->ns - ns;
+    }
+}
+
 fv_status fv_path_store_trace(fv_path_store *p, const fv_photon_job *job, uint64_t *rays, fv_error *err)
 {
     clear(p);
@@ -114,31 +135,8 @@ fv_status fv_path_store_trace(fv_path_store *p, const fv_photon_job *job, uint64
         clear(p);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory keeping %lld photon paths", (long long)job->count);
     }
-    int64_t done = 0;
-    int stop = 0;
-    #pragma omp parallel for schedule(dynamic, 1) num_threads(fv_thread_count(job->threads))
-    for (int64_t k = 0; k < nblocks; k++) {
-        int halt;
-        #pragma omp atomic read
-        halt = stop;
-        if (halt) continue;
-        blk *o = &b[k];
-        o->record = true;
-        int64_t end = (k + 1) * BLOCK < job->count ? (k + 1) * BLOCK : job->count;
-        for (int64_t i = k * BLOCK; i < end; i++) {
-            int np = o->np, ns = o->ns;
-            walk(job, FV_TRACE_STATIC, i, o, p->u[i]);
-            o->pn[i - k * BLOCK] = o->np - np;
-            o->sn[i - k * BLOCK] = o->ns - ns;
-        }
-        int64_t d;
-        #pragma omp atomic capture
-        d = ++done;
-        if (job->progress && omp_get_thread_num() == 0 && !fv_kit_progress_fn(job->progress, (double)d / nblocks)) {
-            #pragma omp atomic write
-            stop = 1;
-        }
-    }
+    trace_job tj = {p, job, b};
+    bool stop = !fv_photon_blocks(job, nblocks, trace_block, &tj);
     /* Concatenated in block order: the store does not depend on the thread count. */
     fv_status st = stop ? fv_error_set(err, FV_ERR_CANCELLED, "render cancelled") : FV_OK;
     int64_t tp = 0, ts = 0;

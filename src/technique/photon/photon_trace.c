@@ -45,23 +45,17 @@ typedef struct run_ctx {
 
 typedef void (*photon_fn)(const run_ctx *c, int64_t i, block_out *out);
 
-static fv_status run_blocks(run_ctx *c, photon_fn fn, fv_photon_map *out, uint64_t *rays, fv_error *err)
+bool fv_photon_blocks(const fv_photon_job *job, int64_t nblocks, fv_photon_block_fn fn, void *ctx)
 {
-    const fv_photon_job *job = c->job;
-    int64_t nblocks = (job->count + BLOCK - 1) / BLOCK;
-    c->blocks = fv_calloc_array((size_t)nblocks, sizeof *c->blocks);
-    if (!c->blocks) return fv_error_set(err, FV_ERR_NOMEM, "out of memory tracing %lld photons", (long long)job->count);
-    int nthreads = fv_thread_count(job->threads);
     int64_t done = 0;
     int stop = 0;
-    #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+    #pragma omp parallel for schedule(dynamic, 1) num_threads(fv_thread_count(job->threads))
     for (int64_t b = 0; b < nblocks; b++) {
         int halt;
         #pragma omp atomic read
         halt = stop;
         if (halt) continue;
-        int64_t end = (b + 1) * BLOCK < job->count ? (b + 1) * BLOCK : job->count;
-        for (int64_t i = b * BLOCK; i < end; i++) fn(c, i, &c->blocks[b]);
+        fn(ctx, b);
         int64_t d;
         #pragma omp atomic capture
         d = ++done;
@@ -71,6 +65,30 @@ static fv_status run_blocks(run_ctx *c, photon_fn fn, fv_photon_map *out, uint64
             stop = 1;
         }
     }
+    return !stop;
+}
+
+typedef struct block_job {
+    run_ctx *c;
+    photon_fn fn;
+} block_job;
+
+static void run_block(void *ctx, int64_t b)
+{
+    block_job *j = ctx;
+    const fv_photon_job *job = j->c->job;
+    int64_t end = (b + 1) * BLOCK < job->count ? (b + 1) * BLOCK : job->count;
+    for (int64_t i = b * BLOCK; i < end; i++) j->fn(j->c, i, &j->c->blocks[b]);
+}
+
+static fv_status run_blocks(run_ctx *c, photon_fn fn, fv_photon_map *out, uint64_t *rays, fv_error *err)
+{
+    const fv_photon_job *job = c->job;
+    int64_t nblocks = (job->count + BLOCK - 1) / BLOCK;
+    c->blocks = fv_calloc_array((size_t)nblocks, sizeof *c->blocks);
+    if (!c->blocks) return fv_error_set(err, FV_ERR_NOMEM, "out of memory tracing %lld photons", (long long)job->count);
+    block_job bj = {c, fn};
+    bool stop = !fv_photon_blocks(job, nblocks, run_block, &bj);
     fv_status st = stop ? fv_error_set(err, FV_ERR_CANCELLED, "render cancelled") : FV_OK;
     for (int64_t b = 0; b < nblocks; b++) {
         if (c->blocks[b].oom && st == FV_OK) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory storing photons");
