@@ -62,6 +62,7 @@ typedef struct gd_state {
     bool lights_move;
     fv_photon_map map;         /* this frame's map: both stores' photons, weighted (below) */
     double n_ls, n_g;          /* how many paths each store traced */
+    int map_ls_n;              /* how many of map's photons came from M_ls; -1: map must be made */
     bool mg_valid;
     fv_focus_cells *focus;     /* this frame's focus cells */
     fv_focus_cells *mg_focus;  /* the cells M_g was guided towards */
@@ -123,6 +124,7 @@ static fv_status gd_create(const fv_scene *scene, fv_params *params, const fv_lo
     st->scene = scene;
     st->maps_index = -1;
     fv_photon_map_init(&st->map);
+    st->map_ls_n = -1;
     st->lights_move = fv_scene_lights_move(scene);
     fv_status s = read_opts(params, &st->o, err);
     if (s == FV_OK) s = fv_path_store_create(&st->ls_store, err);
@@ -363,7 +365,10 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
     fv_kit_phase(&c->prog, f, 0.0, 0.2);
     double t0 = fv_time_ms();
     fv_status rc = fv_dyn_dirs_build(st->dirs, st->scene, err);
-    if (rc == FV_OK && (!fv_path_store_ready(st->ls_store) || st->lights_move)) rc = fv_path_store_trace(st->ls_store, &job, &rays, err);
+    if (rc == FV_OK && (!fv_path_store_ready(st->ls_store) || st->lights_move)) {
+        rc = fv_path_store_trace(st->ls_store, &job, &rays, err);
+        st->map_ls_n = -1;
+    }
     st->n_ls = (double)job.count;
     fv_stats_add_ms(stats, "light_tracing", fv_time_ms() - t0);
 
@@ -388,6 +393,7 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
     if (rc == FV_OK && retrace) {
         st->mg_valid = false;
         st->n_g = 0.0;
+        st->map_ls_n = -1;
         int64_t n_pilot = (int64_t)(n_guided * st->o.pilot_fraction);
         fv_photon_job pilot = job;
         pilot.count = n_pilot;
@@ -412,15 +418,21 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
         }
     }
     fv_stats_add_ms(stats, "guided_tracing", fv_time_ms() - t0);
-    /* The frame's map: both sets, refreshed near the dynamic objects, weighted, in one grid. */
+    /* The frame's map: both sets, refreshed near the dynamic objects, weighted, in one grid; kept
+     * as it is while nothing moves and neither set was traced again. */
     t0 = fv_time_ms();
-    fv_photon_map_clear(&st->map);
-    if (rc == FV_OK) rc = fv_path_store_frame(st->ls_store, st->dirs, scale_ls, st, f->threads, &st->map, &again, &rays, err);
-    int n_ls = st->map.n;
-    if (rc == FV_OK && st->mg_valid) rc = fv_path_store_frame(st->g_store, st->dirs, scale_g, st, f->threads, &st->map, &again_g, &rays, err);
-    if (rc == FV_OK) rc = fv_photon_map_build_mt(&st->map, c->gamma, f->threads, err);
+    bool remake = st->map_ls_n < 0 || fv_dyn_dirs_count(st->dirs) > 0 || st->map.cell != c->gamma;
+    if (rc == FV_OK && remake) {
+        fv_photon_map_clear(&st->map);
+        rc = fv_path_store_frame(st->ls_store, st->dirs, scale_ls, st, f->threads, &st->map, &again, &rays, err);
+        st->map_ls_n = st->map.n;
+        if (rc == FV_OK && st->mg_valid) rc = fv_path_store_frame(st->g_store, st->dirs, scale_g, st, f->threads, &st->map, &again_g, &rays, err);
+        if (rc == FV_OK) rc = fv_photon_map_build_mt(&st->map, c->gamma, f->threads, err);
+    }
+    const int n_ls = st->map_ls_n;
     if (rc != FV_OK) {
         st->mg_valid = false;
+        st->map_ls_n = -1;
         fv_photon_map_clear(&st->map);
     }
     fv_stats_add_ms(stats, "photon_map", fv_time_ms() - t0);
