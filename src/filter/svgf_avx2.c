@@ -11,7 +11,6 @@
 #if defined(__x86_64__) && defined(__GNUC__)
 #pragma GCC push_options
 #pragma GCC target("avx2")
-#include <immintrin.h>
 #include "filter/svgf_impl.h"
 #define SVGF_ISA(name) fv_svgf_##name##_avx2
 #define SVGF_VW 8 /* floats per AVX2 vector */
