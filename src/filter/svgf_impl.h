@@ -61,6 +61,8 @@ struct fv_svgf {
     long *row_surface, *row_hist, *row_holes;
     double *row_len;
     bool avx2;              /* the sweeps' AVX2 build (svgf_avx2.c), else the baseline one */
+    bool blocks;            /* À-Trous pixels with every tap inner (register blocks, gathers); false:
+                               FV_SVGF_ISA_PLAIN, one tap at a time */
     int periph_x, periph_passes; /* fv_svgf_set_periphery (w, iterations: off) */
     int pass_cut;           /* the current pass filters the columns [0, pass_cut) */
 };

@@ -355,7 +355,7 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
              * filtered by atrous_block; the per-tap loops do the rest of the span. */
             int va = s0, vb = s0;
             long offs[NTAP];
-            if (sq == SQ_DEFAULT) {
+            if (sq == SQ_DEFAULT && f->blocks) {
                 int lo = s0, hi = s1;
                 for (int t = 0; t < NTAP && lo < hi; t++) {
                     int a, b;
@@ -368,7 +368,7 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
             for (int part = 0; part < 2; part++) {
                 const int u0 = part ? vb : s0, u1 = part ? s1 : va;
                 if (u0 >= u1) continue;
-                if (g->wrap && sq == SQ_DEFAULT) {
+                if (g->wrap && sq == SQ_DEFAULT && f->blocks) {
                     /* Polar grids: every tap is a pixel (clamp and wrap), so the rest of the span
                      * (short columns, the clamped edges, the ends of the runs) takes its tap indices
                      * from the runs and the per-chunk table, then goes SVGF_VW pixels at a time with
