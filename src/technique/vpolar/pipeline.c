@@ -363,9 +363,6 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     fv_stats_add_count(stats, "sample_share", (double)tr.paths / ((double)p->sw * p->sh));
     fv_stats_add_count(stats, "mrays_per_s", t_trace > 0.0 ? (double)tr.rays / t_trace / 1000.0 : 0.0);
     fv_stats_add_count(stats, "nan_samples", (double)tr.nan_paths);
-    /* Why a trace gains less than its sample count (issue 16): idle packet lanes, sky samples. */
-    fv_stats_add_count(stats, "packet_occupancy", tr.packets ? (double)tr.paths / (8.0 * (double)tr.packets) : 0.0);
-    fv_stats_add_count(stats, "miss_share", tr.paths ? (double)tr.misses / (double)tr.paths : 0.0);
     if (!traced) return fv_error_set(err, FV_ERR_CANCELLED, "render cancelled"); /* history left as it was */
 
     /* 2. denoise in the sample space */

@@ -10,7 +10,7 @@ typedef struct trace_ctx {
     const fv_vp_trace_job *job;
     const fv_vp_gbuf *g;
     const fv_grid *grid;
-    fv_kit_counters *counters; /* rays, NaN, paths (FV_KIT_USER0), packets (USER1), misses (USER2) */
+    fv_kit_counters *counters; /* rays, NaN, paths (FV_KIT_USER0) */
 } trace_ctx;
 
 double fv_vp_survival(const fv_space_view *v, float px, float py, double px_per_deg, double e0, double e1, double p)
@@ -70,7 +70,7 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
     }
     if (!nactive) return;
     fv_scene_intersect8_active(j->scene, j->cam.pos, dir, active, hits, ok);
-    uint64_t rays = 0, bad = 0, misses = 0;
+    uint64_t rays = 0, bad = 0;
     for (int k = 0; k < 8; k++) {
         if (!active[k]) continue;
         long i = pix[k];
@@ -89,7 +89,6 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
             g->depth[i] = first.t;
             g->id[i] = (uint32_t)first.obj + 1u;
         } else {
-            misses++;
             fv_vec3 keep = L;
             store_miss(g, i);
             g->color[3 * i] = keep.x, g->color[3 * i + 1] = keep.y, g->color[3 * i + 2] = keep.z;
@@ -98,8 +97,6 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
     fv_kit_count(c->counters, thread, FV_KIT_RAYS, rays);
     fv_kit_count(c->counters, thread, FV_KIT_USER0, (uint64_t)nactive);
     fv_kit_count(c->counters, thread, FV_KIT_NAN, bad);
-    fv_kit_count(c->counters, thread, FV_KIT_USER1, 1);
-    fv_kit_count(c->counters, thread, FV_KIT_USER2, misses);
 }
 
 static void grid_tile(void *ctx, const fv_tile *t)
@@ -145,8 +142,6 @@ bool fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_re
     res->rays = fv_kit_sum(c->counters, FV_KIT_RAYS);
     res->paths = fv_kit_sum(c->counters, FV_KIT_USER0);
     res->nan_paths = fv_kit_sum(c->counters, FV_KIT_NAN);
-    res->packets = fv_kit_sum(c->counters, FV_KIT_USER1);
-    res->misses = fv_kit_sum(c->counters, FV_KIT_USER2);
     fv_kit_counters_destroy(c->counters);
     return done;
 }

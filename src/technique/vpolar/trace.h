@@ -51,8 +51,6 @@ typedef struct fv_vp_trace_job {
 typedef struct fv_vp_trace_result {
     uint64_t rays, paths;
     uint64_t nan_paths;
-    uint64_t packets;      /* camera packets traced (paths / (8 packets): their occupancy) */
-    uint64_t misses;       /* paths whose camera ray left the scene (sky, background) */
 } fv_vp_trace_result;
 
 /* Linear fall-off (Weier et al. 2016): the probability that a path at screen position (px, py)
