@@ -205,6 +205,7 @@ bool fv_svgf_set_isa(fv_svgf *f, fv_svgf_isa isa)
     bool can = cpu_has_avx2();
     if (isa == FV_SVGF_ISA_AVX2 && !can) return false;
     f->avx2 = isa == FV_SVGF_ISA_AVX2 || (isa == FV_SVGF_ISA_AUTO && can);
+    f->blocks = isa != FV_SVGF_ISA_PLAIN;
     return true;
 }
 

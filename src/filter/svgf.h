@@ -71,7 +71,9 @@ void fv_svgf_destroy(fv_svgf *f);
  * baseline x86-64 (SSE2) build; both give the same bits, so this only matters for speed and for
  * the tests that compare them. False (nothing changes) when AVX2 is asked for and the CPU lacks it.
  * The environment variable FOVEA_SVGF_ISA=baseline, read by fv_svgf_create, forces the baseline. */
-typedef enum fv_svgf_isa { FV_SVGF_ISA_AUTO = 0, FV_SVGF_ISA_BASELINE, FV_SVGF_ISA_AVX2 } fv_svgf_isa;
+/* PLAIN is the baseline build with every pixel's taps added one tap at a time (no register-blocked
+ * pixels, no gathered vectors): the order the vectorised paths must reproduce, for the tests. */
+typedef enum fv_svgf_isa { FV_SVGF_ISA_AUTO = 0, FV_SVGF_ISA_BASELINE, FV_SVGF_ISA_AVX2, FV_SVGF_ISA_PLAIN } fv_svgf_isa;
 bool fv_svgf_set_isa(fv_svgf *f, fv_svgf_isa isa);
 
 /* Fewer À-Trous passes in the periphery (Visual-Polar Sec. 3.5: where the foveated blur will

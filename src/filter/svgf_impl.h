@@ -61,6 +61,8 @@ struct fv_svgf {
     long *row_surface, *row_hist, *row_holes;
     double *row_len;
     bool avx2;              /* the sweeps' AVX2 build (svgf_avx2.c), else the baseline one */
+    bool blocks;            /* À-Trous pixels with every tap inner (register blocks, gathers); false:
+                               FV_SVGF_ISA_PLAIN, one tap at a time */
     int periph_x, periph_passes; /* fv_svgf_set_periphery (w, iterations: off) */
     int pass_cut;           /* the current pass filters the columns [0, pass_cut) */
 };
@@ -147,24 +149,39 @@ static inline bool surface_span(const uint8_t *kind, size_t p0, int x0, int x1, 
 
 /* The pixels of a chunk that are not in a tap's run (polar grids: short columns, clamped edges) take
  * their taps through this table: for each column offset, where fv_grid_tap(x, y, dx, .) starts. The
- * same-angle mapping between columns of different heights is an integer division, done once per
- * column offset here rather than once per tap. */
+ * same-angle mapping between columns of different heights is a division, done once per column
+ * offset here rather than once per tap, and only for the pixels that need it. */
 typedef struct chunk_cols {
     int x[7][CHUNK], row[7][CHUNK], n[7][CHUNK];
     bool ready;     /* built for the current chunk (only chunks that need it build it) */
 } chunk_cols;
 
-static void chunk_columns(const fv_grid *g, int y, int x0, int nc, int step, int ncols, chunk_cols *cc)
+/* floor(a / b) for a >= 0, b > 0, exactly: the quotient in double is within a few ulps of a / b,
+ * and the two integer tests correct the one step it may be off when a / b is (nearly) an integer.
+ * fv_grid_tap's integer division, without the 64-bit divide (a chunk of the fovea needs hundreds). */
+static inline int floor_div(long a, long b, double inv_b)
+{
+    long r = (long)((double)a * inv_b);
+    r += (r + 1) * b <= a;
+    r -= r * b > a;
+    return (int)r;
+}
+
+/* The table for the pixels [k0, k1) of the chunk at x0 (row y, column offsets (i - ncols / 2) step). */
+static void chunk_columns(const fv_grid *g, int y, int x0, int k0, int k1, int step, int ncols, chunk_cols *cc)
 {
     const int half = ncols / 2;
-    for (int i = 0; i < ncols; i++)
-        for (int k = 0; k < nc; k++) {
-            int x = x0 + k, xx = x + (i - half) * step;
+    for (int k = k0; k < k1; k++) {
+        const int x = x0 + k, hs = fv_grid_col_h(g, x);
+        const double inv = 1.0 / (2.0 * (double)hs);
+        for (int i = 0; i < ncols; i++) {
+            int xx = x + (i - half) * step;
             xx = xx < 0 ? 0 : (xx >= g->w ? g->w - 1 : xx);
-            int hs = fv_grid_col_h(g, x), hd = fv_grid_col_h(g, xx), row = y;
-            if (hs != hd) row = (int)(((long)y * 2 + 1) * hd / (2L * hs));
-            cc->x[i][k] = xx, cc->row[i][k] = row, cc->n[i][k] = hd;
+            const int hd = fv_grid_col_h(g, xx);
+            cc->x[i][k] = xx, cc->n[i][k] = hd;
+            cc->row[i][k] = hs == hd ? y : floor_div(((long)y * 2 + 1) * hd, 2L * hs, inv);
         }
+    }
     cc->ready = true;
 }
 
@@ -172,6 +189,7 @@ static void chunk_columns(const fv_grid *g, int y, int x0, int nc, int step, int
 static inline int chunk_tap(const fv_grid *g, const chunk_cols *cc, int ci, int k, int dy)
 {
     int n = cc->n[ci][k], yy = cc->row[ci][k] + dy;
+    yy += yy < 0 ? n : (yy >= n ? -n : 0); /* once around: no division */
     if (yy < 0 || yy >= n) yy = fv_grid_wrap_row(yy, n);
     return yy * g->w + cc->x[ci][k];
 }

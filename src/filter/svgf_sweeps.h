@@ -104,7 +104,7 @@ void SVGF_ISA(variance)(fv_svgf *f, int nt)
                         moments_tap(f, p0 + (x - x0), (int)off + x, x - x0, rzc[x - x0], sq, sn, a1, a2, aw);
                 }
                 if (!g->wrap || (a == s0 && b == s1)) continue;
-                if (!cc.ready) chunk_columns(g, y, x0, nc, 1, 7, &cc);
+                if (!cc.ready) chunk_columns(g, y, x0, s0 - x0, s1 - x0, 1, 7, &cc);
                 fallback_taps(g, &cc, di[t] + 3, dj[t], x0, s0, s1, a, b, fq);
                 for (int r = 0; r < 2; r++) {
                     const int lo = r ? b : s0, hi = r ? s1 : a;
@@ -167,7 +167,7 @@ void SVGF_ISA(prefilter)(fv_svgf *f, const float *var, int nt)
                         aw[x - x0] += kk * surf[off + x];
                     }
                     if (!g->wrap || (a == s0 && b == s1)) continue;
-                    if (!cc.ready) chunk_columns(g, y, x0, nc, 1, 3, &cc);
+                    if (!cc.ready) chunk_columns(g, y, x0, s0 - x0, s1 - x0, 1, 3, &cc);
                     fallback_taps(g, &cc, i, j - 1, x0, s0, s1, a, b, fq);
                     for (int r = 0; r < 2; r++) {
                         const int lo = r ? b : s0, hi = r ? s1 : a;
@@ -238,8 +238,21 @@ TAP_INLINE vfw exp_neg_w(vfw x)
     return p * (vfw)scale;
 }
 
-TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const long *off, const float *kw, const int *cls,
-                             pass_acc *acc)
+/* The tap values of SVGF_VW pixels: a plain load from q (qi NULL) or gathered from the indices
+ * qi[0..SVGF_VW) (lane by lane: on the CPUs measured, faster than AVX2's vgatherdps). */
+TAP_INLINE vfw tap_load(const float *b, long q, const int *qi)
+{
+    if (!qi) return LDW(&b[q]);
+    vfw r;
+    for (int j = 0; j < SVGF_VW; j++) r[j] = b[qi[j]];
+    return r;
+}
+
+/* SVGF_VW pixels from chunk slot k (pixel x, index p) with their 24 taps: tap t is at off[t] + x (qt
+ * NULL: every tap a plain shift) or at the indices qt[t][k..] (any taps, gathered). Only the lanes
+ * [from, to) are stored (a span's last pixels, in a vector that overlaps other pixels). */
+TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const long *off, const int (*qt)[CHUNK],
+                             const float *kw, const int *cls, int from, int to, pass_acc *acc)
 {
     const vfw nxp = LDW(&s->nx[p]), nyp = LDW(&s->ny[p]), nzp = LDW(&s->nz[p]), zp = LDW(&s->z[p]), lp = LDW(&s->l[p]);
     const vfw il = LDW(&acc->inv_l[k]);
@@ -247,19 +260,25 @@ TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const lo
     for (int c = 0; c < 5; c++) rz[c] = LDW(&acc->rz[c][k]);
     vfw ar = LDW(&acc->r[k]), ag = LDW(&acc->g[k]), ab = LDW(&acc->b[k]), av = LDW(&acc->v[k]), aw = LDW(&acc->w[k]);
     for (int t = 0; t < NTAP; t++) {
-        const long q = off[t] + x;
-        vfw c = nxp * LDW(&s->nx[q]) + nyp * LDW(&s->ny[q]) + nzp * LDW(&s->nz[q]);
+        const long q = qt ? 0 : off[t] + x;
+        const int *qi = qt ? &qt[t][k] : NULL;
+        vfw c = nxp * tap_load(s->nx, q, qi) + nyp * tap_load(s->ny, q, qi) + nzp * tap_load(s->nz, q, qi);
         c = 0.5f * (c + fabs_w(c));
         for (int i = 0; i < SQ_DEFAULT; i++) c *= c;
-        const vfw e = fabs_w(zp - LDW(&s->z[q])) * rz[cls[t]] + fabs_w(lp - LDW(&s->l[q])) * il;
+        const vfw e = fabs_w(zp - tap_load(s->z, q, qi)) * rz[cls[t]] + fabs_w(lp - tap_load(s->l, q, qi)) * il;
         const vfw wt = kw[t] * c * exp_neg_w(e);
-        ar += wt * LDW(&s->r[q]);
-        ag += wt * LDW(&s->g[q]);
-        ab += wt * LDW(&s->b[q]);
-        av += wt * wt * LDW(&s->v[q]);
+        ar += wt * tap_load(s->r, q, qi);
+        ag += wt * tap_load(s->g, q, qi);
+        ab += wt * tap_load(s->b, q, qi);
+        av += wt * wt * tap_load(s->v, q, qi);
         aw += wt;
     }
-    STW(&acc->r[k], ar), STW(&acc->g[k], ag), STW(&acc->b[k], ab), STW(&acc->v[k], av), STW(&acc->w[k], aw);
+    if (from == 0 && to == SVGF_VW) {
+        STW(&acc->r[k], ar), STW(&acc->g[k], ag), STW(&acc->b[k], ab), STW(&acc->v[k], av), STW(&acc->w[k], aw);
+        return;
+    }
+    for (int j = from; j < to; j++)
+        acc->r[k + j] = ar[j], acc->g[k + j] = ag[j], acc->b[k + j] = ab[j], acc->v[k + j] = av[j], acc->w[k + j] = aw[j];
 }
 
 /* One pass with taps `step` apart from val[src] to val[1 - src]; the first also writes the history. */
@@ -292,7 +311,7 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
     #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
     for (int y = 0; y < h; y++) {
         pass_acc acc;
-        int fq[CHUNK];
+        int fq[CHUNK], qt[NTAP][CHUNK];
         chunk_cols cc;
         for (int x0 = 0; x0 < w; x0 += CHUNK) {
             const int x1 = imin(x0 + CHUNK, w), nc = x1 - x0;
@@ -336,7 +355,7 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
              * filtered by atrous_block; the per-tap loops do the rest of the span. */
             int va = s0, vb = s0;
             long offs[NTAP];
-            if (sq == SQ_DEFAULT) {
+            if (sq == SQ_DEFAULT && f->blocks) {
                 int lo = s0, hi = s1;
                 for (int t = 0; t < NTAP && lo < hi; t++) {
                     int a, b;
@@ -344,11 +363,45 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
                     lo = imax(lo, a), hi = imin(hi, b);
                 }
                 if (lo < hi) va = lo, vb = lo + (hi - lo) / SVGF_VW * SVGF_VW;
-                for (int x = va; x < vb; x += SVGF_VW) atrous_block(&s, p0 + (x - x0), x, x - x0, offs, kw, cls, &acc);
+                for (int x = va; x < vb; x += SVGF_VW) atrous_block(&s, p0 + (x - x0), x, x - x0, offs, NULL, kw, cls, 0, SVGF_VW, &acc);
             }
             for (int part = 0; part < 2; part++) {
                 const int u0 = part ? vb : s0, u1 = part ? s1 : va;
                 if (u0 >= u1) continue;
+                if (g->wrap && sq == SQ_DEFAULT && f->blocks) {
+                    /* Polar grids: every tap is a pixel (clamp and wrap), so the rest of the span
+                     * (short columns, the clamped edges, the ends of the runs) takes its tap indices
+                     * from the runs and the per-chunk table, then goes SVGF_VW pixels at a time with
+                     * every tap inner like the shifted pixels, its loads gathered. */
+                    cc.ready = false; /* each part builds the table for its own pixels */
+                    for (int t = 0; t < NTAP; t++) {
+                        int a, b;
+                        long off;
+                        tap_run(f, y, di[t], dj[t], u0, u1, &a, &b, &off);
+                        for (int x = a; x < b; x++) qt[t][x - x0] = (int)off + x;
+                        if (a == u0 && b == u1) continue;
+                        if (!cc.ready) chunk_columns(g, y, x0, u0 - x0, u1 - x0, step, 5, &cc);
+                        fallback_taps(g, &cc, di[t] / step + 2, dj[t], x0, u0, u1, a, b, qt[t]);
+                    }
+                    int x = u0;
+                    for (; x + SVGF_VW <= u1; x += SVGF_VW) atrous_block(&s, p0 + (x - x0), x, x - x0, NULL, qt, kw, cls, 0, SVGF_VW, &acc);
+                    if (x < u1 && nc >= SVGF_VW) {
+                        /* The last pixels in one vector ending at u1 (or starting at the chunk's
+                         * start): its other lanes are pixels done already or other parts of the
+                         * chunk; they tap themselves and are not stored. */
+                        const int xs = imax(x0, u1 - SVGF_VW), ks = xs - x0;
+                        for (int t = 0; t < NTAP; t++)
+                            for (int j = ks; j < x - x0; j++) qt[t][j] = (int)p0 + j;
+                        for (int t = 0; t < NTAP; t++)
+                            for (int j = u1 - x0; j < ks + SVGF_VW; j++) qt[t][j] = (int)p0 + j;
+                        atrous_block(&s, p0 + ks, xs, ks, NULL, qt, kw, cls, x - xs, u1 - xs, &acc);
+                        x = u1;
+                    }
+                    for (; x < u1; x++)
+                        for (int t = 0; t < NTAP; t++)
+                            atrous_tap(&s, p0 + (x - x0), qt[t][x - x0], x - x0, kw[t], acc.rz[cls[t]], SQ_DEFAULT, sn, &acc);
+                    continue;
+                }
                 for (int t = 0; t < NTAP; t++) {
                     int a, b;
                     long off;
@@ -362,7 +415,7 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
                         for (int x = a; x < b; x++) atrous_tap(&s, p0 + (x - x0), (int)off + x, x - x0, kw[t], rz, sq, sn, &acc);
                     }
                     if (!g->wrap || (a == u0 && b == u1)) continue;
-                    if (!cc.ready) chunk_columns(g, y, x0, nc, step, 5, &cc);
+                    if (!cc.ready) chunk_columns(g, y, x0, s0 - x0, s1 - x0, step, 5, &cc);
                     fallback_taps(g, &cc, di[t] / step + 2, dj[t], x0, u0, u1, a, b, fq);
                     for (int r = 0; r < 2; r++) {
                         const int lo = r ? b : u0, hi = r ? u1 : a;

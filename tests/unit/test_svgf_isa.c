@@ -145,6 +145,32 @@ static void test_same_bits(void **st)
     free(tri);
 }
 
+/* The vectorised paths against one tap at a time (FV_SVGF_ISA_PLAIN): the register-blocked pixels,
+ * and on the triangle the short columns, the columns beside them and the clamped edge, whose taps
+ * are gathered 4 or 8 pixels at a time, give the same bits as adding each tap to each pixel in
+ * turn; in the baseline build and, where the CPU has it, in the AVX2 build. */
+static void test_plain_same_bits(void **st)
+{
+    (void)st;
+    int *tri = triangle(150, 72);
+    const fv_grid grids[3] = {{150, 72, tri, true}, {150, 72, NULL, true}, {150, 72, NULL, false}};
+    const fv_svgf_isa isas[2] = {FV_SVGF_ISA_BASELINE, FV_SVGF_ISA_AVX2};
+    for (int gi = 0; gi < 3; gi++)
+        for (int ii = 0; ii < (have_avx2() ? 2 : 1); ii++) {
+            fv_svgf *fp = make_filter(&grids[gi], 128.0f, FV_SVGF_ISA_PLAIN);
+            fv_svgf *fv = make_filter(&grids[gi], 128.0f, isas[ii]);
+            for (uint32_t k = 0; k < 4; k++) {
+                frame_buf p = make_frame(&grids[gi], k, gi == 0), v = make_frame(&grids[gi], k, gi == 0);
+                filter(fp, &p, k > 0);
+                filter(fv, &v, k > 0);
+                assert_memory_equal(p.color, v.color, p.n * 3 * sizeof(float));
+                free_frame(&p), free_frame(&v);
+            }
+            fv_svgf_destroy(fp), fv_svgf_destroy(fv);
+        }
+    free(tri);
+}
+
 /* Rows wrap without a seam: rotating a full polar grid's rows by r rotates the filtered image by r
  * (the first frame and one with a history whose coordinates rotate too). */
 static void test_wrap_rotation(void **st)
@@ -230,6 +256,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_bits),
+        cmocka_unit_test(test_plain_same_bits),
         cmocka_unit_test(test_wrap_rotation),
         cmocka_unit_test(test_inactive_never_leak),
     };

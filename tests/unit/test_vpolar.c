@@ -1,5 +1,6 @@
 /* Visual-Polar path tracing and its baselines end to end on the Cornell box: the launch order and
- * the thread count do not change the image (same samples), sample counts follow each method's
+ * the thread count do not change the image (same samples), the map stage's kept coordinates give
+ * the image computed afresh and a moved gaze is mapped afresh, sample counts follow each method's
  * distribution, the denoised sequence converges towards the converged one-bounce path tracer in
  * the fovea, stereo renders both eyes, the space and density views show the layout, and bad
  * parameters are refused naming the key. */
@@ -193,6 +194,57 @@ static void test_converges(void **st)
 
 /* show=space: the grid in the top-left corner, its clipped rows marked; show=density: at least one
  * sample per pixel at the gaze, the reported fovea density, far fewer in the corners. */
+/* The map stage keeps its per-pixel coordinates while the gaze stays (from the second frame at
+ * one gaze, read from the third): the image read through them is the one computed afresh, and a
+ * gaze that moves is mapped afresh. Without the denoiser a frame depends only on its index and
+ * gaze, so frame i of a sequence must equal frame i rendered alone. */
+static float *render_gazes(const fv_gaze *gz, int n, int first, fv_stats *stats_out)
+{
+    fv_error err;
+    const char *kv[] = {"denoise=false", NULL};
+    fv_params *p = fv_test_params(kv);
+    fv_technique *t;
+    if (fv_technique_create("vpolar", g_scene, p, NULL, &t, &err) != FV_OK) fail_msg("%s", err.msg);
+    fv_film *film;
+    assert_int_equal(fv_film_create(W, H, FV_AUX_ALL, &film, &err), FV_OK);
+    fv_camera cam;
+    fv_view_camera(g_view, g_scene, 0.0, W, H, &cam);
+    fv_stats stats;
+    for (int i = first; i < n; i++) {
+        fv_frame fr;
+        fv_frame_init(&fr, &cam);
+        fr.seed = 5, fr.threads = 2, fr.index = i, fr.gaze = gz[i];
+        fv_stats_clear(&stats);
+        if (fv_technique_render(t, &fr, film, &stats, &err) != FV_OK) fail_msg("frame %d: %s", i, err.msg);
+    }
+    float *img = malloc(sizeof(float) * 3 * W * H);
+    memcpy(img, fv_film_color_const(film), sizeof(float) * 3 * W * H);
+    *stats_out = stats;
+    fv_film_destroy(film);
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+    return img;
+}
+
+static void test_map_keeps_coords_while_gaze_stays(void **st)
+{
+    (void)st;
+    const fv_gaze a = {0.3f, 0.6f}, b = {0.31f, 0.6f};
+    const fv_gaze seq[4] = {a, a, a, b};
+    fv_stats s;
+    float *kept = render_gazes(seq, 3, 0, &s); /* frame 2: read */
+    assert_true(fv_stats_get_count(&s, "map_reused") == 1.0);
+    float *fresh = render_gazes(seq, 3, 2, &s);
+    assert_true(fv_stats_get_count(&s, "map_reused") == 0.0);
+    assert_memory_equal(kept, fresh, sizeof(float) * 3 * W * H);
+    free(kept), free(fresh);
+    kept = render_gazes(seq, 4, 0, &s); /* frame 3: the gaze moved */
+    assert_true(fv_stats_get_count(&s, "map_reused") == 0.0);
+    fresh = render_gazes(seq, 4, 3, &s);
+    assert_memory_equal(kept, fresh, sizeof(float) * 3 * W * H);
+    free(kept), free(fresh);
+}
+
 static void test_show_modes(void **st)
 {
     (void)st;
@@ -299,7 +351,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_order_and_threads), cmocka_unit_test(test_sample_counts),
         cmocka_unit_test(test_offscreen_skip_same_image), cmocka_unit_test(test_converges),
-        cmocka_unit_test(test_show_modes),        cmocka_unit_test(test_stereo),        cmocka_unit_test(test_bad_params),
+        cmocka_unit_test(test_map_keeps_coords_while_gaze_stays), cmocka_unit_test(test_show_modes),        cmocka_unit_test(test_stereo),        cmocka_unit_test(test_bad_params),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -20,6 +20,8 @@
 #define MASK_REACH_PX 6.0f /* see the off-screen mask in fv_vp_pipeline_render */
 #define MAP_SPAN 64        /* screen pixels of a row the map stage takes at a time (at most) */
 
+enum { COORDS_NONE = 0, COORDS_STORE, COORDS_READ };
+
 struct fv_vp_pipeline {
     const fv_scene *scene;
     fv_vp_opts o;
@@ -35,6 +37,11 @@ struct fv_vp_pipeline {
     float mask_gx, mask_gy; /* the gaze onscreen was computed for (NaN: not yet) */
     float *lut;             /* per frame, per radius step: column X, mip level, blur sigma */
     int nlut;
+    /* The map stage's per-pixel coordinates (X, V, mip level; the blur's sigma is p->sigma) kept
+     * while the gaze stays: stored on the second frame at the same gaze, read from the third on. */
+    float *coords;          /* 3 per screen pixel, allocated when first stored */
+    float map_gx, map_gy;   /* the gaze of the last map stage (NaN: none) */
+    int coords_state;       /* COORDS_NONE, _STORE (this frame writes them), _READ */
     uint32_t *perm;
     long nperm;
     bool have_prev;
@@ -63,7 +70,10 @@ static void free_buffers(fv_vp_pipeline *p)
     fv_phi_mips_destroy(p->mips);
     free(p->g.color), free(p->g.albedo), free(p->g.normal), free(p->g.depth), free(p->g.position), free(p->g.id);
     free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm), free(p->lut), free(p->onscreen);
-    p->onscreen = NULL;
+    free(p->coords);
+    p->onscreen = NULL, p->coords = NULL;
+    p->map_gx = p->map_gy = NAN;
+    p->coords_state = COORDS_NONE;
     memset(&p->g, 0, sizeof p->g);
     p->space = NULL, p->svgf = NULL, p->mips = NULL, p->prev_coord = NULL, p->sigma = NULL, p->perm = NULL, p->lut = NULL;
     p->sw = p->sh = 0;
@@ -207,6 +217,11 @@ static void build_radial_lut(fv_vp_pipeline *p, const fv_space_view *view)
 static void map_coords(const map_ctx *c, int64_t y, int x0, int n, float *X, float *V, float *level)
 {
     const fv_vp_pipeline *p = c->p;
+    float *kept = p->coords ? &p->coords[3 * ((size_t)y * p->sw + x0)] : NULL;
+    if (p->coords_state == COORDS_READ) {
+        for (int k = 0; k < n; k++) X[k] = kept[3 * k], V[k] = kept[3 * k + 1], level[k] = kept[3 * k + 2];
+        return; /* p->sigma is as the frame that stored them left it */
+    }
     const float inv_step = 1.0f / LUT_STEP, gx = c->view->gx, gy = c->view->gy;
     const float *lut = p->lut;
     const int last = p->nlut - 2;
@@ -225,6 +240,8 @@ static void map_coords(const map_ctx *c, int64_t y, int x0, int n, float *X, flo
         sigma[k] = lut[3 * i + 2] + f * (lut[3 * i + 5] - lut[3 * i + 2]);
     }
     if (p->o.blur) memcpy(&p->sigma[(size_t)y * p->sw + x0], sigma, (size_t)n * sizeof(float));
+    if (p->coords_state == COORDS_STORE)
+        for (int k = 0; k < n; k++) kept[3 * k] = X[k], kept[3 * k + 1] = V[k], kept[3 * k + 2] = level[k];
 }
 
 /* The film's first-hit buffers of screen pixel pix from grid cell near. */
@@ -388,7 +405,16 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     mc.out = fv_film_views_of(film);
     mc.identity = identity;
     mc.polar = fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN;
-    build_radial_lut(p, &view);
+    /* A gaze that stays (a still eye, a screenshot, the viewer) reuses the coordinates: from the
+     * second frame at the same gaze they are kept (if the memory is there), from the third read.
+     * A gaze that moves never pays for keeping them. */
+    const bool still = view.gx == p->map_gx && view.gy == p->map_gy;
+    p->coords_state = !mc.polar || !still ? COORDS_NONE : (p->coords_state == COORDS_NONE ? COORDS_STORE : COORDS_READ);
+    if (p->coords_state == COORDS_STORE && !p->coords && !(p->coords = fv_alloc_array((size_t)p->sw * p->sh, 3 * sizeof(float))))
+        p->coords_state = COORDS_NONE;
+    p->map_gx = view.gx, p->map_gy = view.gy;
+    if (p->coords_state != COORDS_READ) build_radial_lut(p, &view);
+    fv_stats_add_count(stats, "map_reused", p->coords_state == COORDS_READ);
     fv_parallel_for(p->sh, 8, frame->threads, map_rows, &mc);
     fv_stats_add_ms(stats, "map", fv_time_ms() - t0);
 

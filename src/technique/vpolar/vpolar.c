@@ -31,6 +31,8 @@ typedef struct vp_state {
 
 typedef enum vp_kind { K_VPOLAR, K_CARTESIAN, K_CARTESIAN_FULL, K_LINEAR_FALLOFF, K_LOGPOLAR } vp_kind;
 
+#define VP_PERIPHERY_PASSES 3 /* vpolar's periphery_passes default */
+
 static const char *const k_orders[] = {"grid", "random", NULL};
 static const char *const k_offscreen[] = {"skip", "trace", NULL}; /* skip first: the default */
 static const char *const k_show[] = {"screen", "space", "density", NULL};
@@ -85,7 +87,10 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
             (s = fv_params_int(p, "fit_degree", 6, 2, 10, &o->space.fit_degree, err)))
             return s;
         o->blur_follows_space = true;
-        if ((s = fv_params_int(p, "periphery_passes", o->svgf.iterations, 0, 10, &o->periphery_passes, err))) return s;
+        /* Issue 16: three passes beyond the blur's ramp lose nothing in the fovea and lower the
+         * periphery's FLIP on cornell and the city (vp-periphery, docs/results.md), for 8-16%
+         * less denoising; so on by default. */
+        if ((s = fv_params_int(p, "periphery_passes", VP_PERIPHERY_PASSES, 0, 10, &o->periphery_passes, err))) return s;
         break;
     case K_CARTESIAN:
         if ((s = open_range(p, "reduction", 0.61, 0.0, 1.0, &o->space.reduction, err))) return s;
@@ -270,7 +275,7 @@ const fv_technique_class fv_technique_vpolar = {
                 "fovea_deg=float (5.79): radius of the linear, clipped fovea in planar degrees\n"
                 "fit_degree=int (6): degree of the polynomial inverse of Eq. 2\n"
                 "blur=bool (true): foveated blur (blur_fovea_deg default 5.79, stretched with the space)\n"
-                "periphery_passes=int (svgf_iterations: off): SVGF passes for the columns beyond blur_ramp_deg, where the blur is widest\n",
+                "periphery_passes=int (3): SVGF passes for the columns beyond blur_ramp_deg, where the blur is widest (svgf_iterations or more: all)\n",
     create_vpolar, vp_render, vp_destroy,
     FURNACE_TEST, .spp_param = "spp",
 };
