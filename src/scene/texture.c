@@ -4,14 +4,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include "core/alloc.h"
+#include "fovea/film.h"
 #include "fovea/limits.h"
 #include "scene/scene_impl.h"
 #include "scene/texture.h"
-
-float fv_srgb_to_linear(float c)
-{
-    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
-}
 
 fv_status fv_scene_add_texture(fv_scene *s, const fv_texture_desc *t, int *id, fv_error *err)
 {
@@ -33,7 +29,7 @@ fv_status fv_scene_add_texture(fv_scene *s, const fv_texture_desc *t, int *id, f
     if (!x->rgb) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for texture '%s' (%dx%d)", name, t->width, t->height);
     /* One table for the 256 codes instead of a power per channel. */
     float lut[256];
-    for (int i = 0; i < 256; i++) lut[i] = fv_srgb_to_linear((float)i / 255.0f);
+    for (int i = 0; i < 256; i++) lut[i] = fv_srgb_decode((float)i / 255.0f);
     const int ch = t->channels;
     for (long long i = 0; i < n; i++) {
         const unsigned char *p = &t->texels[i * ch];

@@ -16,10 +16,6 @@
 #include "core/sandbox.h"
 #include "fovea/scene.h"
 
-/* sRGB-encoded value in [0,1] -> linear (the IEC 61966-2-1 curve: linear segment below 0.04045,
- * power 2.4 above). */
-float fv_srgb_to_linear(float c);
-
 /* Texture t's linear RGB at (s, t) coordinates uv (u right, v up from the bottom-left corner),
  * bilinear between the four nearest texel centres, repeating outside [0,1]. */
 struct fv_texture;
