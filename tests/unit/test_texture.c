@@ -99,11 +99,10 @@ static void test_uv_at_hit(void **st)
 static void test_refusals(void **st)
 {
     (void)st;
-    fv_scene *s;
-    fv_error err;
-    assert_int_equal(fv_scene_create(&s, &err), FV_OK);
     unsigned char px[4] = {0};
     int id = -1;
+    fv_scene *s = scene_with_texture(px, 1, 1, &id);
+    fv_error err;
     /* The size is checked before the texels are read: a pointer to 4 bytes is enough. */
     fv_texture_desc big = {"big.png", 4097, 4096, 3, px};
     fv_test_expect_fail(fv_scene_add_texture(s, &big, &id, &err), &err, FV_ERR_INVALID, "big.png", "4097x4096");
@@ -111,8 +110,8 @@ static void test_refusals(void **st)
     fv_texture_desc bad = {"c.png", 1, 1, 5, px};
     fv_test_expect_fail(fv_scene_add_texture(s, &bad, &id, &err), &err, FV_ERR_INVALID, "channels", "5 channels");
     fv_material m = fv_material_default(FV_MAT_DIFFUSE);
-    m.albedo_texture = 1;
-    fv_test_expect_fail(fv_scene_add_material(s, &m, &id, &err), &err, FV_ERR_INVALID, "albedo_texture 1", "no texture yet");
+    m.albedo_texture = 2;
+    fv_test_expect_fail(fv_scene_add_material(s, &m, &id, &err), &err, FV_ERR_INVALID, "albedo_texture 2", "no such texture");
     m.albedo_texture = -2;
     fv_test_expect_fail(fv_material_validate(&m, &err), &err, FV_ERR_INVALID, "albedo_texture", "negative id");
     fv_scene_destroy(s);
