@@ -236,7 +236,8 @@ static void test_json(void **st)
     assert_non_null(f);
     fprintf(f, "{\"materials\": {\"a\": {\"albedo\": [0.5, 0.5, 0.5], \"albedo_texture\": \"quad4.png\"},\n"
                "               \"b\": {\"albedo_texture\": \"gone.png\"}},\n"
-               " \"objects\": [{\"mesh\": \"%s\", \"material\": \"a\"}, {\"box\": {\"center\": [3, 0, 0], \"half\": [0.5, 0.5, 0.5]}, \"material\": \"b\"}]}\n",
+               " \"objects\": [{\"mesh\": \"%s\", \"material\": \"a\"}, {\"box\": {\"center\": [3, 0, 0], \"half\": [0.5, 0.5, 0.5]}, \"material\": \"b\"},\n"
+               "             {\"quad\": [[5, -1, 0], [7, -1, 0], [7, 1, 0], [5, 1, 0]], \"material\": \"a\"}]}\n",
             DATA "box.obj");
     fclose(f);
     fv_scene *s;
@@ -256,6 +257,12 @@ static void test_json(void **st)
     assert_true(fv_scene_intersect(s, FV_TRACE_ALL, fv_v3(-0.25f, 0.25f, 3.0f), fv_v3(0, 0, -1), INFINITY, &h));
     fv_material buf;
     near3(fv_hit_material(s, &h, &buf)->albedo, fv_v3(0.5f, 0, 0), 1e-4f, "JSON material on the OBJ's UVs");
+    /* An inline quad spans the texture from its first corner (bottom left here): (5.5, 0.5) is
+     * u = 0.25, v = 0.75, the red quadrant; (6.5, -0.5) the white one. */
+    assert_true(fv_scene_intersect(s, FV_TRACE_ALL, fv_v3(5.5f, 0.5f, 3.0f), fv_v3(0, 0, -1), INFINITY, &h));
+    near3(fv_hit_material(s, &h, &buf)->albedo, fv_v3(0.5f, 0, 0), 1e-4f, "quad, top left");
+    assert_true(fv_scene_intersect(s, FV_TRACE_ALL, fv_v3(6.5f, -0.5f, 3.0f), fv_v3(0, 0, -1), INFINITY, &h));
+    near3(fv_hit_material(s, &h, &buf)->albedo, fv_v3s(0.5f), 1e-4f, "quad, bottom right");
     fv_scene_destroy(s);
     snprintf(cmd, sizeof cmd, "rm -r %s", dir);
     assert_int_equal(system(cmd), 0);
