@@ -57,7 +57,7 @@ static void add_quad(fv_scene *s, const char *name, fv_vec3 a, fv_vec3 b, fv_vec
     fv_error err;
     const uint32_t quad[6] = {0, 1, 2, 0, 2, 3};
     const fv_vec3 v[4] = {a, b, c, d};
-    fv_mesh_desc m = {name, v, 4, NULL, quad, 2, NULL, mat};
+    fv_mesh_desc m = {name, v, 4, NULL, quad, 2, NULL, mat, NULL};
     assert_int_equal(fv_scene_add_mesh(s, &m, NULL, NULL, &err), FV_OK);
 }
 
