@@ -102,6 +102,9 @@ typedef struct fv_image {
 
 /* Reads PNG, PFM or EXR (RGB channels). Errors name the file and what is wrong with it. */
 FV_API fv_status fv_image_read(const char *path, fv_image *out, fv_error *err);
+/* Reads an EXR's layer: its LAYER.R, LAYER.G, LAYER.B channels ("albedo" for the albedo fv_film_write
+ * stores); "" is fv_image_read. */
+FV_API fv_status fv_image_read_layer(const char *path, const char *layer, fv_image *out, fv_error *err);
 FV_API void fv_image_free(fv_image *img);
 
 /* The sRGB transfer function and its inverse, on one channel. */

@@ -33,6 +33,11 @@ extern "C" {
 
 #define FV_COORD_MAX 1.0e9       /* largest |coordinate| of a position, extent or offset */
 #define FV_INTENSITY_MAX 1.0e20  /* largest light intensity (W/sr) or emission */
+/* Textures are kept as linear float RGB, 12 bytes a texel: one of 4096 x 4096 takes 192 MiB, and
+ * all of a scene's together at most four times that. Their decoders refuse a larger image before
+ * reading its pixels (a PNG header may claim 2^31 x 2^31). */
+#define FV_TEXTURE_MAX_TEXELS (4096 * 4096)
+#define FV_TEXTURE_MAX_TOTAL (4 * FV_TEXTURE_MAX_TEXELS)
 
 /* Checks n coordinates (finite, |v| <= FV_COORD_MAX). On failure the message reads
  * "<what>: <why>", e.g. "--camera-pos 1e19,273,-800: coordinate 1e+19 is beyond +-1e+09, the

@@ -46,6 +46,9 @@ typedef struct fv_material {
     float ior;         /* index of refraction > 1 inside the object (DIELECTRIC only) */
     fv_vec3 emission;  /* emitted radiance (W/m^2/sr), on the side the triangle's normal faces */
     bool two_sided_emission;
+    int albedo_texture; /* 0: none; else an id from fv_scene_add_texture: the albedo at a point is
+                           this texture's (linear) colour there times `albedo`, on meshes with UVs
+                           (fv_mesh_desc.uvs); elsewhere (no UVs, SDF objects) `albedo` alone */
 } fv_material;
 
 /* A default material of the given type (grey diffuse, white mirror, ...), to be adjusted. */
@@ -90,7 +93,19 @@ typedef struct fv_mesh_desc {
     int triangle_count;
     const int *materials;        /* optional per-triangle material ids (NULL: all `material`) */
     int material;
+    const fv_vec2 *uvs;          /* optional per-vertex texture coordinates (NULL: none): u to the
+                                    right, v up, (0,0) the image's bottom-left corner, repeating
+                                    outside [0,1] (OBJ's convention; the glTF importer flips v) */
 } fv_mesh_desc;
+
+/* An image a material's albedo_texture reads: 8-bit sRGB-encoded texels, rows from the top,
+ * `channels` bytes per texel (1 grey, 2 grey + alpha, 3 RGB, 4 RGBA; alpha is ignored). */
+typedef struct fv_texture_desc {
+    const char *name;            /* for messages (a file name) */
+    int width, height;
+    int channels;
+    const unsigned char *texels; /* width * height * channels bytes */
+} fv_texture_desc;
 
 /* One key of a rigid animation: scale first, then rotation, then translation. */
 typedef struct fv_anim_key {
@@ -103,10 +118,20 @@ typedef struct fv_anim_key {
 FV_API fv_status fv_scene_create(fv_scene **out, fv_error *err);
 FV_API void fv_scene_destroy(fv_scene *scene);
 
-/* Returns the new material's id in *id. */
+/* Returns the new material's id in *id; its albedo_texture (when not 0) must already exist. */
 FV_API fv_status fv_scene_add_material(fv_scene *scene, const fv_material *m, int *id, fv_error *err);
 /* Looks a material up by name; -1 when absent. */
 FV_API int fv_scene_find_material(const fv_scene *scene, const char *name);
+
+/* Adds a texture: its texels are decoded from sRGB to linear when added (IEC 61966-2-1) and kept
+ * as floats. Sampling is bilinear with wrap mode repeat (no mipmaps). Refused (FV_ERR_INVALID,
+ * naming it): a size below 1 or above FV_TEXTURE_MAX_TEXELS texels (fovea/limits.h), or a scene
+ * whose textures would then hold more than FV_TEXTURE_MAX_TOTAL texels; channels outside 1..4.
+ * Returns its id (>= 1; 0 means "no texture" in fv_material) in *id. */
+FV_API fv_status fv_scene_add_texture(fv_scene *scene, const fv_texture_desc *tex, int *id, fv_error *err);
+/* How many textures the scene holds (ids 1..count). */
+FV_API int fv_scene_texture_count(const fv_scene *scene);
+
 
 /* Adds a triangle mesh as one object (static until fv_scene_animate_object makes it dynamic).
  * Triangles with a non-finite vertex, an index out of range or zero area are dropped, with one
@@ -173,6 +198,7 @@ FV_API int fv_scene_object_count(const fv_scene *scene);
 FV_API int fv_scene_dynamic_object_count(const fv_scene *scene);
 FV_API int fv_scene_light_count(const fv_scene *scene);       /* delta lights + emissive triangles + environment */
 FV_API int fv_scene_material_count(const fv_scene *scene);
+/* The material as added (a textured material's albedo is its constant factor). */
 FV_API const fv_material *fv_scene_material(const fv_scene *scene, int id);
 
 /* ---- loading ---- */

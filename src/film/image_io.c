@@ -340,7 +340,8 @@ static fv_status exr_write(const char *path, const float *rgb, int w, int h, con
     return s;
 }
 
-static fv_status exr_read(const char *path, fv_image *out, fv_error *err)
+/* The colour (layer "": R, G, B, or Y) or layer L's L.R, L.G, L.B channels. */
+static fv_status exr_read(const char *path, const char *layer, fv_image *out, fv_error *err)
 {
     exr_msg m;
     exr_context_initializer_t init = exr_init(&m);
@@ -379,16 +380,19 @@ static fv_status exr_read(const char *path, fv_image *out, fv_error *err)
         goto done;
     }
     /* R, G, B if present; a single Y (luminance) channel fills all three. */
-    const char *want[3] = {"R", "G", "B"};
+    char names[3][80];
+    for (int c = 0; c < 3; c++) snprintf(names[c], sizeof names[c], "%.64s%s%c", layer, layer[0] ? "." : "", "RGB"[c]);
+    const char *want[3] = {names[0], names[1], names[2]};
     bool have[3] = {false, false, false}, have_y = false;
     for (int i = 0; i < chl->num_channels; i++) {
         const exr_attr_chlist_entry_t *e = &chl->entries[i];
         for (int c = 0; c < 3; c++)
             if (strcmp(e->name.str, want[c]) == 0 && e->x_sampling == 1 && e->y_sampling == 1) have[c] = true;
-        if (strcmp(e->name.str, "Y") == 0 && e->x_sampling == 1 && e->y_sampling == 1) have_y = true;
+        if (!layer[0] && strcmp(e->name.str, "Y") == 0 && e->x_sampling == 1 && e->y_sampling == 1) have_y = true;
     }
     if (!(have[0] && have[1] && have[2]) && !have_y) {
-        st = fv_error_set(err, FV_ERR_INVALID, "cannot read '%s': no full-resolution R,G,B (or Y) channels", path);
+        st = fv_error_set(err, FV_ERR_INVALID, "cannot read '%s': no full-resolution %s,%s,%s%s channels", path, want[0], want[1], want[2],
+                          layer[0] ? "" : " (or Y)");
         goto done;
     }
     if (!(have[0] && have[1] && have[2])) want[0] = want[1] = want[2] = "Y";
@@ -487,17 +491,21 @@ fv_status fv_film_write(const fv_film *film, const char *path, float exposure, f
     return exr_write(path, fv_film_color_const(film), w, h, film, err);
 }
 
-fv_status fv_image_read(const char *path, fv_image *out, fv_error *err)
+fv_status fv_image_read(const char *path, fv_image *out, fv_error *err) { return fv_image_read_layer(path, "", out, err); }
+
+fv_status fv_image_read_layer(const char *path, const char *layer, fv_image *out, fv_error *err)
 {
     out->width = out->height = 0;
     out->rgb = NULL;
     struct stat sb;
     if (stat(path, &sb) != 0) return fv_error_set(err, FV_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
     if (S_ISDIR(sb.st_mode)) return fv_error_set(err, FV_ERR_IO, "cannot open '%s': is a directory", path);
-    switch (fv_image_format_from_path(path)) {
+    fv_image_format fmt = fv_image_format_from_path(path);
+    if (layer[0] && fmt != FV_IMG_EXR) return fv_error_set(err, FV_ERR_INVALID, "cannot read layer '%s' of '%s': only EXR files have layers", layer, path);
+    switch (fmt) {
     case FV_IMG_PNG: return png_read(path, out, err);
     case FV_IMG_PFM: return pfm_read(path, out, err);
-    case FV_IMG_EXR: return exr_read(path, out, err);
+    case FV_IMG_EXR: return exr_read(path, layer, out, err);
     default: return fv_error_set(err, FV_ERR_INVALID, "cannot read '%s': unknown image format (use .png, .pfm or .exr)", path);
     }
 }

@@ -10,9 +10,12 @@
  *
  * The node hierarchy is flattened: each mesh instance becomes one object with its node's
  * transform baked in. Materials map onto ours as documented in docs/scene-format.md (MTL: Kd, Ks,
- * Ns, Ni, d, illum, Ke; glTF: base colour, metallic/roughness, transmission, emissive). A file's
- * first camera and its point/spot lights are taken when asked. Limits: textures are ignored (the
- * material's constant colour is used); lines and points are skipped.
+ * Ns, Ni, d, illum, Ke, map_Kd; glTF: base colour and its texture, metallic/roughness,
+ * transmission, emissive). A file's first camera and its point/spot lights are taken when asked.
+ * Base-colour textures (glTF baseColorTexture embedded in a .glb, in a data URI or in a file next
+ * to the model; MTL map_Kd) are decoded in the child too (scene/texture.h) and sent once each;
+ * one that cannot be read is a warning and its material keeps the constant colour. Only the first
+ * UV channel is read. Limits: other texture kinds are ignored; lines and points are skipped.
  */
 #include <assimp/cimport.h>
 #include <assimp/version.h>
@@ -32,7 +35,9 @@
 #include <unistd.h>
 #include "core/alloc.h"
 #include "core/sandbox.h"
+#include "fovea/limits.h"
 #include "scene/load_impl.h"
+#include "scene/texture.h"
 
 bool fv_load_assimp_supports(const char *path)
 {
@@ -128,12 +133,12 @@ static fv_material map_material(const struct aiMaterial *am, int index)
 
 /* ---- the child: assimp's scene as records on a pipe ---- */
 
-enum { REC_MATERIAL = 'M', REC_MESH = 'G', REC_CAMERA = 'C', REC_LIGHT = 'L', REC_WARN = 'W', REC_ERROR = 'E', REC_END = 'Z' };
+enum { REC_TEXTURE = 'T', REC_MATERIAL = 'M', REC_MESH = 'G', REC_CAMERA = 'C', REC_LIGHT = 'L', REC_WARN = 'W', REC_ERROR = 'E', REC_END = 'Z' };
 
 typedef struct mesh_head {
     char name[FV_NAME_MAX];
     int material; /* assimp's material index */
-    int nv, nt, has_normals;
+    int nv, nt, has_normals, has_uvs;
 } mesh_head;
 
 typedef struct light_rec {
@@ -146,12 +151,22 @@ typedef struct camera_rec {
     char name[64];
 } camera_rec;
 
+/* A texture the child has already tried: its path as the file names it, the id it was sent with
+ * (0: it could not be read, for `why`). */
+typedef struct tex_seen {
+    char path[1024];
+    int id;
+    char why[256];
+} tex_seen;
+
 typedef struct import_ctx {
     const char *path;
     const fv_import_opts *opts;
     const struct aiScene *ai;
     int fd;
     bool ok;
+    tex_seen *seen;
+    int nseen, capseen, ntex;
 } import_ctx;
 
 static void put(import_ctx *c, char tag, const void *p, size_t n)
@@ -203,12 +218,14 @@ static void put_mesh(import_ctx *c, const struct aiMesh *am, const fv_xform *x)
     h.material = (int)am->mMaterialIndex;
     h.nv = (int)am->mNumVertices;
     h.has_normals = am->mNormals != NULL;
+    h.has_uvs = am->mTextureCoords[0] != NULL;
     for (unsigned f = 0; f < am->mNumFaces; f++) h.nt += am->mFaces[f].mNumIndices == 3;
     if (h.nt == 0) return;
     fv_vec3 *pos = fv_alloc_array((size_t)h.nv, sizeof(fv_vec3));
     fv_vec3 *nrm = h.has_normals ? fv_alloc_array((size_t)h.nv, sizeof(fv_vec3)) : NULL;
+    fv_vec2 *uv = h.has_uvs ? fv_alloc_array((size_t)h.nv, sizeof(fv_vec2)) : NULL;
     uint32_t *idx = fv_alloc_array((size_t)h.nt, 3 * sizeof(uint32_t));
-    if (!pos || !idx || (h.has_normals && !nrm)) {
+    if (!pos || !idx || (h.has_normals && !nrm) || (h.has_uvs && !uv)) {
         put_text(c, REC_ERROR, "out of memory for a mesh of %d vertices", h.nv);
     } else {
         fv_xform inv = fv_xform_identity();
@@ -220,6 +237,7 @@ static void put_mesh(import_ctx *c, const struct aiMesh *am, const fv_xform *x)
                 const struct aiVector3D *n = &am->mNormals[i];
                 nrm[i] = has_inv ? fv_xform_normal(&inv, fv_v3(n->x, n->y, n->z)) : fv_v3(n->x, n->y, n->z);
             }
+            if (uv) uv[i] = (fv_vec2){am->mTextureCoords[0][i].x, am->mTextureCoords[0][i].y};
         }
         int t = 0;
         for (unsigned f = 0; f < am->mNumFaces; f++) {
@@ -231,10 +249,12 @@ static void put_mesh(import_ctx *c, const struct aiMesh *am, const fv_xform *x)
         put(c, REC_MESH, &h, sizeof h);
         if (c->ok) c->ok = fv_sandbox_write(c->fd, pos, (size_t)h.nv * sizeof *pos);
         if (c->ok && nrm) c->ok = fv_sandbox_write(c->fd, nrm, (size_t)h.nv * sizeof *nrm);
+        if (c->ok && uv) c->ok = fv_sandbox_write(c->fd, uv, (size_t)h.nv * sizeof *uv);
         if (c->ok) c->ok = fv_sandbox_write(c->fd, idx, (size_t)h.nt * 3 * sizeof *idx);
     }
     free(pos);
     free(nrm);
+    free(uv);
     free(idx);
 }
 
@@ -334,6 +354,93 @@ static void put_camera_and_lights(import_ctx *c, const fv_xform *base)
     }
 }
 
+/* The embedded image a texture path names: "*N" (assimp's index), or one whose file name matches
+ * the path's last component (how .glb images are named). NULL when none. */
+static const struct aiTexture *embedded(const struct aiScene *ai, const char *p)
+{
+    if (p[0] == '*') {
+        char *end;
+        long i = strtol(p + 1, &end, 10);
+        return *end == '\0' && i >= 0 && i < (long)ai->mNumTextures ? ai->mTextures[i] : NULL;
+    }
+    const char *base = strrchr(p, '/') ? strrchr(p, '/') + 1 : p;
+    for (unsigned i = 0; i < ai->mNumTextures; i++) {
+        const char *f = ai->mTextures[i]->mFilename.data, *fb = strrchr(f, '/') ? strrchr(f, '/') + 1 : f;
+        if (ai->mTextures[i]->mFilename.length && strcmp(fb, base) == 0) return ai->mTextures[i];
+    }
+    return NULL;
+}
+
+/* Decodes the image texture path tp names: embedded (compressed, or assimp's raw BGRA texels) or
+ * a file relative to the model's folder. */
+static bool texels_of(const import_ctx *c, const char *tp, fv_texels *t, char *why, size_t n)
+{
+    const struct aiTexture *e = embedded(c->ai, tp);
+    if (e && e->mHeight == 0) return fv_texels_decode(e->pcData, e->mWidth, t, why, n);
+    if (e) {
+        if (e->mWidth < 1 || (long long)e->mWidth * e->mHeight > FV_TEXTURE_MAX_TEXELS) {
+            snprintf(why, n, "%ux%u is more than the %d texels a texture may have", e->mWidth, e->mHeight, FV_TEXTURE_MAX_TEXELS);
+            return false;
+        }
+        size_t count = (size_t)e->mWidth * e->mHeight;
+        unsigned char *px = fv_alloc_array(count, 4);
+        if (!px) {
+            snprintf(why, n, "out of memory");
+            return false;
+        }
+        for (size_t i = 0; i < count; i++) {
+            const struct aiTexel *x = &e->pcData[i];
+            px[4 * i] = x->r, px[4 * i + 1] = x->g, px[4 * i + 2] = x->b, px[4 * i + 3] = x->a;
+        }
+        *t = (fv_texels){(int)e->mWidth, (int)e->mHeight, 4, px};
+        return true;
+    }
+    if (tp[0] == '*') {
+        snprintf(why, n, "the file embeds no image %.20s", tp);
+        return false;
+    }
+    char full[4096], rel[1024];
+    snprintf(rel, sizeof rel, "%s", tp);
+    for (char *q = rel; *q; q++)
+        if (*q == '\\') *q = '/'; /* paths written on Windows */
+    const char *slash = strrchr(c->path, '/');
+    if (rel[0] == '/' || !slash) snprintf(full, sizeof full, "%s", rel);
+    else snprintf(full, sizeof full, "%.*s/%s", (int)(slash - c->path), c->path, rel);
+    return fv_texels_decode_file(full, t, why, n);
+}
+
+/* The id the base-colour texture of material am (named mat_name) was sent with, sending it the
+ * first time it is asked for; 0 when it has none, or when it cannot be read: then a warning
+ * names the file and the material. */
+static int material_texture(import_ctx *c, const struct aiMaterial *am, const char *mat_name)
+{
+    struct aiString p;
+    if ((aiGetMaterialString(am, AI_MATKEY_TEXTURE(aiTextureType_BASE_COLOR, 0), &p) != AI_SUCCESS || p.length == 0) &&
+        (aiGetMaterialString(am, AI_MATKEY_TEXTURE(aiTextureType_DIFFUSE, 0), &p) != AI_SUCCESS || p.length == 0))
+        return 0;
+    int k = 0;
+    while (k < c->nseen && strcmp(c->seen[k].path, p.data) != 0) k++;
+    if (k == c->nseen) {
+        if (fv_grow((void **)&c->seen, &c->capseen, c->nseen + 1, sizeof *c->seen)) {
+            put_text(c, REC_ERROR, "out of memory");
+            return 0;
+        }
+        tex_seen *ts = &c->seen[c->nseen++];
+        memset(ts, 0, sizeof *ts);
+        snprintf(ts->path, sizeof ts->path, "%s", p.data);
+        fv_texels t;
+        if (texels_of(c, p.data, &t, ts->why, sizeof ts->why)) {
+            ts->id = ++c->ntex;
+            put(c, REC_TEXTURE, &ts->id, sizeof ts->id);
+            if (c->ok) c->ok = fv_texels_put(c->fd, &t);
+            free(t.px);
+        }
+    }
+    if (c->seen[k].id == 0)
+        put_text(c, REC_WARN, "texture '%.200s' of material '%s': %s; using the constant colour", c->seen[k].path, mat_name, c->seen[k].why);
+    return c->seen[k].id;
+}
+
 static int import_child(void *user, int fd)
 {
     import_ctx *c = user;
@@ -354,6 +461,7 @@ static int import_child(void *user, int fd)
     } else {
         for (unsigned i = 0; c->ok && i < ai->mNumMaterials && c->opts->material_override < 0; i++) {
             fv_material m = map_material(ai->mMaterials[i], (int)i);
+            m.albedo_texture = material_texture(c, ai->mMaterials[i], m.name); /* the child's numbering */
             put(c, REC_MATERIAL, &m, sizeof m);
         }
         fv_xform base = c->opts->xform ? *c->opts->xform : fv_xform_identity();
@@ -362,6 +470,7 @@ static int import_child(void *user, int fd)
         put(c, REC_END, NULL, 0);
     }
     if (ai) aiReleaseImport(ai);
+    free(c->seen);
     return c->ok ? 0 : 3;
 }
 
@@ -469,17 +578,38 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
     size_t mem = (size_t)2 << 30;
     if ((size_t)sb.st_size < ((size_t)64 << 30) / 64 && (size_t)sb.st_size * 64 > mem) mem = (size_t)sb.st_size * 64;
     int cpu = 10 + 2 * (int)(sb.st_size >> 20);
-    import_ctx c = {path, opts, NULL, -1, true};
+    import_ctx c = {path, opts, NULL, -1, true, NULL, 0, 0, 0};
     fv_sandbox *box;
     if ((st = fv_sandbox_start(import_child, &c, mem, cpu, &box, err)) != FV_OK) return st;
 
     int *matmap = NULL, nmat = 0, cap = 0, first = -1, count = 0;
+    int *texmap = NULL, ntex = 0, captex = 0; /* the child's texture numbers -> the scene's ids (0: refused) */
     bool ended = false;
     char tag;
     while (st == FV_OK && !ended && fv_sandbox_read(box, &tag, 1)) {
-        if (tag == REC_MATERIAL) {
+        if (tag == REC_TEXTURE) {
+            int local;
+            fv_texels t;
+            if (!fv_sandbox_read(box, &local, sizeof local) || local != ntex + 1 || !fv_texels_get(box, &t)) break;
+            if (fv_grow((void **)&texmap, &captex, ntex + 1, sizeof *texmap)) {
+                free(t.px);
+                st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+                break;
+            }
+            char name[FV_NAME_MAX];
+            snprintf(name, sizeof name, "%.40s texture %d", opts->prefix, local);
+            fv_texture_desc d = {name, t.w, t.h, t.channels, t.px};
+            fv_error e2;
+            texmap[ntex] = 0;
+            fv_status ts = fv_scene_add_texture(scene, &d, &texmap[ntex], &e2);
+            free(t.px);
+            ntex++;
+            if (ts == FV_ERR_NOMEM) st = fv_error_set(err, ts, "scene '%s': %s", path, e2.msg);
+            else if (ts != FV_OK) fv_log_warn(log, "%s: %s; its materials use their constant colour", path, e2.msg);
+        } else if (tag == REC_MATERIAL) {
             fv_material m;
             if (!fv_sandbox_read(box, &m, sizeof m)) break;
+            m.albedo_texture = m.albedo_texture >= 1 && m.albedo_texture <= ntex ? texmap[m.albedo_texture - 1] : 0;
             char name[FV_NAME_MAX];
             m.name[FV_NAME_MAX - 1] = '\0';
             snprintf(name, sizeof name, "%.31s%.32s", opts->prefix, m.name);
@@ -492,15 +622,18 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
             h.name[FV_NAME_MAX - 1] = '\0';
             if (h.nv < 1 || h.nt < 1 || h.nt > INT_MAX / 3) break; /* not what the child sends: treat as a failed child */
             fv_vec3 *pos = fv_alloc_array((size_t)h.nv, sizeof *pos), *nrm = h.has_normals ? fv_alloc_array((size_t)h.nv, sizeof *nrm) : NULL;
+            fv_vec2 *uv = h.has_uvs ? fv_alloc_array((size_t)h.nv, sizeof *uv) : NULL;
             uint32_t *idx = fv_alloc_array((size_t)h.nt, 3 * sizeof *idx);
-            bool got = pos && idx && (!h.has_normals || nrm) && fv_sandbox_read(box, pos, (size_t)h.nv * sizeof *pos) &&
-                       (!nrm || fv_sandbox_read(box, nrm, (size_t)h.nv * sizeof *nrm)) && fv_sandbox_read(box, idx, (size_t)h.nt * 3 * sizeof *idx);
+            bool alloc = pos && idx && (!h.has_normals || nrm) && (!h.has_uvs || uv);
+            bool got = alloc && fv_sandbox_read(box, pos, (size_t)h.nv * sizeof *pos) &&
+                       (!nrm || fv_sandbox_read(box, nrm, (size_t)h.nv * sizeof *nrm)) &&
+                       (!uv || fv_sandbox_read(box, uv, (size_t)h.nv * sizeof *uv)) && fv_sandbox_read(box, idx, (size_t)h.nt * 3 * sizeof *idx);
             if (got) {
                 int mat = opts->material_override;
                 if (mat < 0) mat = h.material >= 0 && h.material < nmat ? matmap[h.material] : -1;
                 char name[FV_NAME_MAX];
                 snprintf(name, sizeof name, "%.31s%.32s", opts->prefix, h.name);
-                fv_mesh_desc d = {name, pos, h.nv, nrm, idx, h.nt, NULL, mat};
+                fv_mesh_desc d = {name, pos, h.nv, nrm, idx, h.nt, NULL, mat, uv};
                 int id;
                 if (mat < 0) {
                     st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': mesh '%s' uses material %d, which the file does not define", path,
@@ -515,11 +648,12 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
                 } else {
                     fv_error_prefix(err, "scene '%s': ", path);
                 }
-            } else if (!pos || !idx || (h.has_normals && !nrm)) {
+            } else if (!alloc) {
                 st = fv_error_set(err, FV_ERR_NOMEM, "scene '%s': out of memory for a mesh of %d vertices", path, h.nv);
             }
             free(pos);
             free(nrm);
+            free(uv);
             free(idx);
             if (!got && st == FV_OK) break;
         } else if (tag == REC_CAMERA) {
@@ -556,6 +690,7 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
     snprintf(what, sizeof what, "scene '%s': the mesh importer (assimp)", path);
     fv_status fin = fv_sandbox_finish(box, what, &e2);
     free(matmap);
+    free(texmap);
     if (st != FV_OK) return st;
     if (!ended) return fin != FV_OK ? fv_error_set(err, fin, "%s", e2.msg) : fv_error_set(err, FV_ERR_INVALID, "%s: stopped early", what);
     if (count == 0) return fv_error_set(err, FV_ERR_INVALID, "scene '%s': no usable triangles in the file", path);

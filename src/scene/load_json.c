@@ -16,6 +16,7 @@
 #include "gaze/gaze_json.h"
 #include "scene/load_impl.h"
 #include "scene/mesh_gen.h"
+#include "scene/texture.h"
 
 /* Lengths and coordinates: the ray kernels' range (fovea/limits.h). */
 #define BIG FV_COORD_MAX
@@ -50,7 +51,7 @@ static fv_status limited3(const cJSON *o, const char *key, fv_json_limit_fn chec
 
 static fv_status parse_material(const cJSON *o, const json_ctx *c, fv_error *err)
 {
-    static const char *const keys[] = {"type", "albedo", "specular", "roughness", "ior", "emission", "two_sided", NULL};
+    static const char *const keys[] = {"type", "albedo", "albedo_texture", "specular", "roughness", "ior", "emission", "two_sided", NULL};
     char where[FV_NAME_MAX + 16];
     snprintf(where, sizeof where, "materials.%s", o->string);
     if (strlen(o->string) >= FV_NAME_MAX)
@@ -75,6 +76,15 @@ static fv_status parse_material(const cJSON *o, const json_ctx *c, fv_error *err
         return st;
     m.roughness = (float)rough;
     m.ior = (float)ior;
+    const char *tex = NULL;
+    if ((st = fv_json_string(o, "albedo_texture", c->file, where, &tex, err))) return st;
+    if (tex) {
+        /* Relative to the scene file; an unreadable image is a warning (texture.h), not an error. */
+        char path[8192], user[FV_NAME_MAX + 4200];
+        snprintf(path, sizeof path, "%s%s%s", tex[0] == '/' ? "" : c->dir, tex[0] == '/' ? "" : "/", tex);
+        snprintf(user, sizeof user, "%s: %s", c->file, where);
+        if ((st = fv_texture_load_file(c->scene, path, user, c->log, &m.albedo_texture, err))) return st;
+    }
     if ((st = fv_scene_add_material(c->scene, &m, NULL, err)) != FV_OK) fv_error_prefix(err, "%s: ", c->file);
     return st;
 }

@@ -15,6 +15,7 @@ void fv_meshbuf_free(fv_meshbuf *mb)
 {
     free(mb->pos);
     free(mb->nrm);
+    free(mb->uv);
     free(mb->idx);
     free(mb->mat);
     memset(mb, 0, sizeof *mb);
@@ -39,17 +40,21 @@ static bool grow_pair(void **a, size_t sa, void **b, size_t sb, int *cap, int ne
     return true;
 }
 
-int fv_meshbuf_vertex(fv_meshbuf *mb, fv_vec3 p, fv_vec3 n)
+int fv_meshbuf_vertex_uv(fv_meshbuf *mb, fv_vec3 p, fv_vec3 n, fv_vec2 uv)
 {
     if (mb->oom) return -1;
-    if (!grow_pair((void **)&mb->pos, sizeof *mb->pos, (void **)&mb->nrm, sizeof *mb->nrm, &mb->capv, mb->nv + 1)) {
+    if (!grow_pair((void **)&mb->pos, sizeof *mb->pos, (void **)&mb->nrm, sizeof *mb->nrm, &mb->capv, mb->nv + 1) ||
+        fv_grow((void **)&mb->uv, &mb->capuv, mb->nv + 1, sizeof *mb->uv) != 0) {
         mb->oom = true;
         return -1;
     }
     mb->pos[mb->nv] = p;
     mb->nrm[mb->nv] = n;
+    mb->uv[mb->nv] = uv;
     return mb->nv++;
 }
+
+int fv_meshbuf_vertex(fv_meshbuf *mb, fv_vec3 p, fv_vec3 n) { return fv_meshbuf_vertex_uv(mb, p, n, (fv_vec2){0.0f, 0.0f}); }
 
 void fv_meshbuf_tri(fv_meshbuf *mb, int a, int b, int c, int mat)
 {
@@ -83,6 +88,7 @@ void fv_meshbuf_desc(const fv_meshbuf *mb, const char *name, fv_mesh_desc *out)
     out->triangle_count = mb->nt;
     out->materials = mb->mat;
     out->material = mb->nt > 0 ? mb->mat[0] : 0;
+    out->uvs = mb->uv;
 }
 
 fv_status fv_meshbuf_add(const fv_meshbuf *mb, fv_scene *scene, const char *name, const fv_log *log, int *object_id,
@@ -99,8 +105,8 @@ void fv_mesh_quad(fv_meshbuf *mb, fv_vec3 p0, fv_vec3 p1, fv_vec3 p2, fv_vec3 p3
 {
     /* The diagonal p0-p2 splits the quad; both halves share its normal when it is planar. */
     fv_vec3 n = fv_normalize(fv_cross(fv_sub(p1, p0), fv_sub(p2, p0)));
-    int a = fv_meshbuf_vertex(mb, p0, n), b = fv_meshbuf_vertex(mb, p1, n);
-    int c = fv_meshbuf_vertex(mb, p2, n), d = fv_meshbuf_vertex(mb, p3, n);
+    int a = fv_meshbuf_vertex_uv(mb, p0, n, (fv_vec2){0, 0}), b = fv_meshbuf_vertex_uv(mb, p1, n, (fv_vec2){1, 0});
+    int c = fv_meshbuf_vertex_uv(mb, p2, n, (fv_vec2){1, 1}), d = fv_meshbuf_vertex_uv(mb, p3, n, (fv_vec2){0, 1});
     fv_meshbuf_tri(mb, a, b, c, mat);
     fv_meshbuf_tri(mb, a, c, d, mat);
 }
@@ -135,7 +141,7 @@ void fv_mesh_grid(fv_meshbuf *mb, fv_vec3 o, fv_vec3 eu, fv_vec3 ev, int nu, int
     for (int j = 0; j <= nv; j++)
         for (int i = 0; i <= nu; i++) {
             fv_vec3 p = fv_add(o, fv_add(fv_scale(eu, (float)i / (float)nu), fv_scale(ev, (float)j / (float)nv)));
-            if (fv_meshbuf_vertex(mb, p, n) < 0) return;
+            if (fv_meshbuf_vertex_uv(mb, p, n, (fv_vec2){(float)i / (float)nu, (float)j / (float)nv}) < 0) return;
         }
     for (int j = 0; j < nv; j++)
         for (int i = 0; i < nu; i++) {
@@ -192,7 +198,8 @@ void fv_mesh_sphere(fv_meshbuf *mb, fv_vec3 c, float r, int su, int sv, bool inw
         for (int i = 0; i <= su; i++) {
             float ph = 2.0f * FV_PI * (float)(i % su) / (float)su;
             fv_vec3 n = fv_v3(st * cosf(ph), ct, st * sinf(ph));
-            if (fv_meshbuf_vertex(mb, fv_madd(c, n, r), fv_scale(n, sign)) < 0) return;
+            fv_vec2 uv = {(float)i / (float)su, 1.0f - (float)j / (float)sv};
+            if (fv_meshbuf_vertex_uv(mb, fv_madd(c, n, r), fv_scale(n, sign), uv) < 0) return;
         }
     }
     for (int j = 0; j < sv; j++)

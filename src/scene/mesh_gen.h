@@ -2,7 +2,10 @@
  * (quads, tessellated planes, boxes, UV spheres).
  *
  * Every vertex carries a normal: flat shapes store their face normal, spheres their smooth one,
- * so shapes of both kinds can share one builder. An allocation failure sets `oom` and turns every
+ * so shapes of both kinds can share one builder. Every vertex carries texture coordinates too (a
+ * textured material reads them): a quad, each face of a box and a grid span [0,1]^2 from their
+ * first corner (p0 -> p1 is +u, p0 -> p3 is +v); a sphere's u runs once around (+x towards +z)
+ * and its v from the south pole (0) to the north (1). An allocation failure sets `oom` and turns every
  * later call into a no-op, so a builder can be filled without checking each call; the failure is
  * reported once, by fv_meshbuf_add / fv_meshbuf_check (FV_ERR_NOMEM).
  * Limits: at most INT32_MAX/4 vertices and triangles per builder.
@@ -16,9 +19,10 @@
 
 typedef struct fv_meshbuf {
     fv_vec3 *pos, *nrm; /* nv each */
+    fv_vec2 *uv;        /* nv: texture coordinates */
     uint32_t *idx;      /* 3 nt */
     int *mat;           /* nt: per-triangle material id */
-    int nv, nt, capv, capt;
+    int nv, nt, capv, capt, capuv;
     bool smooth;        /* hand the per-vertex normals to the scene (set by curved shapes) */
     bool oom;
 } fv_meshbuf;
@@ -28,7 +32,9 @@ void fv_meshbuf_free(fv_meshbuf *mb);
 /* Empties the builder but keeps its memory for the next mesh. */
 void fv_meshbuf_clear(fv_meshbuf *mb);
 
-/* Adds a vertex and returns its index (-1 once an allocation has failed). */
+/* Adds a vertex with texture coordinates uv and returns its index (-1 once an allocation has
+ * failed); fv_meshbuf_vertex gives it (0, 0). */
+int fv_meshbuf_vertex_uv(fv_meshbuf *mb, fv_vec3 p, fv_vec3 n, fv_vec2 uv);
 int fv_meshbuf_vertex(fv_meshbuf *mb, fv_vec3 p, fv_vec3 n);
 /* Adds triangle a b c (counter-clockwise seen from the side its normal faces). */
 void fv_meshbuf_tri(fv_meshbuf *mb, int a, int b, int c, int mat);

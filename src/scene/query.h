@@ -88,7 +88,31 @@ bool fv_scene_object_dynamic(const fv_scene *s, int obj);
 void fv_scene_object_world_to_local(const fv_scene *s, int obj, fv_xform *out);
 /* World-space box around the object at the scene's current time. */
 void fv_scene_object_bounds(const fv_scene *s, int obj, fv_vec3 *lo, fv_vec3 *hi);
-/* The material of a hit (the hit's mat id). */
-static inline const fv_material *fv_hit_material(const fv_scene *s, const fv_hit *h) { return fv_scene_material(s, h->mat); }
+/* ---- the material at a surface point (texture.c) ----
+ *
+ * The one place a surface's albedo is read: a material with an albedo_texture has its albedo
+ * looked up at the point (texture coordinates interpolated with the hit's barycentrics, the
+ * texture sampled bilinearly and multiplied by the material's constant albedo). An untextured
+ * material, or a point without texture coordinates (a mesh without UVs, an SDF object), gets the
+ * scene's own material, not a copy: the untextured path costs one test. A textured one is copied
+ * into *buf with its albedo resolved; the result points at one or the other, so keep buf alive
+ * as long as the result. */
+
+/* The textured case, out of line: material m (id of triangle prim of object obj) at barycentrics
+ * (u, v). */
+const fv_material *fv_material_textured(const fv_scene *s, const fv_material *m, int obj, int prim, float u, float v, fv_material *buf);
+
+/* Material id mat on triangle prim of object obj at barycentrics (u, v) of its vertices 1 and 2. */
+static inline const fv_material *fv_material_at(const fv_scene *s, int mat, int obj, int prim, float u, float v, fv_material *buf)
+{
+    const fv_material *m = fv_scene_material(s, mat);
+    return m->albedo_texture ? fv_material_textured(s, m, obj, prim, u, v, buf) : m;
+}
+
+/* The material of a hit (its mat id) at the hit. */
+static inline const fv_material *fv_hit_material(const fv_scene *s, const fv_hit *h, fv_material *buf)
+{
+    return fv_material_at(s, h->mat, h->obj, h->prim, h->u, h->v, buf);
+}
 
 #endif

@@ -39,6 +39,7 @@ void fv_scene_destroy(fv_scene *s)
         fv_object *o = &s->objs[i];
         free(o->pos);
         free(o->nrm);
+        free(o->uv);
         free(o->idx);
         free(o->mat);
         fv_anim_free(&o->anim);
@@ -53,6 +54,8 @@ void fv_scene_destroy(fv_scene *s)
     free(s->tri_light);
     free(s->objs);
     free(s->mats);
+    for (int i = 0; i < s->ntex; i++) free(s->tex[i].rgb);
+    free(s->tex);
     for (int i = 0; i < s->ndelta; i++) fv_anim_free(&s->delta[i].anim);
     free(s->delta);
     free(s->lights);
@@ -69,6 +72,8 @@ fv_status fv_scene_add_material(fv_scene *s, const fv_material *m, int *id, fv_e
 {
     fv_status st = check_open(s, err);
     if (st != FV_OK || (st = fv_material_validate(m, err)) != FV_OK) return st;
+    if (m->albedo_texture > s->ntex)
+        return fv_error_set(err, FV_ERR_INVALID, "material '%s': albedo_texture %d does not exist", m->name, m->albedo_texture);
     if (fv_grow((void **)&s->mats, &s->capmat, s->nmat + 1, sizeof *s->mats))
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory adding material '%s'", m->name);
     s->mats[s->nmat] = *m;
@@ -154,6 +159,7 @@ fv_status fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, const fv_log *lo
     o.pos = fv_alloc_array((size_t)o.nv + 1, sizeof(fv_vec3));
     if (!o.pos) goto nomem;
     if (m->normals && !(o.nrm = fv_alloc_array((size_t)o.nv + 1, sizeof(fv_vec3)))) goto nomem;
+    if (m->uvs && !(o.uv = fv_alloc_array((size_t)o.nv, sizeof(fv_vec2)))) goto nomem;
     o.lo = fv_v3s(FLT_MAX);
     o.hi = fv_v3s(-FLT_MAX);
     for (int i = 0; i < m->vertex_count; i++) {
@@ -165,6 +171,7 @@ fv_status fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, const fv_log *lo
             fv_vec3 n = m->normals[i];
             o.nrm[remap[i]] = fv_is_finite3(n) && fv_length(n) > 0.0f ? fv_normalize(n) : fv_v3(0, 0, 0);
         }
+        if (o.uv) o.uv[remap[i]] = m->uvs[i]; /* non-finite ones are read as (0,0) (texture.c) */
     }
     o.pos[o.nv] = fv_v3(0, 0, 0);
     if (o.nrm) o.nrm[o.nv] = fv_v3(0, 0, 0);
@@ -181,6 +188,7 @@ nomem:
     free(o.mat);
     free(o.pos);
     free(o.nrm);
+    free(o.uv);
     return fv_error_set(err, FV_ERR_NOMEM, "out of memory adding mesh '%s' (%d triangles)", name, m->triangle_count);
 }
 

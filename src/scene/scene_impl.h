@@ -26,6 +26,7 @@ typedef struct fv_object {
     float sdf_eps;       /* sphere tracing's hit distance, scaled to the field's bounds */
     fv_vec3 *pos;        /* object-space vertices */
     fv_vec3 *nrm;        /* optional per-vertex normals */
+    fv_vec2 *uv;         /* optional per-vertex texture coordinates (texture.c reads them at hits) */
     uint32_t *idx;       /* 3 per triangle */
     int *mat;            /* per-triangle material ids */
     int nv, nt;
@@ -55,9 +56,19 @@ typedef struct fv_light {
     float power;         /* selection weight ~ emitted power */
 } fv_light;
 
+/* A texture as fv_scene_add_texture keeps it: linear RGB, rows from the top (texture.c). */
+typedef struct fv_texture {
+    char name[FV_NAME_MAX];
+    int w, h;
+    float *rgb;          /* 3 w h */
+} fv_texture;
+
 struct fv_scene {
     fv_material *mats;
     int nmat, capmat;
+    fv_texture *tex;           /* texture id i is tex[i - 1] */
+    int ntex, captex;
+    long long tex_texels;      /* their total, bounded by FV_TEXTURE_MAX_TOTAL */
     fv_object *objs;
     int nobj, capobj;
     fv_delta *delta;           /* delta lights in the order they were added */

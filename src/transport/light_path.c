@@ -23,8 +23,9 @@ bool fv_light_path_emit_u(const fv_scene *s, const float u[5], int64_t count, fv
 bool fv_light_path_scatter(const fv_scene *s, const fv_hit *h, fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux, fv_rng *rng,
                            fv_light_vertex_fn visit, void *ctx)
 {
-    const fv_material *m = fv_hit_material(s, h);
-    if (fv_bsdf_is_smooth(m)) visit(ctx, h->p, *d, *flux, h->ng, h->mat);
+    fv_material mbuf;
+    const fv_material *m = fv_hit_material(s, h, &mbuf);
+    if (fv_bsdf_is_smooth(m)) visit(ctx, h, m, *d, *flux);
     fv_vec3 wo = fv_neg(*d);
     fv_shading sh;
     fv_shading_make(m, h->ng, h->ns, wo, &sh);

@@ -15,10 +15,10 @@
 #include "core/rng.h"
 #include "scene/query.h"
 
-/* A vertex of a light path: where, the unit direction the light arrived along, the flux it
- * carries (signed: negative walks cancel light), the surface's unit geometric normal and its
- * material id (a VPL reflects with it). */
-typedef void (*fv_light_vertex_fn)(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 ng, int mat);
+/* A vertex of a light path: the hit (position, unit geometric normal, ...), its material with the
+ * albedo at the hit (query.h's fv_hit_material: a VPL reflects with it), the unit direction the
+ * light arrived along and the flux it carries (signed: negative walks cancel light). */
+typedef void (*fv_light_vertex_fn)(void *ctx, const fv_hit *h, const fv_material *m, fv_vec3 dir, fv_vec3 flux);
 
 /* Starts a walk: a point on a light picked by power and a direction from its emission, with the
  * flux of one of `count` walks; the origin is already off an area light's surface. Draws five

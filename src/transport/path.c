@@ -40,7 +40,8 @@ fv_vec3 fv_path_trace_from(const fv_scene *s, const fv_path_opts *opt, fv_vec3 o
             }
             break;
         }
-        const fv_material *m = fv_hit_material(s, &h);
+        fv_material mbuf;
+        const fv_material *m = fv_hit_material(s, &h, &mbuf);
         fv_vec3 wo = fv_neg(d);
         if (depth == 1 && first) {
             first->hit = true;

@@ -90,7 +90,7 @@ static fv_scene *overflow_scene(bool sdf_floor, fv_camera *cam)
     const uint32_t quad[6] = {0, 1, 2, 0, 2, 3};
     const fv_vec3 fv[4] = {{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}};
     const fv_vec3 lv[4] = {{-0.5f, 2, -0.5f}, {0.5f, 2, -0.5f}, {0.5f, 2, 0.5f}, {-0.5f, 2, 0.5f}}; /* faces down */
-    fv_mesh_desc fd = {"floor", fv, 4, NULL, quad, 2, NULL, fm}, ld = {"lamp", lv, 4, NULL, quad, 2, NULL, lm};
+    fv_mesh_desc fd = {"floor", fv, 4, NULL, quad, 2, NULL, fm, NULL}, ld = {"lamp", lv, 4, NULL, quad, 2, NULL, lm, NULL};
     if (sdf_floor) {
         /* the same floor as a field: a 4 x 4 slab whose top is y = 0 */
         fv_sdf_node n[2];

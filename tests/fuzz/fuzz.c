@@ -335,6 +335,7 @@ static kind k_kinds[] = {
     {"obj", ".obj", run_scene, {"tests/data", "tests/fuzz/seeds", NULL}, {{0}}, 0},
     {"ply", ".ply", run_scene, {"tests/data", "tests/fuzz/seeds", NULL}, {{0}}, 0},
     {"gltf", ".gltf", run_scene, {"tests/data", "tests/fuzz/seeds", NULL}, {{0}}, 0},
+    {"glb", ".glb", run_scene, {"tests/data/textured", NULL, NULL}, {{0}}, 0}, /* embedded textures */
     {"off", ".off", run_scene, {"tests/fuzz/seeds", NULL, NULL}, {{0}}, 0},
     {"gaze", ".csv", run_gaze, {"tests/fuzz/seeds/gaze", "scenes", NULL}, {{0}}, 0},
     {"camera", ".csv", run_camera, {"tests/fuzz/seeds/camera", "tests/data", NULL}, {{0}}, 0},

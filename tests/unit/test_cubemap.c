@@ -292,11 +292,11 @@ static fv_scene *open_scene(bool occluder)
     assert_int_equal(fv_scene_add_material(s, &mt, &mat, &err), FV_OK);
     static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
     const fv_vec3 floor_v[4] = {{-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}};
-    fv_mesh_desc fl = {"floor", floor_v, 4, NULL, idx, 2, NULL, mat};
+    fv_mesh_desc fl = {"floor", floor_v, 4, NULL, idx, 2, NULL, mat, NULL};
     assert_int_equal(fv_scene_add_mesh(s, &fl, NULL, NULL, &err), FV_OK);
     if (occluder) {
         const fv_vec3 occ_v[4] = {{-0.2f, 0.5f, -0.2f}, {-0.2f, 0.5f, 0.2f}, {0.2f, 0.5f, 0.2f}, {0.2f, 0.5f, -0.2f}};
-        fv_mesh_desc oc = {"occluder", occ_v, 4, NULL, idx, 2, NULL, mat};
+        fv_mesh_desc oc = {"occluder", occ_v, 4, NULL, idx, 2, NULL, mat, NULL};
         assert_int_equal(fv_scene_add_mesh(s, &oc, NULL, NULL, &err), FV_OK);
     }
     const fv_light_desc light = {FV_LIGHT_POINT, {0, 2, 0}, {0, -1, 0}, {1, 1, 1}, 0, 0};

@@ -55,7 +55,7 @@ static fv_scene *quad_under(const fv_env_desc *env, float a)
     fv_scene *s = diffuse_scene(a, &mat);
     const fv_vec3 p[4] = {{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}};
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    fv_mesh_desc d = {"quad", p, 4, NULL, idx, 2, NULL, mat};
+    fv_mesh_desc d = {"quad", p, 4, NULL, idx, 2, NULL, mat, NULL};
     return finish_under(s, &d, env);
 }
 

@@ -38,7 +38,7 @@ static fv_scene *floor_scene(void)
     m.albedo = fv_v3s(0.5f);
     int mat;
     assert_int_equal(fv_scene_add_material(s, &m, &mat, &err), FV_OK);
-    fv_mesh_desc mesh = {"floor", pos, 4, NULL, idx, 2, NULL, mat};
+    fv_mesh_desc mesh = {"floor", pos, 4, NULL, idx, 2, NULL, mat, NULL};
     assert_int_equal(fv_scene_add_mesh(s, &mesh, NULL, NULL, &err), FV_OK);
     return s;
 }

@@ -94,15 +94,15 @@ static fv_scene *occluder_scene(void)
     assert_int_equal(fv_scene_add_material(s, &e, &em, &err), FV_OK);
     const uint32_t quad[6] = {0, 1, 2, 0, 2, 3};
     const fv_vec3 fl[4] = {{-100, 0, -100}, {-100, 0, 100}, {100, 0, 100}, {100, 0, -100}};
-    fv_mesh_desc floor = {"floor", fl, 4, NULL, quad, 2, NULL, mm};
+    fv_mesh_desc floor = {"floor", fl, 4, NULL, quad, 2, NULL, mm, NULL};
     assert_int_equal(fv_scene_add_mesh(s, &floor, NULL, NULL, &err), FV_OK);
     const fv_vec3 lv[4] = {{-10, 100, -10}, {10, 100, -10}, {10, 100, 10}, {-10, 100, 10}};
-    fv_mesh_desc light = {"light", lv, 4, NULL, quad, 2, NULL, em};
+    fv_mesh_desc light = {"light", lv, 4, NULL, quad, 2, NULL, em, NULL};
     assert_int_equal(fv_scene_add_mesh(s, &light, NULL, NULL, &err), FV_OK);
     fv_vec3 bv[8];
     for (int k = 0; k < 8; k++) bv[k] = fv_v3(k & 1 ? 10.0f : -10.0f, k & 2 ? 10.0f : -10.0f, k & 4 ? 10.0f : -10.0f);
     const uint32_t bi[36] = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
-    fv_mesh_desc box = {"box", bv, 8, NULL, bi, 12, NULL, mm};
+    fv_mesh_desc box = {"box", bv, 8, NULL, bi, 12, NULL, mm, NULL};
     int obj;
     assert_int_equal(fv_scene_add_mesh(s, &box, NULL, &obj, &err), FV_OK);
     fv_anim_key keys[2] = {{0.0, {0, 50, 0}, {0, 0, 0, 1}, {1, 1, 1}}, {1.0, {0, 50, 0}, {0, 0, 0, 1}, {1, 1, 1}}};

@@ -80,7 +80,7 @@ static fv_scene *plane_scene(bool area_light)
     assert_int_equal(fv_scene_add_material(s, &m, &mat, &err), FV_OK);
     const fv_vec3 v[4] = {{-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}};
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    fv_mesh_desc d = {"plane", v, 4, NULL, idx, 2, NULL, mat};
+    fv_mesh_desc d = {"plane", v, 4, NULL, idx, 2, NULL, mat, NULL};
     assert_int_equal(fv_scene_add_mesh(s, &d, NULL, NULL, &err), FV_OK);
     if (area_light) {
         /* 1x1 quad at height 1 facing down, radiance 4. */
@@ -90,7 +90,7 @@ static fv_scene *plane_scene(bool area_light)
         int emat;
         assert_int_equal(fv_scene_add_material(s, &e, &emat, &err), FV_OK);
         const fv_vec3 lv[4] = {{-0.5f, 1, -0.5f}, {0.5f, 1, -0.5f}, {0.5f, 1, 0.5f}, {-0.5f, 1, 0.5f}};
-        fv_mesh_desc ld = {"light", lv, 4, NULL, idx, 2, NULL, emat};
+        fv_mesh_desc ld = {"light", lv, 4, NULL, idx, 2, NULL, emat, NULL};
         assert_int_equal(fv_scene_add_mesh(s, &ld, NULL, NULL, &err), FV_OK);
     } else {
         fv_light_desc l = {FV_LIGHT_POINT, {0, 2, 0}, {0, -1, 0}, {10, 10, 10}, 0, 0};

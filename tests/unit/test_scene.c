@@ -18,7 +18,7 @@ static const uint32_t k_quad_idx[6] = {0, 1, 2, 0, 2, 3};
 
 static int add_quad(fv_scene *s, int mat, const char *name)
 {
-    fv_mesh_desc m = {name, k_quad, 4, NULL, k_quad_idx, 2, NULL, mat};
+    fv_mesh_desc m = {name, k_quad, 4, NULL, k_quad_idx, 2, NULL, mat, NULL};
     int id = -1;
     fv_error err;
     assert_int_equal(fv_scene_add_mesh(s, &m, NULL, &id, &err), FV_OK);
@@ -134,14 +134,14 @@ static void test_bad_geometry_dropped(void **st)
     const fv_vec3 v[7] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {NAN, 0, 0}, {2, 0, 0}, {3, 0, 0}, {INFINITY, 1, 1}};
     /* good, NaN vertex, collinear (zero area), repeated vertex, out-of-range index, infinite vertex */
     const uint32_t idx[18] = {0, 1, 2, 0, 3, 2, 0, 1, 4, 1, 1, 2, 0, 1, 99, 6, 1, 2};
-    fv_mesh_desc d = {"bad", v, 7, NULL, idx, 6, NULL, mat};
+    fv_mesh_desc d = {"bad", v, 7, NULL, idx, 6, NULL, mat, NULL};
     int id;
     assert_int_equal(fv_scene_add_mesh(s, &d, &log, &id, &err), FV_OK);
     assert_int_equal(fv_scene_triangle_count(s), 1);
     assert_int_equal(cap.count, 1);
     assert_non_null(strstr(cap.last, "dropped 5 of 6"));
     /* A mesh with nothing valid is refused. */
-    fv_mesh_desc d2 = {"allbad", v, 7, NULL, idx + 3, 1, NULL, mat};
+    fv_mesh_desc d2 = {"allbad", v, 7, NULL, idx + 3, 1, NULL, mat, NULL};
     assert_int_equal(fv_scene_add_mesh(s, &d2, &log, &id, &err), FV_ERR_INVALID);
     assert_non_null(strstr(err.msg, "allbad"));
     fv_scene_destroy(s);
@@ -168,7 +168,7 @@ static void test_refusals(void **st)
     m.ior = 0.5f;
     assert_int_equal(fv_scene_add_material(s, &m, NULL, &err), FV_ERR_INVALID);
     assert_non_null(strstr(err.msg, "ior"));
-    fv_mesh_desc d = {"q", k_quad, 4, NULL, k_quad_idx, 2, NULL, 3};
+    fv_mesh_desc d = {"q", k_quad, 4, NULL, k_quad_idx, 2, NULL, 3, NULL};
     assert_int_equal(fv_scene_add_mesh(s, &d, NULL, NULL, &err), FV_ERR_INVALID); /* material 3 does not exist */
     fv_light_desc l = {FV_LIGHT_SPOT, {0, 1, 0}, {0, -1, 0}, {1, 1, 1}, 40, 30};
     assert_int_equal(fv_scene_add_light(s, &l, &err), FV_ERR_INVALID); /* inner > outer */
@@ -205,7 +205,7 @@ static void test_refusals(void **st)
     m = fv_material_default(FV_MAT_DIFFUSE);
     assert_int_equal(fv_scene_add_material(s, &m, &id, &err), FV_OK);
     const fv_vec3 far_quad[4] = {{-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {2e9f, 0, 1}};
-    fv_mesh_desc fq = {"far", far_quad, 4, NULL, k_quad_idx, 2, NULL, id};
+    fv_mesh_desc fq = {"far", far_quad, 4, NULL, k_quad_idx, 2, NULL, id, NULL};
     int fid;
     assert_int_equal(fv_scene_add_mesh(s, &fq, NULL, &fid, &err), FV_OK); /* one of two triangles kept */
     fv_anim_key keys[2] = {{0, {0, 0, 0}, {0, 0, 0, 1}, {1, 1, 1}}, {1, {1e10f, 0, 0}, {0, 0, 0, 1}, {1, 1, 1}}};
@@ -231,7 +231,7 @@ static void test_area_light_sampling(void **st)
     /* Quad x,z in [-0.5,0.5] at y=1, wound so the normal points down (-y). */
     const fv_vec3 v[4] = {{-0.5f, 1, -0.5f}, {0.5f, 1, -0.5f}, {0.5f, 1, 0.5f}, {-0.5f, 1, 0.5f}};
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    fv_mesh_desc d = {"light", v, 4, NULL, idx, 2, NULL, mat};
+    fv_mesh_desc d = {"light", v, 4, NULL, idx, 2, NULL, mat, NULL};
     assert_int_equal(fv_scene_add_mesh(s, &d, NULL, NULL, &err), FV_OK);
     fv_test_warnings cap = {0};
     fv_log log = {fv_test_warn, &cap};

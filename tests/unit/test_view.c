@@ -32,7 +32,7 @@ static fv_scene *quad_scene(void)
     assert_int_equal(fv_scene_add_material(s, &m, &mat, &err), FV_OK);
     const fv_vec3 p[4] = {{1, 2, 5}, {7, 2, 5}, {7, 10, 5}, {1, 10, 5}};
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    fv_mesh_desc d = {"quad", p, 4, NULL, idx, 2, NULL, mat};
+    fv_mesh_desc d = {"quad", p, 4, NULL, idx, 2, NULL, mat, NULL};
     assert_int_equal(fv_scene_add_mesh(s, &d, NULL, NULL, &err), FV_OK);
     fv_light_desc l = {FV_LIGHT_POINT, {4, 6, 20}, {0, 0, -1}, {100, 100, 100}, 0, 0};
     assert_int_equal(fv_scene_add_light(s, &l, &err), FV_OK);

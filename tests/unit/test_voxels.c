@@ -68,7 +68,7 @@ static int add_box(fv_scene *s, fv_vec3 lo, fv_vec3 hi, int mat)
             for (int q = 0; q < 6; q++) idx[ni++] = (uint32_t)(nv + tri[q]);
             nv += 4;
         }
-    fv_mesh_desc d = {"box", pos, nv, NULL, idx, 12, NULL, mat};
+    fv_mesh_desc d = {"box", pos, nv, NULL, idx, 12, NULL, mat, NULL};
     int id;
     fv_error err;
     assert_int_equal(fv_scene_add_mesh(s, &d, NULL, &id, &err), FV_OK);
@@ -80,7 +80,7 @@ static void add_x_plane(fv_scene *s, float c, int mat)
 {
     fv_vec3 pos[4] = {fv_v3(c, 0, 0), fv_v3(c, 4, 0), fv_v3(c, 4, 4), fv_v3(c, 0, 4)};
     uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    fv_mesh_desc d = {"plane", pos, 4, NULL, idx, 2, NULL, mat};
+    fv_mesh_desc d = {"plane", pos, 4, NULL, idx, 2, NULL, mat, NULL};
     fv_error err;
     assert_int_equal(fv_scene_add_mesh(s, &d, NULL, NULL, &err), FV_OK);
 }

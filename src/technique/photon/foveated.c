@@ -250,7 +250,8 @@ static void trace_path(const trace_ctx *c, int px, int py, int attempt, path_out
             ended = true;
             break;
         }
-        const fv_material *m = fv_scene_material(s, h.mat);
+        fv_material mbuf;
+        const fv_material *m = fv_hit_material(s, &h, &mbuf);
         if (out->len > 0 && fv_max3(m->emission) > 0.0f) { /* reached the light: the last photon holds direct light */
             ended = true;
             break;

@@ -42,7 +42,8 @@ static void eye_walk(const fv_scene *s, fv_vec3 o, fv_vec3 d, int depth, int max
             out->emitted = fv_add(out->emitted, fv_mul(out->weight, fv_light_env_radiance(s, d)));
             return;
         }
-        const fv_material *m = fv_scene_material(s, h.mat);
+        fv_material mbuf;
+        const fv_material *m = fv_hit_material(s, &h, &mbuf);
         fv_vec3 wo = fv_neg(d);
         if (depth == 0) {
             out->first_t = h.t;
@@ -62,6 +63,9 @@ static void eye_walk(const fv_scene *s, fv_vec3 o, fv_vec3 d, int depth, int max
             out->ng = sh.ng;
             out->wo = wo;
             out->mat = h.mat;
+            out->prim = h.prim;
+            out->u = h.u;
+            out->v = h.v;
             out->obj = h.obj;
             return;
         }
@@ -110,7 +114,8 @@ static inline float max_abs3(fv_vec3 v)
 
 fv_vec3 fv_pm_gather(const fv_scene *s, const fv_photon_map *m, const fv_pm_hit *x, float r, double *u_sum)
 {
-    const fv_material *mat = fv_scene_material(s, x->mat);
+    fv_material mbuf;
+    const fv_material *mat = fv_material_at(s, x->mat, x->obj, x->prim, x->u, x->v, &mbuf);
     fv_shading sh;
     fv_shading_make(mat, x->ng, x->n, x->wo, &sh);
     /* A diffuse surface's f_r is albedo / pi for every photon arriving from above (the shading

@@ -20,6 +20,8 @@ typedef struct fv_pm_hit {
     fv_vec3 ng;          /* geometric normal facing the arriving ray */
     fv_vec3 wo;          /* unit direction back along the arriving ray */
     int mat, obj;
+    int prim;            /* the triangle, and the barycentrics u, v on it: the material's texture */
+    float u, v;          /* is read there (query.h's fv_material_at) */
     bool dynamic;        /* on a dynamic object, or reached through one */
     fv_vec3 weight;      /* throughput of the mirror/glass chain before the surface */
     fv_vec3 emitted;     /* emission met along the chain (already weighted) */

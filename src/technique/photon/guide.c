@@ -220,12 +220,12 @@ typedef struct pilot_walk {
     uint32_t in, all;
 } pilot_walk;
 
-static void pilot_visit(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 ng, int mat)
+static void pilot_visit(void *ctx, const fv_hit *h, const fv_material *m, fv_vec3 dir, fv_vec3 flux)
 {
-    (void)dir, (void)flux, (void)ng, (void)mat;
+    (void)m, (void)dir, (void)flux;
     pilot_walk *w = ctx;
     w->all++;
-    w->in += fv_focus_cells_contains(w->focus, pos);
+    w->in += fv_focus_cells_contains(w->focus, h->p);
 }
 
 fv_status fv_photon_guide_learn(fv_photon_guide *g, const fv_photon_job *job, fv_trace_set set, const fv_focus_cells *focus,

@@ -38,15 +38,15 @@ typedef struct blk {
     bool oom, record;
 } blk;
 
-static void keep(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 ng, int mat)
+static void keep(void *ctx, const fv_hit *h, const fv_material *m, fv_vec3 dir, fv_vec3 flux)
 {
-    (void)mat;
+    (void)m;
     blk *b = ctx;
     if (b->oom || fv_grow((void **)&b->p, &b->capp, b->np + 1, sizeof *b->p)) {
         b->oom = true;
         return;
     }
-    b->p[b->np++] = fv_photon_make(pos, dir, flux, ng);
+    b->p[b->np++] = fv_photon_make(h->p, dir, flux, h->ng);
 }
 
 /* Walk i of the job through `set`: fv_light_path_trace's loop, with its segments recorded when

@@ -22,16 +22,16 @@ typedef struct block_out {
 } block_out;
 
 /* The light path's visit: a photon is stored at every diffuse or glossy vertex. */
-static void deposit(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 ng, int mat)
+static void deposit(void *ctx, const fv_hit *h, const fv_material *m, fv_vec3 dir, fv_vec3 flux)
 {
-    (void)mat; /* a photon keeps its flux; the gather applies the receiving BSDF */
+    (void)m; /* a photon keeps its flux; the gather applies the receiving BSDF, at the gather's point */
     block_out *b = ctx;
     if (b->oom) return;
     if (fv_grow((void **)&b->p, &b->cap, b->n + 1, sizeof *b->p)) {
         b->oom = true;
         return;
     }
-    b->p[b->n++] = fv_photon_make(pos, dir, flux, ng);
+    b->p[b->n++] = fv_photon_make(h->p, dir, flux, h->ng);
 }
 
 /* ---- running blocks of photons in parallel, deterministically ---- */

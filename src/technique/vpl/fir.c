@@ -303,7 +303,8 @@ static void vpl_from_hit(const fv_scene *s, const fv_hit *h, fv_vec3 dir, fir_vp
     memset(v, 0, sizeof *v);
     v->p = h->p;
     v->n = fv_dot(h->ng, dir) < 0.0f ? h->ng : fv_neg(h->ng);
-    v->albedo = fv_hit_material(s, h)->albedo;
+    fv_material mbuf;
+    v->albedo = fv_hit_material(s, h, &mbuf)->albedo;
     v->obj = h->obj;
     v->map = -1;
     v->tile = -1;

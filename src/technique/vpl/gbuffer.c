@@ -43,7 +43,8 @@ static void gb_fill(const fv_scene *s, fv_vec3 d, const fv_hit *h, bool ok, fv_g
         g->emit = fv_light_env_radiance(s, d); /* the environment, if any, seen past everything */
         return;
     }
-    const fv_material *m = fv_hit_material(s, h);
+    fv_material mbuf;
+    const fv_material *m = fv_hit_material(s, h, &mbuf);
     const fv_vec3 wo = fv_neg(d);
     g->p = h->p;
     g->t = h->t;

@@ -10,14 +10,14 @@ typedef struct walk_ctx {
 } walk_ctx;
 
 /* The light-path kernel's visit: a VPL reflects what arrives with its surface's diffuse albedo. */
-static void visit(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 ng, int mat)
+static void visit(void *ctx, const fv_hit *h, const fv_material *m, fv_vec3 dir, fv_vec3 flux)
 {
     walk_ctx *w = ctx;
     if (w->made >= w->count) return;
     fv_vpl_light *v = &w->vpls[w->made++];
-    v->p = pos;
-    v->n = fv_dot(ng, dir) < 0.0f ? ng : fv_neg(ng); /* the side the light arrived on */
-    v->power = fv_scale(fv_mul(flux, fv_scene_material(w->s, mat)->albedo), 1.0f / (float)M_PI);
+    v->p = h->p;
+    v->n = fv_dot(h->ng, dir) < 0.0f ? h->ng : fv_neg(h->ng); /* the side the light arrived on */
+    v->power = fv_scale(fv_mul(flux, m->albedo), 1.0f / (float)M_PI); /* the albedo at the hit */
     v->map = -1;
 }
 

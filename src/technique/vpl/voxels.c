@@ -98,10 +98,13 @@ static bool tri_overlaps_cube(fv_vec3 p0, fv_vec3 p1, fv_vec3 p2, float r)
     return true;
 }
 
-static fv_vec3 material_albedo(const fv_scene *s, int mat)
+/* The albedo of material mat on triangle prim of object obj: a textured one's at the triangle's
+ * centroid (a cell is coarser than a texel; SDF objects have no texture coordinates). */
+static fv_vec3 material_albedo(const fv_scene *s, int mat, int obj, int prim)
 {
+    fv_material mbuf;
     const fv_material *m = fv_scene_material(s, mat);
-    return m ? m->albedo : fv_v3s(0.0f);
+    return m ? fv_material_at(s, mat, obj, prim, 1.0f / 3.0f, 1.0f / 3.0f, &mbuf)->albedo : fv_v3s(0.0f);
 }
 
 static fv_vec3 unit_or_zero(fv_vec3 n)
@@ -121,7 +124,7 @@ static void voxelize_mesh(fv_voxels *v, int obj, fv_vox_acc *acc, bool dynamic)
         int c0[3], c1[3];
         if (!cell_range(v, fv_vmin(a, fv_vmin(b, c)), fv_vmax(a, fv_vmax(b, c)), c0, c1)) continue;
         fv_vec3 n = unit_or_zero(fv_cross(fv_sub(b, a), fv_sub(c, a)));
-        fv_vec3 albedo = material_albedo(s, fv_scene_triangle_material(s, obj, p));
+        fv_vec3 albedo = material_albedo(s, fv_scene_triangle_material(s, obj, p), obj, p);
         for (int k = c0[2]; k <= c1[2]; k++)
             for (int j = c0[1]; j <= c1[1]; j++)
                 for (int i = c0[0]; i <= c1[0]; i++) {
@@ -156,7 +159,7 @@ static void voxelize_sdf(fv_voxels *v, int obj, fv_vox_acc *acc, bool dynamic)
                 if (!(fabsf(d) <= half_diag)) continue;
                 /* The gradient over half a cell: the normal of the surface the cell holds. */
                 fv_vec3 n = unit_or_zero(fv_xform_normal(&w2l, fv_sdf_normal(sdf, p, 0.5f * v->h * k_loc)));
-                add_write(v, acc, dynamic, cell_index(v, i, j, k), n, material_albedo(s, mat), obj);
+                add_write(v, acc, dynamic, cell_index(v, i, j, k), n, material_albedo(s, mat, obj, 0), obj);
             }
 }
 

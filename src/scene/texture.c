@@ -1,0 +1,87 @@
+/* fovea — textures in the scene: adding them (sRGB -> linear), sampling them, and the material
+ * at a hit with its albedo read from its texture (see texture.h and query.h). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include "core/alloc.h"
+#include "fovea/film.h"
+#include "fovea/limits.h"
+#include "scene/scene_impl.h"
+#include "scene/texture.h"
+
+fv_status fv_scene_add_texture(fv_scene *s, const fv_texture_desc *t, int *id, fv_error *err)
+{
+    if (s->committed) return fv_error_set(err, FV_ERR_INTERNAL, "scene already committed: it cannot be changed");
+    const char *name = t->name ? t->name : "texture";
+    if (t->width < 1 || t->height < 1 || !t->texels || t->channels < 1 || t->channels > 4)
+        return fv_error_set(err, FV_ERR_INVALID, "texture '%s': bad size %dx%d or %d channels", name, t->width, t->height, t->channels);
+    long long n = (long long)t->width * t->height;
+    if (n > FV_TEXTURE_MAX_TEXELS)
+        return fv_error_set(err, FV_ERR_INVALID, "texture '%s': %dx%d is more than the %d texels a texture may have", name, t->width,
+                            t->height, FV_TEXTURE_MAX_TEXELS);
+    if (s->tex_texels + n > FV_TEXTURE_MAX_TOTAL)
+        return fv_error_set(err, FV_ERR_INVALID, "texture '%s': the scene's textures would hold more than %d texels", name,
+                            FV_TEXTURE_MAX_TOTAL);
+    if (fv_grow((void **)&s->tex, &s->captex, s->ntex + 1, sizeof *s->tex))
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory adding texture '%s'", name);
+    fv_texture *x = &s->tex[s->ntex];
+    x->rgb = fv_alloc_array((size_t)n, 3 * sizeof(float));
+    if (!x->rgb) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for texture '%s' (%dx%d)", name, t->width, t->height);
+    /* One table for the 256 codes instead of a power per channel. */
+    float lut[256];
+    for (int i = 0; i < 256; i++) lut[i] = fv_srgb_decode((float)i / 255.0f);
+    const int ch = t->channels;
+    for (long long i = 0; i < n; i++) {
+        const unsigned char *p = &t->texels[i * ch];
+        bool grey = ch < 3;
+        x->rgb[3 * i] = lut[p[0]];
+        x->rgb[3 * i + 1] = lut[p[grey ? 0 : 1]];
+        x->rgb[3 * i + 2] = lut[p[grey ? 0 : 2]];
+    }
+    snprintf(x->name, sizeof x->name, "%s", name);
+    x->w = t->width;
+    x->h = t->height;
+    s->tex_texels += n;
+    *id = ++s->ntex;
+    return FV_OK;
+}
+
+int fv_scene_texture_count(const fv_scene *s) { return s->ntex; }
+
+/* floor(x) mod n, for any finite x. */
+static int wrap(float x, int n)
+{
+    int i = (int)fmodf(floorf(x), (float)n);
+    return i < 0 ? i + n : i;
+}
+
+fv_vec3 fv_texture_sample(const fv_texture *t, fv_vec2 uv)
+{
+    /* Keep the coordinates' fraction first: float texel positions of a large u lose precision,
+     * and fmodf of a non-finite value is NaN (read as texel 0). */
+    float u = uv.x - floorf(uv.x), v = uv.y - floorf(uv.y);
+    if (!isfinite(u) || !isfinite(v)) u = v = 0.0f;
+    /* Texel centres sit at half-integers; rows run from the top, v from the bottom. */
+    float x = u * (float)t->w - 0.5f, y = (1.0f - v) * (float)t->h - 0.5f;
+    float fx = x - floorf(x), fy = y - floorf(y);
+    int x0 = wrap(x, t->w), y0 = wrap(y, t->h);
+    int x1 = x0 + 1 == t->w ? 0 : x0 + 1, y1 = y0 + 1 == t->h ? 0 : y0 + 1;
+    const float *a = &t->rgb[3 * ((size_t)y0 * t->w + x0)], *b = &t->rgb[3 * ((size_t)y0 * t->w + x1)];
+    const float *c = &t->rgb[3 * ((size_t)y1 * t->w + x0)], *d = &t->rgb[3 * ((size_t)y1 * t->w + x1)];
+    float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy), w01 = (1.0f - fx) * fy, w11 = fx * fy;
+    return fv_v3(w00 * a[0] + w10 * b[0] + w01 * c[0] + w11 * d[0], w00 * a[1] + w10 * b[1] + w01 * c[1] + w11 * d[1],
+                 w00 * a[2] + w10 * b[2] + w01 * c[2] + w11 * d[2]);
+}
+
+const fv_material *fv_material_textured(const fv_scene *s, const fv_material *m, int obj, int prim, float u, float v, fv_material *buf)
+{
+    const fv_object *o = obj >= 0 && obj < s->nobj ? &s->objs[obj] : NULL;
+    if (!o || !o->uv || prim < 0 || prim >= o->nt || m->albedo_texture < 1 || m->albedo_texture > s->ntex) return m;
+    const uint32_t *ix = &o->idx[3 * prim];
+    float w = 1.0f - u - v;
+    fv_vec2 a = o->uv[ix[0]], b = o->uv[ix[1]], c = o->uv[ix[2]];
+    fv_vec2 st = {w * a.x + u * b.x + v * c.x, w * a.y + u * b.y + v * c.y};
+    *buf = *m;
+    buf->albedo = fv_mul(m->albedo, fv_texture_sample(&s->tex[m->albedo_texture - 1], st));
+    return buf;
+}
