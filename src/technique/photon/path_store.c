@@ -149,8 +149,8 @@ fv_status fv_path_store_trace(fv_path_store *p, const fv_photon_job *job, uint64
     int64_t op = 0, os = 0;
     for (int64_t k = 0; k < nblocks; k++) {
         if (st == FV_OK) {
-            memcpy(p->ph + op, b[k].p, (size_t)b[k].np * sizeof *p->ph);
-            memcpy(p->sg + os, b[k].s, (size_t)b[k].ns * sizeof *p->sg);
+            if (b[k].np) memcpy(p->ph + op, b[k].p, (size_t)b[k].np * sizeof *p->ph);
+            if (b[k].ns) memcpy(p->sg + os, b[k].s, (size_t)b[k].ns * sizeof *p->sg);
             int64_t first = k * BLOCK, end = (k + 1) * BLOCK < job->count ? (k + 1) * BLOCK : job->count;
             for (int64_t i = first; i < end; i++) {
                 p->pstart[i] = op, p->sstart[i] = os;
@@ -213,6 +213,7 @@ fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, f
                 again++;
             } else {
                 int m = (int)(p->pstart[i + 1] - p->pstart[i]);
+                if (m == 0) continue; /* a path that stored nothing (nor may o->p exist yet) */
                 if (o->oom || fv_grow((void **)&o->p, &o->capp, o->np + m, sizeof *o->p)) {
                     o->oom = true;
                     continue;
