@@ -12,14 +12,15 @@
  *     periphery the gather is made only on a lattice of every `periphery_step`-th pixel, filtered
  *     at that resolution and filled in at full resolution from the first-hit buffers
  *     (filter/lattice.h); the full-resolution filter runs only over the focus region;
- *   - photon side: the focus region gathers from M_g, light photons guided towards the grid cells
- *     its gather discs touch, their flux divided by the guiding density so the map stays unbiased
- *     (guide.h), in place of fpm's flux-copying foveated photons; the periphery from M_ls, plain
- *     light photons. Both are static photon paths traced once and kept (M_g until the gaze moves
- *     on to other cells); each frame only the paths that pass a dynamic object are traced again,
- *     so the maps are what a full trace of the current scene gives (path_store.h) rather than
- *     pm-t's static map plus negative photons, which leaves light a moving object blocks after a
- *     bounce and adds noise in its shadow (docs/results.md).
+ *   - photon side: light photons guided towards the grid cells the focus region's gather discs
+ *     touch, their flux divided by the guiding density so the map stays unbiased (guide.h), in
+ *     place of fpm's flux-copying foveated photons (M_g), and plain light photons (M_ls), joined
+ *     into one map by the balance heuristic over the emission numbers, gathered by every pixel.
+ *     Both sets are photon paths traced once through the static objects and kept (M_g until the
+ *     gaze moves on to other cells); each frame only the paths that pass a dynamic object are
+ *     traced again, so the map is what a full trace of the current scene gives (path_store.h),
+ *     not pm-t's static map plus negative photons, which leaves light a moving object blocks
+ *     after a bounce and adds noise in its shadow (docs/results.md).
  * Everything else (tracer, grids, gather, filters) is pm's.
  *
  * Stereo: the right eye of a frame reuses the left eye's photon maps (same time, same lights).
