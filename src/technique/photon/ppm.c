@@ -212,4 +212,5 @@ const fv_technique_class fv_technique_ppm = {
     .furnace_radiance = 0.998046875,
     .furnace_tolerance = 0.04,
     .spp_param = "passes",
+    .gathers_photons = true,
 };
