@@ -615,7 +615,7 @@ static fv_status fpm_create(const fv_scene *s, fv_params *p, const fv_log *log, 
     .test_params = "photons=40000", .furnace_params = "radius=0.25", .furnace_radiance = 0.998046875, \
     .furnace_tolerance = 0.04,                                                                       \
     .gathers_photons = true,                                                                         \
-    .spp_instead = "one eye path per pixel centre gathers the photon maps: use --param photons=N, or passes=N to average N passes with pm"
+    .spp_instead = "one eye path per pixel centre gathers the photon maps: use --param photons=N, or passes=N to average N passes with pm; ppm takes --spp as its passes"
 
 const fv_technique_class fv_technique_pm = {
     .name = "pm",
