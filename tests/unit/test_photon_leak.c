@@ -63,15 +63,7 @@ static const fv_camera k_outside = {{2.5f, 2.0f, 4.0f}, {0, 0, 0}, {0, 1, 0}, 45
 /* Mean radiance (over pixels and channels) of one frame of `method` with its test parameters. */
 static double mean_of(const char *method, const char *params, const fv_scene *s, const fv_camera *cam)
 {
-    fv_params *p = fv_test_params_str(params);
-    fv_technique *t = NULL;
-    fv_error err;
-    if (fv_technique_create(method, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s: %s", method, err.msg);
-    fv_film *film;
-    assert_int_equal(fv_film_create(W, H, 0, &film, &err), FV_OK);
-    fv_frame f;
-    fv_frame_init(&f, cam);
-    fv_test_render_frames(t, &f, 1, film, NULL);
+    fv_film *film = fv_test_render_once(method, params, s, cam, 1);
     const float *c = fv_film_color_const(film);
     double sum = 0.0;
     for (size_t i = 0; i < (size_t)3 * W * H; i++) {
@@ -79,8 +71,6 @@ static double mean_of(const char *method, const char *params, const fv_scene *s,
         sum += c[i];
     }
     fv_film_destroy(film);
-    fv_technique_destroy(t);
-    fv_params_destroy(p);
     return sum / (3.0 * W * H);
 }
 
