@@ -193,8 +193,8 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
     return rc;
 }
 
-/* The furnace at r_1 = 0.25 (pm's figure, FURNACE_TEST in pm.c): 0.5 + 0.498047 times the share
- * of photons the gather keeps on the unit sphere. [see docs] */
+/* The furnace at r_1 = 0.25, as pm's (FURNACE_TEST in pm.c): 1 - 0.5^9 whatever the radius below 1,
+ * the gather keeping every photon of the disc on the unit sphere. */
 const fv_technique_class fv_technique_ppm = {
     .name = "ppm",
     .summary = "progressive photon mapping: passes with a shrinking radius averaged, converging to the truth (photon reference)",
