@@ -207,6 +207,13 @@ bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *orig
     return true;
 }
 
+int fv_light_emission_dir_dims(const fv_scene *s, float u0)
+{
+    if (s->nlights == 0) return 1;
+    float pmf;
+    return s->lights[pick_light(s, u0, &pmf)].kind == 1 ? 3 : 1;
+}
+
 bool fv_light_pick_point(const fv_scene *s, fv_rng *rng, fv_light_point *out)
 {
     if (s->nlights == 0) return false;

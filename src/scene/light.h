@@ -55,6 +55,10 @@ float fv_light_env_pdf(const fv_scene *s, fv_vec3 w);
  * by the pick and sampling densities; divide by the number of photons emitted). u[5]. */
 bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *origin, fv_vec3 *dir, fv_vec3 *power,
                               fv_vec3 *normal);
+/* Which two of those five numbers choose the emitted direction of the light u[0] picks: 1 (u[1],
+ * u[2]) for delta lights and the environment, 3 (u[3], u[4]) for emissive triangles, whose u[1],
+ * u[2] choose the point. Photon guiding warps exactly these (technique/photon/guide.h). */
+int fv_light_emission_dir_dims(const fv_scene *s, float u0);
 
 /* A point on a light picked by power (the walk's start when it must aim somewhere itself, as
  * photons towards the dynamic objects do): the light index, its pick probability, the point, and

@@ -8,6 +8,11 @@ bool fv_light_path_emit(const fv_scene *s, fv_rng *rng, int64_t count, fv_vec3 *
 {
     float u[5];
     for (int k = 0; k < 5; k++) u[k] = fv_rng_next(rng);
+    return fv_light_path_emit_u(s, u, count, o, d, flux);
+}
+
+bool fv_light_path_emit_u(const fv_scene *s, const float u[5], int64_t count, fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux)
+{
     fv_vec3 power, n;
     if (!fv_light_sample_emission(s, u, o, d, &power, &n)) return false;
     if (fv_dot(n, n) > 0.0f) *o = fv_offset_point(s, *o, n, *d);

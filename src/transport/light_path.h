@@ -24,6 +24,9 @@ typedef void (*fv_light_vertex_fn)(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 
  * flux of one of `count` walks; the origin is already off an area light's surface. Draws five
  * numbers. False when nothing was emitted. */
 bool fv_light_path_emit(const fv_scene *s, fv_rng *rng, int64_t count, fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux);
+/* The same from five given numbers in [0,1) (fv_light_sample_emission's u), for samplers that
+ * choose them themselves (photon guiding). */
+bool fv_light_path_emit_u(const fv_scene *s, const float u[5], int64_t count, fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux);
 
 /* At hit h of a walk arriving along *d: visits the vertex if the surface is diffuse or glossy,
  * then scatters the walk (new *o, *d, *flux). False when the walk ends there (absorbed, Russian

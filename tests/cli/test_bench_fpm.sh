@@ -1,6 +1,7 @@
 # `fovea bench fpm-speed --quick`: the photon mapping scenario runs end to end and reports what the
 # paper's Table 2 and Fig. 9 need: per-stage times, the foveated paths' reuse rate, and the PM_eq
-# search; bad fpm parameters exit 2.
+# search; fpm-guided beside them with its stages and the passes pm needs to match its fovea; bad
+# fpm and fpm-guided parameters exit 2.
 . "$(dirname "$0")/lib.sh"
 OUT=$TMP/bench
 expect 0 "" -- $FOVEA bench fpm-speed --quick --out "$OUT" --quiet
@@ -8,7 +9,7 @@ python3 - "$OUT/fpm-speed.json" <<'PY' || fail "fpm-speed.json is incomplete or 
 import json, sys
 d = json.load(open(sys.argv[1]))
 rows = {r["method"]: r for r in d["results"]}
-assert set(rows) == {"fpm", "fpm-wo", "pm", "pm-t", "pm-eq"}, list(rows)
+assert set(rows) == {"fpm-guided", "fpm", "fpm-wo", "pm", "pm-t", "pm-eq", "pm-eq-guided"}, list(rows)
 f = rows["fpm"]
 for s in ("light_tracing", "tpm", "foveated_tracing", "render"):
     assert s in f["stages_ms"], s
@@ -18,11 +19,20 @@ assert f["counters"]["foveated_photons"] > 0 and f["counters"]["light_photons"] 
 assert "tpm" not in rows["pm"]["stages_ms"]
 m = rows["pm-eq"]["match"]
 assert m["target"] == "fpm" and m["region"] == "fovea" and m["param"] == "photons"
+g = rows["fpm-guided"]
+for s in ("light_tracing", "focus_cells", "guided_tracing", "render", "fill"):
+    assert s in g["stages_ms"], s
+assert g["counters"]["guided_photons"] > 0 and g["counters"]["focus_cells"] > 0
+m = rows["pm-eq-guided"]["match"]
+assert m["target"] == "fpm-guided" and m["param"] == "passes"
 for r in rows.values():
     assert r["temporal"]["fovea"]["mse"] is not None  # two frames: MSE' exists
 PY
 expect 2 "fov_fraction" -- $FOVEA render cornell-fpm --method fpm --param fov_fraction=1.5 --size 8x8 --out "$TMP/x.png"
 expect 2 "photons" -- $FOVEA render cornell --method pm --param photons=0 --size 8x8 --out "$TMP/x.png"
 expect 2 "radius" -- $FOVEA render cornell --method pm-t --param radius=-1 --size 8x8 --out "$TMP/x.png"
+expect 2 "fovea_spp" -- $FOVEA render cornell-fpm --method fpm-guided --param fovea_spp=0 --size 8x8 --out "$TMP/x.png"
+expect 2 "periphery_step" -- $FOVEA render cornell-fpm --method fpm-guided --param periphery_step=0 --size 8x8 --out "$TMP/x.png"
+expect 2 "fovea_spp" -- $FOVEA render cornell-fpm --method fpm-guided --spp 1000 --size 8x8 --out "$TMP/x.png"
 [ -e "$TMP/x.png" ] && fail "a failed render left x.png"
 finish

@@ -92,7 +92,7 @@ static void test_leaks(void **st)
         const double lit_out = mean_of(c->name, c->test_params, above, &k_outside);
         const double dark[3] = {mean_of(c->name, c->test_params, above, &k_inside), mean_of(c->name, c->test_params, env, &k_inside),
                                 mean_of(c->name, c->test_params, inside, &k_outside)};
-        print_message("%-8s lit inside %.4g, lit outside %.4g; dark: inside (light above) %.3g, inside (sky) %.3g, outside (light inside) %.3g\n",
+        print_message("%-10s lit inside %.4g, lit outside %.4g; dark: inside (light above) %.3g, inside (sky) %.3g, outside (light inside) %.3g\n",
                       c->name, lit_in, lit_out, dark[0], dark[1], dark[2]);
         assert_true(lit_in > 0.01 && lit_out > 0.01);
         const double floor = 1e-4 * fmin(lit_in, lit_out);

@@ -4,7 +4,7 @@
 #include "scene/light.h"
 #include "technique/photon/gather.h"
 
-void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_rng *rng, fv_pm_hit *out)
+static void eye_start(fv_pm_hit *out)
 {
     out->hit = false;
     out->dynamic = false;
@@ -13,7 +13,30 @@ void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_r
     out->first_t = INFINITY;
     out->first_obj = -1;
     out->albedo = fv_v3s(0.0f);
-    for (int depth = 0; depth <= max_depth; depth++) {
+}
+
+/* The two delta lobes of material m seen from wo (local frame), each with the weight it carries
+ * when both are followed (its sampling weight times its probability): false when only one lobe
+ * exists here (a mirror; a dielectric under total internal reflection or at F = 0). */
+static bool two_lobes(const fv_material *m, fv_vec3 wo, fv_bsdf_sample *a, fv_bsdf_sample *b)
+{
+    if (m->type != FV_MAT_DIELECTRIC) return false;
+    if (!fv_bsdf_sample_dir(m, wo, FV_TRANSPORT_RADIANCE, 0.0f, 0.5f, 0.5f, a) ||
+        !fv_bsdf_sample_dir(m, wo, FV_TRANSPORT_RADIANCE, 0x1.fffffep-1f, 0.5f, 0.5f, b))
+        return false;
+    if (!(a->pdf < 1.0f && b->pdf < 1.0f) || a->wi.z * b->wi.z > 0.0f) return false;
+    a->weight = fv_scale(a->weight, a->pdf);
+    b->weight = fv_scale(b->weight, b->pdf);
+    return true;
+}
+
+/* Follows the ray (o, d) from bounce `depth` on, out holding what came before. With split != NULL,
+ * the first bounce off a dielectric follows both lobes: the second continues in *split (a copy of
+ * out at that point), and *split_used says so. */
+static void eye_walk(const fv_scene *s, fv_vec3 o, fv_vec3 d, int depth, int max_depth, fv_rng *rng, fv_pm_hit *out,
+                     fv_pm_hit *split, bool *split_used)
+{
+    for (; depth <= max_depth; depth++) {
         fv_hit h;
         if (!fv_scene_intersect(s, FV_TRACE_ALL, o, d, INFINITY, &h)) { /* escaped: the environment, if any */
             out->emitted = fv_add(out->emitted, fv_mul(out->weight, fv_light_env_radiance(s, d)));
@@ -42,14 +65,38 @@ void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_r
             out->obj = h.obj;
             return;
         }
-        fv_bsdf_sample bs;
-        float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), u2 = fv_rng_next(rng);
-        if (!fv_bsdf_sample_dir(m, sh.wo, FV_TRANSPORT_RADIANCE, u0, u1, u2, &bs)) return;
+        fv_bsdf_sample bs, b2;
+        if (split && two_lobes(m, sh.wo, &bs, &b2)) {
+            *split = *out;
+            split->emitted = fv_v3s(0.0f); /* what came before counts once, in out */
+            split->weight = fv_mul(out->weight, b2.weight);
+            fv_vec3 wi2 = fv_shading_to_world(&sh, b2.wi);
+            eye_walk(s, fv_offset_point(s, h.p, h.ng, wi2), wi2, depth + 1, max_depth, rng, split, NULL, NULL);
+            *split_used = true;
+            split = NULL;
+        } else {
+            float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), u2 = fv_rng_next(rng);
+            if (!fv_bsdf_sample_dir(m, sh.wo, FV_TRANSPORT_RADIANCE, u0, u1, u2, &bs)) return;
+        }
         fv_vec3 wi = fv_shading_to_world(&sh, bs.wi);
         out->weight = fv_mul(out->weight, bs.weight);
         o = fv_offset_point(s, h.p, h.ng, wi);
         d = wi;
     }
+}
+
+void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_rng *rng, fv_pm_hit *out)
+{
+    eye_start(out);
+    eye_walk(s, o, d, 0, max_depth, rng, out, NULL, NULL);
+}
+
+int fv_pm_eye_path_split(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_rng *rng, fv_pm_hit out[2])
+{
+    bool two = false;
+    eye_start(&out[0]);
+    eye_walk(s, o, d, 0, max_depth, rng, &out[0], &out[1], &two);
+    return two ? 2 : 1;
 }
 
 /* max(|r|, |g|, |b|) as fmax(fabs(.), ...) of the flux's components: the same value without

@@ -32,6 +32,12 @@ typedef struct fv_pm_hit {
 /* Follows a camera ray (o, d) through at most max_depth mirror/glass bounces, choosing between
  * reflection and refraction with the Fresnel probabilities drawn from rng. */
 void fv_pm_eye_path(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_rng *rng, fv_pm_hit *out);
+/* The same, but the first dielectric met is split rather than sampled: its reflection and its
+ * refraction are both followed (each weighted by its Fresnel probability), the second into out[1]
+ * (fpm-guided's fovea: the camera-ray noise through glass is pm's fovea error). Returns how many
+ * of out are filled (1 or 2); emission met before the split is counted in out[0] only, so the
+ * pixel's estimate is the sum of the two. */
+int fv_pm_eye_path_split(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, fv_rng *rng, fv_pm_hit out[2]);
 
 /* Sum over the photons of m within r of x of f_r(x, wo, wi) * flux (not yet divided by pi r^2);
  * *u_sum (may be NULL) accumulates max(|flux r|, |flux g|, |flux b|) of the same photons (Eq. 4). */

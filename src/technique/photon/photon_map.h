@@ -24,6 +24,14 @@ typedef struct fv_photon {
     fv_vec3 n;     /* unit geometric normal, on the side the photon arrived from */
 } fv_photon;
 
+/* A photon arriving along dir at a surface of geometric normal ng: its normal is stored on the
+ * side it came from, which the gather's facing test compares. */
+static inline fv_photon fv_photon_make(fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 ng)
+{
+    fv_photon ph = {pos, dir, flux, fv_dot(ng, dir) < 0.0f ? ng : fv_neg(ng)};
+    return ph;
+}
+
 typedef struct fv_photon_map {
     fv_photon *p;          /* after fv_photon_map_build: sorted by grid cell */
     int n, cap;

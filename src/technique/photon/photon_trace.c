@@ -31,11 +31,7 @@ static void deposit(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 n
         b->oom = true;
         return;
     }
-    fv_photon *ph = &b->p[b->n++];
-    ph->pos = pos;
-    ph->dir = dir;
-    ph->flux = flux;
-    ph->n = fv_dot(ng, dir) < 0.0f ? ng : fv_neg(ng); /* the side the photon came from */
+    b->p[b->n++] = fv_photon_make(pos, dir, flux, ng);
 }
 
 /* ---- running blocks of photons in parallel, deterministically ---- */
@@ -92,12 +88,22 @@ static fv_rng photon_rng(const fv_photon_job *job, int64_t i, uint64_t sub)
     return fv_rng_stream(job->seed, FV_STREAM_PHOTONS(job->stream), (uint64_t)i, sub, (uint64_t)job->frame);
 }
 
+bool fv_photon_emit(const fv_photon_job *job, int64_t i, fv_rng *rng, fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux)
+{
+    *rng = photon_rng(job, i, 0);
+    if (!job->warp) return fv_light_path_emit(job->scene, rng, job->count, o, d, flux);
+    float u[5], q = job->warp(job->warp_ctx, rng, u);
+    if (!(q > 0.0f) || !fv_light_path_emit_u(job->scene, u, job->count, o, d, flux)) return false;
+    *flux = fv_scale(*flux, 1.0f / q);
+    return true;
+}
+
 static void light_photon(const run_ctx *c, int64_t i, block_out *out)
 {
     const fv_photon_job *job = c->job;
-    fv_rng rng = photon_rng(job, i, 0);
+    fv_rng rng;
     fv_vec3 o, d, flux;
-    if (!fv_light_path_emit(job->scene, &rng, job->count, &o, &d, &flux)) return;
+    if (!fv_photon_emit(job, i, &rng, &o, &d, &flux)) return;
     fv_light_path_trace(job->scene, c->set, o, d, flux, 0, job->max_depth, &rng, deposit, out, &out->rays);
 }
 
@@ -134,6 +140,12 @@ void fv_dyn_dirs_destroy(fv_dyn_dirs *d)
 }
 
 int fv_dyn_dirs_count(const fv_dyn_dirs *d) { return d->n; }
+
+void fv_dyn_dirs_sphere(const fv_dyn_dirs *d, int k, fv_vec3 *c, float *r)
+{
+    *c = d->sph[k].c;
+    *r = d->sph[k].r;
+}
 
 fv_status fv_dyn_dirs_build(fv_dyn_dirs *d, const fv_scene *s, fv_error *err)
 {

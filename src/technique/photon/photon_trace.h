@@ -31,6 +31,14 @@ fv_status fv_dyn_dirs_create(fv_dyn_dirs **out, fv_error *err);
 void fv_dyn_dirs_destroy(fv_dyn_dirs *d);
 fv_status fv_dyn_dirs_build(fv_dyn_dirs *d, const fv_scene *s, fv_error *err);
 int fv_dyn_dirs_count(const fv_dyn_dirs *d);
+/* Sphere k of the last build: centre and radius (a little over the object's box, plus the ray
+ * offset). */
+void fv_dyn_dirs_sphere(const fv_dyn_dirs *d, int k, fv_vec3 *c, float *r);
+
+/* Photon guiding (technique/photon/guide.h): fills the five numbers a photon's emission uses
+ * (fv_light_path_emit_u) from rng and returns their density relative to uniform numbers, by which
+ * the photon's flux is divided so the map stays unbiased; a density <= 0 drops the photon. */
+typedef float (*fv_photon_warp_fn)(const void *ctx, fv_rng *rng, float u[5]);
 
 typedef struct fv_photon_job {
     const fv_scene *scene;
@@ -42,7 +50,14 @@ typedef struct fv_photon_job {
     uint64_t stream;       /* distinguishes several maps traced in one frame: FV_STREAM_PHOTONS(stream) */
     fv_kit_progress *progress; /* optional: reported as blocks of photons finish; a cancel stops
                                   the tracing with FV_ERR_CANCELLED */
+    fv_photon_warp_fn warp;     /* fv_photon_trace_lights: NULL for uniform emission */
+    const void *warp_ctx;
 } fv_photon_job;
+
+/* The start of photon i of a job: its random stream (left where the walk goes on), origin,
+ * direction and flux (warped and compensated when the job has a warp). False when nothing was
+ * emitted. Every tracer of light photons starts here, so photon i is the same photon in all. */
+bool fv_photon_emit(const fv_photon_job *job, int64_t i, fv_rng *rng, fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux);
 
 /* Traces job->count photons from the lights through `set` (FV_TRACE_ALL for plain photon mapping,
  * FV_TRACE_STATIC for M_ls), appending the stored photons to out. Each carries 1/count of the

@@ -40,6 +40,7 @@
 #include "technique/photon/foveated.h"
 #include "technique/photon/gather.h"
 #include "technique/photon/photon_trace.h"
+#include "technique/photon/temporal.h"
 
 typedef enum pm_mode { MODE_PM = 0, MODE_PMT, MODE_FPM } pm_mode;
 
@@ -55,16 +56,17 @@ typedef struct pm_opts {
     int passes;           /* pm: independent passes averaged (references) */
     bool filter, tpm;
     int eta_region;       /* fpm: 0 fovea, 1 focus region (Eq. 1's r_i) */
+    int terms;            /* fpm: 0 all, 1 the light photons' term only, 2 the foveated photons' only
+                             (the bias analysis, docs/results.md: eta and k stay those of the whole) */
 } pm_opts;
 
 typedef struct pm_state {
     pm_mode mode;
     const fv_scene *scene;
     pm_opts o;
-    fv_photon_map ls, ld, all;
-    bool ls_done;
+    fv_photon_map all;
+    fv_pmt_maps tm;       /* pm-t, fpm: M_ls and M_ld */
     bool lights_move;     /* the scene's lights move: nothing lit by them is kept across frames */
-    fv_dyn_dirs *dirs;
     fv_foveated *fov;
     int fov_w, fov_h;
     /* first-hit buffers of the left eye: normal, position, object id (filter, stereo) */
@@ -107,6 +109,8 @@ static fv_status read_opts(pm_mode mode, fv_params *p, pm_opts *o, fv_error *err
             return s;
         static const char *const regions[] = {"fovea", "focus", NULL};
         if ((s = fv_params_choice(p, "eta_region", 0, regions, &o->eta_region, err))) return s;
+        static const char *const terms[] = {"all", "light", "foveated", NULL};
+        if ((s = fv_params_choice(p, "terms", 0, terms, &o->terms, err))) return s;
         if (o->fov_fraction >= 1.0)
             return fv_error_set(err, FV_ERR_INVALID, "parameter fov_fraction=%g: some light photons are needed (use < 1)", o->fov_fraction);
         /* Absolute counts (the paper's Fig. 6 b, c vary one at a fixed other) replace the split. */
@@ -127,13 +131,11 @@ static fv_status pm_create_mode(pm_mode mode, const fv_scene *scene, fv_params *
     if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     st->mode = mode;
     st->scene = scene;
-    fv_photon_map_init(&st->ls);
-    fv_photon_map_init(&st->ld);
     fv_photon_map_init(&st->all);
     fv_status s = read_opts(mode, params, &st->o, err);
-    if (s == FV_OK && mode != MODE_PM) s = fv_dyn_dirs_create(&st->dirs, err);
+    if (s == FV_OK && mode != MODE_PM) s = fv_pmt_maps_init(&st->tm, scene, err);
     if (s != FV_OK) {
-        fv_dyn_dirs_destroy(st->dirs);
+        fv_pmt_maps_free(&st->tm);
         free(st);
         return s;
     }
@@ -149,10 +151,8 @@ static void pm_destroy(void *state)
 {
     pm_state *st = state;
     if (!st) return;
-    fv_photon_map_free(&st->ls);
-    fv_photon_map_free(&st->ld);
     fv_photon_map_free(&st->all);
-    fv_dyn_dirs_destroy(st->dirs);
+    fv_pmt_maps_free(&st->tm);
     fv_foveated_destroy(st->fov);
     free(st->nbuf);
     free(st->pbuf);
@@ -193,12 +193,6 @@ typedef struct render_ctx {
     fv_kit_progress prog;
 } render_ctx;
 
-static float blend_k(double num, double den)
-{
-    double w = den > 0.0 ? fmin(num / den, 1.0) : (num > 0.0 ? 1.0 : 0.0);
-    return (float)(3.0 * w * w - 2.0 * w * w * w);
-}
-
 /* Plain photon mapping (pm): one map, no blending. */
 static fv_vec3 estimate_plain(const render_ctx *c, const fv_pm_hit *x)
 {
@@ -216,8 +210,8 @@ static void gather_sums(const render_ctx *c, const fv_pm_hit *x, float b, px_sum
     o->b = b;
     o->hit = x->hit;
     if (!x->hit) return;
-    o->ls = fv_pm_gather(st->scene, &st->ls, x, c->gamma, &u_ls);
-    o->ld = fv_pm_gather(st->scene, &st->ld, x, c->gamma, &u_ld);
+    o->ls = fv_pm_gather(st->scene, &st->tm.ls, x, c->gamma, &u_ls);
+    o->ld = fv_pm_gather(st->scene, &st->tm.ld, x, c->gamma, &u_ld);
     if (b < 1.0f) {
         o->fs = fv_pm_gather(st->scene, fv_foveated_static_map(st->fov), x, c->gamma, &u_fs);
         o->fd = fv_pm_gather(st->scene, fv_foveated_dynamic_map(st->fov), x, c->gamma, &u_fd);
@@ -229,15 +223,22 @@ static void gather_sums(const render_ctx *c, const fv_pm_hit *x, float b, px_sum
  * Eq. 3 (all four maps, times eta) in the fovea, linear in b between. */
 static fv_vec3 estimate_sums(const render_ctx *c, const px_sums *o)
 {
-    if (!o->hit) return o->emitted;
-    float kl = blend_k(o->u_ld, o->u_ls);
-    fv_vec3 g = fv_scale(fv_madd(o->ls, o->ld, kl), c->norm);
+    /* terms=light|foveated: one map pair's share of the same estimate (same eta, same k), the
+     * emission and the periphery's light-photon estimate going to the light term: the two add
+     * up to terms=all. */
+    const int terms = c->st->o.terms;
+    fv_vec3 emitted = terms == 2 ? fv_v3s(0.0f) : o->emitted;
+    if (!o->hit) return emitted;
+    float kl = fv_pmt_blend_k(o->u_ld, o->u_ls);
+    fv_vec3 g = terms == 2 ? fv_v3s(0.0f) : fv_scale(fv_madd(o->ls, o->ld, kl), c->norm);
     if (o->b < 1.0f) {
-        float kf = blend_k(o->u_ld + o->u_fd / c->eta, o->u_ls + o->u_fs);
-        fv_vec3 fov = fv_scale(fv_madd(fv_add(o->ls, o->fs), fv_add(o->ld, o->fd), kf), (float)c->eta * c->norm);
+        float kf = fv_pmt_blend_k(o->u_ld + o->u_fd / c->eta, o->u_ls + o->u_fs);
+        fv_vec3 zero = fv_v3s(0.0f), ls = terms == 2 ? zero : o->ls, ld = terms == 2 ? zero : o->ld;
+        fv_vec3 fs = terms == 1 ? zero : o->fs, fd = terms == 1 ? zero : o->fd;
+        fv_vec3 fov = fv_scale(fv_madd(fv_add(ls, fs), fv_add(ld, fd), kf), (float)c->eta * c->norm);
         g = fv_add(fv_scale(fov, 1.0f - o->b), fv_scale(g, o->b));
     }
-    return fv_add(o->emitted, fv_mul(o->weight, g));
+    return fv_add(emitted, fv_mul(o->weight, g));
 }
 
 static fv_vec3 shade(const render_ctx *c, const fv_pm_hit *x, float px, float py)
@@ -332,7 +333,7 @@ static fv_status light_tracing(pm_state *st, const fv_frame *frame, float cell, 
     const fv_scene *s = st->scene;
     uint64_t rays = 0;
     fv_status rc = FV_OK;
-    fv_photon_job job = {s, 0, frame->seed, frame->index, st->o.max_depth, frame->threads, 0, prog};
+    fv_photon_job job = {s, 0, frame->seed, frame->index, st->o.max_depth, frame->threads, 0, prog, NULL, NULL};
     if (st->mode == MODE_PM) {
         fv_photon_map_clear(&st->all);
         job.count = (int64_t)n_light;
@@ -340,32 +341,7 @@ static fv_status light_tracing(pm_state *st, const fv_frame *frame, float cell, 
         if ((rc = fv_photon_trace_lights(&job, FV_TRACE_ALL, &st->all, &rays, err)) == FV_OK) rc = fv_photon_map_build_mt(&st->all, cell, frame->threads, err);
         fv_stats_add_count(stats, "light_photons", st->all.n);
     } else {
-        bool dyn = fv_scene_dynamic_object_count(s) > 0;
-        double n_ls = dyn ? n_light * (1.0 - st->o.dyn_fraction) : n_light, n_ld = dyn ? n_light - n_ls : 0.0;
-        bool fresh = !st->ls_done || st->lights_move;
-        if (fresh) {
-            fv_photon_map_clear(&st->ls);
-            job.count = (int64_t)n_ls;
-            /* traced once, valid for every frame, unless the lights move */
-            job.frame = st->lights_move ? frame->index : 0;
-            job.stream = 1;
-            rc = fv_photon_trace_lights(&job, FV_TRACE_STATIC, &st->ls, &rays, err);
-            st->ls_done = rc == FV_OK;
-            if (!st->ls_done) fv_photon_map_clear(&st->ls); /* a cancelled trace must not leave half a map */
-            job.frame = frame->index;
-        }
-        if (rc == FV_OK && (fresh || st->ls.cell != cell)) rc = fv_photon_map_build_mt(&st->ls, cell, frame->threads, err);
-        fv_photon_map_clear(&st->ld);
-        if (rc == FV_OK && n_ld >= 1.0) {
-            if ((rc = fv_dyn_dirs_build(st->dirs, s, err)) == FV_OK) {
-                job.count = (int64_t)n_ld;
-                job.stream = 2;
-                rc = fv_photon_trace_dynamic(&job, st->dirs, &st->ld, &rays, err);
-            }
-        }
-        if (rc == FV_OK) rc = fv_photon_map_build_mt(&st->ld, cell, frame->threads, err);
-        fv_stats_add_count(stats, "light_photons", st->ls.n + st->ld.n);
-        fv_stats_add_count(stats, "dynamic_photons", st->ld.n);
+        rc = fv_pmt_maps_update(&st->tm, &job, n_light, st->o.dyn_fraction, cell, stats, &rays, err);
     }
     fv_stats_add_count(stats, "rays", (double)rays);
     return rc;
@@ -471,7 +447,7 @@ static fv_status foveated_photons(pm_state *st, render_ctx *c, int w, int h, flo
     fv_stats_add_ms(stats, "tpm", fv_time_ms() - t0);
     t0 = fv_time_ms();
     if (rc == FV_OK)
-        rc = fv_foveated_trace(st->fov, s, frame->camera, &st->ls, &st->ld, c->gamma, cell, frame->seed, frame->index, frame->threads, &fs,
+        rc = fv_foveated_trace(st->fov, s, frame->camera, &st->tm.ls, &st->tm.ld, c->gamma, cell, frame->seed, frame->index, frame->threads, &fs,
                                err);
     fv_stats_add_ms(stats, "foveated_tracing", fv_time_ms() - t0);
     fv_stats_add_count(stats, "foveated_photons", fs.photons_static + fs.photons_dynamic);
@@ -645,7 +621,8 @@ const fv_technique_class fv_technique_fpm = {
                                "light_photons=int, fov_photons=int: absolute counts instead of photons and fov_fraction\n"
                                "paths_per_pixel=int (from the budget): N foveated paths per focus pixel\n"
                                "tpm=bool (true): temporal photon management (false: retrace all foveated paths)\n"
-                               "eta_region=fovea|focus (fovea): the pixels whose gathered flux Eq. 1 sums (r_i)\n",
+                               "eta_region=fovea|focus (fovea): the pixels whose gathered flux Eq. 1 sums (r_i)\n"
+                               "terms=all|light|foveated (all): the focus region's estimate, or only one map pair's share of it (analysis)\n",
     .create = fpm_create,
     .render = pm_render,
     .destroy = pm_destroy,

@@ -157,8 +157,9 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
         fv_kit_phase(&prog, frame, base, 0.4 * span);
         double t0 = fv_time_ms();
         fv_photon_map_clear(&st->map);
-        fv_photon_job job = {st->scene, st->o.photons, frame->seed, frame->index, st->o.max_depth, frame->threads, PPM_STREAM_BASE + (uint64_t)pass,
-                             &prog};
+        fv_photon_job job = {.scene = st->scene, .count = st->o.photons, .seed = frame->seed, .frame = frame->index,
+                             .max_depth = st->o.max_depth, .threads = frame->threads, .stream = PPM_STREAM_BASE + (uint64_t)pass,
+                             .progress = &prog};
         rc = fv_photon_trace_lights(&job, FV_TRACE_ALL, &st->map, &rays, err);
         if (rc == FV_OK) rc = fv_photon_map_build_mt(&st->map, c.r, frame->threads, err);
         photons += st->map.n;

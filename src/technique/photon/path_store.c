@@ -1,0 +1,233 @@
+/* fovea — kept static photon paths, refreshed near the dynamic objects (see path_store.h). */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "core/parallel.h"
+#include "transport/light_path.h"
+#include "technique/photon/path_store.h"
+
+#define BLOCK 2048
+
+/* A ray segment of a walk: o + t d for t in (0, t_end); t_end = inf for a ray that left. */
+typedef struct seg {
+    fv_vec3 o, d;
+    float t_end;
+} seg;
+
+struct fv_path_store {
+    fv_photon_job job;
+    bool ready;
+    int64_t count;
+    fv_photon *ph;       /* every path's photons, path after path */
+    int64_t *pstart;     /* count + 1 offsets into ph */
+    seg *sg;
+    int64_t *sstart;     /* count + 1 offsets into sg */
+};
+
+/* What one block of paths produced, and per path how many photons and segments. */
+typedef struct blk {
+    fv_photon *p;
+    int np, capp;
+    seg *s;
+    int ns, caps;
+    int pn[BLOCK], sn[BLOCK];
+    uint64_t rays;
+    bool oom, record;
+} blk;
+
+static void keep(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 ng, int mat)
+{
+    (void)mat;
+    blk *b = ctx;
+    if (b->oom || fv_grow((void **)&b->p, &b->capp, b->np + 1, sizeof *b->p)) {
+        b->oom = true;
+        return;
+    }
+    b->p[b->np++] = fv_photon_make(pos, dir, flux, ng);
+}
+
+/* Walk i of the job through `set`: fv_light_path_trace's loop, with its segments recorded when
+ * b->record (the same random numbers in the same order, so a walk that meets no dynamic object is
+ * the walk the whole scene gives). */
+static void walk(const fv_photon_job *job, fv_trace_set set, int64_t i, blk *b)
+{
+    fv_rng rng;
+    fv_vec3 o, d, flux;
+    if (!fv_photon_emit(job, i, &rng, &o, &d, &flux)) return;
+    for (int depth = 0; depth < job->max_depth; depth++) {
+        fv_hit h;
+        b->rays++;
+        bool hit = fv_scene_intersect(job->scene, set, o, d, INFINITY, &h);
+        if (b->record) {
+            if (b->oom || fv_grow((void **)&b->s, &b->caps, b->ns + 1, sizeof *b->s)) {
+                b->oom = true;
+                return;
+            }
+            b->s[b->ns++] = (seg){o, d, hit ? h.t : INFINITY};
+        }
+        if (!hit || !fv_light_path_scatter(job->scene, &h, &o, &d, &flux, &rng, keep, b)) return;
+    }
+}
+
+fv_status fv_path_store_create(fv_path_store **out, fv_error *err)
+{
+    *out = calloc(1, sizeof **out);
+    return *out ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+}
+
+static void clear(fv_path_store *p)
+{
+    free(p->ph), free(p->pstart), free(p->sg), free(p->sstart);
+    p->ph = NULL, p->pstart = NULL, p->sg = NULL, p->sstart = NULL;
+    p->count = 0;
+    p->ready = false;
+}
+
+void fv_path_store_destroy(fv_path_store *p)
+{
+    if (!p) return;
+    clear(p);
+    free(p);
+}
+
+bool fv_path_store_ready(const fv_path_store *p) { return p->ready; }
+
+fv_status fv_path_store_trace(fv_path_store *p, const fv_photon_job *job, uint64_t *rays, fv_error *err)
+{
+    clear(p);
+    p->job = *job;
+    if (job->count <= 0 || fv_scene_light_count(job->scene) == 0) {
+        p->ready = true;
+        return FV_OK;
+    }
+    int64_t nblocks = (job->count + BLOCK - 1) / BLOCK;
+    blk *b = fv_calloc_array((size_t)nblocks, sizeof *b);
+    p->pstart = fv_alloc_array((size_t)job->count + 1, sizeof *p->pstart);
+    p->sstart = fv_alloc_array((size_t)job->count + 1, sizeof *p->sstart);
+    if (!b || !p->pstart || !p->sstart) {
+        free(b);
+        clear(p);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory keeping %lld photon paths", (long long)job->count);
+    }
+    int64_t done = 0;
+    int stop = 0;
+    #pragma omp parallel for schedule(dynamic, 1) num_threads(fv_thread_count(job->threads))
+    for (int64_t k = 0; k < nblocks; k++) {
+        int halt;
+        #pragma omp atomic read
+        halt = stop;
+        if (halt) continue;
+        blk *o = &b[k];
+        o->record = true;
+        int64_t end = (k + 1) * BLOCK < job->count ? (k + 1) * BLOCK : job->count;
+        for (int64_t i = k * BLOCK; i < end; i++) {
+            int np = o->np, ns = o->ns;
+            walk(job, FV_TRACE_STATIC, i, o);
+            o->pn[i - k * BLOCK] = o->np - np;
+            o->sn[i - k * BLOCK] = o->ns - ns;
+        }
+        int64_t d;
+        #pragma omp atomic capture
+        d = ++done;
+        if (job->progress && omp_get_thread_num() == 0 && !fv_kit_progress_fn(job->progress, (double)d / nblocks)) {
+            #pragma omp atomic write
+            stop = 1;
+        }
+    }
+    /* Concatenated in block order: the store does not depend on the thread count. */
+    fv_status st = stop ? fv_error_set(err, FV_ERR_CANCELLED, "render cancelled") : FV_OK;
+    int64_t tp = 0, ts = 0;
+    for (int64_t k = 0; k < nblocks; k++) {
+        if (b[k].oom && st == FV_OK) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory keeping photon paths");
+        tp += b[k].np, ts += b[k].ns;
+    }
+    if (st == FV_OK && (!(p->ph = fv_alloc_array((size_t)tp + 1, sizeof *p->ph)) || !(p->sg = fv_alloc_array((size_t)ts + 1, sizeof *p->sg))))
+        st = fv_error_set(err, FV_ERR_NOMEM, "out of memory keeping photon paths");
+    int64_t op = 0, os = 0;
+    for (int64_t k = 0; k < nblocks; k++) {
+        if (st == FV_OK) {
+            memcpy(p->ph + op, b[k].p, (size_t)b[k].np * sizeof *p->ph);
+            memcpy(p->sg + os, b[k].s, (size_t)b[k].ns * sizeof *p->sg);
+            int64_t first = k * BLOCK, end = (k + 1) * BLOCK < job->count ? (k + 1) * BLOCK : job->count;
+            for (int64_t i = first; i < end; i++) {
+                p->pstart[i] = op, p->sstart[i] = os;
+                op += b[k].pn[i - first], os += b[k].sn[i - first];
+            }
+        }
+        if (rays) *rays += b[k].rays;
+        free(b[k].p), free(b[k].s);
+    }
+    free(b);
+    if (st != FV_OK) {
+        clear(p);
+        return st;
+    }
+    p->pstart[job->count] = op, p->sstart[job->count] = os;
+    p->count = job->count;
+    p->ready = true;
+    return FV_OK;
+}
+
+/* Whether segment s passes within r of c (conservatively: its line's closest approach inside the
+ * segment's extent, or an end point inside the sphere). */
+static bool meets(const seg *s, fv_vec3 c, float r)
+{
+    fv_vec3 v = fv_sub(c, s->o);
+    float dd = fv_dot(s->d, s->d), t = fv_dot(v, s->d) / dd;
+    if (t < 0.0f) t = 0.0f;
+    if (t > s->t_end) t = s->t_end;
+    fv_vec3 q = fv_sub(v, fv_scale(s->d, t));
+    return fv_dot(q, q) <= r * r;
+}
+
+fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, int threads, fv_photon_map *out, int64_t *retraced,
+                              uint64_t *rays, fv_error *err)
+{
+    fv_photon_map_clear(out);
+    *retraced = 0;
+    const int nsph = dirs ? fv_dyn_dirs_count(dirs) : 0;
+    if (nsph == 0) return fv_photon_map_append(out, p->ph, (int)(p->count ? p->pstart[p->count] : 0), err);
+    enum { MAXS = 64 };
+    fv_vec3 c[MAXS];
+    float r[MAXS];
+    const int n = nsph < MAXS ? nsph : MAXS;
+    for (int k = 0; k < n; k++) fv_dyn_dirs_sphere(dirs, k, &c[k], &r[k]);
+    int64_t nblocks = (p->count + BLOCK - 1) / BLOCK;
+    blk *b = fv_calloc_array((size_t)nblocks + 1, sizeof *b);
+    if (!b) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    int64_t again = 0;
+    #pragma omp parallel for schedule(dynamic, 1) reduction(+ : again) num_threads(fv_thread_count(threads))
+    for (int64_t k = 0; k < nblocks; k++) {
+        blk *o = &b[k];
+        int64_t end = (k + 1) * BLOCK < p->count ? (k + 1) * BLOCK : p->count;
+        for (int64_t i = k * BLOCK; i < end; i++) {
+            bool hit = nsph > MAXS; /* more objects than we test: retrace everything */
+            for (int64_t j = p->sstart[i]; j < p->sstart[i + 1] && !hit; j++)
+                for (int q = 0; q < n && !hit; q++) hit = meets(&p->sg[j], c[q], r[q]);
+            if (hit) {
+                walk(&p->job, FV_TRACE_ALL, i, o);
+                again++;
+                continue;
+            }
+            int m = (int)(p->pstart[i + 1] - p->pstart[i]);
+            if (o->oom || fv_grow((void **)&o->p, &o->capp, o->np + m, sizeof *o->p)) {
+                o->oom = true;
+                continue;
+            }
+            memcpy(o->p + o->np, p->ph + p->pstart[i], (size_t)m * sizeof *o->p);
+            o->np += m;
+        }
+    }
+    fv_status st = FV_OK;
+    for (int64_t k = 0; k < nblocks; k++) {
+        if (b[k].oom && st == FV_OK) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory for this frame's photons");
+        if (st == FV_OK) st = fv_photon_map_append(out, b[k].p, b[k].np, err);
+        if (rays) *rays += b[k].rays;
+        free(b[k].p), free(b[k].s);
+    }
+    free(b);
+    *retraced = again;
+    return st;
+}
