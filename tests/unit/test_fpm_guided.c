@@ -220,7 +220,7 @@ static void test_path_store_refresh(void **st)
         fv_photon_map_init(&frame);
         fv_photon_map_init(&full);
         int64_t again = 0;
-        assert_int_equal(fv_path_store_frame(store, dirs, 0, &frame, &again, NULL, &err), FV_OK);
+        assert_int_equal(fv_path_store_frame(store, dirs, NULL, NULL, 0, &frame, &again, NULL, &err), FV_OK);
         assert_int_equal(fv_photon_trace_lights(&job, FV_TRACE_ALL, &full, NULL, &err), FV_OK);
         print_message("time %d: %lld of 20000 paths traced again, %d photons (full trace %d)\n", t, (long long)again, frame.n, full.n);
         assert_true(again > 0 && again < 20000);

@@ -192,6 +192,8 @@ void fv_photon_guide_reset(fv_photon_guide *g, const fv_scene *s)
     build(g, NULL);
 }
 
+float fv_photon_guide_density(const fv_photon_guide *g, const float u[5]) { return g->q[cell_of(g, u)]; }
+
 float fv_photon_guide_warp(const void *ctx, fv_rng *rng, float u[5])
 {
     const fv_photon_guide *g = ctx;

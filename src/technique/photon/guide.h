@@ -58,6 +58,8 @@ void fv_photon_guide_reset(fv_photon_guide *g, const fv_scene *s);
 /* The warp for fv_photon_job (ctx: the guide); the guide must have been learnt or reset for the
  * scene the job traces. */
 float fv_photon_guide_warp(const void *ctx, fv_rng *rng, float u[5]);
+/* q at emission numbers u (relative to uniform numbers: 1 everywhere for a uniform guide). */
+float fv_photon_guide_density(const fv_photon_guide *g, const float u[5]);
 /* The share of the pilot's deposits that fell in the focus cells (0 before learning). */
 double fv_photon_guide_focus_share(const fv_photon_guide *g);
 

@@ -1,6 +1,5 @@
 /* fovea — kept static photon paths, refreshed near the dynamic objects (see path_store.h). */
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
@@ -24,6 +23,7 @@ struct fv_path_store {
     int64_t *pstart;     /* count + 1 offsets into ph */
     seg *sg;
     int64_t *sstart;     /* count + 1 offsets into sg */
+    float (*u)[5];       /* each path's emission numbers (what a flux scale may depend on) */
 };
 
 /* What one block of paths produced, and per path how many photons and segments. */
@@ -33,6 +33,7 @@ typedef struct blk {
     seg *s;
     int ns, caps;
     int pn[BLOCK], sn[BLOCK];
+    float u[BLOCK][5];
     uint64_t rays;
     bool oom, record;
 } blk;
@@ -51,11 +52,11 @@ static void keep(void *ctx, fv_vec3 pos, fv_vec3 dir, fv_vec3 flux, fv_vec3 ng, 
 /* Walk i of the job through `set`: fv_light_path_trace's loop, with its segments recorded when
  * b->record (the same random numbers in the same order, so a walk that meets no dynamic object is
  * the walk the whole scene gives). */
-static void walk(const fv_photon_job *job, fv_trace_set set, int64_t i, blk *b)
+static void walk(const fv_photon_job *job, fv_trace_set set, int64_t i, blk *b, float u[5])
 {
     fv_rng rng;
     fv_vec3 o, d, flux;
-    if (!fv_photon_emit(job, i, &rng, &o, &d, &flux)) return;
+    if (!fv_photon_emit(job, i, &rng, u, &o, &d, &flux)) return;
     for (int depth = 0; depth < job->max_depth; depth++) {
         fv_hit h;
         b->rays++;
@@ -79,8 +80,8 @@ fv_status fv_path_store_create(fv_path_store **out, fv_error *err)
 
 static void clear(fv_path_store *p)
 {
-    free(p->ph), free(p->pstart), free(p->sg), free(p->sstart);
-    p->ph = NULL, p->pstart = NULL, p->sg = NULL, p->sstart = NULL;
+    free(p->ph), free(p->pstart), free(p->sg), free(p->sstart), free(p->u);
+    p->ph = NULL, p->pstart = NULL, p->sg = NULL, p->sstart = NULL, p->u = NULL;
     p->count = 0;
     p->ready = false;
 }
@@ -94,6 +95,28 @@ void fv_path_store_destroy(fv_path_store *p)
 
 bool fv_path_store_ready(const fv_path_store *p) { return p->ready; }
 
+typedef struct trace_job {
+    fv_path_store *p;
+    const fv_photon_job *job;
+    blk *b;
+} trace_job;
+
+/* Block k of the paths, recorded into its own output. */
+static void trace_block(void *ctx, int64_t k)
+{
+    const trace_job *t = ctx;
+    const fv_photon_job *job = t->job;
+    blk *o = &t->b[k];
+    o->record = true;
+    int64_t end = (k + 1) * BLOCK < job->count ? (k + 1) * BLOCK : job->count;
+    for (int64_t i = k * BLOCK; i < end; i++) {
+        int np = o->np, ns = o->ns;
+        walk(job, FV_TRACE_STATIC, i, o, t->p->u[i]);
+        o->pn[i - k * BLOCK] = o->np - np;
+        o->sn[i - k * BLOCK] = o->ns - ns;
+    }
+}
+
 fv_status fv_path_store_trace(fv_path_store *p, const fv_photon_job *job, uint64_t *rays, fv_error *err)
 {
     clear(p);
@@ -106,36 +129,14 @@ fv_status fv_path_store_trace(fv_path_store *p, const fv_photon_job *job, uint64
     blk *b = fv_calloc_array((size_t)nblocks, sizeof *b);
     p->pstart = fv_alloc_array((size_t)job->count + 1, sizeof *p->pstart);
     p->sstart = fv_alloc_array((size_t)job->count + 1, sizeof *p->sstart);
-    if (!b || !p->pstart || !p->sstart) {
+    p->u = fv_calloc_array((size_t)job->count, sizeof *p->u);
+    if (!b || !p->pstart || !p->sstart || !p->u) {
         free(b);
         clear(p);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory keeping %lld photon paths", (long long)job->count);
     }
-    int64_t done = 0;
-    int stop = 0;
-    #pragma omp parallel for schedule(dynamic, 1) num_threads(fv_thread_count(job->threads))
-    for (int64_t k = 0; k < nblocks; k++) {
-        int halt;
-        #pragma omp atomic read
-        halt = stop;
-        if (halt) continue;
-        blk *o = &b[k];
-        o->record = true;
-        int64_t end = (k + 1) * BLOCK < job->count ? (k + 1) * BLOCK : job->count;
-        for (int64_t i = k * BLOCK; i < end; i++) {
-            int np = o->np, ns = o->ns;
-            walk(job, FV_TRACE_STATIC, i, o);
-            o->pn[i - k * BLOCK] = o->np - np;
-            o->sn[i - k * BLOCK] = o->ns - ns;
-        }
-        int64_t d;
-        #pragma omp atomic capture
-        d = ++done;
-        if (job->progress && omp_get_thread_num() == 0 && !fv_kit_progress_fn(job->progress, (double)d / nblocks)) {
-            #pragma omp atomic write
-            stop = 1;
-        }
-    }
+    trace_job tj = {p, job, b};
+    bool stop = !fv_photon_blocks(job, nblocks, trace_block, &tj);
     /* Concatenated in block order: the store does not depend on the thread count. */
     fv_status st = stop ? fv_error_set(err, FV_ERR_CANCELLED, "render cancelled") : FV_OK;
     int64_t tp = 0, ts = 0;
@@ -182,13 +183,12 @@ static bool meets(const seg *s, fv_vec3 c, float r)
     return fv_dot(q, q) <= r * r;
 }
 
-fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, int threads, fv_photon_map *out, int64_t *retraced,
-                              uint64_t *rays, fv_error *err)
+fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, fv_path_scale_fn scale, const void *scale_ctx,
+                              int threads, fv_photon_map *out, int64_t *retraced, uint64_t *rays, fv_error *err)
 {
-    fv_photon_map_clear(out);
     *retraced = 0;
     const int nsph = dirs ? fv_dyn_dirs_count(dirs) : 0;
-    if (nsph == 0) return fv_photon_map_append(out, p->ph, (int)(p->count ? p->pstart[p->count] : 0), err);
+    if (nsph == 0 && !scale) return fv_photon_map_append(out, p->ph, (int)(p->count ? p->pstart[p->count] : 0), err);
     enum { MAXS = 64 };
     fv_vec3 c[MAXS];
     float r[MAXS];
@@ -206,18 +206,24 @@ fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, i
             bool hit = nsph > MAXS; /* more objects than we test: retrace everything */
             for (int64_t j = p->sstart[i]; j < p->sstart[i + 1] && !hit; j++)
                 for (int q = 0; q < n && !hit; q++) hit = meets(&p->sg[j], c[q], r[q]);
+            int first = o->np;
             if (hit) {
-                walk(&p->job, FV_TRACE_ALL, i, o);
+                float u[5];
+                walk(&p->job, FV_TRACE_ALL, i, o, u);
                 again++;
-                continue;
+            } else {
+                int m = (int)(p->pstart[i + 1] - p->pstart[i]);
+                if (o->oom || fv_grow((void **)&o->p, &o->capp, o->np + m, sizeof *o->p)) {
+                    o->oom = true;
+                    continue;
+                }
+                memcpy(o->p + o->np, p->ph + p->pstart[i], (size_t)m * sizeof *o->p);
+                o->np += m;
             }
-            int m = (int)(p->pstart[i + 1] - p->pstart[i]);
-            if (o->oom || fv_grow((void **)&o->p, &o->capp, o->np + m, sizeof *o->p)) {
-                o->oom = true;
-                continue;
+            if (scale && o->np > first) {
+                float f = scale(scale_ctx, p->u[i]);
+                for (int j = first; j < o->np; j++) o->p[j].flux = fv_scale(o->p[j].flux, f);
             }
-            memcpy(o->p + o->np, p->ph + p->pstart[i], (size_t)m * sizeof *o->p);
-            o->np += m;
         }
     }
     fv_status st = FV_OK;

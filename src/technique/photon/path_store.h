@@ -28,11 +28,15 @@ void fv_path_store_destroy(fv_path_store *p);
 fv_status fv_path_store_trace(fv_path_store *p, const fv_photon_job *job, uint64_t *rays, fv_error *err);
 /* True once a trace has completed. */
 bool fv_path_store_ready(const fv_path_store *p);
-/* This frame's photons appended to out (cleared first; not built): each kept path's own, or, for
- * a path that meets one of the spheres of dirs (the dynamic objects now), the photons of the same
- * path traced again through the whole scene at its current time. *retraced gets how many paths
- * were. With no sphere the stored photons are copied as they are. */
-fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, int threads, fv_photon_map *out, int64_t *retraced,
-                              uint64_t *rays, fv_error *err);
+/* A factor on a path's flux from the numbers its emission used (multiple importance sampling of
+ * two photon sets, guided.c). */
+typedef float (*fv_path_scale_fn)(const void *ctx, const float u[5]);
+
+/* This frame's photons appended to out (not cleared, not built): each kept path's own, or, for a
+ * path that meets one of the spheres of dirs (the dynamic objects now; NULL: none), the photons of
+ * the same path traced again through the whole scene at its current time; each path's flux times
+ * scale(u) when scale is given. *retraced gets how many paths were traced again. */
+fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, fv_path_scale_fn scale, const void *scale_ctx,
+                              int threads, fv_photon_map *out, int64_t *retraced, uint64_t *rays, fv_error *err);
 
 #endif

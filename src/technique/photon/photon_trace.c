@@ -45,23 +45,17 @@ typedef struct run_ctx {
 
 typedef void (*photon_fn)(const run_ctx *c, int64_t i, block_out *out);
 
-static fv_status run_blocks(run_ctx *c, photon_fn fn, fv_photon_map *out, uint64_t *rays, fv_error *err)
+bool fv_photon_blocks(const fv_photon_job *job, int64_t nblocks, fv_photon_block_fn fn, void *ctx)
 {
-    const fv_photon_job *job = c->job;
-    int64_t nblocks = (job->count + BLOCK - 1) / BLOCK;
-    c->blocks = fv_calloc_array((size_t)nblocks, sizeof *c->blocks);
-    if (!c->blocks) return fv_error_set(err, FV_ERR_NOMEM, "out of memory tracing %lld photons", (long long)job->count);
-    int nthreads = fv_thread_count(job->threads);
     int64_t done = 0;
     int stop = 0;
-    #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+    #pragma omp parallel for schedule(dynamic, 1) num_threads(fv_thread_count(job->threads))
     for (int64_t b = 0; b < nblocks; b++) {
         int halt;
         #pragma omp atomic read
         halt = stop;
         if (halt) continue;
-        int64_t end = (b + 1) * BLOCK < job->count ? (b + 1) * BLOCK : job->count;
-        for (int64_t i = b * BLOCK; i < end; i++) fn(c, i, &c->blocks[b]);
+        fn(ctx, b);
         int64_t d;
         #pragma omp atomic capture
         d = ++done;
@@ -71,6 +65,30 @@ static fv_status run_blocks(run_ctx *c, photon_fn fn, fv_photon_map *out, uint64
             stop = 1;
         }
     }
+    return !stop;
+}
+
+typedef struct block_job {
+    run_ctx *c;
+    photon_fn fn;
+} block_job;
+
+static void run_block(void *ctx, int64_t b)
+{
+    block_job *j = ctx;
+    const fv_photon_job *job = j->c->job;
+    int64_t end = (b + 1) * BLOCK < job->count ? (b + 1) * BLOCK : job->count;
+    for (int64_t i = b * BLOCK; i < end; i++) j->fn(j->c, i, &j->c->blocks[b]);
+}
+
+static fv_status run_blocks(run_ctx *c, photon_fn fn, fv_photon_map *out, uint64_t *rays, fv_error *err)
+{
+    const fv_photon_job *job = c->job;
+    int64_t nblocks = (job->count + BLOCK - 1) / BLOCK;
+    c->blocks = fv_calloc_array((size_t)nblocks, sizeof *c->blocks);
+    if (!c->blocks) return fv_error_set(err, FV_ERR_NOMEM, "out of memory tracing %lld photons", (long long)job->count);
+    block_job bj = {c, fn};
+    bool stop = !fv_photon_blocks(job, nblocks, run_block, &bj);
     fv_status st = stop ? fv_error_set(err, FV_ERR_CANCELLED, "render cancelled") : FV_OK;
     for (int64_t b = 0; b < nblocks; b++) {
         if (c->blocks[b].oom && st == FV_OK) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory storing photons");
@@ -88,11 +106,15 @@ static fv_rng photon_rng(const fv_photon_job *job, int64_t i, uint64_t sub)
     return fv_rng_stream(job->seed, FV_STREAM_PHOTONS(job->stream), (uint64_t)i, sub, (uint64_t)job->frame);
 }
 
-bool fv_photon_emit(const fv_photon_job *job, int64_t i, fv_rng *rng, fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux)
+bool fv_photon_emit(const fv_photon_job *job, int64_t i, fv_rng *rng, float u[5], fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux)
 {
     *rng = photon_rng(job, i, 0);
-    if (!job->warp) return fv_light_path_emit(job->scene, rng, job->count, o, d, flux);
-    float u[5], q = job->warp(job->warp_ctx, rng, u);
+    if (!job->warp) {
+        /* fv_light_path_emit's five numbers, kept for the caller */
+        for (int k = 0; k < 5; k++) u[k] = fv_rng_next(rng);
+        return fv_light_path_emit_u(job->scene, u, job->count, o, d, flux);
+    }
+    float q = job->warp(job->warp_ctx, rng, u);
     if (!(q > 0.0f) || !fv_light_path_emit_u(job->scene, u, job->count, o, d, flux)) return false;
     *flux = fv_scale(*flux, 1.0f / q);
     return true;
@@ -102,8 +124,9 @@ static void light_photon(const run_ctx *c, int64_t i, block_out *out)
 {
     const fv_photon_job *job = c->job;
     fv_rng rng;
+    float u[5];
     fv_vec3 o, d, flux;
-    if (!fv_photon_emit(job, i, &rng, &o, &d, &flux)) return;
+    if (!fv_photon_emit(job, i, &rng, u, &o, &d, &flux)) return;
     fv_light_path_trace(job->scene, c->set, o, d, flux, 0, job->max_depth, &rng, deposit, out, &out->rays);
 }
 

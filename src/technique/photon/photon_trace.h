@@ -54,10 +54,18 @@ typedef struct fv_photon_job {
     const void *warp_ctx;
 } fv_photon_job;
 
-/* The start of photon i of a job: its random stream (left where the walk goes on), origin,
- * direction and flux (warped and compensated when the job has a warp). False when nothing was
- * emitted. Every tracer of light photons starts here, so photon i is the same photon in all. */
-bool fv_photon_emit(const fv_photon_job *job, int64_t i, fv_rng *rng, fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux);
+/* The start of photon i of a job: its random stream (left where the walk goes on), the five numbers
+ * its emission used (fv_light_sample_emission's u), origin, direction and flux (warped and
+ * compensated when the job has a warp). False when nothing was emitted. Every tracer of light
+ * photons starts here, so photon i is the same photon in all. */
+bool fv_photon_emit(const fv_photon_job *job, int64_t i, fv_rng *rng, float u[5], fv_vec3 *o, fv_vec3 *d, fv_vec3 *flux);
+
+/* Runs fn(ctx, b) for every block b in [0, nblocks) on job->threads threads in any order, reporting
+ * progress to job->progress from one thread; false when the callback cancelled (the remaining
+ * blocks are skipped). Callers keep each block's output apart and join them in block order, so
+ * their results do not depend on the thread count. */
+typedef void (*fv_photon_block_fn)(void *ctx, int64_t block);
+bool fv_photon_blocks(const fv_photon_job *job, int64_t nblocks, fv_photon_block_fn fn, void *ctx);
 
 /* Traces job->count photons from the lights through `set` (FV_TRACE_ALL for plain photon mapping,
  * FV_TRACE_STATIC for M_ls), appending the stored photons to out. Each carries 1/count of the
