@@ -237,6 +237,11 @@ bool fv_json_scalar_text(const cJSON *item, char *buf, size_t n)
     if (cJSON_IsNumber(item) && isfinite(item->valuedouble)) {
         double v = item->valuedouble;
         if (v == floor(v) && fabs(v) < 1e15) return snprintf(buf, n, "%.0f", v) < (int)n;
+        /* The shortest text that reads back as v: 9.7 stays "9.7" in reports, not 9.6999999999999993. */
+        for (int prec = 15; prec < 17; prec++) {
+            if (snprintf(buf, n, "%.*g", prec, v) >= (int)n) return false;
+            if (strtod(buf, NULL) == v) return true;
+        }
         return snprintf(buf, n, "%.17g", v) < (int)n;
     }
     return false;

@@ -55,7 +55,8 @@ static inline uint32_t fv_rng_u32(fv_rng *r)
 #define FV_STREAM_ORDER 0x6f72646572ULL          /* a random launch order (one permutation per seed) */
 #define FV_STREAM_MASK 0x6d61736bULL             /* fipr: the foveation mask's xi per pixel (pixel * 2 + eye, 0, frame) */
 #define FV_STREAM_VPL 0x76706cULL                /* ir: walk w (w, 0, frame); fir: (purpose << 40 + i, 0, frame) */
-/* Light photon map k (1: static M_ls, 2: dynamic M_ld, 100 + pass: pm's maps): (photon, sub, frame). */
+/* Light photon map k (1: static M_ls, 2: dynamic M_ld, 100 + pass: pm's maps, 2^32 + pass: ppm's):
+ * (photon, sub, frame). */
 #define FV_STREAM_PHOTONS(k) ((uint64_t)(k) * 0x9e3779b97f4a7c15ULL)
 
 static inline fv_rng fv_rng_stream(uint64_t seed, uint64_t stream, uint64_t index, uint64_t sample, uint64_t frame)

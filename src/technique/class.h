@@ -33,6 +33,10 @@ typedef struct fv_technique_class {
     /* The key of the method's samples-per-pixel parameter (what `--spp N` sets), NULL when it has
      * none; then spp_instead names what to use instead, as a clause of one line. */
     const char *spp_param, *spp_instead;
+    /* The method estimates light from photons gathered in a disc about each shading point (the
+     * photon family): tests/unit/test_photon_leak.c checks that no light leaks through walls
+     * thinner than the disc. */
+    bool gathers_photons;
 } fv_technique_class;
 
 /* The class of a registered method by index or name (NULL when unknown). */

@@ -20,6 +20,7 @@ extern const fv_technique_class fv_technique_pm;
 extern const fv_technique_class fv_technique_pm_t;
 extern const fv_technique_class fv_technique_fpm;
 extern const fv_technique_class fv_technique_fpm_guided;
+extern const fv_technique_class fv_technique_ppm;
 extern const fv_technique_class fv_technique_vpolar;
 extern const fv_technique_class fv_technique_cartesian;
 extern const fv_technique_class fv_technique_cartesian_full;
@@ -38,7 +39,7 @@ static const fv_technique_class *const k_classes[] = {
     &fv_technique_vpolar,   &fv_technique_cartesian, &fv_technique_cartesian_full, &fv_technique_linear_falloff,
     &fv_technique_logpolar, &fv_technique_sdf_gt,   &fv_technique_sdf_relaxed,    &fv_technique_ipr,
     &fv_technique_fipr,     &fv_technique_ir,        &fv_technique_ir_low,
-    &fv_technique_fir,      &fv_technique_fpm_guided,
+    &fv_technique_fir,      &fv_technique_fpm_guided, &fv_technique_ppm,
 };
 
 #define N_CLASSES ((int)(sizeof k_classes / sizeof k_classes[0]))

@@ -81,7 +81,7 @@ static float dist2(fv_vec3 p, fv_vec3 x)
 }
 
 /* Brute force: the input photons within r of x, in the query's order; with facing, only those
- * the gather's scalar tests keep (!(n . N <= 0.5), !(-dir . N <= 0)). Photons within r lie in the
+ * the gather's scalar test keeps (!(n . N <= 0.5)). Photons within r lie in the
  * cells of [x - r, x + r] (the box a query visits) unless rounding puts one just outside; those
  * are listed separately (*outside) and must be rare. */
 static int reference(const fv_photon *p, int n, float cell, fv_vec3 x, float r, const fv_vec3 *facing, ref_item *out, int *outside)
@@ -93,7 +93,7 @@ static int reference(const fv_photon *p, int n, float cell, fv_vec3 x, float r, 
     *outside = 0;
     for (int j = 0; j < n; j++) {
         if (!(dist2(p[j].pos, x) <= r2)) continue;
-        if (facing && (fv_dot(p[j].n, *facing) <= 0.5f || fv_dot(fv_neg(p[j].dir), *facing) <= 0.0f)) continue;
+        if (facing && fv_dot(p[j].n, *facing) <= 0.5f) continue;
         ref_item it = {coord(p[j].pos.z, inv), coord(p[j].pos.y, inv), coord(p[j].pos.x, inv), j};
         if (it.cx < lo[0] || it.cx > hi[0] || it.cy < lo[1] || it.cy > hi[1] || it.cz < lo[2] || it.cz > hi[2]) {
             (*outside)++;
@@ -223,8 +223,10 @@ static void test_tiny(void **st)
 }
 
 /* The gather, on a diffuse and a glossy surface, against the straightforward one: every photon
- * within r in the query order, the normal test, wi in the shading frame, fv_bsdf_eval, f * flux
- * summed in float and max |flux| in double. Equal to the bit. */
+ * within r in the query order, the normal test, f * flux summed in float and max |flux| in double,
+ * f being albedo / pi on the diffuse surface whichever side of its tangent plane the photon came
+ * from (the disc's flux density), fv_bsdf_eval of wi in the shading frame on the glossy one.
+ * Equal to the bit. */
 static void test_gather_sums(void **st)
 {
     (void)st;
@@ -272,9 +274,9 @@ static void test_gather_sums(void **st)
             const fv_photon *ph = &p[ref[i].j];
             if (fv_dot(ph->n, sh.n) <= 0.5f) continue;
             fv_vec3 wi = fv_shading_to_local(&sh, fv_neg(ph->dir));
-            if (wi.z <= 0.0f) continue;
             float pdf;
-            sum = fv_add(sum, fv_mul(fv_bsdf_eval(mat, sh.wo, wi, &pdf), ph->flux));
+            fv_vec3 f = mat->type == FV_MAT_DIFFUSE ? fv_scale(mat->albedo, FV_INV_PI) : fv_bsdf_eval(mat, sh.wo, wi, &pdf);
+            sum = fv_add(sum, fv_mul(f, ph->flux));
             u += fmax(fabs(ph->flux.x), fmax(fabs(ph->flux.y), fabs(ph->flux.z)));
         }
         double u_got = 0.0;

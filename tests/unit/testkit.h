@@ -125,4 +125,23 @@ static inline void fv_test_render_frames(fv_technique *t, const fv_frame *first,
     if (stats) *stats = s;
 }
 
+/* One frame (index 0, `seed`) of `method` with the parameters `list` (as fv_test_params_str) in
+ * scene s through cam, into a new film the caller destroys. Fails the test on any error. */
+static inline fv_film *fv_test_render_once(const char *method, const char *list, const fv_scene *s, const fv_camera *cam, uint64_t seed)
+{
+    fv_params *p = fv_test_params_str(list);
+    fv_technique *t = NULL;
+    fv_error err;
+    if (fv_technique_create(method, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s: %s", method, err.msg);
+    fv_film *film = NULL;
+    if (fv_film_create(cam->width, cam->height, 0, &film, &err) != FV_OK) fail_msg("%s", err.msg);
+    fv_frame f;
+    fv_frame_init(&f, cam);
+    f.seed = seed;
+    fv_test_render_frames(t, &f, 1, film, NULL);
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+    return film;
+}
+
 #endif

@@ -118,8 +118,10 @@ fv_vec3 fv_pm_gather(const fv_scene *s, const fv_photon_map *m, const fv_pm_hit 
     const fv_material *mat = fv_material_at(s, x->mat, x->obj, x->prim, x->u, x->v, &mbuf);
     fv_shading sh;
     fv_shading_make(mat, x->ng, x->n, x->wo, &sh);
-    /* A diffuse surface's f_r is albedo / pi for every photon arriving from above (the shading
-     * keeps wo above it): fv_bsdf_eval's value, taken once. */
+    /* A diffuse surface's f_r is albedo / pi (the shading keeps wo above it): fv_bsdf_eval's value
+     * for a photon from above, taken once, and applied to every photon the disc holds: on a curved
+     * surface those that arrived from below this point's tangent plane are part of the flux
+     * density the disc averages (photon_map.h, fv_photon_query_facing). */
     const bool diffuse = mat->type == FV_MAT_DIFFUSE;
     const fv_vec3 f_diffuse = fv_scale(mat->albedo, FV_INV_PI);
     fv_vec3 sum = fv_v3s(0.0f);
@@ -129,9 +131,8 @@ fv_vec3 fv_pm_gather(const fv_scene *s, const fv_photon_map *m, const fv_pm_hit 
     int k;
     fv_photon_query_begin(&q, m, x->p, r);
     /* Photons on another surface (the other side of a thin wall, a nearby perpendicular face)
-     * would leak light: keep those whose surface faces the same way, arriving from above (wi's z
-     * in the shading frame > 0). The query makes both tests; then the sums, each a loop of its
-     * own (short dependency chains, few registers). */
+     * would leak light: keep those whose surface faces the same way (the query tests it); then
+     * the sums, each a loop of its own (short dependency chains, few registers). */
     fv_photon_query_facing(&q, sh.n);
     while ((k = fv_photon_query_next(&q, idx, 128)) > 0) {
         if (diffuse) {

@@ -218,7 +218,7 @@ fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, f
                     o->oom = true;
                     continue;
                 }
-                memcpy(o->p + o->np, p->ph + p->pstart[i], (size_t)m * sizeof *o->p);
+                if (m > 0) memcpy(o->p + o->np, p->ph + p->pstart[i], (size_t)m * sizeof *o->p); /* o->p may still be NULL */
                 o->np += m;
             }
             if (scale && o->np > first) {

@@ -86,14 +86,14 @@ static fv_status reserve(fv_photon_map *m, fv_error *err)
         m->key_cap = n;
     }
     if (m->soa_cap < n) {
-        float *a = realloc(m->px, 9 * ((size_t)n + FV_PHOTON_BLOCK) * sizeof *a);
+        float *a = realloc(m->px, 6 * ((size_t)n + FV_PHOTON_BLOCK) * sizeof *a);
         if (!a) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
         m->px = a;
         m->soa_cap = n;
     }
     size_t stride = (size_t)m->soa_cap + FV_PHOTON_BLOCK;
-    float **arr[9] = {&m->px, &m->py, &m->pz, &m->nx, &m->ny, &m->nz, &m->wx, &m->wy, &m->wz};
-    for (int k = 1; k < 9; k++) *arr[k] = m->px + (size_t)k * stride;
+    float **arr[6] = {&m->px, &m->py, &m->pz, &m->nx, &m->ny, &m->nz};
+    for (int k = 1; k < 6; k++) *arr[k] = m->px + (size_t)k * stride;
     return FV_OK;
 }
 
@@ -182,8 +182,8 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
         }
         for (int i = i0; i < i1; i++) m->scratch[cnt[m->key[i]]++] = m->p[i];
         #pragma omp barrier
-        /* The SoA copies from the sorted records: sequential reads and writes (scattering ten
-         * arrays at once would miss the cache ten times per photon). */
+        /* The SoA copies from the sorted records: sequential reads and writes (scattering seven
+         * arrays at once would miss the cache seven times per photon). */
         #pragma omp for schedule(static)
         for (int d = 0; d < n; d++) {
             const fv_photon *ph = &m->scratch[d];
@@ -193,16 +193,13 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
             m->nx[d] = ph->n.x;
             m->ny[d] = ph->n.y;
             m->nz[d] = ph->n.z;
-            m->wx[d] = -ph->dir.x;
-            m->wy[d] = -ph->dir.y;
-            m->wz[d] = -ph->dir.z;
         }
     }
     free(count);
     /* Padding far away: a block reading past the last photon never accepts it. */
     for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
         m->px[n + k] = m->py[n + k] = m->pz[n + k] = INFINITY;
-        m->nx[n + k] = m->ny[n + k] = m->nz[n + k] = m->wx[n + k] = m->wy[n + k] = m->wz[n + k] = 0.0f;
+        m->nx[n + k] = m->ny[n + k] = m->nz[n + k] = 0.0f;
     }
     fv_photon *tp = m->p;
     int tc = m->cap;
@@ -271,8 +268,8 @@ void fv_photon_query_facing(fv_photon_query *q, fv_vec3 n)
     q->n = n;
 }
 
-/* Bit k set when photon i + k passes the query: d2 <= r2, and with q->facing !(n . N <= 0.5) and
- * !(w . N <= 0) (w = -dir), the comparisons of the scalar gather, NaN included. The arithmetic is
+/* Bit k set when photon i + k passes the query: d2 <= r2, and with q->facing !(n . N <= 0.5), the
+ * comparisons of the scalar gather, NaN included. The arithmetic is
  * the scalar one too, (a x b x + a y b y) + a z b z, so the same photons pass whichever branch
  * compiles; SSE2 (every x86-64) tests four at a time. */
 static inline unsigned block_mask(const fv_photon_map *m, const fv_photon_query *q, uint32_t i)
@@ -289,14 +286,12 @@ static inline unsigned block_mask(const fv_photon_map *m, const fv_photon_query 
     }
     if (q->facing && mask) {
         const __m128 Nx = _mm_set1_ps(q->n.x), Ny = _mm_set1_ps(q->n.y), Nz = _mm_set1_ps(q->n.z);
-        const __m128 half = _mm_set1_ps(0.5f), zero = _mm_setzero_ps();
+        const __m128 half = _mm_set1_ps(0.5f);
         unsigned face = 0;
         for (int k = 0; k < FV_PHOTON_BLOCK; k += 4) {
             __m128 nd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(m->nx + i + k), Nx), _mm_mul_ps(_mm_loadu_ps(m->ny + i + k), Ny)),
                                    _mm_mul_ps(_mm_loadu_ps(m->nz + i + k), Nz));
-            __m128 wd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(m->wx + i + k), Nx), _mm_mul_ps(_mm_loadu_ps(m->wy + i + k), Ny)),
-                                   _mm_mul_ps(_mm_loadu_ps(m->wz + i + k), Nz));
-            face |= (unsigned)_mm_movemask_ps(_mm_and_ps(_mm_cmpnle_ps(nd, half), _mm_cmpnle_ps(wd, zero))) << k;
+            face |= (unsigned)_mm_movemask_ps(_mm_cmpnle_ps(nd, half)) << k;
         }
         mask &= face;
     }
@@ -307,8 +302,7 @@ static inline unsigned block_mask(const fv_photon_map *m, const fv_photon_query 
         float dx = X[k] - x, dy = Y[k] - y, dz = Z[k] - z;
         bool pass = dx * dx + dy * dy + dz * dz <= r2;
         if (q->facing)
-            pass = pass && !(m->nx[i + k] * q->n.x + m->ny[i + k] * q->n.y + m->nz[i + k] * q->n.z <= 0.5f) &&
-                   !(m->wx[i + k] * q->n.x + m->wy[i + k] * q->n.y + m->wz[i + k] * q->n.z <= 0.0f);
+            pass = pass && !(m->nx[i + k] * q->n.x + m->ny[i + k] * q->n.y + m->nz[i + k] * q->n.z <= 0.5f);
         mask |= (unsigned)pass << k;
     }
     return mask;

@@ -44,10 +44,9 @@ typedef struct fv_photon_map {
     bool wrap[3];
     uint32_t *start;       /* ncells + 1 offsets into p */
     uint32_t ncells;       /* 0: not built */
-    /* Position, normal and -dir (where the photon came from) of p again, one array per component
-     * (SoA), padded by FV_PHOTON_BLOCK: a query tests a block of photons at a time without
-     * loading the rest of each. */
-    float *px, *py, *pz, *nx, *ny, *nz, *wx, *wy, *wz;
+    /* Position and normal of p again, one array per component (SoA), padded by FV_PHOTON_BLOCK:
+     * a query tests a block of photons at a time without loading the rest of each. */
+    float *px, *py, *pz, *nx, *ny, *nz;
     int soa_cap;
     fv_photon *scratch;
     int scratch_cap;
@@ -95,8 +94,12 @@ fv_status fv_photon_map_build(fv_photon_map *m, float cell, fv_error *err);
  * all are found. */
 void fv_photon_query_begin(fv_photon_query *q, const fv_photon_map *m, fv_vec3 x, float r);
 int fv_photon_query_next(fv_photon_query *q, uint32_t *restrict idx, int cap);
-/* After begin: keep only the photons on a surface facing like n (n_photon . n > 0.5) that arrived
- * from above it (-dir . n > 0), the gather's tests, made a block at a time. */
+/* After begin: keep only the photons on a surface facing like n (n_photon . n > 0.5), the gather's
+ * test against light leaking through thin walls and around corners, made a block at a time.
+ * Where a photon came from is not tested: on a flat surface it always arrived from above (it is
+ * stored on the side it came from), and on a curved one the photons arriving from below the
+ * query's tangent plane belong to the flux density the disc averages (rejecting them made a unit
+ * sphere r^2 / 8 too dark; docs/photon-mapping.md, "The normal test"). */
 void fv_photon_query_facing(fv_photon_query *q, fv_vec3 n);
 
 /* Calls fn for every photon within radius r (r <= 3 cell) of x. */

@@ -1,0 +1,217 @@
+/* fovea — `ppm`, stochastic progressive photon mapping (Knaus & Zwicker, "Progressive Photon
+ * Mapping: A Probabilistic Approach", ACM TOG 2011): the photon reference that converges to the
+ * truth (docs/photon-mapping.md, "ppm").
+ *
+ * A pass is plain photon mapping with its own radius: an independent photon map (its own random
+ * stream), a fresh jittered eye path per pixel (so pixels are averaged over their area, as pt
+ * does), the disc estimate of gather.c. Pass i's radius follows Eq. 15 (ppm.h): the variance of a
+ * pass grows as its radius shrinks, slowly enough that the plain average of the passes' estimates
+ * converges (Sec. 4) while the bias, which the radius drives (boundaries, blur into shadows),
+ * vanishes. Unlike pbrt's SPPM the radius is one per pass, not one per pixel: the probabilistic
+ * formulation needs no per-pixel statistics, and every pass stays pm's estimator exactly.
+ *
+ * Everything is pm's: photon_trace.c traces, photon_map.c grids (a cell of the pass's radius),
+ * gather.c follows eye paths and gathers; no filter, which would be a bias of its own. Each eye is
+ * rendered on its own, each frame from scratch.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "core/parallel.h"
+#include "technique/class.h"
+#include "technique/kit.h"
+#include "technique/photon/gather.h"
+#include "technique/photon/photon_trace.h"
+#include "technique/photon/ppm.h"
+
+/* The photon stream of pass i (core/rng.h): above every pm pass's (100 + pass). */
+#define PPM_STREAM_BASE (1ULL << 32)
+
+typedef struct ppm_opts {
+    int photons;      /* per pass */
+    int passes;
+    double alpha;     /* Eq. 15 */
+    double radius;    /* r_1; 0: Eq. 8 */
+    int max_depth, eye_depth;
+} ppm_opts;
+
+typedef struct ppm_state {
+    const fv_scene *scene;
+    ppm_opts o;
+    fv_photon_map map;
+} ppm_state;
+
+static fv_status read_opts(fv_params *p, ppm_opts *o, fv_error *err)
+{
+    fv_status s;
+    memset(o, 0, sizeof *o);
+    if ((s = fv_params_int(p, "photons", 100000, 1, 500000000, &o->photons, err)) ||
+        (s = fv_params_int(p, "passes", 64, 1, 10000000, &o->passes, err)) ||
+        (s = fv_params_float(p, "alpha", 2.0 / 3.0, 0.0, 1.0, &o->alpha, err)) ||
+        (s = fv_params_float(p, "radius", 0.0, 0.0, 1e30, &o->radius, err)) ||
+        (s = fv_params_int(p, "max_depth", 8, 1, 64, &o->max_depth, err)) || (s = fv_params_int(p, "eye_depth", 8, 1, 64, &o->eye_depth, err)))
+        return s;
+    /* The readers' bounds are inclusive; Eq. 15 needs both ends open: alpha = 0 would shrink the
+     * radius as fast as the photons accumulate (no variance reduction), 1 would never shrink it. */
+    if (!(o->alpha > 0.0 && o->alpha < 1.0))
+        return fv_error_set(err, FV_ERR_INVALID, "parameter alpha=%g: must lie strictly between 0 and 1 (2/3 by default)", o->alpha);
+    if (fv_params_has(p, "radius") && !(o->radius > 0.0))
+        return fv_error_set(err, FV_ERR_INVALID, "parameter radius=%g: the initial gather radius must be > 0 (leave it out for Eq. 8)",
+                            o->radius);
+    return FV_OK;
+}
+
+static fv_status ppm_create(const fv_scene *scene, fv_params *params, const fv_log *log, void **state, fv_error *err)
+{
+    (void)log;
+    ppm_state *st = calloc(1, sizeof *st);
+    if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    st->scene = scene;
+    fv_photon_map_init(&st->map);
+    fv_status s = read_opts(params, &st->o, err);
+    if (s != FV_OK) {
+        free(st);
+        return s;
+    }
+    *state = st;
+    return FV_OK;
+}
+
+static void ppm_destroy(void *state)
+{
+    ppm_state *st = state;
+    if (!st) return;
+    fv_photon_map_free(&st->map);
+    free(st);
+}
+
+typedef struct pass_ctx {
+    const ppm_state *st;
+    const fv_frame *frame;
+    fv_camera_basis cam;
+    fv_film_views out;
+    double *sum;            /* per pixel and channel, over the passes so far */
+    int pass;
+    float r, norm;          /* this pass's radius and 1 / (pi r^2) */
+    fv_kit_counters *counters;
+} pass_ctx;
+
+/* One pass's estimate for every pixel of the tile, added to the sums. */
+static void pass_tile(void *ctx, const fv_tile *tile)
+{
+    pass_ctx *c = ctx;
+    const int w = c->cam.width;
+    uint64_t rays = 0, bad = 0;
+    for (int y = tile->y0; y < tile->y1; y++)
+        for (int x = tile->x0; x < tile->x1; x++) {
+            size_t pix = (size_t)y * w + x;
+            fv_rng rng = fv_kit_rng(c->frame, pix, (uint64_t)c->pass);
+            float jx = fv_rng_next(&rng), jy = fv_rng_next(&rng);
+            fv_pm_hit h;
+            fv_pm_eye_path(c->st->scene, c->cam.pos, fv_camera_dir(&c->cam, (float)x + jx, (float)y + jy), c->st->o.eye_depth, &rng, &h);
+            rays++;
+            fv_vec3 L = h.emitted;
+            if (h.hit) L = fv_add(L, fv_mul(h.weight, fv_scale(fv_pm_gather(c->st->scene, &c->st->map, &h, c->r, NULL), c->norm)));
+            L = fv_kit_guard(L, &bad);
+            double *s = &c->sum[3 * pix];
+            s[0] += L.x, s[1] += L.y, s[2] += L.z;
+            if (c->pass == 0) fv_film_store_first_hit(&c->out, pix, h.first_obj >= 0, h.first_t, h.first_p, h.first_n, h.albedo, h.first_obj);
+        }
+    fv_kit_count(c->counters, tile->thread, FV_KIT_RAYS, rays);
+    fv_kit_count(c->counters, tile->thread, FV_KIT_NAN, bad);
+}
+
+static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+{
+    ppm_state *st = state;
+    const int w = fv_film_width(film), h = fv_film_height(film), passes = st->o.passes;
+    pass_ctx c;
+    memset(&c, 0, sizeof c);
+    fv_status rc = fv_frame_camera(frame->camera, film, &c.cam, err);
+    if (rc != FV_OK) return rc;
+    const size_t n = (size_t)w * h;
+    c.st = st;
+    c.frame = frame;
+    c.out = fv_film_views_of(film);
+    c.sum = fv_calloc_array(n * 3, sizeof *c.sum);
+    c.counters = fv_kit_counters_create();
+    if (!c.sum || !c.counters) {
+        free(c.sum);
+        fv_kit_counters_destroy(c.counters);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory for %dx%d progressive photon mapping", w, h);
+    }
+    fv_vec3 lo, hi;
+    fv_scene_bounds(st->scene, &lo, &hi);
+    const double r1 = st->o.radius > 0.0 ? st->o.radius : fv_photon_radius_eq8(lo, hi, w, h);
+    double r2 = r1 * r1;
+    fv_kit_progress prog = {0};
+    uint64_t rays = 0;
+    double photons = 0.0, t_light = 0.0, t_render = 0.0;
+    for (int pass = 0; pass < passes && rc == FV_OK; pass++) {
+        /* Progress: each pass an equal share; in it, tracing light the first 40%, pixels the rest. */
+        const double base = (double)pass / passes, span = 1.0 / passes;
+        c.pass = pass;
+        c.r = (float)sqrt(r2);
+        c.norm = 1.0f / (FV_PI * c.r * c.r);
+        fv_kit_phase(&prog, frame, base, 0.4 * span);
+        double t0 = fv_time_ms();
+        fv_photon_map_clear(&st->map);
+        fv_photon_job job = {.scene = st->scene, .count = st->o.photons, .seed = frame->seed, .frame = frame->index,
+                             .max_depth = st->o.max_depth, .threads = frame->threads, .stream = PPM_STREAM_BASE + (uint64_t)pass,
+                             .progress = &prog};
+        rc = fv_photon_trace_lights(&job, FV_TRACE_ALL, &st->map, &rays, err);
+        if (rc == FV_OK) rc = fv_photon_map_build_mt(&st->map, c.r, frame->threads, err);
+        photons += st->map.n;
+        t_light += fv_time_ms() - t0;
+        if (rc != FV_OK) break;
+        fv_kit_phase(&prog, frame, base + 0.4 * span, 0.6 * span);
+        t0 = fv_time_ms();
+        if (!fv_parallel_tiles(w, h, frame->threads, pass_tile, &c, fv_kit_progress_fn, &prog))
+            rc = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+        t_render += fv_time_ms() - t0;
+        r2 = fv_ppm_next_r2(r2, st->o.alpha, pass + 1);
+    }
+    if (rc == FV_OK) {
+        /* The mean of the passes' estimates (Knaus & Zwicker Eq. 5); finite sums can still
+         * overflow float when divided back. */
+        uint64_t bad = 0;
+        for (size_t i = 0; i < n; i++) {
+            fv_vec3 v = fv_kit_guard(fv_v3((float)(c.sum[3 * i] / passes), (float)(c.sum[3 * i + 1] / passes), (float)(c.sum[3 * i + 2] / passes)), &bad);
+            c.out.color[3 * i] = v.x, c.out.color[3 * i + 1] = v.y, c.out.color[3 * i + 2] = v.z;
+        }
+        fv_kit_count(c.counters, 0, FV_KIT_NAN, bad);
+    }
+    fv_stats_add_ms(stats, "light_tracing", t_light);
+    fv_stats_add_ms(stats, "render", t_render);
+    fv_kit_report(c.counters, stats);
+    fv_stats_add_count(stats, "rays", (double)rays);
+    fv_stats_add_count(stats, "light_photons", photons);
+    fv_stats_add_count(stats, "radius_first", r1);
+    fv_stats_add_count(stats, "radius_last", c.r);
+    fv_kit_counters_destroy(c.counters);
+    free(c.sum);
+    return rc;
+}
+
+/* The furnace at r_1 = 0.25, as pm's (FURNACE_TEST in pm.c): 1 - 0.5^9 whatever the radius below 1,
+ * the gather keeping every photon of the disc on the unit sphere. */
+const fv_technique_class fv_technique_ppm = {
+    .name = "ppm",
+    .summary = "progressive photon mapping: passes with a shrinking radius averaged, converging to the truth (photon reference)",
+    .params_help = "passes=int (64): passes averaged, each with its own photon map and a jittered eye path per pixel (--spp)\n"
+                   "photons=int (100000): photons per pass\n"
+                   "radius=float (Eq. 8): gather radius of the first pass, in scene units\n"
+                   "alpha=float (0.667): radius shrinking, r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1), in (0, 1)\n"
+                   "max_depth=int (8): photon bounces\n"
+                   "eye_depth=int (8): mirror/glass bounces of eye rays\n",
+    .create = ppm_create,
+    .render = ppm_render,
+    .destroy = ppm_destroy,
+    .test_params = "photons=20000,passes=4",
+    .furnace_params = "radius=0.25",
+    .furnace_radiance = 0.998046875,
+    .furnace_tolerance = 0.04,
+    .spp_param = "passes",
+    .gathers_photons = true,
+};
