@@ -82,7 +82,7 @@ static fv_status read_opts(fv_params *p, gd_opts *o, fv_error *err)
     fv_status s;
     memset(o, 0, sizeof *o);
     if ((s = fv_params_int(p, "photons", 300000, 1, 500000000, &o->photons, err)) ||
-        (s = fv_params_float(p, "radius", 0.0, 0.0, 1e30, &o->radius, err)) ||
+        (s = fv_photon_read_radius(p, "gather radius", &o->radius, err)) ||
         (s = fv_params_int(p, "max_depth", 8, 1, 64, &o->max_depth, err)) ||
         (s = fv_params_int(p, "eye_depth", 8, 1, 64, &o->eye_depth, err)) || (s = fv_params_bool(p, "filter", true, &o->filter, err)) ||
         (s = fv_params_bool(p, "split", true, &o->split, err)) ||
@@ -95,10 +95,6 @@ static fv_status read_opts(fv_params *p, gd_opts *o, fv_error *err)
         (s = fv_params_int(p, "acuity_levels", 1, 0, 3, &o->acuity_levels, err)) ||
         (s = fv_params_int(p, "focus_passes", 1, 0, 8, &o->focus_passes, err)))
         return s;
-    for (int i = 0; i < fv_params_count(p); i++)
-        if (strcmp(fv_params_key(p, i), "radius") == 0 && !(o->radius > 0.0))
-            return fv_error_set(err, FV_ERR_INVALID, "parameter radius=%s: the gather radius must be > 0 (leave it out for Eq. 8)",
-                                fv_params_value(p, i));
     return FV_OK;
 }
 

@@ -8,6 +8,7 @@
 #endif
 #include "core/alloc.h"
 #include "core/parallel.h"
+#include "core/params_read.h"
 #include "technique/photon/photon_map.h"
 
 void fv_photon_map_init(fv_photon_map *m) { memset(m, 0, sizeof *m); }
@@ -386,4 +387,14 @@ float fv_photon_radius_eq8(fv_vec3 lo, fv_vec3 hi, int width, int height)
 {
     fv_vec3 e = fv_sub(hi, lo);
     return (e.x + e.y + e.z) / 3.0f / ((width + height) / 2.0f) * 20.0f;
+}
+
+fv_status fv_photon_read_radius(struct fv_params *p, const char *what, double *radius, fv_error *err)
+{
+    fv_status s = fv_params_float(p, "radius", 0.0, 0.0, 1e30, radius, err);
+    if (s != FV_OK || !fv_params_has(p, "radius") || *radius > 0.0) return s;
+    const char *v = "";
+    for (int i = 0; i < fv_params_count(p); i++)
+        if (strcmp(fv_params_key(p, i), "radius") == 0) v = fv_params_value(p, i);
+    return fv_error_set(err, FV_ERR_INVALID, "parameter radius=%s: the %s must be > 0 (leave it out for Eq. 8)", v, what);
 }

@@ -112,5 +112,9 @@ int fv_photon_map_nearest(const fv_photon_map *m, fv_vec3 x, fv_vec3 n, float r,
 /* The gather radius of Foveated Photon Mapping Eq. 8: the mean extent of the scene's bounding
  * box over the mean image side, times 20. */
 float fv_photon_radius_eq8(fv_vec3 lo, fv_vec3 hi, int width, int height);
+/* The "radius" parameter of a photon method: 0 (left out) means Eq. 8 at the render's size; given,
+ * it must be > 0, else FV_ERR_INVALID naming the value and `what` ("gather radius", ...). */
+struct fv_params;
+fv_status fv_photon_read_radius(struct fv_params *p, const char *what, double *radius, fv_error *err);
 
 #endif

@@ -86,17 +86,10 @@ static fv_status read_opts(pm_mode mode, fv_params *p, pm_opts *o, fv_error *err
     fv_status s;
     memset(o, 0, sizeof *o);
     if ((s = fv_params_int(p, "photons", 300000, 1, 500000000, &o->photons, err)) ||
-        (s = fv_params_float(p, "radius", 0.0, 0.0, 1e30, &o->radius, err)) ||
+        (s = fv_photon_read_radius(p, "gather radius", &o->radius, err)) ||
         (s = fv_params_int(p, "max_depth", 8, 1, FV_FOV_MAX_DEPTH, &o->max_depth, err)) ||
         (s = fv_params_int(p, "eye_depth", 8, 1, 64, &o->eye_depth, err)) || (s = fv_params_bool(p, "filter", true, &o->filter, err)))
         return s;
-    if (fv_params_count(p) > 0) {
-        /* radius = 0 means "Eq. 8"; an explicit negative or zero radius is a mistake. */
-        for (int i = 0; i < fv_params_count(p); i++)
-            if (strcmp(fv_params_key(p, i), "radius") == 0 && !(o->radius > 0.0))
-                return fv_error_set(err, FV_ERR_INVALID, "parameter radius=%s: the gather radius must be > 0 (leave it out for Eq. 8)",
-                                    fv_params_value(p, i));
-    }
     if (mode == MODE_PM && (s = fv_params_int(p, "passes", 1, 1, 100000, &o->passes, err))) return s;
     if (mode != MODE_PM) {
         if ((s = fv_params_float(p, "dyn_fraction", 0.2, 0.0, 0.95, &o->dyn_fraction, err))) return s;

@@ -49,16 +49,13 @@ static fv_status read_opts(fv_params *p, ppm_opts *o, fv_error *err)
     if ((s = fv_params_int(p, "photons", 100000, 1, 500000000, &o->photons, err)) ||
         (s = fv_params_int(p, "passes", 64, 1, 10000000, &o->passes, err)) ||
         (s = fv_params_float(p, "alpha", 2.0 / 3.0, 0.0, 1.0, &o->alpha, err)) ||
-        (s = fv_params_float(p, "radius", 0.0, 0.0, 1e30, &o->radius, err)) ||
+        (s = fv_photon_read_radius(p, "initial gather radius", &o->radius, err)) ||
         (s = fv_params_int(p, "max_depth", 8, 1, 64, &o->max_depth, err)) || (s = fv_params_int(p, "eye_depth", 8, 1, 64, &o->eye_depth, err)))
         return s;
     /* The readers' bounds are inclusive; Eq. 15 needs both ends open: alpha = 0 would shrink the
      * radius as fast as the photons accumulate (no variance reduction), 1 would never shrink it. */
     if (!(o->alpha > 0.0 && o->alpha < 1.0))
         return fv_error_set(err, FV_ERR_INVALID, "parameter alpha=%g: must lie strictly between 0 and 1 (2/3 by default)", o->alpha);
-    if (fv_params_has(p, "radius") && !(o->radius > 0.0))
-        return fv_error_set(err, FV_ERR_INVALID, "parameter radius=%g: the initial gather radius must be > 0 (leave it out for Eq. 8)",
-                            o->radius);
     return FV_OK;
 }
 
