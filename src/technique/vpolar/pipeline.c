@@ -187,10 +187,11 @@ static double blur_scale(const fv_vp_pipeline *p, const fv_space_view *view)
     return 0.5 * sqrt((double)p->sw * p->sw + (double)p->sh * p->sh) / view->rho_max;
 }
 
-/* The screen distance from the gaze beyond which the blur has its full sigma (Sec. 3.5). */
-static double blur_full_radius(const fv_vp_pipeline *p, const fv_space_view *view)
+/* The screen distance from the gaze of eccentricity e_deg on the blur's profile (Sec. 3.5), which
+ * stretches with the space. */
+static double blur_profile_radius(const fv_vp_pipeline *p, const fv_space_view *view, double e_deg)
 {
-    return p->o.blur_ramp_deg * p->ppd / blur_scale(p, view);
+    return e_deg * p->ppd / blur_scale(p, view);
 }
 
 /* Everything the map stage needs that depends only on the distance from the gaze, tabulated for
@@ -376,9 +377,10 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
         fv_svgf_frame fr = {p->g.color, p->g.albedo, p->g.normal, p->g.depth, p->g.position, p->g.id,
                             hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
         if (p->o.blur && p->o.periphery_passes < p->o.svgf.iterations && fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
-            /* The columns wholly beyond the radius where the blur reaches its full sigma. */
+            /* The columns wholly beyond periphery_deg (by default where the blur reaches its full
+             * sigma). */
             float X, V;
-            fv_space_from_screen(&view, view.gx + (float)blur_full_radius(p, &view), view.gy, &X, &V, NULL);
+            fv_space_from_screen(&view, view.gx + (float)blur_profile_radius(p, &view, p->o.periphery_deg), view.gy, &X, &V, NULL);
             fv_svgf_set_periphery(p->svgf, (int)ceilf(X), p->o.periphery_passes);
         }
         fv_svgf_info info;

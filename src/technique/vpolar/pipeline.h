@@ -33,8 +33,10 @@ typedef struct fv_vp_opts {
     double blur_sigma;         /* at 1280 pixels wide; scaled with the width (Sec. 3.5: 6.8) */
     double blur_fovea_deg, blur_ramp_deg;
     bool blur_follows_space;   /* Visual-Polar: the blur's fovea stretches with the space (Sec. 3.2) */
-    int periphery_passes;      /* SVGF passes beyond blur_ramp_deg (fv_svgf_set_periphery); >= the
+    int periphery_passes;      /* SVGF passes beyond periphery_deg (fv_svgf_set_periphery); >= the
                                   iterations: every pass everywhere */
+    double periphery_deg;      /* where the periphery's fewer passes start (blur_ramp_deg by default),
+                                  stretched with the space like the blur's profile */
 } fv_vp_opts;
 
 typedef struct fv_vp_pipeline fv_vp_pipeline;

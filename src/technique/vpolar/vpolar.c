@@ -90,7 +90,9 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
         /* Issue 16: three passes beyond the blur's ramp lose nothing in the fovea and lower the
          * periphery's FLIP on cornell and the city (vp-periphery, docs/results.md), for 8-16%
          * less denoising; so on by default. */
-        if ((s = fv_params_int(p, "periphery_passes", VP_PERIPHERY_PASSES, 0, 10, &o->periphery_passes, err))) return s;
+        if ((s = fv_params_int(p, "periphery_passes", VP_PERIPHERY_PASSES, 0, 10, &o->periphery_passes, err)) ||
+            (s = fv_params_float(p, "periphery_deg", o->blur_ramp_deg, 0.0, 180.0, &o->periphery_deg, err)))
+            return s;
         break;
     case K_CARTESIAN:
         if ((s = open_range(p, "reduction", 0.61, 0.0, 1.0, &o->space.reduction, err))) return s;
@@ -275,7 +277,8 @@ const fv_technique_class fv_technique_vpolar = {
                 "fovea_deg=float (5.79): radius of the linear, clipped fovea in planar degrees\n"
                 "fit_degree=int (6): degree of the polynomial inverse of Eq. 2\n"
                 "blur=bool (true): foveated blur (blur_fovea_deg default 5.79, stretched with the space)\n"
-                "periphery_passes=int (3): SVGF passes for the columns beyond blur_ramp_deg, where the blur is widest (svgf_iterations or more: all)\n",
+                "periphery_passes=int (3): SVGF passes for the columns beyond periphery_deg (svgf_iterations or more: all)\n"
+                "periphery_deg=float (blur_ramp_deg): eccentricity where periphery_passes starts, on the blur's profile\n",
     create_vpolar, vp_render, vp_destroy,
     FURNACE_TEST, .spp_param = "spp",
 };
