@@ -129,6 +129,15 @@ static void free_buffers(fv_svgf *f)
     for (int i = 0; i < nb; i++) free(*ptr[i]);
     free(f->kind), free(f->hist_id);
     free(f->row_surface), free(f->row_hist), free(f->row_holes), free(f->row_len);
+    for (int i = 0; i < LN_COUNT; i++) free(f->ln[i]);
+}
+
+/* FOVEA_SVGF_LINES=off: no fovea lines (C2 in svgf_sweeps.h) in the filters created while it is set;
+ * the same bits, for measuring what the lines save (docs/filters.md). */
+static bool lines_off(void)
+{
+    const char *v = getenv("FOVEA_SVGF_LINES");
+    return v && strcmp(v, "off") == 0;
 }
 
 fv_status fv_svgf_create(const fv_grid *grid, const fv_svgf_opts *o, fv_svgf **out, fv_error *err)
@@ -175,6 +184,15 @@ fv_status fv_svgf_create(const fv_grid *grid, const fv_svgf_opts *o, fv_svgf **o
     ok = ok && (f->row_hist = fv_calloc_array(h, sizeof(long))) != NULL;
     ok = ok && (f->row_holes = fv_calloc_array(h, sizeof(long))) != NULL;
     ok = ok && (f->row_len = fv_calloc_array(h, sizeof(double))) != NULL;
+    /* The fovea's lines: the short columns and the columns their passes reach (C2 in
+     * svgf_sweeps.h), for polar grids that have short columns. */
+    const long long ln_size = (long long)imin(grid->w, f->full_from + 4 * LINE_STEP_MAX) * (grid->h + 2 * LINE_GHOST) + CHUNK;
+    if (grid->wrap && f->full_from > 0 && ln_size <= INT32_MAX && !lines_off()) {
+        f->lines_w = imin(grid->w, f->full_from + 4 * LINE_STEP_MAX);
+        f->line_stride = grid->h + 2 * LINE_GHOST;
+        /* CHUNK floats more: a vector's lanes past the last line's end (never stored). */
+        for (int i = 0; i < LN_COUNT && ok; i++) ok = (f->ln[i] = fv_calloc_array((size_t)ln_size, sizeof(float))) != NULL;
+    }
     if (!ok) {
         free_buffers(f);
         free(f);
@@ -417,6 +435,7 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
     const bool history = f->have_history && fr->prev_coord;
 
     sweep_accumulate(f, fr, history, nt);
+    f->ln_features = false;
     if (f->avx2)
         fv_svgf_variance_avx2(f, nt);
     else

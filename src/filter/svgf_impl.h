@@ -36,6 +36,13 @@
 
 enum { KIND_NONE = 0, KIND_SURFACE = 1, KIND_HOLE = 2 };
 enum { V_R, V_G, V_B, V_VAR, V_LUM, NVAL };
+/* The fovea's lines: the frame's features (normal, depth, depth gradient, 1 on a surface), the
+ * pass's inputs (prefiltered variance, values) and its output values. */
+enum { LN_NX, LN_NY, LN_NZ, LN_Z, LN_GRAD, LN_SURF, LN_FEATURES, LN_GVAR = LN_FEATURES, LN_VAL, LN_OUT = LN_VAL + NVAL,
+       LN_COUNT = LN_OUT + NVAL };
+#define LINE_STEP_MAX 16        /* passes with taps this far apart or closer use the lines */
+#define LINE_GHOST (2 * LINE_STEP_MAX) /* the farthest tap along a line */
+#define LINE_CHUNK (CHUNK - 8)  /* lanes per chunk: a vector may run 7 lanes past the chunk */
 
 static const float k_b3[5] = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
 static const float k_g3[3] = {0.25f, 0.5f, 0.25f};
@@ -65,6 +72,14 @@ struct fv_svgf {
                                FV_SVGF_ISA_PLAIN, one tap at a time */
     int periph_x, periph_passes; /* fv_svgf_set_periphery (w, iterations: off) */
     int pass_cut;           /* the current pass filters the columns [0, pass_cut) */
+    /* Polar grids with short columns: the fovea's lines (see "C2." in svgf_sweeps.h). The columns
+     * [0, lines_w) copied column-major, a line of line_stride floats per column: LINE_GHOST lanes
+     * holding its last rows, its col_h rows, LINE_GHOST lanes holding its first rows (wrapped as
+     * often as a short column needs), then unused lanes up to h. NULL: no lines (screen grids,
+     * full polar grids). */
+    int lines_w, line_stride;
+    float *ln[LN_COUNT];
+    bool ln_features;       /* ln's features hold this frame's (set by the first pass that needs them) */
 };
 
 /* ---- small helpers */

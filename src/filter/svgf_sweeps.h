@@ -248,11 +248,30 @@ TAP_INLINE vfw tap_load(const float *b, long q, const int *qi)
     return r;
 }
 
+/* The tap values of SVGF_VW pixels whose indices lie within two vectors from q: two loads and a
+ * shuffle (on AVX2 two vpermps and a blend) instead of a load per lane. */
+typedef int32_t viw_u __attribute__((vector_size(4 * SVGF_VW), aligned(4), may_alias));
+TAP_INLINE vfw tap_window(const float *b, long q, viw d)
+{
+    return __builtin_shuffle(LDW(&b[q]), LDW(&b[q + SVGF_VW]), d);
+}
+
+/* For the gathered taps of the fovea's lines: true when the indices qi[0..SVGF_VW) lie in
+ * [qi[0], qi[0] + 2 SVGF_VW), with *d their offsets from qi[0]. */
+TAP_INLINE bool tap_window_fits(const int *qi, viw *d)
+{
+    *d = *(const viw_u *)(const void *)qi - qi[0];
+    bool fits = true;
+    for (int j = 0; j < SVGF_VW; j++) fits &= (uint32_t)(*d)[j] < 2u * SVGF_VW;
+    return fits;
+}
+
 /* SVGF_VW pixels from chunk slot k (pixel x, index p) with their 24 taps: tap t is at off[t] + x (qt
- * NULL: every tap a plain shift) or at the indices qt[t][k..] (any taps, gathered). Only the lanes
- * [from, to) are stored (a span's last pixels, in a vector that overlaps other pixels). */
+ * NULL: every tap a plain shift) or at the indices qt[t][k..] (any taps, gathered; with gath, only
+ * the taps t with gath[t], the others shifts). Only the lanes [from, to) are stored (a span's last
+ * pixels, in a vector that overlaps other pixels). */
 TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const long *off, const int (*qt)[CHUNK],
-                             const float *kw, const int *cls, int from, int to, pass_acc *acc)
+                             const bool *gath, const float *kw, const int *cls, int from, int to, pass_acc *acc)
 {
     const vfw nxp = LDW(&s->nx[p]), nyp = LDW(&s->ny[p]), nzp = LDW(&s->nz[p]), zp = LDW(&s->z[p]), lp = LDW(&s->l[p]);
     const vfw il = LDW(&acc->inv_l[k]);
@@ -260,18 +279,24 @@ TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const lo
     for (int c = 0; c < 5; c++) rz[c] = LDW(&acc->rz[c][k]);
     vfw ar = LDW(&acc->r[k]), ag = LDW(&acc->g[k]), ab = LDW(&acc->b[k]), av = LDW(&acc->v[k]), aw = LDW(&acc->w[k]);
     for (int t = 0; t < NTAP; t++) {
-        const long q = qt ? 0 : off[t] + x;
-        const int *qi = qt ? &qt[t][k] : NULL;
-        vfw c = nxp * tap_load(s->nx, q, qi) + nyp * tap_load(s->ny, q, qi) + nzp * tap_load(s->nz, q, qi);
+        const int *qi = qt && (!gath || gath[t]) ? &qt[t][k] : NULL;
+        long q = qi ? 0 : off[t] + x;
+        viw d;
+        /* The lines' gathered taps mostly fit a window of two vectors (neighbouring rows of a
+         * column land on neighbouring rows of the next). */
+        const bool win = gath && qi && tap_window_fits(qi, &d);
+#define TAP_VALUES(b) (win ? tap_window((b), qi[0], d) : tap_load((b), q, qi))
+        vfw c = nxp * TAP_VALUES(s->nx) + nyp * TAP_VALUES(s->ny) + nzp * TAP_VALUES(s->nz);
         c = 0.5f * (c + fabs_w(c));
         for (int i = 0; i < SQ_DEFAULT; i++) c *= c;
-        const vfw e = fabs_w(zp - tap_load(s->z, q, qi)) * rz[cls[t]] + fabs_w(lp - tap_load(s->l, q, qi)) * il;
+        const vfw e = fabs_w(zp - TAP_VALUES(s->z)) * rz[cls[t]] + fabs_w(lp - TAP_VALUES(s->l)) * il;
         const vfw wt = kw[t] * c * exp_neg_w(e);
-        ar += wt * tap_load(s->r, q, qi);
-        ag += wt * tap_load(s->g, q, qi);
-        ab += wt * tap_load(s->b, q, qi);
-        av += wt * wt * tap_load(s->v, q, qi);
+        ar += wt * TAP_VALUES(s->r);
+        ag += wt * TAP_VALUES(s->g);
+        ab += wt * TAP_VALUES(s->b);
+        av += wt * wt * TAP_VALUES(s->v);
         aw += wt;
+#undef TAP_VALUES
     }
     if (from == 0 && to == SVGF_VW) {
         STW(&acc->r[k], ar), STW(&acc->g[k], ag), STW(&acc->b[k], ab), STW(&acc->v[k], av), STW(&acc->w[k], aw);
@@ -279,6 +304,162 @@ TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const lo
     }
     for (int j = from; j < to; j++)
         acc->r[k + j] = ar[j], acc->g[k + j] = ag[j], acc->b[k + j] = ab[j], acc->v[k + j] = av[j], acc->w[k + j] = aw[j];
+}
+
+/* ---- C2. the fovea's lines (polar grids with short columns; issue 16)
+ *
+ * Row-major, a short column's taps into its neighbours land on other rows (the same angle in a
+ * column of another height): a different row, far apart in memory, for each pixel of a vector, so
+ * the row loop's gathers miss the caches. Column-major, the taps of neighbouring rows of a column
+ * lie a lane or two apart in the neighbouring column's line. So the passes with taps up to
+ * LINE_STEP_MAX apart copy the columns they reach into the lines (the features once a frame, the
+ * values once a pass), filter the short columns and the columns within two taps of them along
+ * their lines, SVGF_VW rows at a time, and write the results in the grid's order. The taps are
+ * fv_grid_tap's and each pixel adds them in the same order, so the bits are those of the row loop
+ * (test_svgf_isa: against one tap at a time). */
+
+/* Copies the columns [0, xr) of the n grid-ordered buffers src into the lines dst, ghosts included
+ * (a column shorter than the ghosts wraps more than once). Blocks of 8 columns, rows outer: the
+ * reads are runs of a row. */
+static void lines_load(const fv_svgf *f, float *const *dst, float *const *src, int n, int xr, int nt)
+{
+    const fv_grid *g = &f->g;
+    const int w = g->w, stride = f->line_stride;
+    #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
+    for (int xb = 0; xb < xr; xb += 8) {
+        const int xe = imin(xb + 8, xr);
+        int lmax = 0;
+        for (int x = xb; x < xe; x++) lmax = imax(lmax, fv_grid_col_h(g, x));
+        for (int b = 0; b < n; b++)
+            for (int y = -LINE_GHOST; y < lmax + LINE_GHOST; y++)
+                for (int x = xb; x < xe; x++) {
+                    const int n_rows = fv_grid_col_h(g, x);
+                    if (y >= n_rows + LINE_GHOST) continue;
+                    const int yy = y >= 0 && y < n_rows ? y : fv_grid_wrap_row(y, n_rows);
+                    dst[b][(size_t)x * stride + LINE_GHOST + y] = src[b][(size_t)yy * w + x];
+                }
+    }
+}
+
+/* The lines' output values of the columns [0, xt) back in the grid's order (dst), and into the
+ * history where write_hist; blocks of 8 columns, rows outer, like lines_load. */
+static void lines_store(fv_svgf *f, float *const *dst, bool write_hist, int xt, int nt)
+{
+    const fv_grid *g = &f->g;
+    const int w = g->w, stride = f->line_stride;
+    #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
+    for (int xb = 0; xb < xt; xb += 8) {
+        const int xe = imin(xb + 8, xt);
+        int lmax = 0;
+        for (int x = xb; x < xe; x++) lmax = imax(lmax, fv_grid_col_h(g, x));
+        for (int c = 0; c < NVAL; c++) {
+            const float *o = f->ln[LN_OUT + c] + LINE_GHOST;
+            for (int y = 0; y < lmax; y++)
+                for (int x = xb; x < xe; x++)
+                    if (y < fv_grid_col_h(g, x)) dst[c][(size_t)y * w + x] = o[(size_t)x * stride + y];
+        }
+        if (!write_hist) continue;
+        for (int y = 0; y < lmax; y++)
+            for (int x = xb; x < xe; x++) {
+                const size_t p = (size_t)y * w + x, q = (size_t)x * stride + LINE_GHOST + y;
+                if (y >= fv_grid_col_h(g, x) || f->kind[p] != KIND_SURFACE) continue;
+                for (int c = 0; c < 3; c++) f->hist_illum[3 * p + c] = f->ln[LN_OUT + V_R + c][q];
+            }
+    }
+}
+
+/* One pass over the columns [0, xt) along their lines (taps `step` apart; di, dj, kw, cls as in the
+ * row loop), from the lines' values to their output values. */
+static void lines_pass(fv_svgf *f, int step, int xt, const int *di, const int *dj, const float *kw, const int *cls, int nt)
+{
+    const fv_grid *g = &f->g;
+    const int w = g->w, stride = f->line_stride;
+    const float sd = f->o.sigma_depth, sl = f->o.sigma_lum;
+    float *const *dst = &f->ln[LN_OUT];
+    const float *grad = f->ln[LN_GRAD], *gvar = f->ln[LN_GVAR], *zg = f->ln[LN_Z], *surf = f->ln[LN_SURF];
+    const pass_src s = {f->ln[LN_NX], f->ln[LN_NY], f->ln[LN_NZ], f->ln[LN_Z], f->ln[LN_VAL + V_R],
+                        f->ln[LN_VAL + V_G], f->ln[LN_VAL + V_B], f->ln[LN_VAL + V_VAR], f->ln[LN_VAL + V_LUM]};
+    const float dist[5] = {1.0f, sqrtf(2.0f), 2.0f, sqrtf(5.0f), sqrtf(8.0f)};
+    const float wc = k_b3[2] * k_b3[2];
+    #pragma omp parallel for schedule(dynamic, 2) num_threads(nt)
+    for (int x = 0; x < xt; x++) {
+        pass_acc acc;
+        int qt[NTAP][CHUNK], rows[5][CHUNK];
+        long off[NTAP];
+        bool gath[NTAP];
+        const int n_rows = fv_grid_col_h(g, x), base = x * stride + LINE_GHOST;
+        int cx[5], cn[5]; /* the tap columns (clamped) and their heights */
+        for (int c = 0; c < 5; c++) {
+            cx[c] = imin(imax(x + (c - 2) * step, 0), w - 1);
+            cn[c] = fv_grid_col_h(g, cx[c]);
+        }
+        for (int y0 = 0; y0 < n_rows; y0 += LINE_CHUNK) {
+            const int nc = imin(LINE_CHUNK, n_rows - y0);
+            const int q0 = base + y0;
+            int s0 = 0, s1 = nc;
+            while (s0 < s1 && surf[q0 + s0] == 0.0f) s0++;
+            while (s1 > s0 && surf[q0 + s1 - 1] == 0.0f) s1--;
+            if (s0 == s1) {
+                for (int c = 0; c < NVAL; c++) memset(&dst[c][q0], 0, (size_t)nc * sizeof(float));
+                continue;
+            }
+            /* Per-pixel terms as in the row loop; the slots past the chunk (a vector's last lanes)
+             * get zeros and are never stored. */
+            float zs[CHUNK], ze[CHUNK];
+            for (int k = 0; k < CHUNK; k++) {
+                if (k >= nc) {
+                    acc.inv_l[k] = zs[k] = 0.0f, ze[k] = 1.0f;
+                    acc.r[k] = acc.g[k] = acc.b[k] = acc.v[k] = acc.w[k] = 0.0f;
+                    continue;
+                }
+                const int q = q0 + k;
+                acc.inv_l[k] = 1.0f / (sl * sqrtf(gvar[q]) + LUM_EPS);
+                zs[k] = sd * grad[q] * (float)step, ze[k] = depth_eps(zg[q]);
+                acc.r[k] = wc * s.r[q], acc.g[k] = wc * s.g[q], acc.b[k] = wc * s.b[q];
+                acc.v[k] = wc * wc * s.v[q], acc.w[k] = wc;
+            }
+            for (int c = 0; c < 5; c++) {
+                const float dc = dist[c];
+                for (int k = 0; k < CHUNK; k++) acc.rz[c][k] = 1.0f / (zs[k] * dc + ze[k]);
+            }
+            /* The row of each tap column at the same angle, where its height differs: fv_grid_tap's
+             * floor((2 y + 1) hd / (2 hs)), one division per chunk and then stepped lane by lane
+             * (quotient and remainder of a numerator that grows by 2 hd per row). */
+            for (int c = 0; c < 5; c++) {
+                if (cn[c] == n_rows) continue;
+                const long den = 2L * n_rows, num = ((long)y0 * 2 + 1) * cn[c], inc = 2L * cn[c];
+                long q = num / den, r = num % den;
+                const long dq = inc / den, dr = inc % den;
+                for (int k = 0; k < nc; k++) {
+                    rows[c][k] = (int)q;
+                    q += dq, r += dr;
+                    const long over = r >= den;
+                    q += over, r -= over * den;
+                }
+            }
+            for (int t = 0; t < NTAP; t++) {
+                const int c = di[t] / step + 2, lb = cx[c] * stride + LINE_GHOST + dj[t];
+                gath[t] = cn[c] != n_rows;
+                off[t] = lb;
+                if (!gath[t]) continue;
+                for (int k = 0; k < nc; k++) qt[t][k] = lb + rows[c][k];
+                for (int k = nc; k < CHUNK; k++) qt[t][k] = qt[t][nc - 1]; /* unstored lanes: any valid index */
+            }
+            for (int k = s0; k < s1; k += SVGF_VW)
+                atrous_block(&s, (size_t)(base + y0 + k), y0 + k, k, off, qt, gath, kw, cls, 0, SVGF_VW, &acc);
+            for (int k = 0; k < nc; k++) {
+                const int q = q0 + k;
+                if (surf[q] == 0.0f) {
+                    for (int c = 0; c < NVAL; c++) dst[c][q] = 0.0f;
+                    continue;
+                }
+                float ws = acc.w[k], r = acc.r[k] / ws, gg = acc.g[k] / ws, b = acc.b[k] / ws;
+                dst[V_R][q] = r, dst[V_G][q] = gg, dst[V_B][q] = b;
+                dst[V_VAR][q] = acc.v[k] / (ws * ws);
+                dst[V_LUM][q] = luminance(r, gg, b);
+            }
+        }
+    }
 }
 
 /* One pass with taps `step` apart from val[src] to val[1 - src]; the first also writes the history. */
@@ -308,12 +489,28 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
             t++;
         }
     const float wc = k_b3[2] * k_b3[2];
+    /* The short columns and the columns within two taps of them go along the fovea's lines (C2);
+     * the row loop takes the columns from xt on. */
+    int xt = 0;
+    if (f->lines_w && f->blocks && sq == SQ_DEFAULT && step <= LINE_STEP_MAX) {
+        xt = imin(imin(f->full_from + 2 * step, f->pass_cut), w);
+        if (!f->ln_features) {
+            float *feat[LN_FEATURES] = {f->nx[0], f->ny[0], f->nz[0], f->z[0], f->grad, f->surf};
+            lines_load(f, &f->ln[LN_NX], feat, LN_FEATURES, f->lines_w, nt);
+            f->ln_features = true;
+        }
+        float *in[1 + NVAL] = {f->gvar};
+        for (int c = 0; c < NVAL; c++) in[1 + c] = f->val[src][c];
+        lines_load(f, &f->ln[LN_GVAR], in, 1 + NVAL, imin(f->full_from + 4 * step, w), nt);
+        lines_pass(f, step, xt, di, dj, kw, cls, nt);
+        lines_store(f, dst, write_hist, xt, nt);
+    }
     #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
     for (int y = 0; y < h; y++) {
         pass_acc acc;
         int fq[CHUNK], qt[NTAP][CHUNK];
         chunk_cols cc;
-        for (int x0 = 0; x0 < w; x0 += CHUNK) {
+        for (int x0 = xt; x0 < w; x0 += CHUNK) {
             const int x1 = imin(x0 + CHUNK, w), nc = x1 - x0;
             const size_t p0 = (size_t)y * w + x0;
             /* Columns from pass_cut on sit this pass out (fv_svgf_set_periphery): their values go
@@ -363,7 +560,7 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
                     lo = imax(lo, a), hi = imin(hi, b);
                 }
                 if (lo < hi) va = lo, vb = lo + (hi - lo) / SVGF_VW * SVGF_VW;
-                for (int x = va; x < vb; x += SVGF_VW) atrous_block(&s, p0 + (x - x0), x, x - x0, offs, NULL, kw, cls, 0, SVGF_VW, &acc);
+                for (int x = va; x < vb; x += SVGF_VW) atrous_block(&s, p0 + (x - x0), x, x - x0, offs, NULL, NULL, kw, cls, 0, SVGF_VW, &acc);
             }
             for (int part = 0; part < 2; part++) {
                 const int u0 = part ? vb : s0, u1 = part ? s1 : va;
@@ -384,7 +581,7 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
                         fallback_taps(g, &cc, di[t] / step + 2, dj[t], x0, u0, u1, a, b, qt[t]);
                     }
                     int x = u0;
-                    for (; x + SVGF_VW <= u1; x += SVGF_VW) atrous_block(&s, p0 + (x - x0), x, x - x0, NULL, qt, kw, cls, 0, SVGF_VW, &acc);
+                    for (; x + SVGF_VW <= u1; x += SVGF_VW) atrous_block(&s, p0 + (x - x0), x, x - x0, NULL, qt, NULL, kw, cls, 0, SVGF_VW, &acc);
                     if (x < u1 && nc >= SVGF_VW) {
                         /* The last pixels in one vector ending at u1 (or starting at the chunk's
                          * start): its other lanes are pixels done already or other parts of the
@@ -394,7 +591,7 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
                             for (int j = ks; j < x - x0; j++) qt[t][j] = (int)p0 + j;
                         for (int t = 0; t < NTAP; t++)
                             for (int j = u1 - x0; j < ks + SVGF_VW; j++) qt[t][j] = (int)p0 + j;
-                        atrous_block(&s, p0 + ks, xs, ks, NULL, qt, kw, cls, x - xs, u1 - xs, &acc);
+                        atrous_block(&s, p0 + ks, xs, ks, NULL, qt, NULL, kw, cls, x - xs, u1 - xs, &acc);
                         x = u1;
                     }
                     for (; x < u1; x++)

@@ -171,6 +171,43 @@ static void test_plain_same_bits(void **st)
     free(tri);
 }
 
+/* Fewer passes beyond a column (fv_svgf_set_periphery), the cut inside the short columns, beside
+ * them and far from them: every build gives the bits of one tap at a time (the fovea's lines stop
+ * at the cut), and the cut changes the image (its columns really skip passes). */
+static void test_periphery_same_bits(void **st)
+{
+    (void)st;
+    int *tri = triangle(150, 72);
+    const fv_grid g = {150, 72, tri, true};
+    const fv_svgf_isa isas[2] = {FV_SVGF_ISA_BASELINE, FV_SVGF_ISA_AVX2};
+    const int cuts[3] = {10, 30, 90};
+    for (int ci = 0; ci < 3; ci++)
+        for (int ii = 0; ii < (have_avx2() ? 2 : 1); ii++) {
+            fv_svgf *fp = make_filter(&g, 128.0f, FV_SVGF_ISA_PLAIN);
+            fv_svgf *fv = make_filter(&g, 128.0f, isas[ii]);
+            fv_svgf *fall = make_filter(&g, 128.0f, isas[ii]);
+            fv_svgf_set_periphery(fp, cuts[ci], 2);
+            fv_svgf_set_periphery(fv, cuts[ci], 2);
+            for (uint32_t k = 0; k < 3; k++) {
+                frame_buf p = make_frame(&g, k, true), v = make_frame(&g, k, true), a = make_frame(&g, k, true);
+                filter(fp, &p, k > 0);
+                filter(fv, &v, k > 0);
+                filter(fall, &a, k > 0);
+                assert_memory_equal(p.color, v.color, p.n * 3 * sizeof(float));
+                size_t differ = 0;
+                for (int y = 0; y < g.h; y++)
+                    for (int x = cuts[ci]; x < g.w; x++) {
+                        const size_t i = 3 * ((size_t)y * g.w + x);
+                        differ += memcmp(&v.color[i], &a.color[i], 3 * sizeof(float)) != 0;
+                    }
+                assert_true(differ > 0);
+                free_frame(&p), free_frame(&v), free_frame(&a);
+            }
+            fv_svgf_destroy(fp), fv_svgf_destroy(fv), fv_svgf_destroy(fall);
+        }
+    free(tri);
+}
+
 /* Rows wrap without a seam: rotating a full polar grid's rows by r rotates the filtered image by r
  * (the first frame and one with a history whose coordinates rotate too). */
 static void test_wrap_rotation(void **st)
@@ -257,6 +294,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_bits),
         cmocka_unit_test(test_plain_same_bits),
+        cmocka_unit_test(test_periphery_same_bits),
         cmocka_unit_test(test_wrap_rotation),
         cmocka_unit_test(test_inactive_never_leak),
     };
