@@ -37,6 +37,7 @@ struct fv_vp_pipeline {
     float mask_gx, mask_gy; /* the gaze onscreen was computed for (NaN: not yet) */
     float *lut;             /* per frame, per radius step: column X, mip level, blur sigma */
     int nlut;
+    float lut_gx, lut_gy;   /* the gaze lut was built for (NaN: none) */
     /* The map stage's per-pixel coordinates (X, V, mip level; the blur's sigma is p->sigma) kept
      * while the gaze stays: stored on the second frame at the same gaze, read from the third on. */
     float *coords;          /* 3 per screen pixel, allocated when first stored */
@@ -73,6 +74,7 @@ static void free_buffers(fv_vp_pipeline *p)
     free(p->coords);
     p->onscreen = NULL, p->coords = NULL;
     p->map_gx = p->map_gy = NAN;
+    p->lut_gx = p->lut_gy = NAN;
     p->coords_state = COORDS_NONE;
     memset(&p->g, 0, sizeof p->g);
     p->space = NULL, p->svgf = NULL, p->mips = NULL, p->prev_coord = NULL, p->sigma = NULL, p->perm = NULL, p->lut = NULL;
@@ -154,20 +156,52 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
 /* Where each sample's first hit was in the previous frame's sample space. */
 typedef struct reproject_ctx {
     fv_vp_pipeline *p;
+    bool lut;               /* p->lut is the previous view's radial table (polar spaces) */
 } reproject_ctx;
 
+#define REPROJECT_SPAN 256
+
+/* Polar spaces take the column from the previous frame's radial table, as its map stage did
+ * (issue 16: fv_space_from_screen's logarithm per sample was 2% of a frame), and the angle from
+ * fv_space_turns, in a loop that vectorises; the samples that did not project get NaN. */
 static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
 {
-    fv_vp_pipeline *p = ((reproject_ctx *)ctx)->p;
-    for (int64_t i = b; i < e; i++) {
-        float *pc = &p->prev_coord[2 * i];
-        pc[0] = pc[1] = NAN;
-        if (!p->g.sampled[i] || p->g.id[i] == 0 || (p->onscreen && !p->onscreen[i])) continue;
-        fv_vec3 x = fv_v3(p->g.position[3 * i], p->g.position[3 * i + 1], p->g.position[3 * i + 2]);
-        float px, py;
-        if (!fv_camera_project(&p->prev_cam, x, &px, &py)) continue;
-        if (px < 0.0f || py < 0.0f || px > (float)p->sw || py > (float)p->sh) continue;
-        fv_space_from_screen(&p->prev_view, px, py, &pc[0], &pc[1], NULL);
+    const reproject_ctx *rc = ctx;
+    fv_vp_pipeline *p = rc->p;
+    float px[REPROJECT_SPAN], py[REPROJECT_SPAN];
+    uint8_t ok[REPROJECT_SPAN];
+    const float inv_step = 1.0f / LUT_STEP, gx = p->prev_view.gx, gy = p->prev_view.gy;
+    const float *lut = p->lut;
+    const int last = p->nlut - 2;
+    for (int64_t i0 = b; i0 < e; i0 += REPROJECT_SPAN) {
+        const int n = e - i0 < REPROJECT_SPAN ? (int)(e - i0) : REPROJECT_SPAN;
+        for (int k = 0; k < n; k++) {
+            const int64_t i = i0 + k;
+            ok[k] = 0, px[k] = gx, py[k] = gy;
+            if (!p->g.sampled[i] || p->g.id[i] == 0 || (p->onscreen && !p->onscreen[i])) continue;
+            fv_vec3 x = fv_v3(p->g.position[3 * i], p->g.position[3 * i + 1], p->g.position[3 * i + 2]);
+            float qx, qy;
+            if (!fv_camera_project(&p->prev_cam, x, &qx, &qy)) continue;
+            if (qx < 0.0f || qy < 0.0f || qx > (float)p->sw || qy > (float)p->sh) continue;
+            ok[k] = 1, px[k] = qx, py[k] = qy;
+        }
+        float *pc = &p->prev_coord[2 * i0];
+        if (!rc->lut) {
+            for (int k = 0; k < n; k++) {
+                pc[2 * k] = pc[2 * k + 1] = NAN;
+                if (ok[k]) fv_space_from_screen(&p->prev_view, px[k], py[k], &pc[2 * k], &pc[2 * k + 1], NULL);
+            }
+            continue;
+        }
+        #pragma omp simd
+        for (int k = 0; k < n; k++) {
+            const float dx = px[k] - gx, dy = py[k] - gy, t = sqrtf(dx * dx + dy * dy) * inv_step;
+            int j = (int)t;
+            j = j < last ? j : last;
+            const float f = t - (float)j, X = lut[3 * j] + f * (lut[3 * j + 3] - lut[3 * j]), V = fv_space_turns(dx, dy);
+            pc[2 * k] = ok[k] ? X : NAN;
+            pc[2 * k + 1] = ok[k] ? V : NAN;
+        }
     }
 }
 
@@ -202,6 +236,7 @@ static void build_radial_lut(fv_vp_pipeline *p, const fv_space_view *view)
 {
     double sigma_px = p->o.blur_sigma * (double)p->sw / 1280.0;
     const double scale = blur_scale(p, view);
+    p->lut_gx = view->gx, p->lut_gy = view->gy;
     for (int i = 0; i < p->nlut; i++) {
         float r = (float)i * LUT_STEP, X, V, rows;
         fv_space_from_screen(view, view->gx + r, view->gy, &X, &V, &rows);
@@ -371,7 +406,10 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     if (p->o.denoise) {
         bool hist = p->have_prev && prev_cam != NULL;
         if (hist) {
-            reproject_ctx rc = {p};
+            /* The map stage of the previous frame built the table for its view (a gaze that
+             * stayed kept it). */
+            reproject_ctx rc = {p, fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN && p->prev_view.gx == p->lut_gx &&
+                                       p->prev_view.gy == p->lut_gy};
             fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
         }
         fv_svgf_frame fr = {p->g.color, p->g.albedo, p->g.normal, p->g.depth, p->g.position, p->g.id,
