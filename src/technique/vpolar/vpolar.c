@@ -15,6 +15,7 @@
  * per screen pixel (Fig. 1, right, and Fig. 8), averaged over a 13x13 window.
  */
 #include <stdlib.h>
+#include <math.h>
 #include <string.h>
 #include "core/alloc.h"
 #include "technique/class.h"
@@ -32,6 +33,7 @@ typedef struct vp_state {
 typedef enum vp_kind { K_VPOLAR, K_CARTESIAN, K_CARTESIAN_FULL, K_LINEAR_FALLOFF, K_LOGPOLAR } vp_kind;
 
 #define VP_PERIPHERY_PASSES 3 /* vpolar's periphery_passes default */
+#define VP_PERIPHERY_DEG 20.0 /* and where they start (at most blur_ramp_deg) */
 
 static const char *const k_orders[] = {"grid", "random", NULL};
 static const char *const k_offscreen[] = {"skip", "trace", NULL}; /* skip first: the default */
@@ -87,11 +89,12 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
             (s = fv_params_int(p, "fit_degree", 6, 2, 10, &o->space.fit_degree, err)))
             return s;
         o->blur_follows_space = true;
-        /* Issue 16: three passes beyond the blur's ramp lose nothing in the fovea and lower the
-         * periphery's FLIP on cornell and the city (vp-periphery, docs/results.md), for 8-16%
-         * less denoising; so on by default. */
+        /* Issue 16: three passes beyond 20 degrees, where the blur already has 60% of its sigma,
+         * lose nothing in the fovea and the transition and change the periphery's FLIP and
+         * flicker by under 1% on cornell and the city (vp-periphery, docs/results.md); beyond
+         * 15 degrees the transition starts to lose. So on by default. */
         if ((s = fv_params_int(p, "periphery_passes", VP_PERIPHERY_PASSES, 0, 10, &o->periphery_passes, err)) ||
-            (s = fv_params_float(p, "periphery_deg", o->blur_ramp_deg, 0.0, 180.0, &o->periphery_deg, err)))
+            (s = fv_params_float(p, "periphery_deg", fmin(VP_PERIPHERY_DEG, o->blur_ramp_deg), 0.0, 180.0, &o->periphery_deg, err)))
             return s;
         break;
     case K_CARTESIAN:
@@ -278,7 +281,7 @@ const fv_technique_class fv_technique_vpolar = {
                 "fit_degree=int (6): degree of the polynomial inverse of Eq. 2\n"
                 "blur=bool (true): foveated blur (blur_fovea_deg default 5.79, stretched with the space)\n"
                 "periphery_passes=int (3): SVGF passes for the columns beyond periphery_deg (svgf_iterations or more: all)\n"
-                "periphery_deg=float (blur_ramp_deg): eccentricity where periphery_passes starts, on the blur's profile\n",
+                "periphery_deg=float (20, at most blur_ramp_deg): eccentricity where periphery_passes starts, on the blur's profile\n",
     create_vpolar, vp_render, vp_destroy,
     FURNACE_TEST, .spp_param = "spp",
 };
