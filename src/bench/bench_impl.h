@@ -12,7 +12,7 @@ typedef struct fv_bench_result {
     const fv_bench_method *m;
     double *ms;                 /* per repeat: mean ms per frame */
     double ms_median, ms_min, ms_max;
-    double speedup;             /* baseline median / this median */
+    double speedup;             /* median over rounds of baseline / this (run.c) */
     fv_stats stages;            /* per stage: median over repeats of the mean per frame */
     fv_stats counters;          /* mean per frame, last repeat */
     fv_metric_report error;     /* mean over frames, per region */

@@ -1,7 +1,9 @@
 /* fovea — the benchmark runner: every method of a scenario renders the same frames (same scene
  * times, cameras, gaze and seeds) in one process, so the ratios between them are fair on a shared,
  * noisy machine. Timing covers the technique's render call only, repeated with a fresh technique
- * state each repeat (temporal methods replay their whole sequence) and summarised by the median.
+ * state each repeat (temporal methods replay their whole sequence) and summarised by the median;
+ * the methods' repeats are interleaved (round r runs every method once) and the speed-up is the
+ * median of the per-round ratios.
  * Errors are measured on the last repeat against a reference rendered once and cached on disk
  * under a hash of everything that determines it.
  */
@@ -306,92 +308,172 @@ static fv_status write_crop(const fv_scenario *sc, const float *rgb, fv_gaze g, 
     return st;
 }
 
+/* One method's measurement, split so that the runner can interleave the methods' repeats. */
+typedef struct method_run {
+    method_ctx c;
+    render_job j;
+    int reps;
+    double *stage_per_rep;     /* per stage name (stage_names' order), per repeat */
+    fv_stats stage_names;
+} method_run;
+
+static void method_free(method_run *mr)
+{
+    fv_temporal_destroy(mr->c.temporal);
+    free(mr->stage_per_rep);
+    free(mr->c.flip_map);
+    free(mr->c.last);
+    memset(mr, 0, sizeof *mr);
+}
+
+/* Buffers and one untimed frame: thread start-up and cold caches would otherwise land in the first
+ * repeat of whichever method runs first. */
+static fv_status method_begin(const fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, fv_bench_result *res,
+                              method_run *mr, fv_error *err)
+{
+    const fv_scenario *sc = info->sc;
+    memset(mr, 0, sizeof *mr);
+    mr->reps = info->opt->repeats > 0 ? info->opt->repeats : sc->repeats;
+    size_t npix = (size_t)sc->width * sc->height;
+    method_ctx *c = &mr->c;
+    c->info = info;
+    c->frames = frames;
+    c->res = res;
+    fv_metric_opts_default(&c->mopts);
+    c->mopts.exposure = sc->exposure;
+    res->ms = calloc((size_t)mr->reps, sizeof(double));
+    res->speedup = 0.0;
+    mr->stage_per_rep = calloc((size_t)mr->reps * FV_STATS_MAX, sizeof(double));
+    c->flip_map = fv_alloc_array(npix, sizeof(float));
+    c->last = fv_alloc_array(npix, 3 * sizeof(float));
+    if (!res->ms || !mr->stage_per_rep || !c->flip_map || !c->last) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    fv_stats_clear(&mr->stage_names);
+    mr->j = (render_job){sc, scene, info->driver, res->m, info->opt->log};
+    return render_sequence(&mr->j, 0, 1, on_warmup_frame, NULL, err);
+}
+
+/* Repeat r of the sequence, timed; the last one also measures the errors. */
+static fv_status method_repeat(method_run *mr, int index, int total, int r, fv_error *err)
+{
+    method_ctx *c = &mr->c;
+    const fv_scenario *sc = c->info->sc;
+    fv_bench_result *res = c->res;
+    const int reps = mr->reps;
+    say(c->info->opt, "[%d/%d] %s: repeat %d/%d, %d frame(s)", index + 1, total, res->m->label, r + 1, reps, sc->frames);
+    c->measure = r == reps - 1;
+    c->ms_sum = 0.0;
+    fv_stats_clear(&c->stage_sum);
+    fv_stats_clear(&c->counter_sum);
+    fv_status st = FV_OK;
+    if (c->measure) {
+        memset(&res->error, 0, sizeof res->error);
+        memset(res->error_vs, 0, sizeof res->error_vs);
+        if (sc->frames - sc->measure_from > 1 && (st = fv_temporal_create(sc->width, sc->height, &c->mopts, &c->temporal, err)) != FV_OK)
+            return st;
+    }
+    if ((st = render_sequence(&mr->j, 0, sc->frames, on_method_frame, c, err)) != FV_OK) return st;
+    res->ms[r] = c->ms_sum / sc->frames;
+    for (int k = 0; k < c->stage_sum.n_stages; k++) {
+        fv_stats_add_ms(&mr->stage_names, c->stage_sum.stage[k].name, 0.0);
+        for (int q = 0; q < mr->stage_names.n_stages; q++)
+            if (strcmp(mr->stage_names.stage[q].name, c->stage_sum.stage[k].name) == 0)
+                mr->stage_per_rep[(size_t)q * reps + r] = c->stage_sum.stage[k].value / sc->frames;
+    }
+    return FV_OK;
+}
+
+/* Medians over the repeats, the errors' PSNR, and the images of the last frame. */
+static fv_status method_end(method_run *mr, fv_error *err)
+{
+    method_ctx *c = &mr->c;
+    const fv_bench_run_info *info = c->info;
+    const fv_scenario *sc = info->sc;
+    fv_bench_result *res = c->res;
+    const int reps = mr->reps;
+    res->ms_median = median(res->ms, reps);
+    res->ms_min = res->ms_max = res->ms[0];
+    for (int r = 1; r < reps; r++) {
+        res->ms_min = fmin(res->ms_min, res->ms[r]);
+        res->ms_max = fmax(res->ms_max, res->ms[r]);
+    }
+    fv_stats_clear(&res->stages);
+    for (int q = 0; q < mr->stage_names.n_stages; q++)
+        fv_stats_add_ms(&res->stages, mr->stage_names.stage[q].name, median(mr->stage_per_rep + (size_t)q * reps, reps));
+    fv_stats_clear(&res->counters);
+    for (int k = 0; k < c->counter_sum.n_counters; k++)
+        fv_stats_add_count(&res->counters, c->counter_sum.counter[k].name, c->counter_sum.counter[k].value / sc->frames);
+    for (int k = -1; k < sc->nextra; k++)
+        for (int r = 0; r < FV_REGION_COUNT; r++) {
+            fv_metric_values *v = k < 0 ? &res->error.region[r] : &res->error_vs[k].region[r];
+            v->psnr = v->mse > 0.0 ? 10.0 * log10(1.0 / v->mse) : v->mse == 0.0 ? INFINITY : NAN;
+        }
+    if (c->temporal) {
+        res->has_temporal = true;
+        for (int r = 0; r < FV_REGION_COUNT; r++)
+            fv_temporal_result(c->temporal, (fv_region)r, &res->temporal_mse[r], &res->temporal_e[r]);
+    }
+    /* Images of the last frame: the frame, its FLIP heat map with the region rings, the fovea. */
+    char path[4096 + 128];
+    const frame_setup *lf = &c->frames[sc->frames - 1];
+    const char *label = res->m->label;
+    snprintf(res->img, sizeof res->img, "%s/%s.png", sc->name, label);
+    snprintf(res->heat, sizeof res->heat, "%s/%s-flip.png", sc->name, label);
+    snprintf(res->crop, sizeof res->crop, "%s/%s-fovea.png", sc->name, label);
+    snprintf(path, sizeof path, "%s/%s", info->out_dir, res->img);
+    fv_status st = fv_image_write(path, c->last, sc->width, sc->height, sc->exposure, err);
+    snprintf(path, sizeof path, "%s/%s", info->out_dir, res->heat);
+    if (st == FV_OK) st = fv_heatmap_write(path, c->flip_map, sc->width, sc->height, 1.0f, &sc->eye, lf->gaze, err);
+    snprintf(path, sizeof path, "%s/%s", info->out_dir, res->crop);
+    if (st == FV_OK) st = write_crop(sc, c->last, lf->gaze, path, err);
+    return st;
+}
+
+/* One method on its own, every repeat in a row (the match searches). */
 static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, int index, int total,
                             fv_bench_result *res, fv_error *err)
 {
+    method_run mr;
+    fv_status st = method_begin(info, scene, frames, res, &mr, err);
+    for (int r = 0; r < mr.reps && st == FV_OK; r++) st = method_repeat(&mr, index, total, r, err);
+    if (st == FV_OK) st = method_end(&mr, err);
+    method_free(&mr);
+    return st;
+}
+
+/* The scenario's methods, their repeats interleaved: round r renders every method's repeat r, so a
+ * machine that slows down or speeds up (other processes, a shared host) does so for all of them
+ * alike, and the speed-up is the median over rounds of the baseline's time over the method's, each
+ * ratio taken within one round. */
+static fv_status run_methods(const fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, fv_bench_result *res,
+                             int total, fv_error *err)
+{
     const fv_scenario *sc = info->sc;
-    const fv_bench_method *m = res->m;
-    int reps = info->opt->repeats > 0 ? info->opt->repeats : sc->repeats;
-    size_t npix = (size_t)sc->width * sc->height;
-    method_ctx c;
-    memset(&c, 0, sizeof c);
-    c.info = info;
-    c.frames = frames;
-    c.res = res;
-    fv_metric_opts_default(&c.mopts);
-    c.mopts.exposure = sc->exposure;
-    res->ms = calloc((size_t)reps, sizeof(double));
-    double *stage_per_rep = calloc((size_t)reps * FV_STATS_MAX, sizeof(double));
-    c.flip_map = fv_alloc_array(npix, sizeof(float));
-    c.last = fv_alloc_array(npix, 3 * sizeof(float));
+    method_run *mr = fv_calloc_array((size_t)sc->nmethods, sizeof *mr);
+    if (!mr) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_status st = FV_OK;
-    if (!res->ms || !stage_per_rep || !c.flip_map || !c.last) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    fv_stats stage_names;
-    fv_stats_clear(&stage_names);
-    render_job j = {sc, scene, info->driver, m, info->opt->log};
-    /* One untimed frame first: thread start-up and cold caches would otherwise land in the
-     * first repeat of whichever method runs first. */
-    if (st == FV_OK) st = render_sequence(&j, 0, 1, on_warmup_frame, NULL, err);
-    for (int r = 0; r < reps && st == FV_OK; r++) {
-        say(info->opt, "[%d/%d] %s: repeat %d/%d, %d frame(s)", index + 1, total, m->label, r + 1, reps, sc->frames);
-        c.measure = r == reps - 1;
-        c.ms_sum = 0.0;
-        fv_stats_clear(&c.stage_sum);
-        fv_stats_clear(&c.counter_sum);
-        if (c.measure) {
-            memset(&res->error, 0, sizeof res->error);
-            memset(res->error_vs, 0, sizeof res->error_vs);
-            if (sc->frames - sc->measure_from > 1 && (st = fv_temporal_create(sc->width, sc->height, &c.mopts, &c.temporal, err)) != FV_OK) break;
-        }
-        if ((st = render_sequence(&j, 0, sc->frames, on_method_frame, &c, err)) != FV_OK) break;
-        res->ms[r] = c.ms_sum / sc->frames;
-        for (int k = 0; k < c.stage_sum.n_stages; k++) {
-            fv_stats_add_ms(&stage_names, c.stage_sum.stage[k].name, 0.0);
-            for (int q = 0; q < stage_names.n_stages; q++)
-                if (strcmp(stage_names.stage[q].name, c.stage_sum.stage[k].name) == 0)
-                    stage_per_rep[(size_t)q * reps + r] = c.stage_sum.stage[k].value / sc->frames;
-        }
+    int begun = 0;
+    for (; begun < sc->nmethods && st == FV_OK; begun++) {
+        res[begun].m = &sc->methods[begun];
+        st = method_begin(info, scene, frames, &res[begun], &mr[begun], err);
     }
+    const int reps = st == FV_OK && sc->nmethods > 0 ? mr[0].reps : 0;
+    for (int r = 0; r < reps && st == FV_OK; r++)
+        for (int i = 0; i < sc->nmethods && st == FV_OK; i++) st = method_repeat(&mr[i], i, total, r, err);
+    for (int i = 0; i < sc->nmethods && st == FV_OK; i++) st = method_end(&mr[i], err);
     if (st == FV_OK) {
-        res->ms_median = median(res->ms, reps);
-        res->ms_min = res->ms_max = res->ms[0];
-        for (int r = 1; r < reps; r++) {
-            res->ms_min = fmin(res->ms_min, res->ms[r]);
-            res->ms_max = fmax(res->ms_max, res->ms[r]);
+        int b = -1;
+        for (int i = 0; i < sc->nmethods; i++)
+            if (strcmp(sc->methods[i].label, sc->baseline) == 0) b = i;
+        double *ratio = fv_calloc_array((size_t)reps, sizeof(double));
+        if (!ratio) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        for (int i = 0; i < sc->nmethods && ratio && b >= 0; i++) {
+            for (int r = 0; r < reps; r++) ratio[r] = res[i].ms[r] > 0.0 ? res[b].ms[r] / res[i].ms[r] : 0.0;
+            res[i].speedup = median(ratio, reps);
         }
-        fv_stats_clear(&res->stages);
-        for (int q = 0; q < stage_names.n_stages; q++)
-            fv_stats_add_ms(&res->stages, stage_names.stage[q].name, median(stage_per_rep + (size_t)q * reps, reps));
-        fv_stats_clear(&res->counters);
-        for (int k = 0; k < c.counter_sum.n_counters; k++)
-            fv_stats_add_count(&res->counters, c.counter_sum.counter[k].name, c.counter_sum.counter[k].value / sc->frames);
-        for (int k = -1; k < sc->nextra; k++)
-            for (int r = 0; r < FV_REGION_COUNT; r++) {
-                fv_metric_values *v = k < 0 ? &res->error.region[r] : &res->error_vs[k].region[r];
-                v->psnr = v->mse > 0.0 ? 10.0 * log10(1.0 / v->mse) : v->mse == 0.0 ? INFINITY : NAN;
-            }
-        if (c.temporal) {
-            res->has_temporal = true;
-            for (int r = 0; r < FV_REGION_COUNT; r++)
-                fv_temporal_result(c.temporal, (fv_region)r, &res->temporal_mse[r], &res->temporal_e[r]);
-        }
-        /* Images of the last frame: the frame, its FLIP heat map with the region rings, the fovea. */
-        char path[4096 + 128];
-        const frame_setup *lf = &frames[sc->frames - 1];
-        snprintf(res->img, sizeof res->img, "%s/%s.png", sc->name, m->label);
-        snprintf(res->heat, sizeof res->heat, "%s/%s-flip.png", sc->name, m->label);
-        snprintf(res->crop, sizeof res->crop, "%s/%s-fovea.png", sc->name, m->label);
-        snprintf(path, sizeof path, "%s/%s", info->out_dir, res->img);
-        st = fv_image_write(path, c.last, sc->width, sc->height, sc->exposure, err);
-        snprintf(path, sizeof path, "%s/%s", info->out_dir, res->heat);
-        if (st == FV_OK) st = fv_heatmap_write(path, c.flip_map, sc->width, sc->height, 1.0f, &sc->eye, lf->gaze, err);
-        snprintf(path, sizeof path, "%s/%s", info->out_dir, res->crop);
-        if (st == FV_OK) st = write_crop(sc, c.last, lf->gaze, path, err);
+        free(ratio);
     }
-    fv_temporal_destroy(c.temporal);
-    free(stage_per_rep);
-    free(c.flip_map);
-    free(c.last);
+    for (int i = 0; i < begun; i++) method_free(&mr[i]);
+    free(mr);
     return st;
 }
 
@@ -647,17 +729,15 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
         goto done;
     }
-    for (int i = 0; i < sc->nmethods && st == FV_OK; i++) {
-        res[i].m = &sc->methods[i];
-        st = run_method(&info, scene, frames, i, nrows, &res[i], err);
-    }
+    st = run_methods(&info, scene, frames, res, nrows, err);
     for (int k = 0; k < sc->nmatches && st == FV_OK; k++)
         st = run_match(&info, scene, frames, res, k, &match_methods[k], &res[sc->nmethods + k], err);
     if (st != FV_OK) goto done;
+    /* The match searches ran after the rounds: their speed-up is the ratio of medians. */
     double base = 0.0;
     for (int i = 0; i < sc->nmethods; i++)
         if (strcmp(sc->methods[i].label, sc->baseline) == 0) base = res[i].ms_median;
-    for (int i = 0; i < nrows; i++) res[i].speedup = res[i].ms_median > 0.0 ? base / res[i].ms_median : 0.0;
+    for (int i = sc->nmethods; i < nrows; i++) res[i].speedup = res[i].ms_median > 0.0 ? base / res[i].ms_median : 0.0;
     st = fv_bench_write_reports(&info, res, nrows, err);
 done:
     if (frames)
