@@ -21,8 +21,10 @@
  * exponents powf. The exponential is an inline approximation (exp_neg). Spans of a chunk with no
  * surface (background, rows beyond short columns) are skipped. In the À-Trous pass the pixels whose
  * 24 taps are all shifts go 4 or 8 at a time with every tap inner, the sums in registers
- * (atrous_block). B and C live in svgf_sweeps.h, built here for the baseline x86-64 and in
- * svgf_avx2.c for AVX2; fv_svgf_set_isa picks one (issue 16: same bits, twice the lanes).
+ * (atrous_block). A polar grid's short columns and the columns within two taps of them are
+ * filtered along column-major copies instead, where their taps lie close together (the fovea's
+ * lines, C2 in svgf_sweeps.h). B and C live in svgf_sweeps.h, built here for the baseline x86-64
+ * and in svgf_avx2.c for AVX2; fv_svgf_set_isa picks one (issue 16: same bits, twice the lanes).
  *
  * Choices the paper leaves open, and why:
  *  - Depth gradient: per axis (along the column and across columns, through the grid's own taps) the
@@ -47,8 +49,9 @@
  *    zero normal and zero values in the working buffers, so as a tap its weight is exactly 0 and
  *    the inner loops need no test.
  *
- * Memory: about 140 bytes per grid pixel, all allocated by fv_svgf_create; nothing is allocated per
- * frame (the per-chunk scratch is on the stack, about 4 KB).
+ * Memory: about 140 bytes per grid pixel, plus the fovea's lines (68 bytes per cell of the short
+ * columns and the 64 columns beyond them, padded to h + 64 rows), all allocated by fv_svgf_create;
+ * nothing is allocated per frame (the per-chunk scratch is on the stack, about 12 KB).
  */
 #include <math.h>
 #include <stdbool.h>

@@ -62,7 +62,9 @@ fv_status fv_svgf_opts_validate(const fv_svgf_opts *o, fv_error *err);
 /* The filter and its history for one grid. The grid is copied; its col_h array is not and must
  * outlive the filter. o NULL: the defaults. Bad options, a column height outside [1, h] or more
  * than 2^31 - 1 pixels -> FV_ERR_INVALID; FV_ERR_NOMEM (nothing leaked). Every buffer is allocated
- * here (about 140 bytes per pixel), none per frame. */
+ * here (about 140 bytes per pixel; a polar grid with short columns also keeps column-major copies
+ * of its first columns, docs/filters.md), none per frame. FOVEA_SVGF_LINES=off in the environment
+ * leaves those copies out (the same bits, slower: for measurements). */
 typedef struct fv_svgf fv_svgf;
 
 fv_status fv_svgf_create(const fv_grid *grid, const fv_svgf_opts *o, fv_svgf **out, fv_error *err);
