@@ -280,7 +280,7 @@ TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const lo
     vfw ar = LDW(&acc->r[k]), ag = LDW(&acc->g[k]), ab = LDW(&acc->b[k]), av = LDW(&acc->v[k]), aw = LDW(&acc->w[k]);
     for (int t = 0; t < NTAP; t++) {
         const int *qi = qt && (!gath || gath[t]) ? &qt[t][k] : NULL;
-        long q = qi ? 0 : off[t] + x;
+        const long q = qi ? 0 : off[t] + x;
         viw d;
         /* The lines' gathered taps mostly fit a window of two vectors (neighbouring rows of a
          * column land on neighbouring rows of the next). */
@@ -309,9 +309,10 @@ TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const lo
 /* ---- C2. the fovea's lines (polar grids with short columns; issue 16)
  *
  * Row-major, a short column's taps into its neighbours land on other rows (the same angle in a
- * column of another height): a different row, far apart in memory, for each pixel of a vector, so
- * the row loop's gathers miss the caches. Column-major, the taps of neighbouring rows of a column
- * lie a lane or two apart in the neighbouring column's line. So the passes with taps up to
+ * column of another height): a different row, kilobytes from the next, for each pixel of a vector,
+ * so the row loop gathers them lane by lane from all over the grid. Column-major, the taps of
+ * neighbouring rows of a column lie a lane or two apart in the neighbouring column's line, mostly
+ * within two vectors (tap_window). So the passes with taps up to
  * LINE_STEP_MAX apart copy the columns they reach into the lines (the features once a frame, the
  * values once a pass), filter the short columns and the columns within two taps of them along
  * their lines, SVGF_VW rows at a time, and write the results in the grid's order. The taps are

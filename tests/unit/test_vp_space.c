@@ -2,8 +2,9 @@
  * by hand, the grid's sample count against the reduction, forward/inverse round trips, a grid that
  * reaches the farthest corner from any gaze with the same samples, a fovea of at least one sample
  * per pixel with a constant density, a periphery whose density follows the acuity, the φ wrap, the
- * fit error, log-polar and Cartesian maps worked by hand, refused options, and an off-screen mask
- * that no screen pixel's trilinear φ-mip lookup ever reads past. */
+ * fit error, log-polar and Cartesian maps worked by hand, refused options, an off-screen mask
+ * that no screen pixel's trilinear φ-mip lookup ever reads past, and a radial table within 1e-3
+ * columns of the exact map. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -398,6 +399,44 @@ static void test_turns(void **st)
     assert_float_equal(fv_space_turns(0.0f, 0.0f), 0.0f, 0.0);
 }
 
+/* The radial table the map stage and the denoiser's reprojection read (fv_space_radial_table,
+ * fv_space_table_x, every 0.5 px as the pipeline builds it): the column it gives at any distance
+ * from the gaze is within 1e-3 columns of fv_space_from_screen, for gazes at the centre, a corner
+ * and an edge (the profile stretches with the gaze), in every direction; its mip level is
+ * fv_space_from_screen's at the entries. */
+static void test_radial_table(void **st)
+{
+    (void)st;
+    fv_space *s = make(FV_SPACE_VPOLAR, 0.61);
+    const fv_gaze gazes[3] = {{0.5f, 0.5f}, {0.02f, 0.97f}, {0.5f, 0.0f}};
+    const float step = 0.5f;
+    const int n = (int)(sqrt((double)W * W + (double)H * H) / step) + 3;
+    float *table = malloc(sizeof(float) * 3 * (size_t)n);
+    for (int gi = 0; gi < 3; gi++) {
+        const fv_space_view v = fv_space_view_at(s, gazes[gi]);
+        fv_space_radial_table(&v, step, n, 3, table);
+        for (int i = 0; i < n; i += 97) {
+            float X, V, rows;
+            fv_space_from_screen(&v, v.gx + (float)i * step, v.gy, &X, &V, &rows);
+            assert_float_equal(table[3 * i], X, 0.0);
+            assert_float_equal(table[3 * i + 1], rows > 1.0f ? log2f(rows) : 0.0f, 0.0);
+        }
+        double worst = 0.0;
+        for (int k = 0; k < 200000; k++) {
+            const float px = (float)W * (float)fmod(k * 0.618034, 1.0), py = (float)H * (float)fmod(k * 0.414214 + 0.1, 1.0);
+            const float dx = px - v.gx, dy = py - v.gy;
+            float X, V;
+            fv_space_from_screen(&v, px, py, &X, &V, NULL);
+            const double d = fabs(fv_space_table_x(table, 3, n, 1.0f / step, sqrtf(dx * dx + dy * dy)) - X);
+            worst = d > worst ? d : worst;
+        }
+        print_message("gaze (%.2f, %.2f): table column within %.2g of the exact\n", gazes[gi].x, gazes[gi].y, worst);
+        assert_true(worst < 1e-3);
+    }
+    free(table);
+    fv_space_destroy(s);
+}
+
 /* The level-0 rows [*lo, *hi] (unwrapped: may run below 0 or past the column's height) that feed
  * row j of level k of column x: each level's row averages the rows of the level below that overlap
  * its angles (phi_mips.h). */
@@ -478,7 +517,7 @@ int main(void)
         cmocka_unit_test(test_phi_wrap),        cmocka_unit_test(test_fit_error),
         cmocka_unit_test(test_logpolar),        cmocka_unit_test(test_cartesian),
         cmocka_unit_test(test_bad_options),     cmocka_unit_test(test_onscreen_mask),
-        cmocka_unit_test(test_turns),
+        cmocka_unit_test(test_turns),           cmocka_unit_test(test_radial_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -171,8 +171,6 @@ static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
     float px[REPROJECT_SPAN], py[REPROJECT_SPAN];
     uint8_t ok[REPROJECT_SPAN];
     const float inv_step = 1.0f / LUT_STEP, gx = p->prev_view.gx, gy = p->prev_view.gy;
-    const float *lut = p->lut;
-    const int last = p->nlut - 2;
     for (int64_t i0 = b; i0 < e; i0 += REPROJECT_SPAN) {
         const int n = e - i0 < REPROJECT_SPAN ? (int)(e - i0) : REPROJECT_SPAN;
         for (int k = 0; k < n; k++) {
@@ -195,10 +193,8 @@ static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
         }
         #pragma omp simd
         for (int k = 0; k < n; k++) {
-            const float dx = px[k] - gx, dy = py[k] - gy, t = sqrtf(dx * dx + dy * dy) * inv_step;
-            int j = (int)t;
-            j = j < last ? j : last;
-            const float f = t - (float)j, X = lut[3 * j] + f * (lut[3 * j + 3] - lut[3 * j]), V = fv_space_turns(dx, dy);
+            const float dx = px[k] - gx, dy = py[k] - gy;
+            const float X = fv_space_table_x(p->lut, 3, p->nlut, inv_step, sqrtf(dx * dx + dy * dy)), V = fv_space_turns(dx, dy);
             pc[2 * k] = ok[k] ? X : NAN;
             pc[2 * k + 1] = ok[k] ? V : NAN;
         }
@@ -237,13 +233,11 @@ static void build_radial_lut(fv_vp_pipeline *p, const fv_space_view *view)
     double sigma_px = p->o.blur_sigma * (double)p->sw / 1280.0;
     const double scale = blur_scale(p, view);
     p->lut_gx = view->gx, p->lut_gy = view->gy;
+    fv_space_radial_table(view, LUT_STEP, p->nlut, 3, p->lut);
     for (int i = 0; i < p->nlut; i++) {
-        float r = (float)i * LUT_STEP, X, V, rows;
-        fv_space_from_screen(view, view->gx + r, view->gy, &X, &V, &rows);
-        float *e = &p->lut[3 * i];
-        e[0] = X;
-        e[1] = rows > 1.0f ? log2f(rows) : 0.0f;
-        e[2] = p->o.blur ? (float)fv_blur_sigma_at((double)r / p->ppd * scale, p->o.blur_fovea_deg, p->o.blur_ramp_deg, sigma_px) : 0.0f;
+        const float r = (float)i * LUT_STEP;
+        p->lut[3 * i + 2] =
+            p->o.blur ? (float)fv_blur_sigma_at((double)r / p->ppd * scale, p->o.blur_fovea_deg, p->o.blur_ramp_deg, sigma_px) : 0.0f;
     }
 }
 
@@ -270,7 +264,7 @@ static void map_coords(const map_ctx *c, int64_t y, int x0, int n, float *X, flo
         int i = (int)t;
         i = i < last ? i : last;
         float f = t - (float)i;
-        X[k] = lut[3 * i] + f * (lut[3 * i + 3] - lut[3 * i]);
+        X[k] = fv_space_table_x(lut, 3, p->nlut, inv_step, sqrtf(dx * dx + dy * dy));
         level[k] = lut[3 * i + 1] + f * (lut[3 * i + 4] - lut[3 * i + 1]);
         V[k] = fv_space_turns(dx, dy);
         sigma[k] = lut[3 * i + 2] + f * (lut[3 * i + 5] - lut[3 * i + 2]);

@@ -367,6 +367,16 @@ long fv_space_onscreen_mask(const fv_space_view *v, float reach_px, uint8_t *mas
     return on;
 }
 
+void fv_space_radial_table(const fv_space_view *v, float step, int n, int stride, float *table)
+{
+    for (int i = 0; i < n; i++) {
+        float X, V, rows;
+        fv_space_from_screen(v, v->gx + (float)i * step, v->gy, &X, &V, &rows);
+        table[stride * i] = X;
+        table[stride * i + 1] = rows > 1.0f ? log2f(rows) : 0.0f;
+    }
+}
+
 void fv_space_to_screen(const fv_space_view *v, float X, float V, float *px, float *py)
 {
     const fv_space *s = v->space;

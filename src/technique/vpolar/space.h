@@ -121,6 +121,25 @@ static inline float fv_space_turns(float dx, float dy)
     return uv.f;
 }
 
+/* A radial table of one view, for the lookups that depend only on the distance from the gaze (the
+ * map stage, the denoiser's reprojection): entry i, at table[i * stride], holds the column X at
+ * distance i * step from the gaze (fv_space_from_screen along +x) and, next to it, the mip level
+ * (log2 of the rows one pixel spans along φ, 0 below one row); n >= 2 entries. */
+void fv_space_radial_table(const fv_space_view *v, float step, int n, int stride, float *table);
+
+/* The column at distance r >= 0 from the gaze, linear between the entries of a radial table (the
+ * last interval continues past its end); 1 / step as inv_step. For a Visual-Polar table every
+ * 0.5 px at 1280x1440, within 1e-3 columns of fv_space_from_screen (test_vp_space): X is linear in
+ * the fovea and smooth beyond it (Eq. 2 meets the fovea's pi e^2 with its slope). */
+static inline float fv_space_table_x(const float *table, int stride, int n, float inv_step, float r)
+{
+    const float t = r * inv_step;
+    int i = (int)t;
+    i = i < n - 2 ? i : n - 2;
+    const float f = t - (float)i;
+    return table[stride * i] + f * (table[stride * (i + 1)] - table[stride * i]);
+}
+
 /* For every grid cell (storage w * h, rows beyond a column's height 0): 1 when some point of the
  * cell lies within reach_px of the screen, reach_px plus the cell's own size (a bilinear lookup
  * from the screen reaches the neighbouring cells), 0 when the whole cell is farther off screen.
