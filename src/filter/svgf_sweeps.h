@@ -211,6 +211,22 @@ TAP_INLINE void atrous_tap(const pass_src *s, size_t p, int q, int k, float kw, 
     acc->w[k] += wt;
 }
 
+/* A pass's result for chunk slot k at index q of dst (and its illumination into hist, when given):
+ * the sums over their weight, or zeros off a surface. Divisions, not a reciprocal: a mean of equal
+ * values then comes out exactly equal. */
+static inline void pass_result(const pass_acc *acc, int k, bool surface, float *const *dst, size_t q, float *hist)
+{
+    if (!surface) {
+        for (int c = 0; c < NVAL; c++) dst[c][q] = 0.0f;
+        return;
+    }
+    float ws = acc->w[k], r = acc->r[k] / ws, gg = acc->g[k] / ws, b = acc->b[k] / ws;
+    dst[V_R][q] = r, dst[V_G][q] = gg, dst[V_B][q] = b;
+    dst[V_VAR][q] = acc->v[k] / (ws * ws);
+    dst[V_LUM][q] = luminance(r, gg, b);
+    if (hist) hist[0] = r, hist[1] = gg, hist[2] = b;
+}
+
 /* SVGF_VW pixels at a time with every tap inner (the pixels whose 24 taps are all plain shifts):
  * the sums and the centre pixels' features stay in registers across the taps, where the per-tap
  * loops above load and store them once per tap. The arithmetic is atrous_tap's, operation for
@@ -319,6 +335,14 @@ TAP_INLINE void atrous_block(const pass_src *s, size_t p, int x, int k, const lo
  * fv_grid_tap's and each pixel adds them in the same order, so the bits are those of the row loop
  * (test_svgf_isa: against one tap at a time). */
 
+/* The most rows any column of [xb, xe) holds. */
+static int block_rows(const fv_grid *g, int xb, int xe)
+{
+    int most = 0;
+    for (int x = xb; x < xe; x++) most = imax(most, fv_grid_col_h(g, x));
+    return most;
+}
+
 /* Copies the columns [0, xr) of the n grid-ordered buffers src into the lines dst, ghosts included
  * (a column shorter than the ghosts wraps more than once). Blocks of 8 columns, rows outer: the
  * reads are runs of a row. */
@@ -328,9 +352,7 @@ static void lines_load(const fv_svgf *f, float *const *dst, float *const *src, i
     const int w = g->w, stride = f->line_stride;
     #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
     for (int xb = 0; xb < xr; xb += 8) {
-        const int xe = imin(xb + 8, xr);
-        int lmax = 0;
-        for (int x = xb; x < xe; x++) lmax = imax(lmax, fv_grid_col_h(g, x));
+        const int xe = imin(xb + 8, xr), lmax = block_rows(g, xb, xe);
         for (int b = 0; b < n; b++)
             for (int y = -LINE_GHOST; y < lmax + LINE_GHOST; y++)
                 for (int x = xb; x < xe; x++) {
@@ -350,9 +372,7 @@ static void lines_store(fv_svgf *f, float *const *dst, bool write_hist, int xt, 
     const int w = g->w, stride = f->line_stride;
     #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
     for (int xb = 0; xb < xt; xb += 8) {
-        const int xe = imin(xb + 8, xt);
-        int lmax = 0;
-        for (int x = xb; x < xe; x++) lmax = imax(lmax, fv_grid_col_h(g, x));
+        const int xe = imin(xb + 8, xt), lmax = block_rows(g, xb, xe);
         for (int c = 0; c < NVAL; c++) {
             const float *o = f->ln[LN_OUT + c] + LINE_GHOST;
             for (int y = 0; y < lmax; y++)
@@ -448,17 +468,7 @@ static void lines_pass(fv_svgf *f, int step, int xt, const int *di, const int *d
             }
             for (int k = s0; k < s1; k += SVGF_VW)
                 atrous_block(&s, (size_t)(base + y0 + k), y0 + k, k, off, qt, gath, kw, cls, 0, SVGF_VW, &acc);
-            for (int k = 0; k < nc; k++) {
-                const int q = q0 + k;
-                if (surf[q] == 0.0f) {
-                    for (int c = 0; c < NVAL; c++) dst[c][q] = 0.0f;
-                    continue;
-                }
-                float ws = acc.w[k], r = acc.r[k] / ws, gg = acc.g[k] / ws, b = acc.b[k] / ws;
-                dst[V_R][q] = r, dst[V_G][q] = gg, dst[V_B][q] = b;
-                dst[V_VAR][q] = acc.v[k] / (ws * ws);
-                dst[V_LUM][q] = luminance(r, gg, b);
-            }
+            for (int k = 0; k < nc; k++) pass_result(&acc, k, surf[q0 + k] != 0.0f, dst, (size_t)(q0 + k), NULL);
         }
     }
 }
@@ -629,17 +639,8 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
                 }
             }
             for (int k = 0; k < ne; k++) {
-                size_t p = p0 + k;
-                if (kind[p] != KIND_SURFACE) {
-                    for (int c = 0; c < NVAL; c++) dst[c][p] = 0.0f;
-                    continue;
-                }
-                /* Divisions, not a reciprocal: a mean of equal values then comes out exactly equal. */
-                float ws = acc.w[k], r = acc.r[k] / ws, gg = acc.g[k] / ws, b = acc.b[k] / ws;
-                dst[V_R][p] = r, dst[V_G][p] = gg, dst[V_B][p] = b;
-                dst[V_VAR][p] = acc.v[k] / (ws * ws);
-                dst[V_LUM][p] = luminance(r, gg, b);
-                if (write_hist) f->hist_illum[3 * p] = r, f->hist_illum[3 * p + 1] = gg, f->hist_illum[3 * p + 2] = b;
+                const size_t p = p0 + k;
+                pass_result(&acc, k, kind[p] == KIND_SURFACE, dst, p, write_hist ? &f->hist_illum[3 * p] : NULL);
             }
         }
     }

@@ -192,6 +192,65 @@ static void test_converges(void **st)
     free(ref), free(raw), free(one), free(many), free(labels);
 }
 
+/* Frames [first, n) of vpolar with the parameters kv, a still camera and the gaze gz[i] (with
+ * history: every frame after the first has a previous camera, the same); returns the last image
+ * (caller frees), the last frame's stats and the lowest history_fraction after the first frame. */
+static float *render_gazes(const char *const *kv, const fv_gaze *gz, int n, int first, bool history, fv_stats *stats_out,
+                           double *min_history)
+{
+    fv_error err;
+    fv_params *p = fv_test_params(kv);
+    fv_technique *t;
+    if (fv_technique_create("vpolar", g_scene, p, NULL, &t, &err) != FV_OK) fail_msg("%s", err.msg);
+    fv_film *film;
+    assert_int_equal(fv_film_create(W, H, FV_AUX_ALL, &film, &err), FV_OK);
+    fv_camera cam;
+    fv_view_camera(g_view, g_scene, 0.0, W, H, &cam);
+    fv_stats stats;
+    if (min_history) *min_history = 1.0;
+    for (int i = first; i < n; i++) {
+        fv_frame fr;
+        fv_frame_init(&fr, &cam);
+        fr.seed = 5, fr.threads = 2, fr.index = i, fr.gaze = gz[i];
+        if (history && i > first) fr.prev_camera = &cam;
+        fv_stats_clear(&stats);
+        if (fv_technique_render(t, &fr, film, &stats, &err) != FV_OK) fail_msg("frame %d: %s", i, err.msg);
+        const double h = fv_stats_get_count(&stats, "history_fraction");
+        if (min_history && i > first && h < *min_history) *min_history = h;
+    }
+    float *img = malloc(sizeof(float) * 3 * W * H);
+    memcpy(img, fv_film_color_const(film), sizeof(float) * 3 * W * H);
+    if (stats_out) *stats_out = stats;
+    fv_film_destroy(film);
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+    return img;
+}
+
+/* The map stage keeps its per-pixel coordinates while the gaze stays (from the second frame at
+ * one gaze, read from the third): the image read through them is the one computed afresh, and a
+ * gaze that moves is mapped afresh. Without the denoiser a frame depends only on its index and
+ * gaze, so frame i of a sequence must equal frame i rendered alone. */
+static void test_map_keeps_coords_while_gaze_stays(void **st)
+{
+    (void)st;
+    const fv_gaze a = {0.3f, 0.6f}, b = {0.31f, 0.6f};
+    const fv_gaze seq[4] = {a, a, a, b};
+    const char *nodenoise[] = {"denoise=false", NULL};
+    fv_stats s;
+    float *kept = render_gazes(nodenoise, seq, 3, 0, false, &s, NULL); /* frame 2: read */
+    assert_true(fv_stats_get_count(&s, "map_reused") == 1.0);
+    float *fresh = render_gazes(nodenoise, seq, 3, 2, false, &s, NULL);
+    assert_true(fv_stats_get_count(&s, "map_reused") == 0.0);
+    assert_memory_equal(kept, fresh, sizeof(float) * 3 * W * H);
+    free(kept), free(fresh);
+    kept = render_gazes(nodenoise, seq, 4, 0, false, &s, NULL); /* frame 3: the gaze moved */
+    assert_true(fv_stats_get_count(&s, "map_reused") == 0.0);
+    fresh = render_gazes(nodenoise, seq, 4, 3, false, &s, NULL);
+    assert_memory_equal(kept, fresh, sizeof(float) * 3 * W * H);
+    free(kept), free(fresh);
+}
+
 /* The denoiser's history follows the previous frame's gaze: with a still camera and the gaze
  * jumping between the centre and a corner every frame (the space's profile stretches differently
  * for each), each sample's history is looked up in the previous frame's space (the radial table
@@ -201,90 +260,17 @@ static void test_converges(void **st)
 static void test_history_follows_gaze(void **st)
 {
     (void)st;
-    fv_error err;
     const char *kv[] = {"blur=false", NULL};
-    fv_params *p = fv_test_params(kv);
-    fv_technique *t;
-    if (fv_technique_create("vpolar", g_scene, p, NULL, &t, &err) != FV_OK) fail_msg("%s", err.msg);
-    fv_film *film;
-    assert_int_equal(fv_film_create(W, H, FV_AUX_ALL, &film, &err), FV_OK);
-    fv_camera cam;
-    fv_view_camera(g_view, g_scene, 0.0, W, H, &cam);
-    const fv_gaze gz[2] = {{0.5f, 0.5f}, {0.05f, 0.1f}};
-    fv_stats stats;
-    double worst = 1.0;
-    for (int i = 0; i < 6; i++) {
-        fv_frame fr;
-        fv_frame_init(&fr, &cam);
-        fr.seed = 5, fr.threads = 2, fr.index = i, fr.gaze = gz[i % 2];
-        if (i > 0) fr.prev_camera = &cam;
-        fv_stats_clear(&stats);
-        if (fv_technique_render(t, &fr, film, &stats, &err) != FV_OK) fail_msg("frame %d: %s", i, err.msg);
-        if (i > 0) {
-            const double h = fv_stats_get_count(&stats, "history_fraction");
-            worst = h < worst ? h : worst;
-        }
-    }
+    fv_gaze gz[6];
+    for (int i = 0; i < 6; i++) gz[i] = i % 2 ? (fv_gaze){0.05f, 0.1f} : (fv_gaze){0.5f, 0.5f};
+    double worst;
+    free(render_gazes(kv, gz, 6, 0, true, NULL, &worst));
     print_message("gaze jumping every frame: history found for at least %.3f of the samples\n", worst);
     assert_true(worst > 0.6);
-    fv_film_destroy(film);
-    fv_technique_destroy(t);
-    fv_params_destroy(p);
 }
 
 /* show=space: the grid in the top-left corner, its clipped rows marked; show=density: at least one
  * sample per pixel at the gaze, the reported fovea density, far fewer in the corners. */
-/* The map stage keeps its per-pixel coordinates while the gaze stays (from the second frame at
- * one gaze, read from the third): the image read through them is the one computed afresh, and a
- * gaze that moves is mapped afresh. Without the denoiser a frame depends only on its index and
- * gaze, so frame i of a sequence must equal frame i rendered alone. */
-static float *render_gazes(const fv_gaze *gz, int n, int first, fv_stats *stats_out)
-{
-    fv_error err;
-    const char *kv[] = {"denoise=false", NULL};
-    fv_params *p = fv_test_params(kv);
-    fv_technique *t;
-    if (fv_technique_create("vpolar", g_scene, p, NULL, &t, &err) != FV_OK) fail_msg("%s", err.msg);
-    fv_film *film;
-    assert_int_equal(fv_film_create(W, H, FV_AUX_ALL, &film, &err), FV_OK);
-    fv_camera cam;
-    fv_view_camera(g_view, g_scene, 0.0, W, H, &cam);
-    fv_stats stats;
-    for (int i = first; i < n; i++) {
-        fv_frame fr;
-        fv_frame_init(&fr, &cam);
-        fr.seed = 5, fr.threads = 2, fr.index = i, fr.gaze = gz[i];
-        fv_stats_clear(&stats);
-        if (fv_technique_render(t, &fr, film, &stats, &err) != FV_OK) fail_msg("frame %d: %s", i, err.msg);
-    }
-    float *img = malloc(sizeof(float) * 3 * W * H);
-    memcpy(img, fv_film_color_const(film), sizeof(float) * 3 * W * H);
-    *stats_out = stats;
-    fv_film_destroy(film);
-    fv_technique_destroy(t);
-    fv_params_destroy(p);
-    return img;
-}
-
-static void test_map_keeps_coords_while_gaze_stays(void **st)
-{
-    (void)st;
-    const fv_gaze a = {0.3f, 0.6f}, b = {0.31f, 0.6f};
-    const fv_gaze seq[4] = {a, a, a, b};
-    fv_stats s;
-    float *kept = render_gazes(seq, 3, 0, &s); /* frame 2: read */
-    assert_true(fv_stats_get_count(&s, "map_reused") == 1.0);
-    float *fresh = render_gazes(seq, 3, 2, &s);
-    assert_true(fv_stats_get_count(&s, "map_reused") == 0.0);
-    assert_memory_equal(kept, fresh, sizeof(float) * 3 * W * H);
-    free(kept), free(fresh);
-    kept = render_gazes(seq, 4, 0, &s); /* frame 3: the gaze moved */
-    assert_true(fv_stats_get_count(&s, "map_reused") == 0.0);
-    fresh = render_gazes(seq, 4, 3, &s);
-    assert_memory_equal(kept, fresh, sizeof(float) * 3 * W * H);
-    free(kept), free(fresh);
-}
-
 static void test_show_modes(void **st)
 {
     (void)st;
