@@ -363,6 +363,12 @@ static void test_bad_params(void **st)
     expect_refused("vpolar", "svgf_alpha=0", "alpha");
     expect_refused("vpolar", "sigma_lum=-4", "sigma_lum");
     expect_refused("vpolar", "photons=5", "photons");
+    expect_refused("vpolar", "periphery_deg=-1", "periphery_deg");
+    expect_refused("vpolar", "periphery_deg=200", "periphery_deg");
+    expect_refused("vpolar", "periphery_deg=nan", "periphery_deg");
+    expect_refused("vpolar", "periphery_passes=-1", "periphery_passes");
+    expect_refused("vpolar", "periphery_passes=11", "periphery_passes");
+    expect_refused("cartesian", "periphery_deg=20", "periphery_deg");
     expect_refused("cartesian", "reduction=1", "reduction");
     expect_refused("log-polar", "sigma=1", "sigma");
     expect_refused("log-polar", "sigma=-2", "sigma");
