@@ -227,6 +227,31 @@ static inline void pass_result(const pass_acc *acc, int k, bool surface, float *
     if (hist) hist[0] = r, hist[1] = gg, hist[2] = b;
 }
 
+/* The per-pixel terms of a pass for chunk slots [0, n), pixel k at index p0 + k of s, gvar and grad
+ * (the grid's buffers or the fovea's lines): the luminance weight's 1 / (sigma_l sqrt(var) + eps),
+ * 1 / (sigma_depth |grad z| |p - q| + eps) for the five tap distances, and the sums started with
+ * the centre. One vectorised loop per term (the divisions dominate). */
+TAP_INLINE void pass_terms(const fv_svgf *f, const pass_src *s, const float *gvar, const float *grad, size_t p0, int n,
+                           int step, pass_acc *acc)
+{
+    const float sd = f->o.sigma_depth, sl = f->o.sigma_lum, wc = k_b3[2] * k_b3[2];
+    const float dist[5] = {1.0f, sqrtf(2.0f), 2.0f, sqrtf(5.0f), sqrtf(8.0f)};
+    float zs[CHUNK], ze[CHUNK];
+    #pragma omp simd
+    for (int k = 0; k < n; k++) {
+        size_t p = p0 + k;
+        acc->inv_l[k] = 1.0f / (sl * sqrtf(gvar[p]) + LUM_EPS);
+        zs[k] = sd * grad[p] * (float)step, ze[k] = depth_eps(s->z[p]);
+        acc->r[k] = wc * s->r[p], acc->g[k] = wc * s->g[p], acc->b[k] = wc * s->b[p];
+        acc->v[k] = wc * wc * s->v[p], acc->w[k] = wc;
+    }
+    for (int c = 0; c < 5; c++) {
+        const float dc = dist[c];
+        #pragma omp simd
+        for (int k = 0; k < n; k++) acc->rz[c][k] = 1.0f / (zs[k] * dc + ze[k]);
+    }
+}
+
 /* SVGF_VW pixels at a time with every tap inner (the pixels whose 24 taps are all plain shifts):
  * the sums and the centre pixels' features stay in registers across the taps, where the per-tap
  * loops above load and store them once per tap. The arithmetic is atrous_tap's, operation for
@@ -395,13 +420,10 @@ static void lines_pass(fv_svgf *f, int step, int xt, const int *di, const int *d
 {
     const fv_grid *g = &f->g;
     const int w = g->w, stride = f->line_stride;
-    const float sd = f->o.sigma_depth, sl = f->o.sigma_lum;
     float *const *dst = &f->ln[LN_OUT];
-    const float *grad = f->ln[LN_GRAD], *gvar = f->ln[LN_GVAR], *zg = f->ln[LN_Z], *surf = f->ln[LN_SURF];
+    const float *grad = f->ln[LN_GRAD], *gvar = f->ln[LN_GVAR], *surf = f->ln[LN_SURF];
     const pass_src s = {f->ln[LN_NX], f->ln[LN_NY], f->ln[LN_NZ], f->ln[LN_Z], f->ln[LN_VAL + V_R],
                         f->ln[LN_VAL + V_G], f->ln[LN_VAL + V_B], f->ln[LN_VAL + V_VAR], f->ln[LN_VAL + V_LUM]};
-    const float dist[5] = {1.0f, sqrtf(2.0f), 2.0f, sqrtf(5.0f), sqrtf(8.0f)};
-    const float wc = k_b3[2] * k_b3[2];
     #pragma omp parallel for schedule(dynamic, 2) num_threads(nt)
     for (int x = 0; x < xt; x++) {
         pass_acc acc;
@@ -424,24 +446,12 @@ static void lines_pass(fv_svgf *f, int step, int xt, const int *di, const int *d
                 for (int c = 0; c < NVAL; c++) memset(&dst[c][q0], 0, (size_t)nc * sizeof(float));
                 continue;
             }
-            /* Per-pixel terms as in the row loop; the slots past the chunk (a vector's last lanes)
-             * get zeros and are never stored. */
-            float zs[CHUNK], ze[CHUNK];
-            for (int k = 0; k < CHUNK; k++) {
-                if (k >= nc) {
-                    acc.inv_l[k] = zs[k] = 0.0f, ze[k] = 1.0f;
-                    acc.r[k] = acc.g[k] = acc.b[k] = acc.v[k] = acc.w[k] = 0.0f;
-                    continue;
-                }
-                const int q = q0 + k;
-                acc.inv_l[k] = 1.0f / (sl * sqrtf(gvar[q]) + LUM_EPS);
-                zs[k] = sd * grad[q] * (float)step, ze[k] = depth_eps(zg[q]);
-                acc.r[k] = wc * s.r[q], acc.g[k] = wc * s.g[q], acc.b[k] = wc * s.b[q];
-                acc.v[k] = wc * wc * s.v[q], acc.w[k] = wc;
-            }
-            for (int c = 0; c < 5; c++) {
-                const float dc = dist[c];
-                for (int k = 0; k < CHUNK; k++) acc.rz[c][k] = 1.0f / (zs[k] * dc + ze[k]);
+            /* The slots past the chunk (a vector's last lanes) get finite terms and are never
+             * stored. */
+            pass_terms(f, &s, gvar, grad, (size_t)q0, nc, step, &acc);
+            for (int k = nc; k < CHUNK; k++) {
+                acc.inv_l[k] = acc.r[k] = acc.g[k] = acc.b[k] = acc.v[k] = acc.w[k] = 0.0f;
+                for (int c = 0; c < 5; c++) acc.rz[c][k] = 1.0f;
             }
             /* The row of each tap column at the same angle, where its height differs: fv_grid_tap's
              * floor((2 y + 1) hd / (2 hs)), one division per chunk and then stepped lane by lane
@@ -479,17 +489,16 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
     const fv_grid *g = &f->g;
     const int w = g->w, h = g->h;
     const uint8_t *kind = f->kind;
-    const float sd = f->o.sigma_depth, sn = f->o.sigma_normal, sl = f->o.sigma_lum;
+    const float sn = f->o.sigma_normal;
     const int sq = f->normal_squarings;
     float *const *dst = f->val[1 - src];
     const float *grad = f->grad, *gvar = f->gvar;
     const pass_src s = {f->nx[0], f->ny[0], f->nz[0], f->z[0], f->val[src][V_R], f->val[src][V_G],
                         f->val[src][V_B], f->val[src][V_VAR], f->val[src][V_LUM]};
     /* The taps around the centre: kernel weight, offsets, and the distance class (1, sqrt 2, 2,
-     * sqrt 5, sqrt 8 times the step). */
+     * sqrt 5, sqrt 8 times the step: pass_terms' five distances). */
     float kw[NTAP];
     int cls[NTAP], di[NTAP], dj[NTAP];
-    const float dist[5] = {1.0f, sqrtf(2.0f), 2.0f, sqrtf(5.0f), sqrtf(8.0f)};
     for (int j = 0, t = 0; j < 5; j++)
         for (int i = 0; i < 5; i++) {
             if (i == 2 && j == 2) continue;
@@ -499,7 +508,6 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
             di[t] = (i - 2) * step, dj[t] = (j - 2) * step;
             t++;
         }
-    const float wc = k_b3[2] * k_b3[2];
     /* The short columns and the columns within two taps of them go along the fovea's lines (C2);
      * the row loop takes the columns from xt on. */
     int xt = 0;
@@ -542,22 +550,7 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
                 for (int c = 0; c < NVAL; c++) memset(&dst[c][p0], 0, (size_t)ne * sizeof(float));
                 continue;
             }
-            /* Per-pixel terms, one vectorised loop per term (the divisions dominate). */
-            float zs[CHUNK], ze[CHUNK];
-            #pragma omp simd
-            for (int k = 0; k < nc; k++) {
-                size_t p = p0 + k;
-                acc.inv_l[k] = 1.0f / (sl * sqrtf(gvar[p]) + LUM_EPS);
-                zs[k] = sd * grad[p] * (float)step, ze[k] = depth_eps(s.z[p]);
-                acc.r[k] = wc * s.r[p], acc.g[k] = wc * s.g[p], acc.b[k] = wc * s.b[p];
-                acc.v[k] = wc * wc * s.v[p], acc.w[k] = wc;
-            }
-            /* 1 / (sigma_depth |grad z| |p - q| + eps) for the five distances. */
-            for (int c = 0; c < 5; c++) {
-                const float dc = dist[c];
-                #pragma omp simd
-                for (int k = 0; k < nc; k++) acc.rz[c][k] = 1.0f / (zs[k] * dc + ze[k]);
-            }
+            pass_terms(f, &s, gvar, grad, p0, nc, step, &acc);
             cc.ready = false;
             /* [va, vb): the pixels whose taps are all plain shifts, a whole number of vectors,
              * filtered by atrous_block; the per-tap loops do the rest of the span. */

@@ -254,20 +254,16 @@ static void map_coords(const map_ctx *c, int64_t y, int x0, int n, float *X, flo
     }
     const float inv_step = 1.0f / LUT_STEP, gx = c->view->gx, gy = c->view->gy;
     const float *lut = p->lut;
-    const int last = p->nlut - 2;
     float sigma[MAP_SPAN];
     const float dy = (float)y + 0.5f - gy;
+    /* The table's three entries (column, mip level, blur sigma) read the same way. */
     #pragma omp simd
     for (int k = 0; k < n; k++) {
-        float dx = (float)(x0 + k) + 0.5f - gx;
-        float t = sqrtf(dx * dx + dy * dy) * inv_step;
-        int i = (int)t;
-        i = i < last ? i : last;
-        float f = t - (float)i;
-        X[k] = fv_space_table_x(lut, 3, p->nlut, inv_step, sqrtf(dx * dx + dy * dy));
-        level[k] = lut[3 * i + 1] + f * (lut[3 * i + 4] - lut[3 * i + 1]);
+        const float dx = (float)(x0 + k) + 0.5f - gx, r = sqrtf(dx * dx + dy * dy);
+        X[k] = fv_space_table_x(lut, 3, p->nlut, inv_step, r);
+        level[k] = fv_space_table_x(lut + 1, 3, p->nlut, inv_step, r);
         V[k] = fv_space_turns(dx, dy);
-        sigma[k] = lut[3 * i + 2] + f * (lut[3 * i + 5] - lut[3 * i + 2]);
+        sigma[k] = fv_space_table_x(lut + 2, 3, p->nlut, inv_step, r);
     }
     if (p->o.blur) memcpy(&p->sigma[(size_t)y * p->sw + x0], sigma, (size_t)n * sizeof(float));
     if (p->coords_state == COORDS_STORE)

@@ -128,7 +128,9 @@ static inline float fv_space_turns(float dx, float dy)
 void fv_space_radial_table(const fv_space_view *v, float step, int n, int stride, float *table);
 
 /* The column at distance r >= 0 from the gaze, linear between the entries of a radial table (the
- * last interval continues past its end); 1 / step as inv_step. For a Visual-Polar table every
+ * last interval continues past its end); 1 / step as inv_step. From table + 1 the same reads the
+ * mip level, and any value a caller keeps every `stride` floats beside them (the pipeline's blur
+ * sigma). For a Visual-Polar table every
  * 0.5 px at 1280x1440, within 1e-3 columns of fv_space_from_screen (test_vp_space): X is linear in
  * the fovea and smooth beyond it (Eq. 2 meets the fovea's pi e^2 with its slope). */
 static inline float fv_space_table_x(const float *table, int stride, int n, float inv_step, float r)
