@@ -37,7 +37,7 @@ typedef struct fv_camera_basis {
 FV_API fv_status fv_camera_basis_make(const fv_camera *cam, fv_camera_basis *out, fv_error *err);
 
 /* Direction (unit) of the ray through film position (px, py) in pixels, e.g. (x + 0.5, y + 0.5). */
-static inline fv_vec3 fv_camera_dir(const fv_camera_basis *b, float px, float py)
+FV_HD static inline fv_vec3 fv_camera_dir(const fv_camera_basis *b, float px, float py)
 {
     float sx = (2.0f * px / (float)b->width - 1.0f) * b->tan_half_x;
     float sy = (1.0f - 2.0f * py / (float)b->height) * b->tan_half_y;

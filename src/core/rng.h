@@ -8,6 +8,7 @@
 #define FV_CORE_RNG_H
 
 #include <stdint.h>
+#include "fovea/math.h" /* FV_HD: these run in CUDA kernels too */
 
 typedef struct fv_rng {
     uint64_t key;
@@ -15,7 +16,7 @@ typedef struct fv_rng {
 } fv_rng;
 
 /* A strong 64-bit finaliser (the splitmix64 / murmur3 style xor-shift-multiply cascade). */
-static inline uint64_t fv_hash64(uint64_t x)
+FV_HD static inline uint64_t fv_hash64(uint64_t x)
 {
     x ^= x >> 30;
     x *= 0xbf58476d1ce4e5b9ULL;
@@ -25,12 +26,12 @@ static inline uint64_t fv_hash64(uint64_t x)
     return x;
 }
 
-static inline uint64_t fv_hash_combine(uint64_t h, uint64_t v)
+FV_HD static inline uint64_t fv_hash_combine(uint64_t h, uint64_t v)
 {
     return fv_hash64(h ^ (v + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2)));
 }
 
-static inline fv_rng fv_rng_make(uint64_t seed, uint64_t pixel, uint64_t sample, uint64_t frame)
+FV_HD static inline fv_rng fv_rng_make(uint64_t seed, uint64_t pixel, uint64_t sample, uint64_t frame)
 {
     fv_rng r;
     r.key = fv_hash_combine(fv_hash_combine(fv_hash_combine(fv_hash64(seed), pixel), sample), frame);
@@ -38,7 +39,7 @@ static inline fv_rng fv_rng_make(uint64_t seed, uint64_t pixel, uint64_t sample,
     return r;
 }
 
-static inline uint32_t fv_rng_u32(fv_rng *r)
+FV_HD static inline uint32_t fv_rng_u32(fv_rng *r)
 {
     return (uint32_t)(fv_hash64(r->key + 0x632be59bd9b4e019ULL * (uint64_t)(++r->dim)) >> 32);
 }
@@ -59,7 +60,7 @@ static inline uint32_t fv_rng_u32(fv_rng *r)
  * (photon, sub, frame). */
 #define FV_STREAM_PHOTONS(k) ((uint64_t)(k) * 0x9e3779b97f4a7c15ULL)
 
-static inline fv_rng fv_rng_stream(uint64_t seed, uint64_t stream, uint64_t index, uint64_t sample, uint64_t frame)
+FV_HD static inline fv_rng fv_rng_stream(uint64_t seed, uint64_t stream, uint64_t index, uint64_t sample, uint64_t frame)
 {
     return fv_rng_make(seed ^ stream, index, sample, frame);
 }
@@ -67,10 +68,10 @@ static inline fv_rng fv_rng_stream(uint64_t seed, uint64_t stream, uint64_t inde
 /* The seed a reference image is rendered with, from a scenario's seed: no measured method ever
  * draws from it, so a 1-sample method's first sample is not the reference's first sample (which
  * would understate its error). */
-static inline uint64_t fv_seed_reference(uint64_t seed) { return fv_hash_combine(fv_hash64(seed), 0x7265666572656e63ULL); }
+FV_HD static inline uint64_t fv_seed_reference(uint64_t seed) { return fv_hash_combine(fv_hash64(seed), 0x7265666572656e63ULL); }
 
 /* Uniform float in [0, 1): 24 random mantissa bits. */
-static inline float fv_rng_next(fv_rng *r)
+FV_HD static inline float fv_rng_next(fv_rng *r)
 {
     return (float)(fv_rng_u32(r) >> 8) * (1.0f / 16777216.0f);
 }

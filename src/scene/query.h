@@ -12,6 +12,7 @@
 #include <stdbool.h>
 #include "fovea/scene.h"
 #include "fovea/sdf.h"
+#include "kernel/hit.h"
 
 /* ---- ray queries (scene.c) ---- */
 
@@ -22,14 +23,6 @@ typedef enum fv_trace_set {
     FV_TRACE_DYNAMIC      /* dynamic objects only */
 } fv_trace_set;
 
-typedef struct fv_hit {
-    float t;
-    fv_vec3 p;      /* world position */
-    fv_vec3 ng;     /* unit geometric normal, world, as wound (not flipped toward the ray) */
-    fv_vec3 ns;     /* unit shading normal, world, same hemisphere as ng */
-    int obj, prim, mat;
-    float u, v;     /* barycentrics of vertices 1 and 2 */
-} fv_hit;
 
 /* Closest hit along o + t d, t in (eps, tmax). d need not be unit (t is then in units of d). */
 bool fv_scene_intersect(const fv_scene *s, fv_trace_set set, fv_vec3 o, fv_vec3 d, float tmax, fv_hit *hit);
