@@ -1,12 +1,10 @@
 /* fovea — light sampling shared by every technique: next-event estimation from a shading point,
  * the density of hitting an emitter by chance (for MIS), and emission of photons/VPLs.
  *
- * A light is picked with probability proportional to its emitted power (table built at commit).
- * Area lights are sampled uniformly by area on the chosen triangle. The environment (kind 2) is
- * sampled by direction: a hemisphere about its up axis in proportion to the hemisphere's mean
- * luminance, then uniformly within it, so a uniform environment is sampled uniformly over the
- * sphere (density 1/(4 pi)); its photons start on a disc of the scene's bounding-sphere radius
- * facing their direction (power L pi R^2 / pdf). Point and spot lights may move
+ * The sampling itself is kernel code (kernel/light.h: the pick by power, area lights uniform by
+ * area, the environment by hemisphere), shared with the GPU; these wrap it for fv_scene and add
+ * what only the CPU needs: photon and VPL emission (the environment's photons start on a disc of
+ * the scene's bounding-sphere radius facing their direction, power L pi R^2 / pdf). Point and spot lights may move
  * (fv_scene_animate_light): every query answers at the scene's current time; the pick table stays
  * valid because a delta light's power does not depend on where it stands.
  */
@@ -15,17 +13,11 @@
 
 #include <stdbool.h>
 #include "core/rng.h"
+#include "kernel/light.h"
 #include "scene/query.h"
 
 typedef struct fv_light fv_light;
 
-typedef struct fv_light_sample {
-    fv_vec3 wi;      /* unit direction from the shading point to the light */
-    float dist;      /* distance to the sampled point (environment: a point beyond the scene's bounds) */
-    fv_vec3 li;      /* incident radiance (area, environment) or intensity / dist^2 (delta) */
-    float pdf;       /* solid-angle density including the light pick (area, environment); pick probability (delta) */
-    bool delta;
-} fv_light_sample;
 
 /* Samples incident light at p with three uniform numbers; false when nothing was sampled
  * (no light, or the point is behind a one-sided emitter). Visibility is NOT tested. */
@@ -35,6 +27,11 @@ bool fv_light_sample_li(const fv_scene *s, fv_vec3 p, float u0, float u1, float 
  * picked by power among themselves; pdf is the density of that restricted choice. For a technique
  * that shades delta lights one by one and samples only the rest. */
 bool fv_light_sample_li_area(const fv_scene *s, fv_vec3 p, float u0, float u1, float u2, fv_light_sample *out);
+
+/* The scene's light table as kernels read it (kernel/light.h): what the shared path kernel samples. */
+const fv_klights *fv_scene_klights(const fv_scene *s);
+/* The table index of emissive triangle (obj, prim), -1 when it is not a light. */
+int fv_light_of_triangle(const fv_scene *s, int obj, int prim);
 
 /* Radiance emitted by triangle (obj, prim) toward direction w (unit, pointing away from the
  * surface), given its geometric normal ng. */

@@ -386,7 +386,7 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
     s->lights_move = false;
     for (int i = 0; i < s->ndelta; i++) {
         fv_light *l = &s->lights[k];
-        l->kind = 0;
+        l->kind = FV_KLIGHT_DELTA;
         l->desc = s->delta[i].desc;
         l->delta = i;
         float lum = fv_luminance(l->desc.intensity);
@@ -404,7 +404,7 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
             s->lights_move |= s->delta[i].anim.nkeys > 0;
         }
     }
-    s->nlights_delta = k;
+    s->klights.ndelta = k;
     for (int i = 0; i < s->nobj; i++) {
         fv_object *o = &s->objs[i];
         if (!object_emissive(s, o)) continue;
@@ -415,9 +415,10 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
             float area = tri_area(o, t);
             if (!(fv_max3(m->emission) > 0.0f) || !(area > 0.0f)) continue;
             fv_light *l = &s->lights[k];
-            l->kind = 1;
+            l->kind = FV_KLIGHT_TRIANGLE;
             l->obj = i;
             l->prim = t;
+            fv_scene_triangle(s, i, t, &l->a, &l->b, &l->c);
             l->area = area;
             fv_vec3 a = o->pos[o->idx[3 * t]], b = o->pos[o->idx[3 * t + 1]], c = o->pos[o->idx[3 * t + 2]];
             l->n = fv_normalize(fv_cross(fv_sub(b, a), fv_sub(c, a)));
@@ -430,23 +431,23 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
             if (l->power > 0.0f) s->tri_light[i][t] = k++;
         }
     }
-    s->env_light = -1;
+    s->klights.env_light = -1;
     if (s->has_env) {
         /* Its photons leave a disc of the bounding sphere's radius (light.c), so its power is
          * pi R^2 times the integral of the radiance over the sphere of directions: 2 pi times the
          * two hemispheres' mean radiances, (horizon + zenith) / 2 and (horizon + ground) / 2. */
-        s->env_c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
-        s->env_r = 0.5f * fv_length(fv_sub(s->hi, s->lo));
+        s->klights.env_c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
+        s->klights.env_r = 0.5f * fv_length(fv_sub(s->hi, s->lo));
         float up = 0.5f * fv_luminance(fv_add(s->env.horizon, s->env.zenith));
         float down = 0.5f * fv_luminance(fv_add(s->env.horizon, s->env.ground));
-        s->env_p_up = up + down > 0.0f ? up / (up + down) : 0.5f;
+        s->klights.env_p_up = up + down > 0.0f ? up / (up + down) : 0.5f;
         fv_light *l = &s->lights[k];
-        l->kind = 2;
-        l->power = FV_PI * s->env_r * s->env_r * 2.0f * FV_PI * (up + down);
+        l->kind = FV_KLIGHT_ENV;
+        l->power = FV_PI * s->klights.env_r * s->klights.env_r * 2.0f * FV_PI * (up + down);
         if (!isfinite(l->power)) return fv_error_set(err, FV_ERR_INVALID, "environment: radiance too large (its power overflows a float)");
-        if (l->power > 0.0f) s->env_light = k++;
+        if (l->power > 0.0f) s->klights.env_light = k++;
     }
-    s->nlights = k;
+    s->klights.n = k;
     double total = 0.0;
     for (int i = 0; i < k; i++) total += s->lights[i].power;
     double acc = 0.0;
@@ -455,6 +456,9 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
         acc += s->lights[i].power;
     }
     s->light_cdf[k] = 1.0f;
+    s->klights.light = s->lights;
+    s->klights.cdf = s->light_cdf;
+    s->klights.env = s->env;
     return FV_OK;
 }
 
@@ -491,7 +495,7 @@ fv_status fv_scene_commit(fv_scene *s, const fv_log *log, fv_error *err)
     s->eps = 1e-4f * diag;
 
     if ((st = build_lights(s, err)) != FV_OK) return st;
-    if (s->nlights == 0) {
+    if (s->klights.n == 0) {
         fv_vec3 c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
         /* Within the intensity limit, so a huge scene gets a dim light rather than a refusal that
          * names a light the user never wrote. */
@@ -559,7 +563,7 @@ fv_status fv_scene_set_time(fv_scene *s, double t, fv_error *err)
     if (t == s->time) return FV_OK;
     s->time = t;
     /* Lights first: a scene whose only motion is its lights has no dynamic object to update. */
-    for (int i = 0; i < s->nlights_delta && s->lights_move; i++) {
+    for (int i = 0; i < s->klights.ndelta && s->lights_move; i++) {
         fv_light *l = &s->lights[i];
         if (s->delta[l->delta].anim.nkeys > 0) light_move(&s->delta[l->delta], l, t);
     }
@@ -862,6 +866,6 @@ int fv_scene_dynamic_object_count(const fv_scene *s)
     for (int i = 0; i < s->nobj; i++) n += s->objs[i].dynamic;
     return n;
 }
-int fv_scene_light_count(const fv_scene *s) { return s->committed ? s->nlights : s->ndelta; }
+int fv_scene_light_count(const fv_scene *s) { return s->committed ? s->klights.n : s->ndelta; }
 int fv_scene_material_count(const fv_scene *s) { return s->nmat; }
 const fv_material *fv_scene_material(const fv_scene *s, int id) { return id >= 0 && id < s->nmat ? &s->mats[id] : NULL; }

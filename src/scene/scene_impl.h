@@ -16,6 +16,7 @@
 #include <embree3/rtcore.h>
 #include "fovea/scene.h"
 #include "fovea/sdf.h"
+#include "kernel/light.h"
 #include "scene/anim.h"
 #include "scene/query.h"
 
@@ -43,18 +44,7 @@ typedef struct fv_delta {
     fv_anim anim;
 } fv_delta;
 
-/* One sampleable light: a delta light, an emissive triangle or the environment. */
-typedef struct fv_light {
-    int kind;            /* 0: delta light (desc), 1: emissive triangle, 2: the environment (fv_scene.env) */
-    fv_light_desc desc;  /* delta light at the scene's current time: what the samplers read */
-    int delta;           /* delta light: its index in fv_scene.delta */
-    int obj, prim;       /* emissive triangle */
-    float area;
-    fv_vec3 n;           /* unit geometric normal of the triangle */
-    fv_vec3 emission;
-    bool two_sided;
-    float power;         /* selection weight ~ emitted power */
-} fv_light;
+/* One sampleable light (struct fv_light) is kernel data: kernel/light.h. */
 
 /* A texture as fv_scene_add_texture keeps it: linear RGB, rows from the top (texture.c). */
 typedef struct fv_texture {
@@ -80,14 +70,9 @@ struct fv_scene {
     bool committed;
     fv_light *lights;          /* the delta lights that emit first (in the order added), then triangles, then
                                   the environment */
-    int env_light;             /* index of the environment in lights[], -1: none */
-    float env_p_up;            /* probability of sampling the environment's upper hemisphere */
-    fv_vec3 env_c;             /* the bounding sphere the environment's photons are aimed at */
-    float env_r;
-    int nlights;
-    int nlights_delta;         /* how many of lights[] are delta lights */
+    float *light_cdf;          /* klights.n + 1 entries, light_cdf[n] = 1 */
+    fv_klights klights;        /* the table as kernels read it: lights, light_cdf, counts, the environment */
     bool lights_move;          /* some delta light has keys */
-    float *light_cdf;          /* nlights + 1 entries, light_cdf[nlights] = 1 */
     int **tri_light;           /* per object: per triangle light index or -1 (NULL: none) */
     RTCDevice dev;
     RTCScene rtc_static, rtc_all, rtc_dynamic;

@@ -1,5 +1,6 @@
 /* fovea — textures in the scene: adding them (sRGB -> linear), sampling them, and the material
- * at a hit with its albedo read from its texture (see texture.h and query.h). */
+ * at a hit with its albedo read from its texture (see texture.h and query.h; the sampling itself
+ * is kernel code, kernel/texture.h). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -7,6 +8,7 @@
 #include "fovea/film.h"
 #include "fovea/limits.h"
 #include "scene/scene_impl.h"
+#include "kernel/texture.h"
 #include "scene/texture.h"
 
 fv_status fv_scene_add_texture(fv_scene *s, const fv_texture_desc *t, int *id, fv_error *err)
@@ -48,29 +50,10 @@ fv_status fv_scene_add_texture(fv_scene *s, const fv_texture_desc *t, int *id, f
 
 int fv_scene_texture_count(const fv_scene *s) { return s->ntex; }
 
-/* floor(x) mod n, for any finite x. */
-static int wrap(float x, int n)
-{
-    int i = (int)fmodf(floorf(x), (float)n);
-    return i < 0 ? i + n : i;
-}
-
 fv_vec3 fv_texture_sample(const fv_texture *t, fv_vec2 uv)
 {
-    /* Keep the coordinates' fraction first: float texel positions of a large u lose precision,
-     * and fmodf of a non-finite value is NaN (read as texel 0). */
-    float u = uv.x - floorf(uv.x), v = uv.y - floorf(uv.y);
-    if (!isfinite(u) || !isfinite(v)) u = v = 0.0f;
-    /* Texel centres sit at half-integers; rows run from the top, v from the bottom. */
-    float x = u * (float)t->w - 0.5f, y = (1.0f - v) * (float)t->h - 0.5f;
-    float fx = x - floorf(x), fy = y - floorf(y);
-    int x0 = wrap(x, t->w), y0 = wrap(y, t->h);
-    int x1 = x0 + 1 == t->w ? 0 : x0 + 1, y1 = y0 + 1 == t->h ? 0 : y0 + 1;
-    const float *a = &t->rgb[3 * ((size_t)y0 * t->w + x0)], *b = &t->rgb[3 * ((size_t)y0 * t->w + x1)];
-    const float *c = &t->rgb[3 * ((size_t)y1 * t->w + x0)], *d = &t->rgb[3 * ((size_t)y1 * t->w + x1)];
-    float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy), w01 = (1.0f - fx) * fy, w11 = fx * fy;
-    return fv_v3(w00 * a[0] + w10 * b[0] + w01 * c[0] + w11 * d[0], w00 * a[1] + w10 * b[1] + w01 * c[1] + w11 * d[1],
-                 w00 * a[2] + w10 * b[2] + w01 * c[2] + w11 * d[2]);
+    fv_ktexture k = {t->w, t->h, t->rgb};
+    return fv_ktexture_sample(&k, uv);
 }
 
 const fv_material *fv_material_textured(const fv_scene *s, const fv_material *m, int obj, int prim, float u, float v, fv_material *buf)
@@ -78,10 +61,7 @@ const fv_material *fv_material_textured(const fv_scene *s, const fv_material *m,
     const fv_object *o = obj >= 0 && obj < s->nobj ? &s->objs[obj] : NULL;
     if (!o || !o->uv || prim < 0 || prim >= o->nt || m->albedo_texture < 1 || m->albedo_texture > s->ntex) return m;
     const uint32_t *ix = &o->idx[3 * prim];
-    float w = 1.0f - u - v;
-    fv_vec2 a = o->uv[ix[0]], b = o->uv[ix[1]], c = o->uv[ix[2]];
-    fv_vec2 st = {w * a.x + u * b.x + v * c.x, w * a.y + u * b.y + v * c.y};
-    *buf = *m;
-    buf->albedo = fv_mul(m->albedo, fv_texture_sample(&s->tex[m->albedo_texture - 1], st));
-    return buf;
+    const fv_texture *t = &s->tex[m->albedo_texture - 1];
+    fv_ktexture k = {t->w, t->h, t->rgb};
+    return fv_kmaterial_textured(m, &k, o->uv[ix[0]], o->uv[ix[1]], o->uv[ix[2]], u, v, buf);
 }

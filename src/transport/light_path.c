@@ -1,6 +1,6 @@
 /* fovea — light paths from the lights (see light_path.h). */
 #include <math.h>
-#include "scene/bsdf.h"
+#include "kernel/bsdf.h"
 #include "scene/light.h"
 #include "transport/light_path.h"
 

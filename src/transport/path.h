@@ -1,9 +1,8 @@
 /* fovea — the path tracing kernel shared by every technique that traces camera paths: `pt` (the
  * reference), the trace stage of `vpolar` and its baselines, and any family that needs a path
  * traced estimate. One integrator, so the reference and the foveated methods never drift apart.
- *
- * `max_depth` is the number of path vertices that gather light: 1 = direct light only (emission
- * seen directly plus one light connection), the convention of Embree's `--max-path-length`.
+ * The estimator is kernel/path_impl.h, the same source as the GPU's (kernel/pt.h); its options
+ * and first-hit record are kernel/path.h.
  */
 #ifndef FV_TRANSPORT_PATH_H
 #define FV_TRANSPORT_PATH_H
@@ -12,21 +11,8 @@
 #include <stdint.h>
 #include "core/rng.h"
 #include "fovea/params.h"
+#include "kernel/path.h"
 #include "scene/query.h"
-
-typedef struct fv_path_opts {
-    int spp;
-    int max_depth;
-    int rr_depth;
-} fv_path_opts;
-
-/* What the first hit of a camera path saw, for the film's auxiliary buffers. */
-typedef struct fv_path_first_hit {
-    bool hit;
-    float t;
-    fv_vec3 p, n, albedo;
-    int obj;
-} fv_path_first_hit;
 
 /* Reads spp (16), max_depth (8), rr_depth (3) from params, marking them used. */
 fv_status fv_path_read_opts(fv_params *p, fv_path_opts *opt, fv_error *err);

@@ -16,7 +16,7 @@
 #include <string.h>
 #include <cmocka.h>
 #include "fovea/fovea.h"
-#include "scene/bsdf.h"
+#include "kernel/bsdf.h"
 #include "technique/photon/gather.h"
 #include "technique/photon/photon_map.h"
 

@@ -1,6 +1,6 @@
 /* fovea — eye paths and photon density estimates (see gather.h). */
 #include <math.h>
-#include "scene/bsdf.h"
+#include "kernel/bsdf.h"
 #include "scene/light.h"
 #include "technique/photon/gather.h"
 
