@@ -16,11 +16,19 @@
  */
 #include <math.h>
 #include <stdint.h>
-#include <string.h>
 #include "sdf/sdf_impl.h"
 
 #ifndef FV_K_WIDE
 #error "define FV_K_WIDE before including sdf/kernel.h"
+#endif
+
+#if FV_K_WIDE
+#include <string.h>
+#define FV_KFN static inline
+#else
+/* The scalar build is also what GPU kernels evaluate (kernel/sdf_trace.h): host-and-device under
+ * nvcc (FV_HD, fovea/math.h), plain static inline for a C compiler, so the CPU's bits do not change. */
+#define FV_KFN FV_HD static inline
 #endif
 
 #if FV_K_WIDE
@@ -30,56 +38,56 @@
 typedef float kf __attribute__((vector_size(32)));
 typedef int32_t ki __attribute__((vector_size(32)));
 typedef uint32_t ku __attribute__((vector_size(32)));
-static inline kf k_splat(float c) { return (kf){0} + c; }
-static inline ki k_spliti(int c) { return (ki){0} + c; }
+FV_KFN kf k_splat(float c) { return (kf){0} + c; }
+FV_KFN ki k_spliti(int c) { return (ki){0} + c; }
 /* Comparisons give -1/0 lanes: blend through the bits. */
-static inline kf k_sel(ki m, kf a, kf b) { return (kf)(((ki)a & m) | ((ki)b & ~m)); }
-static inline ki k_seli(ki m, ki a, ki b) { return (a & m) | (b & ~m); }
+FV_KFN kf k_sel(ki m, kf a, kf b) { return (kf)(((ki)a & m) | ((ki)b & ~m)); }
+FV_KFN ki k_seli(ki m, ki a, ki b) { return (a & m) | (b & ~m); }
 /* Lane by lane so each lane gets the same correctly rounded sqrtf as the scalar build; GCC turns
  * the loop into sqrtps. */
-static inline kf k_sqrt(kf x)
+FV_KFN kf k_sqrt(kf x)
 {
     kf r;
     for (int i = 0; i < 8; i++) r[i] = sqrtf(x[i]);
     return r;
 }
-static inline ki k_f2i(kf x) { return __builtin_convertvector(x, ki); }
-static inline kf k_i2f(ki x) { return __builtin_convertvector(x, kf); }
-static inline ku k_i2u(ki x) { return (ku)x; }
-static inline kf k_abs(kf x) { return (kf)((ki)x & 0x7fffffff); }
+FV_KFN ki k_f2i(kf x) { return __builtin_convertvector(x, ki); }
+FV_KFN kf k_i2f(ki x) { return __builtin_convertvector(x, kf); }
+FV_KFN ku k_i2u(ki x) { return (ku)x; }
+FV_KFN kf k_abs(kf x) { return (kf)((ki)x & 0x7fffffff); }
 #else
 typedef float kf;
 typedef int32_t ki;
 typedef uint32_t ku;
-static inline kf k_splat(float c) { return c; }
-static inline ki k_spliti(int c) { return c; }
-static inline kf k_sel(ki m, kf a, kf b) { return m ? a : b; }
-static inline ki k_seli(ki m, ki a, ki b) { return m ? a : b; }
-static inline kf k_sqrt(kf x) { return sqrtf(x); }
-static inline ki k_f2i(kf x) { return (ki)x; }
-static inline kf k_i2f(ki x) { return (kf)x; }
-static inline ku k_i2u(ki x) { return (ku)x; }
-static inline kf k_abs(kf x) { return fabsf(x); }
+FV_KFN kf k_splat(float c) { return c; }
+FV_KFN ki k_spliti(int c) { return c; }
+FV_KFN kf k_sel(ki m, kf a, kf b) { return m ? a : b; }
+FV_KFN ki k_seli(ki m, ki a, ki b) { return m ? a : b; }
+FV_KFN kf k_sqrt(kf x) { return sqrtf(x); }
+FV_KFN ki k_f2i(kf x) { return (ki)x; }
+FV_KFN kf k_i2f(ki x) { return (kf)x; }
+FV_KFN ku k_i2u(ki x) { return (ku)x; }
+FV_KFN kf k_abs(kf x) { return fabsf(x); }
 #endif
 
 /* A far value that stays finite, so b + m and m - b below never produce inf - inf. */
 #define FV_K_FAR 1e30f
 
-static inline kf k_min(kf a, kf b) { return k_sel(a < b, a, b); }
-static inline kf k_max(kf a, kf b) { return k_sel(a > b, a, b); }
-static inline kf k_clamp(kf x, kf lo, kf hi) { return k_min(k_max(x, lo), hi); }
+FV_KFN kf k_min(kf a, kf b) { return k_sel(a < b, a, b); }
+FV_KFN kf k_max(kf a, kf b) { return k_sel(a > b, a, b); }
+FV_KFN kf k_clamp(kf x, kf lo, kf hi) { return k_min(k_max(x, lo), hi); }
 /* floor through truncation; callers clamp x to +-1e9 first so the conversion stays in range. */
-static inline kf k_floor(kf x)
+FV_KFN kf k_floor(kf x)
 {
     kf t = k_i2f(k_f2i(x));
     return k_sel(t > x, t - 1.0f, t);
 }
-static inline kf k_len3(kf x, kf y, kf z) { return k_sqrt(x * x + y * y + z * z); }
-static inline kf k_len2(kf x, kf y) { return k_sqrt(x * x + y * y); }
+FV_KFN kf k_len3(kf x, kf y, kf z) { return k_sqrt(x * x + y * y + z * z); }
+FV_KFN kf k_len2(kf x, kf y) { return k_sqrt(x * x + y * y); }
 
 /* Box of half extents (bx, by, bz): the length of the outside part plus the (negative) largest
  * axis distance inside. */
-static inline kf k_box(kf x, kf y, kf z, float bx, float by, float bz)
+FV_KFN kf k_box(kf x, kf y, kf z, float bx, float by, float bz)
 {
     kf qx = k_abs(x) - bx, qy = k_abs(y) - by, qz = k_abs(z) - bz;
     kf zero = k_splat(0.0f);
@@ -91,7 +99,7 @@ static inline kf k_box(kf x, kf y, kf z, float bx, float by, float bz)
 /* Capped cone in the (rho, y) half plane: the section is the trapezoid (0,-h) (r1,-h) (r2,h) (0,h);
  * its surface edges are the two caps and the slanted side (the rho = 0 edge is the axis, not
  * surface). The distance is to the nearest of the three edges, negative inside. */
-static inline kf k_cone(kf x, kf y, kf z, const float *f)
+FV_KFN kf k_cone(kf x, kf y, kf z, const float *f)
 {
     float r1 = f[0], r2 = f[1], h = f[2], er = f[3], ey = f[4], inv = f[5];
     kf zero = k_splat(0.0f), one = k_splat(1.0f);
@@ -112,7 +120,7 @@ static inline kf k_cone(kf x, kf y, kf z, const float *f)
 
 /* Lattice value in [-1, 1): an integer hash of the cell and the octave's seed, mixed with the
  * "lowbias32" finaliser (shift-xor-multiply, constants from C. Wellons' hash-prospector). */
-static inline kf k_lattice(ki iu, ki iw, uint32_t seed)
+FV_KFN kf k_lattice(ki iu, ki iw, uint32_t seed)
 {
     ku h = (k_i2u(iu) * 0x8da6b343u) ^ (k_i2u(iw) * 0xd8163841u) ^ (seed * 0xcb1ab31fu);
     h ^= h >> 16;
@@ -125,7 +133,7 @@ static inline kf k_lattice(ki iu, ki iw, uint32_t seed)
 
 /* Value noise: lattice values blended with the smoothstep s(t) = t^2 (3 - 2t), |s'| <= 3/2, so each
  * partial derivative is at most 3/2 * 2 = 3 and the gradient at most 3 sqrt(2) (docs/sdf.md). */
-static inline kf k_value_noise(kf u, kf w, uint32_t seed)
+FV_KFN kf k_value_noise(kf u, kf w, uint32_t seed)
 {
     u = k_clamp(u, k_splat(-1e9f), k_splat(1e9f));
     w = k_clamp(w, k_splat(-1e9f), k_splat(1e9f));
@@ -142,7 +150,7 @@ static inline kf k_value_noise(kf u, kf w, uint32_t seed)
 /* Height field y = base + sum_o A 2^-o noise(F 2^o (x, z)): g = y - height has gradient norm at most
  * sqrt(1 + L_h^2) with L_h = octaves * A * F * 3 sqrt(2) (every octave contributes A F 3 sqrt(2)),
  * so g / sqrt(1 + L_h^2) (f[3] holds the reciprocal) is 1-Lipschitz and never exceeds the distance. */
-static inline kf k_heightfield(kf x, kf y, kf z, const fv_sdf_op *op)
+FV_KFN kf k_heightfield(kf x, kf y, kf z, const fv_sdf_op *op)
 {
     kf hsum = k_splat(0.0f);
     float amp = op->f[1], freq = op->f[2];
@@ -157,7 +165,7 @@ static inline kf k_heightfield(kf x, kf y, kf z, const fv_sdf_op *op)
 /* One repeated axis: the cell index k = round(x / c) (clamped to -n..n when limited), the point in
  * the cell q = x - k c, and the distance to the cell's walls on this axis (FV_K_FAR where the cell
  * is open: beyond the last cell of a limited repetition). */
-static inline kf k_repeat_axis(kf x, float c, float ic, float n, kf *wall)
+FV_KFN kf k_repeat_axis(kf x, float c, float ic, float n, kf *wall)
 {
     kf k = k_floor(k_clamp(x * ic, k_splat(-1e9f), k_splat(1e9f)) + 0.5f);
     if (n > 0.0f) k = k_clamp(k, k_splat(-n), k_splat(n));
@@ -172,7 +180,7 @@ static inline kf k_repeat_axis(kf x, float c, float ic, float n, kf *wall)
 }
 
 /* Runs the program at one point per lane. */
-static inline void k_eval(const fv_sdf *s, kf x0, kf y0, kf z0, kf *dout, ki *mout)
+FV_KFN void k_eval(const fv_sdf *s, kf x0, kf y0, kf z0, kf *dout, ki *mout)
 {
     kf PX[FV_SDF_MAX_DEPTH + 2], PY[FV_SDF_MAX_DEPTH + 2], PZ[FV_SDF_MAX_DEPTH + 2], PW[FV_SDF_MAX_DEPTH + 2];
     kf DS[FV_SDF_MAX_DEPTH + 2];
@@ -299,7 +307,7 @@ static inline void k_eval(const fv_sdf *s, kf x0, kf y0, kf z0, kf *dout, ki *mo
 
 #if FV_K_WIDE
 /* Eight points from plain arrays through the kernel, for the entry points of each vector build. */
-static inline void k_eval_arrays(const fv_sdf *s, const float x[8], const float y[8], const float z[8], float d[8], int mat[8])
+FV_KFN void k_eval_arrays(const fv_sdf *s, const float x[8], const float y[8], const float z[8], float d[8], int mat[8])
 {
     kf vx, vy, vz, vd;
     ki vm;

@@ -1,0 +1,148 @@
+/* fovea — sphere tracing one SDF object of a kernel scene (kernel/scene.h), for the portable
+ * traversal (kernel/traverse.h) on the CPU and on CUDA.
+ *
+ * The same algorithm as the Embree user geometry (scene/scene_sdf.c's sdf_trace): clip to the
+ * field's padded box, walk out of the hit band when the ray starts inside it, march at most
+ * FV_SDF_TRACE_STEPS steps, refine FV_SDF_REFINE times; the normal is fv_sdf_normal's central
+ * differences and the material the nearest leaf's. The field is evaluated by the scalar build of
+ * the one SDF kernel (sdf/kernel.h with FV_K_WIDE 0, host-and-device under nvcc), so on the CPU
+ * every distance, and therefore every hit, is bit-identical to the Embree path's.
+ *
+ * Includes sdf/kernel.h, which defines static functions: a unit that includes this header must
+ * not include another build of sdf/kernel.h.
+ */
+#ifndef FV_KERNEL_SDF_TRACE_H
+#define FV_KERNEL_SDF_TRACE_H
+
+#include <math.h>
+#include <stdbool.h>
+#include "fovea/math.h"
+#include "kernel/scene.h"
+
+#ifdef FV_K_WIDE
+#error "kernel/sdf_trace.h builds the scalar SDF kernel: include it in a unit without another sdf/kernel.h"
+#endif
+#define FV_K_WIDE 0
+#include "sdf/kernel.h"
+
+/* Kept equal to scene/scene_sdf.c's constants of the same names (its banner explains them). */
+#define FV_KSDF_TRACE_STEPS 512
+#define FV_KSDF_REFINE 3
+
+/* The object's field as the kernel evaluates it: a view of its ops in the shared program array. */
+FV_HD static inline fv_sdf fv_ksdf_field(const fv_kscene *s, const fv_kobject *ob)
+{
+    fv_sdf f;
+    f.ops = (fv_sdf_op *)(s->sdf_ops + ob->sdf_first); /* read only; the struct's field is not const */
+    f.count = ob->sdf_count;
+    f.lo = ob->lo;
+    f.hi = ob->hi;
+    f.normal_h = ob->sdf_normal_h;
+    return f;
+}
+
+/* fv_sdf_distance: the field at object-space p, and the nearest leaf's material when mat is set. */
+FV_HD static inline float fv_ksdf_distance(const fv_sdf *f, fv_vec3 p, int *mat)
+{
+    kf d;
+    ki m;
+    k_eval(f, p.x, p.y, p.z, &d, &m);
+    if (mat) *mat = m;
+    return d;
+}
+
+/* fv_sdf_normal with the default step: six scalar probes, the same values the eight-lane call
+ * gives (sdf_eval.h: lane i of the wide build is bit-identical to the scalar one). */
+FV_HD static inline fv_vec3 fv_ksdf_normal(const fv_sdf *f, fv_vec3 p)
+{
+    float h = f->normal_h;
+    float dx0 = fv_ksdf_distance(f, fv_v3(p.x + h, p.y, p.z), 0), dx1 = fv_ksdf_distance(f, fv_v3(p.x - h, p.y, p.z), 0);
+    float dy0 = fv_ksdf_distance(f, fv_v3(p.x, p.y + h, p.z), 0), dy1 = fv_ksdf_distance(f, fv_v3(p.x, p.y - h, p.z), 0);
+    float dz0 = fv_ksdf_distance(f, fv_v3(p.x, p.y, p.z + h), 0), dz1 = fv_ksdf_distance(f, fv_v3(p.x, p.y, p.z - h), 0);
+    fv_vec3 g = fv_v3(dx0 - dx1, dy0 - dy1, dz0 - dz1);
+    float l = fv_length(g);
+    return l > 0.0f && isfinite(l) ? fv_scale(g, 1.0f / l) : fv_v3(0.0f, 0.0f, 0.0f);
+}
+
+/* core/ray_box.h's fv_ray_box_clip, written again here with the same operations (kernel headers
+ * include no core/ header but rng.h): narrows [*t0, *t1] to the part of o + t d inside [lo, hi]. */
+FV_HD static inline bool fv_ksdf_box_clip(fv_vec3 o, fv_vec3 d, fv_vec3 lo, fv_vec3 hi, float *t0, float *t1)
+{
+    const float oa[3] = {o.x, o.y, o.z}, da[3] = {d.x, d.y, d.z}, la[3] = {lo.x, lo.y, lo.z}, ha[3] = {hi.x, hi.y, hi.z};
+    float a = *t0, b = *t1;
+    for (int k = 0; k < 3; k++) {
+        if (da[k] == 0.0f) {
+            if (oa[k] < la[k] || oa[k] > ha[k]) return false;
+            continue;
+        }
+        float inv = 1.0f / da[k];
+        float ta = (la[k] - oa[k]) * inv, tb = (ha[k] - oa[k]) * inv;
+        if (ta > tb) {
+            float sw = ta;
+            ta = tb;
+            tb = sw;
+        }
+        if (ta > a) a = ta;
+        if (tb < b) b = tb;
+    }
+    *t0 = a;
+    *t1 = b;
+    return a <= b;
+}
+
+/* The box the tracer clips to and the top level bounds the object by: the field's bounds grown
+ * by four hit distances (scene_sdf.c's padded_box). */
+FV_HD static inline void fv_ksdf_padded_box(const fv_kobject *ob, fv_vec3 *lo, fv_vec3 *hi)
+{
+    fv_vec3 pad = fv_v3s(4.0f * ob->sdf_eps);
+    *lo = fv_sub(ob->lo, pad);
+    *hi = fv_add(ob->hi, pad);
+}
+
+/* Sphere-traces object-space o + t d for t in [tnear, tfar] (d need not be unit); the hit's t in
+ * *thit. Statement for statement scene_sdf.c's sdf_trace. */
+FV_HD static inline bool fv_ksdf_trace(const fv_kscene *s, const fv_kobject *ob, fv_vec3 o, fv_vec3 d, float tnear, float tfar,
+                                       float *thit)
+{
+    fv_vec3 lo, hi;
+    fv_ksdf_padded_box(ob, &lo, &hi);
+    float t0 = tnear, t1 = tfar;
+    if (!fv_ksdf_box_clip(o, d, lo, hi, &t0, &t1)) return false;
+    float dl = fv_length(d);
+    if (!(dl > 0.0f) || !isfinite(dl)) return false;
+    const fv_sdf f = fv_ksdf_field(s, ob);
+    const float eps = ob->sdf_eps, inv_dl = 1.0f / dl;
+
+    float t = t0;
+    float dist = fv_ksdf_distance(&f, fv_madd(o, d, t), 0);
+    /* A ray starting inside the hit band at its own origin is leaving that surface: walk out of
+     * the band first, or it would hit itself at t = tnear. */
+    int step = 0;
+    if (t0 == tnear && fabsf(dist) < eps) {
+        while (fabsf(dist) < eps) {
+            t += fmaxf(fabsf(dist), eps) * inv_dl;
+            if (t > t1 || ++step >= FV_KSDF_TRACE_STEPS) return false;
+            dist = fv_ksdf_distance(&f, fv_madd(o, d, t), 0);
+        }
+    }
+    /* side: +1 marching outside the solid, -1 inside (a refracted ray). */
+    float side = dist >= 0.0f ? 1.0f : -1.0f;
+    for (; step < FV_KSDF_TRACE_STEPS; step++) {
+        float ds = side * dist;
+        if (ds < eps) {
+            for (int k = 0; k < FV_KSDF_REFINE; k++) {
+                t += ds * inv_dl;
+                ds = side * fv_ksdf_distance(&f, fv_madd(o, d, t), 0);
+            }
+            if (!(t >= tnear && t <= tfar)) return false;
+            *thit = t;
+            return true;
+        }
+        t += ds * inv_dl;
+        if (t > t1) return false;
+        dist = fv_ksdf_distance(&f, fv_madd(o, d, t), 0);
+    }
+    return false;
+}
+
+#endif
