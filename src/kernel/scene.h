@@ -14,6 +14,11 @@
  * count, naming `count` (0..7, 0: empty) consecutive entries of the leaf's primitive array: ktris
  * for the bottom level (triangles pre-transformed to v0, e1, e2, 48 bytes, so a leaf's
  * triangles are read in order without gathering vertices), inst for the top level.
+ * Measured (tests/unit/test_traverse.c, binned SAH, leaves of at most 4): city, 180,906
+ * triangles: 90,423 nodes (5.8 MB), 90,424 leaves (about 2 triangles each), depth 24, 20.4 MB
+ * for the whole snapshot, built in 90-160 ms on 2 cores; cornell: 32 triangles, 16 nodes, 17
+ * leaves. On one CPU core this loop traces about a third as many rays as Embree's SIMD BVH
+ * (0.7 vs 2.3 Mrays/s in city); it is written for one ray per GPU thread.
  *
  * Two levels: bottom-level BVHs over object-space triangles in `nodes` (the static meshes' BVH
  * first, then one per dynamic mesh, each never rebuilt), and a small top-level BVH `tnodes` over

@@ -39,7 +39,7 @@
 #define OVERLAP_MAX 1e-2 /* ties between coplanar overlapping surfaces per ray */
 
 typedef struct tally {
-    long rays, hits, ties, coplanar, graze, occl_rays, occl_diff;
+    long rays, hits, exact_t, ties, coplanar, graze, occl_rays, occl_diff;
     long bad; /* real mismatches: same surface with wrong fields, or different surfaces apart */
 } tally;
 
@@ -97,6 +97,7 @@ static bool compare_ray(const fv_scene *s, const fv_kscene *k, fv_vec3 o, fv_vec
     }
     if (!ha) return false;
     c->hits++;
+    c->exact_t += a.t == b.t;
     /* 1e-4 relative, plus a few ulps of the coordinates: a ray starting next to a surface has a
      * tiny t known only to the coordinates' absolute precision. */
     float scale = fmaxf(fv_max3(fv_vmax(fv_vmax(o, fv_neg(o)), fv_vmax(a.p, fv_neg(a.p)))), 1.0f) / fv_length(d);
@@ -173,8 +174,8 @@ static void compare_scene(const char *name, const fv_scene *s, const fv_view *v,
 
 static void check_tally(const char *name, const tally *c)
 {
-    print_message("%s: %ld rays, %ld hits, ties %ld (%.2g), coplanar %ld (%.2g), graze %ld (%.2g), bad %ld; occlusion %ld rays, %ld differ (%.2g)\n",
-                  name, c->rays, c->hits, c->ties, (double)c->ties / (double)c->rays, c->coplanar, (double)c->coplanar / (double)c->rays,
+    print_message("%s: %ld rays, %ld hits (%ld with t bit-identical), ties %ld (%.2g), coplanar %ld (%.2g), graze %ld (%.2g), bad %ld; occlusion %ld rays, %ld differ (%.2g)\n",
+                  name, c->rays, c->hits, c->exact_t, c->ties, (double)c->ties / (double)c->rays, c->coplanar, (double)c->coplanar / (double)c->rays,
                   c->graze, (double)c->graze / (double)c->rays, c->bad,
                   c->occl_rays, c->occl_diff, c->occl_rays ? (double)c->occl_diff / (double)c->occl_rays : 0.0);
     assert_true(c->rays > 0);
@@ -198,7 +199,9 @@ static fv_scene_export *export_of(const fv_scene *s, const char *name)
     return x;
 }
 
-static void run_builtin(const char *name, int nrandom, int w, int h)
+/* exact_t: every hit's t must be bit-identical (static fields: both tracers run the same scalar
+ * SDF kernel on the same world-space ray). */
+static void run_builtin(const char *name, int nrandom, int w, int h, bool exact_t)
 {
     fv_scene *s;
     fv_view *v;
@@ -208,6 +211,7 @@ static void run_builtin(const char *name, int nrandom, int w, int h)
     tally c = {0};
     compare_scene(name, s, v, fv_scene_export_view(x), nrandom, w, h, &c);
     check_tally(name, &c);
+    if (exact_t) assert_int_equal(c.exact_t, c.hits);
     fv_scene_export_destroy(x);
     fv_view_destroy(v);
     fv_scene_destroy(s);
@@ -216,7 +220,7 @@ static void run_builtin(const char *name, int nrandom, int w, int h)
 static void test_cornell(void **state)
 {
     (void)state;
-    run_builtin("cornell", 40000, 64, 48);
+    run_builtin("cornell", 40000, 64, 48, false);
 }
 
 /* Single-thread speed of both on the same rays, printed for the docs (not asserted: machines
@@ -250,7 +254,7 @@ static void time_rays(const char *name, const fv_scene *s, const fv_kscene *k)
 static void test_city(void **state)
 {
     (void)state;
-    run_builtin("city", 60000, 96, 72);
+    run_builtin("city", 60000, 96, 72, false);
     fv_scene *s;
     fv_error err;
     assert_int_equal(fv_scene_load("city", NULL, &s, NULL, &err), FV_OK);
@@ -263,7 +267,7 @@ static void test_city(void **state)
 static void test_sdf_primitives(void **state)
 {
     (void)state;
-    run_builtin("sdf-primitives", 6000, 40, 30);
+    run_builtin("sdf-primitives", 20000, 64, 48, true);
 }
 
 /* The moving mirror cube of cornell-fpm at two times: the export follows fv_scene_set_time. */
