@@ -30,6 +30,9 @@ typedef struct fv_bench_options {
     /* Progress lines ("[2/6] pt-4: repeat 1/3, frame 2/5"); may be NULL. */
     void (*status)(void *user, const char *line);
     void *status_user;
+    /* "cpu", "portable", "cuda", "auto" or NULL: the device of every measured method that has it
+     * and whose parameters name none (fovea/device.h); references stay where the scenario puts them. */
+    const char *device;
 } fv_bench_options;
 
 /* Runs the scenario file at `path`. Bad scenario -> FV_ERR_INVALID naming file and field. Writes

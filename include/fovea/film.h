@@ -67,7 +67,7 @@ FV_API fv_film_views fv_film_views_of(fv_film *film);
 
 /* Writes pixel pix's auxiliary buffers (those the film has) from the first surface its camera ray
  * met; with hit false, the "nothing" values: depth +inf, zero vectors, id 0. */
-static inline void fv_film_store_first_hit(const fv_film_views *v, size_t pix, bool hit, float t, fv_vec3 p, fv_vec3 n, fv_vec3 albedo,
+FV_HD static inline void fv_film_store_first_hit(const fv_film_views *v, size_t pix, bool hit, float t, fv_vec3 p, fv_vec3 n, fv_vec3 albedo,
                                            int obj)
 {
     const fv_vec3 zero = {0.0f, 0.0f, 0.0f};

@@ -20,6 +20,7 @@
 #include "fovea/stats.h"
 #include "fovea/frame.h"
 #include "fovea/technique.h"
+#include "fovea/device.h"
 #include "fovea/metrics.h"
 #include "fovea/bench.h"
 #include "fovea/sdf.h"

@@ -19,6 +19,7 @@ typedef struct fv_bench_result {
     fv_metric_report error_vs[FV_BENCH_MAX_EXTRA]; /* the same against each extra reference */
     bool has_temporal;
     double temporal_mse[FV_REGION_COUNT], temporal_e[FV_REGION_COUNT];
+    double image_mean[3];       /* the last frame's mean linear RGB (devices compared: gpu-pt) */
     char img[4096], heat[4096], crop[4096]; /* paths relative to the output folder */
 } fv_bench_result;
 

@@ -127,6 +127,8 @@ static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *
         cJSON_AddItemToObject(e, "mse", r->has_temporal ? num(r->temporal_mse[g]) : cJSON_CreateNull());
         cJSON_AddItemToObject(e, "e", r->has_temporal ? num(r->temporal_e[g]) : cJSON_CreateNull());
     }
+    cJSON *mean = cJSON_AddArrayToObject(o, "image_mean");
+    for (int k = 0; k < 3; k++) cJSON_AddItemToArray(mean, num(r->image_mean[k]));
     cJSON *co = cJSON_AddObjectToObject(o, "counters");
     for (int i = 0; i < r->counters.n_counters; i++)
         cJSON_AddItemToObject(co, r->counters.counter[i].name, num(r->counters.counter[i].value));
@@ -234,6 +236,22 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
                 sci(d, v[FV_REGION_FOVEA].ssim), sci(e, v[FV_REGION_FOVEA].flip), sci(f, v[FV_REGION_ALL].flip),
                 sci(g, r->has_temporal ? r->temporal_mse[FV_REGION_FOVEA] : NAN),
                 sci(h, r->has_temporal ? r->temporal_mse[FV_REGION_PERIPHERY] : NAN));
+    }
+    /* Ray throughput where a method counts its rays: one camera ray per sample is primary, the
+     * rest (bounces and shadow rays) secondary. */
+    bool rays = false;
+    for (int i = 0; i < n; i++) rays |= fv_stats_get_count(&res[i].counters, "rays") > 0.0;
+    if (rays) {
+        tprintf(&t, "\n| method | M rays/s | primary M rays/s | secondary M rays/s | rays per sample | image mean (R, G, B) |\n"
+                    "|---|---:|---:|---:|---:|---|\n");
+        for (int i = 0; i < n; i++) {
+            const fv_bench_result *r = &res[i];
+            double all = fv_stats_get_count(&r->counters, "rays"), prim = fv_stats_get_count(&r->counters, "samples");
+            if (!(all > 0.0) || !(r->ms_median > 0.0)) continue;
+            double per_s = 1e3 / r->ms_median / 1e6;
+            tprintf(&t, "| %s | %.1f | %.1f | %.1f | %.2f | %.4f, %.4f, %.4f |\n", r->m->label, all * per_s, prim * per_s, (all - prim) * per_s,
+                    prim > 0.0 ? all / prim : 0.0, r->image_mean[0], r->image_mean[1], r->image_mean[2]);
+        }
     }
     for (int k = 0; k < sc->nextra; k++) {
         tprintf(&t, "\nAgainst `%s` (%s):\n\n| method | MSE fovea | MSE transition | MSE periphery | FLIP fovea | FLIP all |\n|---|---:|---:|---:|---:|---:|\n",

@@ -16,6 +16,8 @@
 #include "bench/bench_impl.h"
 #include "core/alloc.h"
 #include "core/fileio.h"
+#include "core/params_read.h"
+#include "fovea/device.h"
 #include "core/rng.h"
 #include "fovea/fovea.h"
 #include "scene/edit.h"
@@ -412,6 +414,12 @@ static fv_status method_end(method_run *mr, fv_error *err)
         for (int r = 0; r < FV_REGION_COUNT; r++)
             fv_temporal_result(c->temporal, (fv_region)r, &res->temporal_mse[r], &res->temporal_e[r]);
     }
+    const size_t npix = (size_t)sc->width * sc->height;
+    for (int k = 0; k < 3; k++) {
+        double sum = 0.0;
+        for (size_t q = 0; q < npix; q++) sum += c->last[3 * q + k];
+        res->image_mean[k] = sum / (double)npix;
+    }
     /* Images of the last frame: the frame, its FLIP heat map with the region rings, the fovea. */
     char path[4096 + 128];
     const frame_setup *lf = &c->frames[sc->frames - 1];
@@ -651,6 +659,26 @@ fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err)
     return st;
 }
 
+/* --device: every measured method that runs on that device and names none in its parameters is
+ * moved there; the others stay on the CPU. A name that is no device is refused. */
+static fv_status apply_device(fv_scenario *sc, const char *device, fv_error *err)
+{
+    if (!device) return FV_OK;
+    fv_device d;
+    fv_status st = fv_device_parse(device, NULL, &d, err);
+    if (st != FV_OK) {
+        fv_error_prefix(err, "--device: ");
+        return st;
+    }
+    for (int i = 0; i < sc->nmethods && st == FV_OK; i++) {
+        fv_bench_method *m = &sc->methods[i];
+        fv_device md;
+        if (fv_params_has(m->params, "device") || fv_device_parse(device, m->method, &md, err) != FV_OK) continue;
+        if (md != FV_DEVICE_CPU && fv_technique_has_device(fv_technique_index(m->method), md)) st = fv_params_set(m->params, "device", device, err);
+    }
+    return st;
+}
+
 fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *err)
 {
     fv_scenario *sc = NULL;
@@ -675,6 +703,7 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
 
     say(opt, "scenario %s: scene %s, %dx%d, %d frame(s), %d method(s)", sc->name, sc->scene, sc->width, sc->height, sc->frames,
         sc->nmethods);
+    if ((st = apply_device(sc, opt->device, err)) != FV_OK) goto done;
     /* Everything --check checks, before anything is rendered. */
     if ((st = validate(sc, path, opt->log, &scene, &view, err)) != FV_OK) goto done;
     /* Folders only once the scenario, its scene and every method are known to be good: bad input

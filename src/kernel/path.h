@@ -9,6 +9,8 @@
 #define FV_KERNEL_PATH_H
 
 #include <stdbool.h>
+#include <stdint.h>
+#include "fovea/camera.h"
 #include "fovea/math.h"
 
 typedef struct fv_path_opts {
@@ -24,6 +26,25 @@ typedef struct fv_path_first_hit {
     fv_vec3 p, n, albedo;
     int obj;
 } fv_path_first_hit;
+
+/* One eye of one frame of camera paths, as a device kernel is launched with it: the camera, the
+ * frame's seed, eye and index (the random stream of sample k of pixel p is the camera stream at
+ * (p * 2 + eye, k, frame), technique/kit.h's convention) and the path options. */
+typedef struct fv_kpt_frame {
+    fv_camera_basis cam;
+    uint64_t seed;
+    int eye, frame;
+    fv_path_opts opt;
+} fv_kpt_frame;
+
+/* A radiance estimate that is not finite is replaced by black and counted in *dropped, so one bad
+ * path never poisons a pixel, a filter or a reference (technique/kit.h's guard is this one). */
+FV_HD static inline fv_vec3 fv_path_guard(fv_vec3 L, uint64_t *dropped)
+{
+    if (fv_is_finite3(L)) return L;
+    (*dropped)++;
+    return fv_v3s(0.0f);
+}
 
 /* The balance heuristic for two strategies' densities (Veach 1997, ch. 9). */
 FV_HD static inline float fv_path_mis(float a, float b) { return a / (a + b); }

@@ -44,6 +44,7 @@ struct fv_scene_export {
     RTCDevice dev;        /* the scene's Embree device (the builder runs on its threads) */
     bool has_dynamic;
     int *tri_obj;         /* while creating: each global triangle's object */
+    fv_ktexture *tex;     /* the scene's textures as kernels read them (texels are the scene's) */
     fv_scene_export_stats stats;
 };
 
@@ -495,6 +496,17 @@ static fv_status copy_arrays(fv_scene_export *x, const fv_scene *s, fv_error *er
     k->sdf_ops = x->sdf_ops, k->nsdf_ops = op;
     k->ktris = x->ktris, k->nktris = t;
     k->mats = s->mats, k->nmat = s->nmat;
+    /* The light table is the scene's own: set_time moves its delta lights in place. */
+    k->lights = s->klights;
+    if (s->ntex > 0) {
+        if (!(x->tex = fv_calloc_array((size_t)s->ntex, sizeof *x->tex))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory exporting the scene");
+        for (int i = 0; i < s->ntex; i++) {
+            x->tex[i].w = s->tex[i].w;
+            x->tex[i].h = s->tex[i].h;
+            x->tex[i].rgb = s->tex[i].rgb;
+        }
+    }
+    k->tex = x->tex, k->ntex = s->ntex;
     k->eps = s->eps;
     k->time = s->time;
     return FV_OK;
@@ -607,6 +619,7 @@ void fv_scene_export_stats_get(const fv_scene_export *x, fv_scene_export_stats *
 void fv_scene_export_destroy(fv_scene_export *x)
 {
     if (!x) return;
+    free(x->tex);
     free(x->vtx);
     free(x->nrm);
     free(x->uv);

@@ -9,6 +9,7 @@
 #define FV_TECHNIQUE_CLASS_H
 
 #include "core/params_read.h"
+#include "fovea/device.h"
 #include "fovea/technique.h"
 
 typedef struct fv_technique_class {
@@ -22,6 +23,11 @@ typedef struct fv_technique_class {
      * Adds stage timings and counters to stats. */
     fv_status (*render)(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);
     void (*destroy)(void *state);
+    /* Devices beyond the CPU (fovea/device.h): a bit (1 << FV_DEVICE_*) per device the method
+     * also runs on; 0 for a CPU-only method. Such a method is created by create_on, which is told
+     * the device the registry resolved from the parameter `device` (create is then unused). */
+    unsigned devices;
+    fv_status (*create_on)(const fv_scene *scene, fv_params *params, fv_device device, const fv_log *log, void **state, fv_error *err);
     /* The method sphere-traces signed distance fields only: the registry refuses a scene without
      * an SDF object, and the conformance suite runs it in the SDF twins of its scenes. */
     bool sdf_only;

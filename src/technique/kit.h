@@ -15,6 +15,7 @@
 #include "fovea/math.h"
 #include "fovea/stats.h"
 #include "fovea/status.h"
+#include "kernel/path.h"
 
 /* ---- the frame ---- */
 
@@ -70,12 +71,7 @@ void fv_kit_report(const fv_kit_counters *k, fv_stats *stats);
 
 /* A radiance estimate that is not finite is replaced by black and counted in *dropped, so one bad
  * path never poisons a pixel, a filter or a reference, and the stats say how many there were. */
-static inline fv_vec3 fv_kit_guard(fv_vec3 L, uint64_t *dropped)
-{
-    if (fv_is_finite3(L)) return L;
-    (*dropped)++;
-    return fv_v3s(0.0f);
-}
+static inline fv_vec3 fv_kit_guard(fv_vec3 L, uint64_t *dropped) { return fv_path_guard(L, dropped); }
 
 /* ---- progress and cancel ---- */
 

@@ -77,6 +77,48 @@ fv_status fv_technique_set_spp(const char *name, fv_params *params, int spp, fv_
     return fv_params_set(params, cls->spp_param, v, err);
 }
 
+bool fv_technique_has_device(int i, fv_device d)
+{
+    if (i < 0 || i >= N_CLASSES) return false;
+    return d == FV_DEVICE_CPU || (k_classes[i]->devices & (1u << d)) != 0;
+}
+
+/* The methods that run on device d, as a list for a refusal. */
+static void methods_on(fv_device d, char *list, size_t n)
+{
+    list[0] = '\0';
+    for (int i = 0; i < N_CLASSES; i++) {
+        if (!fv_technique_has_device(i, d)) continue;
+        size_t l = strlen(list);
+        snprintf(list + l, n - l, "%s%s", l ? ", " : "", k_classes[i]->name);
+    }
+}
+
+fv_status fv_device_check(const char *method, const char *name, fv_device *out, fv_error *err)
+{
+    fv_status s = fv_device_parse(name, method, out, err);
+    if (s != FV_OK) return s;
+    if (!fv_technique_has_device(fv_technique_index(method), *out)) {
+        char list[256];
+        methods_on(*out, list, sizeof list);
+        return fv_error_set(err, FV_ERR_INVALID, "method '%s' does not run on device %s (methods that do: %s)", method ? method : "(null)",
+                            fv_device_name(*out), list);
+    }
+    char why[256];
+    if (!fv_device_available(*out, why, sizeof why))
+        return fv_error_set(err, FV_ERR_INVALID, "method '%s' on device %s: %s", method, fv_device_name(*out), why);
+    return FV_OK;
+}
+
+/* The parameter `device` (what --device sets), checked by fv_device_check. */
+static fv_status read_device(const fv_technique_class *cls, fv_params *p, fv_device *out, fv_error *err)
+{
+    static const char *const names[] = {"cpu", "portable", "cuda", "auto", NULL};
+    int k = 0;
+    fv_status s = fv_params_choice(p, "device", 0, names, &k, err);
+    return s != FV_OK ? s : fv_device_check(cls->name, names[k], out, err);
+}
+
 struct fv_technique {
     const fv_technique_class *cls;
     void *state;
@@ -110,7 +152,9 @@ fv_status fv_technique_create(const char *name, const fv_scene *scene, const fv_
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     }
     t->cls = cls;
-    s = cls->create(scene, own, log, &t->state, err);
+    fv_device device = FV_DEVICE_CPU;
+    s = read_device(cls, own, &device, err);
+    if (s == FV_OK) s = cls->create_on ? cls->create_on(scene, own, device, log, &t->state, err) : cls->create(scene, own, log, &t->state, err);
     if (s == FV_OK && (s = fv_params_check_used(own, cls->name, err)) != FV_OK) cls->destroy(t->state);
     fv_params_destroy(own);
     if (s != FV_OK) {

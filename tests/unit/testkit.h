@@ -144,4 +144,48 @@ static inline fv_film *fv_test_render_once(const char *method, const char *list,
     return film;
 }
 
+/* ---- two renders of the same estimator ----
+ *
+ * How two films that drew the same random numbers differ (pt on the CPU, the portable backend and
+ * CUDA): each channel's mean, the share of pixels equal within `tol` relative (or absolute below
+ * 1e-6), and the RMS of the per-pixel difference relative to the image's mean. */
+typedef struct fv_test_agreement {
+    double mean_a[3], mean_b[3];
+    double max_mean_rel; /* the largest |mean_b - mean_a| / mean_a over the channels */
+    double equal_share;  /* pixels whose three channels agree within tol */
+    double rms_rel;      /* sqrt(mean((b - a)^2)) / mean(a) over all channels */
+} fv_test_agreement;
+
+static inline fv_test_agreement fv_test_agree(const fv_film *a, const fv_film *b, double tol)
+{
+    fv_test_agreement r;
+    memset(&r, 0, sizeof r);
+    const float *ca = fv_film_color_const(a), *cb = fv_film_color_const(b);
+    size_t n = (size_t)fv_film_width(a) * fv_film_height(a);
+    double sq = 0.0, all = 0.0;
+    size_t equal = 0;
+    for (size_t i = 0; i < n; i++) {
+        bool same = true;
+        for (int c = 0; c < 3; c++) {
+            double x = ca[3 * i + c], y = cb[3 * i + c];
+            r.mean_a[c] += x;
+            r.mean_b[c] += y;
+            sq += (y - x) * (y - x);
+            all += x;
+            if (fabs(y - x) > tol * fabs(x) && fabs(y - x) > 1e-6) same = false;
+        }
+        equal += same;
+    }
+    for (int c = 0; c < 3; c++) {
+        r.mean_a[c] /= (double)n;
+        r.mean_b[c] /= (double)n;
+        double rel = r.mean_a[c] > 0.0 ? fabs(r.mean_b[c] - r.mean_a[c]) / r.mean_a[c] : fabs(r.mean_b[c]);
+        if (rel > r.max_mean_rel) r.max_mean_rel = rel;
+    }
+    r.equal_share = (double)equal / (double)n;
+    double mean = all / (3.0 * (double)n);
+    r.rms_rel = mean > 0.0 ? sqrt(sq / (3.0 * (double)n)) / mean : sqrt(sq / (3.0 * (double)n));
+    return r;
+}
+
 #endif

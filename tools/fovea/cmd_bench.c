@@ -23,6 +23,8 @@ static void usage(FILE *f)
                "  --full            the papers' sizes (the scenario's \"full\" block)\n"
                "  --repeats N       timing repeats (overrides the scenario)\n"
                "  --threads N       worker threads, 0 = all [0]\n"
+               "  --device D        run every measured method that has device D there (cpu, portable, cuda,\n"
+               "                    auto; docs/gpu.md); methods and references naming a device keep theirs\n"
                "  --check           only validate the scenario\n"
                "  --list            list the scenarios found\n"
                "  --quiet           no progress lines\n");
@@ -134,8 +136,8 @@ static void on_status(void *user, const char *line)
 
 int fv_cmd_bench(int argc, char **argv)
 {
-    enum { O_OUT = 256, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_CHECK, O_LIST, O_QUIET, O_HELP };
-    static const struct option longs[] = {{"out", 1, 0, O_OUT},       {"cache", 1, 0, O_CACHE},     {"quick", 0, 0, O_QUICK},
+    enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_CHECK, O_LIST, O_QUIET, O_HELP };
+    static const struct option longs[] = {{"out", 1, 0, O_OUT},       {"device", 1, 0, O_DEVICE},   {"cache", 1, 0, O_CACHE},     {"quick", 0, 0, O_QUICK},
                                           {"full", 0, 0, O_FULL},     {"repeats", 1, 0, O_REPEATS}, {"threads", 1, 0, O_THREADS},
                                           {"check", 0, 0, O_CHECK},   {"list", 0, 0, O_LIST},       {"quiet", 0, 0, O_QUIET},
                                           {"help", 0, 0, O_HELP},     {0, 0, 0, 0}};
@@ -151,6 +153,7 @@ int fv_cmd_bench(int argc, char **argv)
     while ((c = getopt_long(argc, argv, "h", longs, NULL)) != -1) {
         switch (c) {
         case O_OUT: opt.out_dir = optarg; break;
+        case O_DEVICE: opt.device = optarg; break;
         case O_CACHE: opt.cache_dir = optarg; break;
         case O_QUICK:
         case O_FULL:

@@ -20,6 +20,8 @@ static void help(void)
            "  --method NAME         rendering method (fovea methods) [pt]\n"
            "  --spp N               samples per pixel: sets the method's own parameter for it (an error names\n"
            "                        what to use instead for a method without one)\n"
+           "  --device D            cpu, portable (the GPU kernels on the CPU), cuda or auto (cuda when built with\n"
+           "                        it, a GPU is present and the method has it) [cpu] (docs/gpu.md)\n"
            "  --size WxH            image size [512x512]\n"
            "  --frames N            number of frames; >1 writes numbered files OUT_0000.ext ... [1]\n"
            "  --fps F               frames per second of scene time [30]\n"
@@ -63,7 +65,7 @@ static bool dir_writable(const char *path)
 }
 
 typedef struct render_opts {
-    const char *scene, *method, *out;
+    const char *scene, *method, *out, *device;
     int width, height, frames, threads, spp;
     double fps, time0, exposure, stereo;
     unsigned long long seed;
@@ -78,11 +80,11 @@ typedef struct render_opts {
 
 static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
-    enum { O_METHOD = 256, O_SPP, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
+    enum { O_METHOD = 256, O_SPP, O_DEVICE, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
            O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP,
            O_MISSING };
     static const struct option longs[] = {
-        {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
+        {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"device", 1, 0, O_DEVICE}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
         {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
         {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE}, {"gaze-missing", 1, 0, O_MISSING},
@@ -103,6 +105,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
         }
         switch (c) {
         case O_METHOD: o->method = optarg; break;
+        case O_DEVICE: o->device = optarg; break;
         case O_SPP:
             if (!fv_cli_parse_int(optarg, 1, 1 << 20, &l)) return fv_cli_usage_error(cmd, "--spp %s: expected an integer in [1, 1048576]", optarg);
             o->spp = (int)l;
@@ -237,6 +240,13 @@ int fv_cmd_render(int argc, char **argv)
         goto done;
     }
     if ((rc = fv_cli_check_method(cmd, o.method)) != 0) goto done;
+    if (o.device) {
+        fv_device dev;
+        if ((s = fv_device_check(o.method, o.device, &dev, &err)) != FV_OK || (s = fv_params_set(params, "device", o.device, &err)) != FV_OK) {
+            rc = fv_cli_fail(cmd, s, err.msg);
+            goto done;
+        }
+    }
     if (o.spp > 0 && (s = fv_technique_set_spp(o.method, params, o.spp, &err)) != FV_OK) {
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;

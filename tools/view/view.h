@@ -21,6 +21,7 @@
 /* ---- command line ---- */
 typedef struct fv_vw_args {
     const char *scene, *method, *gaze_trace, *script, *fps_log;
+    const char *device; /* --device: for every method that has it (NULL: the CPU) */
     int width, height, threads;
     double scale, stereo;
     bool has_gaze;
@@ -87,10 +88,11 @@ const fv_vw_main_param *fv_vw_main_param_of(const char *method);
 /* The baseline shown beside method in the split view. */
 const char *fv_vw_baseline_of(const char *method);
 /* (Re)creates slot s with registry method m and main-parameter position value (-1: default);
- * user_params (may be NULL) is the bag for that method; the slot keeps its old technique when
- * creation fails (err says why). */
-fv_status fv_vw_slot_create(fv_vw_slot *s, const fv_scene *scene, int m, int value, const fv_params *user_params, const fv_log *log,
-                            fv_error *err);
+ * user_params (may be NULL) is the bag for that method; device (may be NULL) is --device, given to
+ * the method when it has that device (the others run on the CPU); the slot keeps its old technique
+ * when creation fails (err says why). */
+fv_status fv_vw_slot_create(fv_vw_slot *s, const fv_scene *scene, int m, int value, const fv_params *user_params, const char *device,
+                            const fv_log *log, fv_error *err);
 void fv_vw_slot_destroy(fv_vw_slot *s);
 /* Films of the given size and eye count (recreated only when they change). */
 fv_status fv_vw_slot_films(fv_vw_slot *s, int w, int h, int eyes, fv_error *err);

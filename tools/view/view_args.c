@@ -11,6 +11,7 @@ static void help(void)
            "  SCENE                 built-in name (fovea scenes) or a scene file [cornell]\n"
            "  --method NAME         rendering method (fovea methods) [vpolar]\n"
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
+           "  --device D            cpu, portable, cuda or auto, for the methods that have it (docs/gpu.md) [cpu]\n"
            "  --size WxH            window size [640x360]\n"
            "  --scale S             render at S x the window size, scaled to it [1]\n"
            "  --gaze X,Y            fixed gaze (normalised) instead of the mouse\n"
@@ -27,9 +28,9 @@ static void help(void)
 
 int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
 {
-    enum { O_METHOD = 256, O_PARAM, O_SIZE, O_SCALE, O_GAZE, O_TRACE, O_STEREO, O_THREADS, O_SCRIPT, O_FPSLOG, O_HELP };
+    enum { O_METHOD = 256, O_PARAM, O_DEVICE, O_SIZE, O_SCALE, O_GAZE, O_TRACE, O_STEREO, O_THREADS, O_SCRIPT, O_FPSLOG, O_HELP };
     static const struct option longs[] = {
-        {"method", 1, 0, O_METHOD}, {"param", 1, 0, O_PARAM},   {"size", 1, 0, O_SIZE},       {"scale", 1, 0, O_SCALE},
+        {"method", 1, 0, O_METHOD}, {"param", 1, 0, O_PARAM}, {"device", 1, 0, O_DEVICE},   {"size", 1, 0, O_SIZE},       {"scale", 1, 0, O_SCALE},
         {"gaze", 1, 0, O_GAZE},     {"gaze-trace", 1, 0, O_TRACE}, {"stereo", 1, 0, O_STEREO}, {"threads", 1, 0, O_THREADS},
         {"script", 1, 0, O_SCRIPT}, {"fps-log", 1, 0, O_FPSLOG}, {"help", 0, 0, O_HELP},
         FV_CLI_SCENE_LONGOPTS, {0, 0, 0, 0}};
@@ -48,6 +49,7 @@ int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
         }
         switch (c) {
         case O_METHOD: a->method = optarg; break;
+        case O_DEVICE: a->device = optarg; break;
         case O_PARAM:
             if (fv_params_parse(a->params, optarg, &err) != FV_OK) return fv_cli_fail(cmd, err.status, err.msg);
             break;

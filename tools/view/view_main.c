@@ -34,11 +34,13 @@ static int prepare(fv_vw_app *app, fv_vw_script *script)
     if ((s = fv_film_check_size(a->width, a->height, &err)) != FV_OK) return fv_cli_fail(k_cmd, s, err.msg);
     int rc;
     if ((rc = fv_cli_check_method(k_cmd, a->method)) != 0) return rc;
+    fv_device dev;
+    if (a->device && (s = fv_device_check(a->method, a->device, &dev, &err)) != FV_OK) return fv_cli_fail(k_cmd, s, err.msg);
     if (a->script && (s = fv_vw_script_load(a->script, script, &err)) != FV_OK) return fv_cli_fail(k_cmd, s, err.msg);
     if (a->gaze_trace && (s = fv_gaze_path_load_csv(a->gaze_trace, &app->gaze_trace, &err)) != FV_OK) return fv_cli_fail(k_cmd, s, err.msg);
     if ((rc = fv_cli_open_scene(k_cmd, a->scene, &app->log, &a->scene_opts, &app->scene, &app->view)) != 0) return rc;
     app->user_method = fv_technique_index(a->method);
-    if ((s = fv_vw_slot_create(&app->main, app->scene, app->user_method, -1, a->params, &app->log, &err)) != FV_OK)
+    if ((s = fv_vw_slot_create(&app->main, app->scene, app->user_method, -1, a->params, a->device, &app->log, &err)) != FV_OK)
         return fv_cli_fail(k_cmd, s, err.msg);
     if (a->fps_log) {
         if (!(app->fps_log = fopen(a->fps_log, "w"))) return fv_cli_usage_error(k_cmd, "--fps-log %s: cannot write there", a->fps_log);

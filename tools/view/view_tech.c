@@ -55,14 +55,18 @@ static void drop_accum(fv_vw_slot *s)
     s->accum_n = 0;
 }
 
-fv_status fv_vw_slot_create(fv_vw_slot *s, const fv_scene *scene, int m, int value, const fv_params *user_params, const fv_log *log,
-                            fv_error *err)
+fv_status fv_vw_slot_create(fv_vw_slot *s, const fv_scene *scene, int m, int value, const fv_params *user_params, const char *device,
+                            const fv_log *log, fv_error *err)
 {
     const char *name = fv_technique_name(m);
     const fv_vw_main_param *mp = fv_vw_main_param_of(name);
     fv_params *p = NULL;
     fv_status st = user_params ? fv_params_clone(user_params, &p, err) : fv_params_create(&p, err);
     if (st == FV_OK && mp && value >= 0) st = fv_params_set(p, mp->key, mp->values[value], err);
+    fv_device d;
+    fv_error ignored;
+    if (st == FV_OK && device && fv_device_parse(device, name, &d, &ignored) == FV_OK && d != FV_DEVICE_CPU && fv_technique_has_device(m, d))
+        st = fv_params_set(p, "device", device, err);
     fv_technique *t = NULL;
     if (st == FV_OK) st = fv_technique_create(name, scene, p, log, &t, err);
     fv_params_destroy(p);
@@ -128,7 +132,7 @@ void fv_vw_cycle(fv_vw_app *app, int dir)
         if (m == app->user_method) value = -1;
         fv_error_clear(&err);
         /* a method that refuses the scene (the sdf family without fields) is skipped silently */
-        if (fv_vw_slot_create(&app->main, app->scene, m, value, user, &app->log, &err) == FV_OK) {
+        if (fv_vw_slot_create(&app->main, app->scene, m, value, user, app->args.device, &app->log, &err) == FV_OK) {
             fv_vw_say(app, "method %s", fv_technique_name(m));
             fv_vw_update_baseline(app);
             return;
@@ -161,7 +165,7 @@ void fv_vw_step_param(fv_vw_app *app, int dir)
     fv_error err;
     fv_error_clear(&err);
     const fv_params *user = s->method == app->user_method ? app->args.params : NULL;
-    if (fv_vw_slot_create(s, app->scene, s->method, v, user, &app->log, &err) != FV_OK) fv_vw_say(app, "%s", err.msg);
+    if (fv_vw_slot_create(s, app->scene, s->method, v, user, app->args.device, &app->log, &err) != FV_OK) fv_vw_say(app, "%s", err.msg);
     else fv_vw_say(app, "%s %s=%s", name, mp->key, mp->values[v]);
 }
 
@@ -178,7 +182,7 @@ void fv_vw_update_baseline(fv_vw_app *app)
     fv_error err;
     fv_error_clear(&err);
     int value = !strcmp(fv_technique_name(m), "pt") ? 0 : -1;
-    if (fv_vw_slot_create(&app->base, app->scene, m, value, NULL, &app->log, &err) != FV_OK) {
+    if (fv_vw_slot_create(&app->base, app->scene, m, value, NULL, app->args.device, &app->log, &err) != FV_OK) {
         fv_vw_say(app, "baseline %s: %s", fv_technique_name(m), err.msg);
         app->split = false;
     }

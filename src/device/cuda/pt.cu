@@ -1,0 +1,244 @@
+/* fovea — the CUDA backend of `pt` (see device/cuda_backend.h): the flat scene copied to the GPU
+ * field by field, and the pixel kernel of kernel/pt.h launched one thread a pixel.
+ *
+ * Design (docs/gpu.md): a megakernel. Each thread runs its pixel's whole paths, the same function
+ * the portable backend runs on the CPU, so the GPU's image equals the portable one up to float
+ * rounding. A wavefront design (a queue of rays per bounce) would trade this sameness for
+ * coherence; it is measured against this one before it replaces it.
+ *
+ * Memory: the scene's arrays are copied once at create; update re-copies only what time changes
+ * (objects' transforms, instances, the top-level BVH, the light table). The film's buffers stay
+ * allocated between frames of one size.
+ */
+#include <cuda_runtime.h>
+#include <stdio.h>
+#include <string.h>
+#include "device/cuda_backend.h"
+#include "kernel/pt.h"
+
+/* Threads of a block: 8 x 8 pixels, a tile whose paths start coherent. */
+#define FV_CUDA_BLOCK 8
+
+struct fv_cuda_pt {
+    fv_kscene dev;           /* the scene with device pointers */
+    void *owned[32];         /* every device allocation of the scene, freed at destroy */
+    int nowned;
+    fv_ktexture *tex_host;   /* the texture records with device texel pointers, as uploaded */
+    float *color, *depth, *normal, *albedo, *position;
+    uint32_t *id;
+    size_t film_pixels;
+    unsigned long long *counts; /* rays, non-finite estimates */
+    cudaEvent_t start, stop;
+};
+
+static fv_status cuda_fail(cudaError_t e, const char *what, fv_error *err)
+{
+    return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %s while %s", cudaGetErrorString(e), what);
+}
+
+extern "C" bool fv_cuda_probe(char *why, size_t why_len)
+{
+    int n = 0;
+    cudaError_t e = cudaGetDeviceCount(&n);
+    if (e != cudaSuccess || n == 0) {
+        if (why && why_len) snprintf(why, why_len, "no CUDA device (%s)", e != cudaSuccess ? cudaGetErrorString(e) : "none found");
+        return false;
+    }
+    cudaDeviceProp p;
+    if ((e = cudaGetDeviceProperties(&p, 0)) != cudaSuccess) {
+        if (why && why_len) snprintf(why, why_len, "no CUDA device (%s)", cudaGetErrorString(e));
+        return false;
+    }
+    /* The build carries code for sm_80 and sm_90 (plus PTX for newer): older GPUs cannot run it. */
+    if (p.major < 8) {
+        if (why && why_len) snprintf(why, why_len, "no CUDA device of compute capability 8.0 or newer (%s is %d.%d)", p.name, p.major, p.minor);
+        return false;
+    }
+    return true;
+}
+
+/* A copy of n elements of `bytes` each to the GPU, remembered for destroy; NULL stays NULL. */
+static fv_status upload(fv_cuda_pt *c, const void *src, size_t n, size_t bytes, void **dst, fv_error *err)
+{
+    *dst = NULL;
+    if (!src || n == 0) return FV_OK;
+    if (c->nowned == (int)(sizeof c->owned / sizeof c->owned[0]))
+        return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: too many scene arrays");
+    cudaError_t e = cudaMalloc(dst, n * bytes);
+    if (e != cudaSuccess) return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for the scene")
+                                                                : cuda_fail(e, "allocating the scene", err);
+    c->owned[c->nowned++] = *dst;
+    if ((e = cudaMemcpy(*dst, src, n * bytes, cudaMemcpyHostToDevice)) != cudaSuccess) return cuda_fail(e, "copying the scene", err);
+    return FV_OK;
+}
+
+#define UPLOAD(field, count, type)                                                                      \
+    do {                                                                                                \
+        void *p_;                                                                                       \
+        if ((s = upload(c, h->field, (size_t)(count), sizeof(type), &p_, err)) != FV_OK) return s;      \
+        c->dev.field = (const type *)p_;                                                                \
+    } while (0)
+
+static fv_status upload_scene(fv_cuda_pt *c, const fv_kscene *h, fv_error *err)
+{
+    fv_status s;
+    c->dev = *h;
+    UPLOAD(vtx, h->nvtx, fv_vec3);
+    UPLOAD(nrm, h->nnrm, fv_vec3);
+    UPLOAD(uv, h->nuv, fv_vec2);
+    UPLOAD(tri_vtx, h->ntri_vtx, uint32_t);
+    UPLOAD(tri_mat, h->ntri, int32_t);
+    UPLOAD(tri_light, h->ntri, int32_t);
+    UPLOAD(objs, h->nobj, fv_kobject);
+    UPLOAD(sdf_ops, h->nsdf_ops, fv_sdf_op);
+    UPLOAD(nodes, h->nnodes, fv_knode);
+    UPLOAD(ktris, h->nktris, fv_ktri);
+    UPLOAD(inst, h->ninst, fv_kinst);
+    UPLOAD(tnodes, h->ntnodes, fv_knode);
+    UPLOAD(mats, h->nmat, fv_material);
+    void *p;
+    if ((s = upload(c, h->lights.light, (size_t)h->lights.n, sizeof(fv_light), &p, err)) != FV_OK) return s;
+    c->dev.lights.light = (const fv_light *)p;
+    if ((s = upload(c, h->lights.cdf, (size_t)h->lights.n + 1, sizeof(float), &p, err)) != FV_OK) return s;
+    c->dev.lights.cdf = (const float *)p;
+    if (h->ntex > 0) {
+        c->tex_host = (fv_ktexture *)calloc((size_t)h->ntex, sizeof *c->tex_host);
+        if (!c->tex_host) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        for (int i = 0; i < h->ntex; i++) {
+            c->tex_host[i] = h->tex[i];
+            if ((s = upload(c, h->tex[i].rgb, (size_t)h->tex[i].w * (size_t)h->tex[i].h * 3, sizeof(float), &p, err)) != FV_OK) return s;
+            c->tex_host[i].rgb = (const float *)p;
+        }
+        if ((s = upload(c, c->tex_host, (size_t)h->ntex, sizeof(fv_ktexture), &p, err)) != FV_OK) return s;
+        c->dev.tex = (const fv_ktexture *)p;
+    }
+    return FV_OK;
+}
+
+/* Re-copies an array whose contents time changes, in place (its size does not change). */
+static fv_status refresh(const void *dst, const void *src, size_t bytes, fv_error *err)
+{
+    if (!dst || !src || !bytes) return FV_OK;
+    cudaError_t e = cudaMemcpy((void *)dst, src, bytes, cudaMemcpyHostToDevice);
+    return e == cudaSuccess ? FV_OK : cuda_fail(e, "updating the scene", err);
+}
+
+extern "C" fv_status fv_cuda_pt_update(fv_cuda_pt *c, const fv_kscene *h, fv_error *err)
+{
+    if (h->nobj != c->dev.nobj || h->ninst != c->dev.ninst || h->ntnodes != c->dev.ntnodes || h->lights.n != c->dev.lights.n)
+        return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: the scene's shape changed between frames");
+    fv_status s;
+    if ((s = refresh(c->dev.objs, h->objs, (size_t)h->nobj * sizeof(fv_kobject), err)) != FV_OK) return s;
+    if ((s = refresh(c->dev.inst, h->inst, (size_t)h->ninst * sizeof(fv_kinst), err)) != FV_OK) return s;
+    if ((s = refresh(c->dev.tnodes, h->tnodes, (size_t)h->ntnodes * sizeof(fv_knode), err)) != FV_OK) return s;
+    if ((s = refresh(c->dev.lights.light, h->lights.light, (size_t)h->lights.n * sizeof(fv_light), err)) != FV_OK) return s;
+    c->dev.time = h->time;
+    return FV_OK;
+}
+
+extern "C" void fv_cuda_pt_destroy(fv_cuda_pt *c)
+{
+    if (!c) return;
+    for (int i = 0; i < c->nowned; i++) cudaFree(c->owned[i]);
+    cudaFree(c->color);
+    cudaFree(c->depth);
+    cudaFree(c->normal);
+    cudaFree(c->albedo);
+    cudaFree(c->position);
+    cudaFree(c->id);
+    cudaFree(c->counts);
+    if (c->start) cudaEventDestroy(c->start);
+    if (c->stop) cudaEventDestroy(c->stop);
+    free(c->tex_host);
+    free(c);
+}
+
+extern "C" fv_status fv_cuda_pt_create(const fv_kscene *host, fv_cuda_pt **out, fv_error *err)
+{
+    *out = NULL;
+    fv_cuda_pt *c = (fv_cuda_pt *)calloc(1, sizeof *c);
+    if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    fv_status s = upload_scene(c, host, err);
+    cudaError_t e;
+    if (s == FV_OK && (e = cudaMalloc((void **)&c->counts, 2 * sizeof(unsigned long long))) != cudaSuccess) s = cuda_fail(e, "allocating counters", err);
+    if (s == FV_OK && ((e = cudaEventCreate(&c->start)) != cudaSuccess || (e = cudaEventCreate(&c->stop)) != cudaSuccess))
+        s = cuda_fail(e, "creating events", err);
+    if (s != FV_OK) {
+        fv_cuda_pt_destroy(c);
+        return s;
+    }
+    *out = c;
+    return FV_OK;
+}
+
+__global__ void fv_cuda_pt_kernel(fv_kscene s, fv_kpt_frame f, fv_film_views out, unsigned long long *counts)
+{
+    int x = (int)(blockIdx.x * blockDim.x + threadIdx.x), y = (int)(blockIdx.y * blockDim.y + threadIdx.y);
+    if (x >= f.cam.width || y >= f.cam.height) return;
+    uint64_t rays = 0, bad = 0;
+    fv_kpt_pixel(&s, &f, x, y, &out, &rays, &bad);
+    atomicAdd(&counts[0], (unsigned long long)rays);
+    if (bad) atomicAdd(&counts[1], (unsigned long long)bad);
+}
+
+/* (Re)allocates the device film's buffer for a host buffer that is set, NULL for one that is not. */
+static cudaError_t film_buffer(void **dev, const void *host, size_t bytes, bool resize)
+{
+    if (resize || !host) {
+        cudaFree(*dev);
+        *dev = NULL;
+    }
+    if (host && !*dev) return cudaMalloc(dev, bytes);
+    return cudaSuccess;
+}
+
+extern "C" fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays,
+                                       uint64_t *nan_samples, double *kernel_ms, fv_error *err)
+{
+    const size_t n = (size_t)f->cam.width * (size_t)f->cam.height;
+    bool resize = n != c->film_pixels;
+    cudaError_t e;
+    if ((e = film_buffer((void **)&c->color, out->color, 3 * n * sizeof(float), resize)) != cudaSuccess ||
+        (e = film_buffer((void **)&c->depth, out->depth, n * sizeof(float), resize)) != cudaSuccess ||
+        (e = film_buffer((void **)&c->normal, out->normal, 3 * n * sizeof(float), resize)) != cudaSuccess ||
+        (e = film_buffer((void **)&c->albedo, out->albedo, 3 * n * sizeof(float), resize)) != cudaSuccess ||
+        (e = film_buffer((void **)&c->position, out->position, 3 * n * sizeof(float), resize)) != cudaSuccess ||
+        (e = film_buffer((void **)&c->id, out->id, n * sizeof(uint32_t), resize)) != cudaSuccess) {
+        c->film_pixels = 0;
+        return cuda_fail(e, "allocating the film", err);
+    }
+    c->film_pixels = n;
+    fv_film_views dv;
+    dv.color = c->color;
+    dv.depth = c->depth;
+    dv.normal = c->normal;
+    dv.albedo = c->albedo;
+    dv.position = c->position;
+    dv.id = c->id;
+    if ((e = cudaMemset(c->counts, 0, 2 * sizeof(unsigned long long))) != cudaSuccess) return cuda_fail(e, "clearing counters", err);
+    dim3 block(FV_CUDA_BLOCK, FV_CUDA_BLOCK);
+    dim3 grid((unsigned)((f->cam.width + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK), (unsigned)((f->cam.height + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK));
+    cudaEventRecord(c->start);
+    fv_cuda_pt_kernel<<<grid, block>>>(c->dev, *f, dv, c->counts);
+    cudaEventRecord(c->stop);
+    if ((e = cudaGetLastError()) != cudaSuccess) return cuda_fail(e, "launching the pt kernel", err);
+    if ((e = cudaEventSynchronize(c->stop)) != cudaSuccess) return cuda_fail(e, "running the pt kernel", err);
+    float ms = 0.0f;
+    cudaEventElapsedTime(&ms, c->start, c->stop);
+    *kernel_ms = ms;
+    unsigned long long counts[2];
+    if ((e = cudaMemcpy(counts, c->counts, sizeof counts, cudaMemcpyDeviceToHost)) != cudaSuccess) return cuda_fail(e, "reading counters", err);
+    *rays = counts[0];
+    *nan_samples = counts[1];
+    struct {
+        void *host;
+        const void *dev;
+        size_t bytes;
+    } back[6] = {{out->color, c->color, 3 * n * sizeof(float)},       {out->depth, c->depth, n * sizeof(float)},
+                 {out->normal, c->normal, 3 * n * sizeof(float)},     {out->albedo, c->albedo, 3 * n * sizeof(float)},
+                 {out->position, c->position, 3 * n * sizeof(float)}, {out->id, c->id, n * sizeof(uint32_t)}};
+    for (int i = 0; i < 6; i++)
+        if (back[i].host && (e = cudaMemcpy(back[i].host, back[i].dev, back[i].bytes, cudaMemcpyDeviceToHost)) != cudaSuccess)
+            return cuda_fail(e, "reading the film back", err);
+    return FV_OK;
+}

@@ -1,0 +1,40 @@
+/* fovea — the CUDA backend as the rest of the library sees it: plain C declarations, no CUDA
+ * header (the .cu files under device/cuda/ implement them with nvcc). In a build without CUDA
+ * (FOVEA_HAVE_CUDA undefined) device/cuda_stub.c answers instead: "built without CUDA".
+ */
+#ifndef FV_DEVICE_CUDA_BACKEND_H
+#define FV_DEVICE_CUDA_BACKEND_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include "fovea/camera.h"
+#include "fovea/film.h"
+#include "fovea/status.h"
+#include "kernel/path.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct fv_kscene;
+
+/* True when a CUDA device can run our kernels; else false with the reason in why. */
+bool fv_cuda_probe(char *why, size_t why_len);
+
+
+typedef struct fv_cuda_pt fv_cuda_pt;
+/* Copies the flat scene (host memory) to the GPU. */
+fv_status fv_cuda_pt_create(const struct fv_kscene *host, fv_cuda_pt **out, fv_error *err);
+/* Brings the GPU's copy to the host snapshot's time: what moves (instances, top level, lights). */
+fv_status fv_cuda_pt_update(fv_cuda_pt *c, const struct fv_kscene *host, fv_error *err);
+/* Renders into the film's buffers (host memory): colour and whichever auxiliary buffers are set.
+ * *rays and *nan_samples receive the counts; *kernel_ms the kernel's own time (events). */
+fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays, uint64_t *nan_samples,
+                            double *kernel_ms, fv_error *err);
+void fv_cuda_pt_destroy(fv_cuda_pt *c);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,38 @@
+/* fovea — the CUDA backend of a build without CUDA (see cuda_backend.h): every entry refuses with
+ * "fovea was built without CUDA", so --device cuda exits 2 with that line. */
+#ifndef FOVEA_HAVE_CUDA
+#include <stdio.h>
+#include "device/cuda_backend.h"
+
+static const char k_no_cuda[] = "fovea was built without CUDA (configure with a CUDA compiler on the PATH, or -DFOVEA_CUDA=ON; docs/gpu.md)";
+
+bool fv_cuda_probe(char *why, size_t why_len)
+{
+    if (why && why_len) snprintf(why, why_len, "%s", k_no_cuda);
+    return false;
+}
+
+fv_status fv_cuda_pt_create(const struct fv_kscene *host, fv_cuda_pt **out, fv_error *err)
+{
+    (void)host;
+    *out = NULL;
+    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
+}
+
+fv_status fv_cuda_pt_update(fv_cuda_pt *c, const struct fv_kscene *host, fv_error *err)
+{
+    (void)c, (void)host;
+    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
+}
+
+fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays, uint64_t *nan_samples,
+                            double *kernel_ms, fv_error *err)
+{
+    (void)c, (void)f, (void)out, (void)rays, (void)nan_samples, (void)kernel_ms;
+    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
+}
+
+void fv_cuda_pt_destroy(fv_cuda_pt *c) { (void)c; }
+#else
+typedef int fv_cuda_stub_unused; /* ISO C: a translation unit is not empty */
+#endif

@@ -1,0 +1,23 @@
+/* fovea — the material at a hit on the flat scene (kernel/scene.h): the same rule as the CPU's
+ * fv_hit_material (scene/query.h), with the same texture lookup (kernel/texture.h): a textured
+ * material on a mesh with UVs gets its albedo read at the hit, anything else the scene's own.
+ */
+#ifndef FV_KERNEL_MATERIAL_H
+#define FV_KERNEL_MATERIAL_H
+
+#include "kernel/hit.h"
+#include "kernel/scene.h"
+#include "kernel/texture.h"
+
+FV_HD static inline const fv_material *fv_kscene_material_at(const fv_kscene *s, const fv_hit *h, fv_material *buf)
+{
+    const fv_material *m = &s->mats[h->mat];
+    if (!m->albedo_texture) return m;
+    const fv_kobject *o = &s->objs[h->obj];
+    if (o->uv_off < 0 || o->is_sdf || h->prim < 0 || h->prim >= o->ntri || m->albedo_texture < 1 || m->albedo_texture > s->ntex) return m;
+    const uint32_t *ix = &s->tri_vtx[3 * (o->first_tri + h->prim)];
+    const fv_vec2 *uv = &s->uv[o->uv_off - o->vtx_off];
+    return fv_kmaterial_textured(m, &s->tex[m->albedo_texture - 1], uv[ix[0]], uv[ix[1]], uv[ix[2]], h->u, h->v, buf);
+}
+
+#endif

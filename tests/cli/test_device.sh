@@ -1,0 +1,33 @@
+# `--device`: each refusal exits 2 with one line naming why and leaves no file; the portable
+# backend renders pt to an image like the CPU's (docs/gpu.md).
+. "$(dirname "$0")/lib.sh"
+OUT=$TMP/out.png
+R="$FOVEA render"
+
+expect 2 "device 'gpu' is not one of cpu, portable, cuda, auto" -- $R cornell --device gpu --size 8x8 --out "$OUT"
+expect 2 "device '' is not one of" -- $R cornell --device "" --size 8x8 --out "$OUT"
+# A method without a CUDA version names the methods that have one.
+expect 2 "method 'vpolar' does not run on device cuda (methods that do: pt)" -- $R cornell --method vpolar --device cuda --size 8x8 --out "$OUT"
+expect 2 "method 'fpm' does not run on device portable (methods that do: pt)" -- $R cornell --method fpm --device portable --size 8x8 --out "$OUT"
+# The same refusals through --param.
+expect 2 "parameter device=nope: expected one of cpu, portable, cuda, auto" -- $R cornell --method pt --param device=nope --size 8x8 --out "$OUT"
+# pt on CUDA: this build has no CUDA, or this machine no GPU (CI has neither); either is one line.
+if "$FOVEA" render cornell --device cuda --spp 1 --size 8x8 --out "$TMP/cuda.png" 2>"$TMP/cuda.err"; then
+  [ -s "$TMP/cuda.png" ] || fail "--device cuda succeeded without writing its image"
+else
+  code=$?
+  [ "$code" = 2 ] || fail "--device cuda exited $code, expected 2 or 0"
+  [ "$(grep -c '' "$TMP/cuda.err")" = 1 ] || fail "--device cuda printed more than one line: $(cat "$TMP/cuda.err")"
+  grep -qE "built without CUDA|no CUDA device" "$TMP/cuda.err" || fail "--device cuda refusal names neither cause: $(cat "$TMP/cuda.err")"
+  [ ! -e "$TMP/cuda.png" ] || fail "--device cuda refused but left $TMP/cuda.png"
+fi
+[ ! -e "$OUT" ] || fail "a refused render left $OUT"
+
+# auto falls back to the CPU where CUDA cannot run, and for a method without CUDA.
+expect 0 "" -- $R cornell --method vpolar --device auto --size 16x16 --out "$TMP/auto-vp.png"
+expect 0 "" -- $R cornell --device auto --spp 1 --size 16x16 --out "$TMP/auto.png"
+# The portable backend renders pt and every auxiliary channel (unit tests compare it with the CPU's).
+expect 0 "" -- $R cornell --device portable --spp 2 --size 24x24 --out "$TMP/portable.exr"
+[ -s "$TMP/portable.exr" ] || fail "--device portable wrote no image"
+expect 0 "" -- $R cornell --device portable --spp 2 --size 24x24 --frames 2 --stereo 0.1 --out "$TMP/portable-st.png"
+finish

@@ -1,0 +1,112 @@
+/* GPU tests (ctest label `gpu`; scripts/gpu-check runs them on an NVIDIA machine): `pt` on CUDA
+ * against `pt` on the portable backend, which runs the same kernel source on the CPU with the same
+ * random numbers, so the images agree pixel by pixel within float tolerance (the GPU's cosf and
+ * sinf differ from the C library's in the last bits, which may send a rare path elsewhere); two
+ * CUDA runs are bit-identical; the first-hit buffers agree. Exits 77 (skipped) where CUDA cannot
+ * run: a build without CUDA, a machine without a GPU.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+#include "fovea/fovea.h"
+#include "../unit/testkit.h"
+
+static fv_film *render(const fv_scene *s, const fv_camera *cam, const char *params, double time, int frames)
+{
+    fv_params *p = fv_test_params_str(params);
+    fv_technique *t = NULL;
+    fv_error err;
+    if (fv_technique_create("pt", s, p, NULL, &t, &err) != FV_OK) fail_msg("pt %s: %s", params, err.msg);
+    fv_film *film = NULL;
+    if (fv_film_create(cam->width, cam->height, FV_AUX_DEPTH | FV_AUX_ID | FV_AUX_ALBEDO, &film, &err) != FV_OK) fail_msg("%s", err.msg);
+    fv_frame f;
+    fv_frame_init(&f, cam);
+    f.seed = 11;
+    f.time = time;
+    fv_stats stats;
+    fv_test_render_frames(t, &f, frames, film, &stats);
+    if (fv_stats_get_count(&stats, "rays") <= 0.0) fail_msg("pt %s counted no rays", params);
+    if (fv_stats_get_count(&stats, "nan_samples") != 0.0) fail_msg("pt %s: %g non-finite samples", params, fv_stats_get_count(&stats, "nan_samples"));
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+    return film;
+}
+
+static void compare_scene(const char *name, int w, int h, double time, int frames)
+{
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load(name, &s, &v) != 0) fail_msg("cannot load %s", name);
+    fv_error err;
+    if (fv_scene_set_time(s, time, &err) != FV_OK) fail_msg("%s", err.msg);
+    fv_camera cam;
+    fv_view_camera(v, s, time, w, h, &cam);
+    fv_film *p = render(s, &cam, "spp=4 device=portable", time, frames);
+    fv_film *c1 = render(s, &cam, "spp=4 device=cuda", time, frames);
+    fv_film *c2 = render(s, &cam, "spp=4 device=cuda", time, frames);
+    fv_test_agreement r = fv_test_agree(p, c1, 1e-3);
+    printf("%s: portable (%.4f %.4f %.4f) cuda (%.4f %.4f %.4f): largest mean difference %.3g%%, %.2f%% of pixels equal within 1e-3, "
+           "RMS %.3g%% of the mean\n",
+           name, r.mean_a[0], r.mean_a[1], r.mean_a[2], r.mean_b[0], r.mean_b[1], r.mean_b[2], 100.0 * r.max_mean_rel, 100.0 * r.equal_share,
+           100.0 * r.rms_rel);
+    if (!(r.max_mean_rel <= 0.005)) fail_msg("%s: means differ by %.3g%%", name, 100.0 * r.max_mean_rel);
+    if (!(r.equal_share >= 0.95)) fail_msg("%s: only %.2f%% of pixels equal", name, 100.0 * r.equal_share);
+    if (!(r.rms_rel <= 0.05)) fail_msg("%s: RMS difference %.3g%% of the mean", name, 100.0 * r.rms_rel);
+    size_t n = (size_t)w * h;
+    if (memcmp(fv_film_color_const(c1), fv_film_color_const(c2), 3 * n * sizeof(float)) != 0) fail_msg("%s: two CUDA runs differ", name);
+    const uint32_t *ip = fv_film_id(p), *ic = fv_film_id(c1);
+    size_t same = 0;
+    for (size_t i = 0; i < n; i++) same += ip[i] == ic[i];
+    if (!((double)same >= 0.995 * (double)n)) fail_msg("%s: the first hit's object differs in %zu of %zu pixels", name, n - same, n);
+    fv_film_destroy(p);
+    fv_film_destroy(c1);
+    fv_film_destroy(c2);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+static void test_cornell(void **st)
+{
+    (void)st;
+    compare_scene("cornell", 128, 128, 0.0, 1);
+}
+
+static void test_city(void **st)
+{
+    (void)st;
+    compare_scene("city", 160, 96, 0.0, 1);
+}
+
+static void test_moving(void **st)
+{
+    (void)st;
+    compare_scene("cornell-fpm", 96, 96, 0.7, 3);
+}
+
+static void test_textured(void **st)
+{
+    (void)st;
+    compare_scene(FOVEA_TEST_DATA "/textured/box.glb", 96, 96, 0.0, 1);
+}
+
+static void test_sdf(void **st)
+{
+    (void)st;
+    compare_scene("sdf-primitives", 96, 96, 0.0, 1);
+}
+
+int main(void)
+{
+    char why[256];
+    if (!fv_device_available(FV_DEVICE_CUDA, why, sizeof why)) {
+        printf("skipped: %s\n", why);
+        return 77;
+    }
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_cornell), cmocka_unit_test(test_city), cmocka_unit_test(test_moving),
+                                       cmocka_unit_test(test_textured), cmocka_unit_test(test_sdf)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
