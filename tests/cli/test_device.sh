@@ -30,4 +30,12 @@ expect 0 "" -- $R cornell --device auto --spp 1 --size 16x16 --out "$TMP/auto.pn
 expect 0 "" -- $R cornell --device portable --spp 2 --size 24x24 --out "$TMP/portable.exr"
 [ -s "$TMP/portable.exr" ] || fail "--device portable wrote no image"
 expect 0 "" -- $R cornell --device portable --spp 2 --size 24x24 --frames 2 --stereo 0.1 --out "$TMP/portable-st.png"
+
+# bench --device: the measured methods that have the device run there, and the report says so.
+expect 2 "--device: device 'gpu' is not one of" -- $FOVEA bench pt-cornell --quick --device gpu --out "$TMP/bench-bad" --quiet
+[ ! -e "$TMP/bench-bad" ] || fail "a refused bench wrote $TMP/bench-bad"
+expect 0 "" -- $FOVEA bench pt-cornell --quick --device portable --out "$TMP/bench" --quiet
+n=$(grep -cE '"device":[[:space:]]*"portable"' "$TMP/bench/pt-cornell.json")
+[ "$n" -ge 3 ] || fail "bench --device portable: $n methods report device portable, expected the sweep's 3"
+grep -q "M rays/s" "$TMP/bench/pt-cornell.md" || fail "bench report lacks the ray throughput table"
 finish

@@ -90,7 +90,8 @@ static void test_moving(void **st)
 static void test_textured(void **st)
 {
     (void)st;
-    compare_scene(FOVEA_TEST_DATA "/textured/box.glb", 96, 96, 0.0, 1);
+    char path[4096];
+    compare_scene(fv_test_data("textured/box.glb", path, sizeof path), 96, 96, 0.0, 1);
 }
 
 static void test_sdf(void **st)

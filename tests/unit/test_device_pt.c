@@ -114,7 +114,8 @@ static void test_moving_object(void **st)
 static void test_textured_mesh(void **st)
 {
     (void)st;
-    compare_scene(FOVEA_TEST_DATA "/textured/box.glb", 48, 48, 0.0, 1, "");
+    char path[4096];
+    compare_scene(fv_test_data("textured/box.glb", path, sizeof path), 48, 48, 0.0, 1, "");
 }
 
 static void test_sdf_scene(void **st)

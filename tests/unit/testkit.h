@@ -12,6 +12,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
 #include "fovea/fovea.h"
@@ -97,6 +98,18 @@ static inline int fv_test_load(const char *name, fv_scene **scene, fv_view **vie
     if (fv_scene_load(name, NULL, scene, view, &err) == FV_OK) return 0;
     fprintf(stderr, "%s: %s\n", name, err.msg);
     return -1;
+}
+
+/* The path of test data file `rel` (under tests/data): $FOVEA_TEST_DATA when set (a test binary
+ * carried to another machine, scripts/gpu-check), else the source tree's folder it was built with. */
+static inline const char *fv_test_data(const char *rel, char *buf, size_t n)
+{
+    const char *dir = getenv("FOVEA_TEST_DATA");
+#ifdef FOVEA_TEST_DATA
+    if (!dir) dir = FOVEA_TEST_DATA;
+#endif
+    snprintf(buf, n, "%s/%s", dir ? dir : "tests/data", rel);
+    return buf;
 }
 
 /* ---- rendering by hand ---- */

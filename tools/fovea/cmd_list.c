@@ -19,6 +19,10 @@ int fv_cmd_methods(int argc, char **argv)
             printf("%18s--param %.*s\n", "", len, h);
             h = nl ? nl + 1 : h + len;
         }
+        /* Every method runs on the CPU; the others are the ones --device may choose. */
+        if (fv_technique_has_device(i, FV_DEVICE_PORTABLE) || fv_technique_has_device(i, FV_DEVICE_CUDA))
+            printf("%18sdevices: cpu%s%s (--device D or --param device=D; docs/gpu.md)\n", "", fv_technique_has_device(i, FV_DEVICE_PORTABLE) ? ", portable" : "",
+                   fv_technique_has_device(i, FV_DEVICE_CUDA) ? ", cuda" : "");
         if (argc == 2) return FV_EXIT_OK;
     }
     if (argc == 2) return fv_cli_usage_error("methods", "unknown method '%s'", argv[1]);

@@ -194,8 +194,7 @@ const fv_technique_class fv_technique_pt = {
     .summary = "reference path tracer: NEE + MIS, Russian roulette (ground truth)",
     .params_help = "spp=int (16): samples per pixel\n"
                    "max_depth=int (8): path vertices that gather light, 1 = direct light only\n"
-                   "rr_depth=int (3): depth from which Russian roulette may end paths\n"
-                   "device=cpu|portable|cuda|auto (cpu): where it runs (docs/gpu.md); --device sets it\n",
+                   "rr_depth=int (3): depth from which Russian roulette may end paths\n",
     .create_on = pt_create,
     .devices = (1u << FV_DEVICE_PORTABLE) | (1u << FV_DEVICE_CUDA),
     .render = pt_render,
