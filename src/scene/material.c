@@ -1,4 +1,4 @@
-/* fovea — material defaults, names and validation (the BSDFs themselves are in bsdf.c). */
+/* fovea — material defaults, names and validation (the BSDFs themselves are kernel/bsdf.h). */
 #include <stdio.h>
 #include <string.h>
 #include "fovea/limits.h"
