@@ -1,6 +1,6 @@
 /* fovea — the slab test: where a ray crosses an axis-aligned box. Shared by the SDF user geometry
  * (scene/scene_sdf.c), which clips each ray to a field's box before sphere-tracing it, and the
- * sphere tracers of the SDF family (technique/sdf/world.c). */
+ * sphere tracers of the SDF family (technique/sdf/world.c); kernel code too (kernel/sdf_trace.h). */
 #ifndef FV_CORE_RAY_BOX_H
 #define FV_CORE_RAY_BOX_H
 
@@ -9,7 +9,7 @@
 
 /* Narrows [*t0, *t1] to the part of o + t d (d need not be unit) inside [lo, hi]; false when
  * nothing is left. A ray parallel to a slab is inside it everywhere or nowhere. */
-static inline bool fv_ray_box_clip(fv_vec3 o, fv_vec3 d, fv_vec3 lo, fv_vec3 hi, float *t0, float *t1)
+FV_HD static inline bool fv_ray_box_clip(fv_vec3 o, fv_vec3 d, fv_vec3 lo, fv_vec3 hi, float *t0, float *t1)
 {
     const float oa[3] = {o.x, o.y, o.z}, da[3] = {d.x, d.y, d.z}, la[3] = {lo.x, lo.y, lo.z}, ha[3] = {hi.x, hi.y, hi.z};
     float a = *t0, b = *t1;

@@ -1,10 +1,10 @@
 /* fovea — sphere tracing one SDF object of a kernel scene (kernel/scene.h), for the portable
  * traversal (kernel/traverse.h) on the CPU and on CUDA.
  *
- * The same algorithm as the Embree user geometry (scene/scene_sdf.c's sdf_trace): clip to the
- * field's padded box, walk out of the hit band when the ray starts inside it, march at most
- * FV_SDF_TRACE_STEPS steps, refine FV_SDF_REFINE times; the normal is fv_sdf_normal's central
- * differences and the material the nearest leaf's. The field is evaluated by the scalar build of
+ * The one sphere tracer of SDF objects, which the Embree user geometry (scene/scene_sdf.c) calls
+ * too: clip to the field's padded box, walk out of the hit band when the ray starts inside it,
+ * march at most FV_KSDF_TRACE_STEPS steps, refine FV_KSDF_REFINE times; the normal is
+ * fv_sdf_normal's central differences and the material the nearest leaf's. The field is evaluated by the scalar build of
  * the one SDF kernel (sdf/kernel.h with FV_K_WIDE 0, host-and-device under nvcc), so on the CPU
  * every distance, and therefore every hit, is bit-identical to the Embree path's.
  *
@@ -16,6 +16,7 @@
 
 #include <math.h>
 #include <stdbool.h>
+#include "core/ray_box.h"
 #include "fovea/math.h"
 #include "kernel/scene.h"
 
@@ -25,8 +26,10 @@
 #define FV_K_WIDE 0
 #include "sdf/kernel.h"
 
-/* Kept equal to scene/scene_sdf.c's constants of the same names (its banner explains them). */
+/* A ray that needs more steps than this is reported as a miss. */
 #define FV_KSDF_TRACE_STEPS 512
+/* Newton-like steps along the ray after the hit, which put the point on the surface to float
+ * precision for rays that are not grazing. */
 #define FV_KSDF_REFINE 3
 
 /* The object's field as the kernel evaluates it: a view of its ops in the shared program array. */
@@ -64,75 +67,54 @@ FV_HD static inline fv_vec3 fv_ksdf_normal(const fv_sdf *f, fv_vec3 p)
     return l > 0.0f && isfinite(l) ? fv_scale(g, 1.0f / l) : fv_v3(0.0f, 0.0f, 0.0f);
 }
 
-/* core/ray_box.h's fv_ray_box_clip, written again here with the same operations (kernel headers
- * include no core/ header but rng.h): narrows [*t0, *t1] to the part of o + t d inside [lo, hi]. */
-FV_HD static inline bool fv_ksdf_box_clip(fv_vec3 o, fv_vec3 d, fv_vec3 lo, fv_vec3 hi, float *t0, float *t1)
+/* The box the tracer clips to and a BVH bounds the field by: its bounds grown by four hit
+ * distances eps, so a surface on the box's face (a plane clipped by its own bounding box) is still
+ * reached from outside. */
+FV_HD static inline void fv_sdf_padded_box(fv_vec3 field_lo, fv_vec3 field_hi, float eps, fv_vec3 *lo, fv_vec3 *hi)
 {
-    const float oa[3] = {o.x, o.y, o.z}, da[3] = {d.x, d.y, d.z}, la[3] = {lo.x, lo.y, lo.z}, ha[3] = {hi.x, hi.y, hi.z};
-    float a = *t0, b = *t1;
-    for (int k = 0; k < 3; k++) {
-        if (da[k] == 0.0f) {
-            if (oa[k] < la[k] || oa[k] > ha[k]) return false;
-            continue;
-        }
-        float inv = 1.0f / da[k];
-        float ta = (la[k] - oa[k]) * inv, tb = (ha[k] - oa[k]) * inv;
-        if (ta > tb) {
-            float sw = ta;
-            ta = tb;
-            tb = sw;
-        }
-        if (ta > a) a = ta;
-        if (tb < b) b = tb;
-    }
-    *t0 = a;
-    *t1 = b;
-    return a <= b;
+    fv_vec3 pad = fv_v3s(4.0f * eps);
+    *lo = fv_sub(field_lo, pad);
+    *hi = fv_add(field_hi, pad);
 }
 
-/* The box the tracer clips to and the top level bounds the object by: the field's bounds grown
- * by four hit distances (scene_sdf.c's padded_box). */
-FV_HD static inline void fv_ksdf_padded_box(const fv_kobject *ob, fv_vec3 *lo, fv_vec3 *hi)
-{
-    fv_vec3 pad = fv_v3s(4.0f * ob->sdf_eps);
-    *lo = fv_sub(ob->lo, pad);
-    *hi = fv_add(ob->hi, pad);
-}
-
-/* Sphere-traces object-space o + t d for t in [tnear, tfar] (d need not be unit); the hit's t in
- * *thit. Statement for statement scene_sdf.c's sdf_trace. */
-FV_HD static inline bool fv_ksdf_trace(const fv_kscene *s, const fv_kobject *ob, fv_vec3 o, fv_vec3 d, float tnear, float tfar,
-                                       float *thit)
+/* Sphere-traces field f along o + t d for t in [tnear, tfar] (object space; d need not be unit),
+ * hitting where the distance falls below eps (Polychronakis et al. 2023, Sec. 2.1: march by the
+ * distance the field returns, which never overshoots); the hit's t in *thit. The one tracer of SDF
+ * objects: Embree's user geometry (scene/scene_sdf.c) and the portable traversal call it. */
+FV_HD static inline bool fv_sdf_trace_field(const fv_sdf *f, float eps, fv_vec3 o, fv_vec3 d, float tnear, float tfar, float *thit)
 {
     fv_vec3 lo, hi;
-    fv_ksdf_padded_box(ob, &lo, &hi);
+    fv_sdf_padded_box(f->lo, f->hi, eps, &lo, &hi);
     float t0 = tnear, t1 = tfar;
-    if (!fv_ksdf_box_clip(o, d, lo, hi, &t0, &t1)) return false;
+    if (!fv_ray_box_clip(o, d, lo, hi, &t0, &t1)) return false;
     float dl = fv_length(d);
     if (!(dl > 0.0f) || !isfinite(dl)) return false;
-    const fv_sdf f = fv_ksdf_field(s, ob);
-    const float eps = ob->sdf_eps, inv_dl = 1.0f / dl;
+    const float inv_dl = 1.0f / dl;
 
     float t = t0;
-    float dist = fv_ksdf_distance(&f, fv_madd(o, d, t), 0);
-    /* A ray starting inside the hit band at its own origin is leaving that surface: walk out of
-     * the band first, or it would hit itself at t = tnear. */
+    float dist = fv_ksdf_distance(f, fv_madd(o, d, t), 0);
+    /* A ray that starts on a surface (inside the hit band at its own origin, not where it enters
+     * the box) is leaving that surface: walk out of the band before looking for hits, or it would
+     * hit itself at t = tnear. Fields whose bound is loose (height fields, smooth unions) can
+     * leave a ray offset by the scene's epsilon still inside the band. */
     int step = 0;
     if (t0 == tnear && fabsf(dist) < eps) {
         while (fabsf(dist) < eps) {
             t += fmaxf(fabsf(dist), eps) * inv_dl;
             if (t > t1 || ++step >= FV_KSDF_TRACE_STEPS) return false;
-            dist = fv_ksdf_distance(&f, fv_madd(o, d, t), 0);
+            dist = fv_ksdf_distance(f, fv_madd(o, d, t), 0);
         }
     }
-    /* side: +1 marching outside the solid, -1 inside (a refracted ray). */
+    /* side: +1 when marching outside the solid, -1 inside (a refracted ray), so side * dist is
+     * the distance to the surface ahead either way, and < eps once the surface is reached or
+     * crossed. */
     float side = dist >= 0.0f ? 1.0f : -1.0f;
     for (; step < FV_KSDF_TRACE_STEPS; step++) {
         float ds = side * dist;
         if (ds < eps) {
             for (int k = 0; k < FV_KSDF_REFINE; k++) {
                 t += ds * inv_dl;
-                ds = side * fv_ksdf_distance(&f, fv_madd(o, d, t), 0);
+                ds = side * fv_ksdf_distance(f, fv_madd(o, d, t), 0);
             }
             if (!(t >= tnear && t <= tfar)) return false;
             *thit = t;
@@ -140,9 +122,23 @@ FV_HD static inline bool fv_ksdf_trace(const fv_kscene *s, const fv_kobject *ob,
         }
         t += ds * inv_dl;
         if (t > t1) return false;
-        dist = fv_ksdf_distance(&f, fv_madd(o, d, t), 0);
+        dist = fv_ksdf_distance(f, fv_madd(o, d, t), 0);
     }
     return false;
+}
+
+/* The field of object ob of a kernel scene, traced as above. */
+FV_HD static inline bool fv_ksdf_trace(const fv_kscene *s, const fv_kobject *ob, fv_vec3 o, fv_vec3 d, float tnear, float tfar,
+                                       float *thit)
+{
+    const fv_sdf f = fv_ksdf_field(s, ob);
+    return fv_sdf_trace_field(&f, ob->sdf_eps, o, d, tnear, tfar, thit);
+}
+
+/* The top level's box of object ob: its field's padded box. */
+FV_HD static inline void fv_ksdf_padded_box(const fv_kobject *ob, fv_vec3 *lo, fv_vec3 *hi)
+{
+    fv_sdf_padded_box(ob->lo, ob->hi, ob->sdf_eps, lo, hi);
 }
 
 #endif

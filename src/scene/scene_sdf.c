@@ -12,7 +12,7 @@
  *
  * Limits: the hit is where |distance| falls below 1e-4 of the field's bounds diagonal (then
  * refined), so a ray grazing a surface closer than that counts as a hit, as in any sphere tracer;
- * a ray that needs more than FV_SDF_TRACE_STEPS steps is reported as a miss. SDF objects never
+ * a ray that needs more than FV_KSDF_TRACE_STEPS steps is reported as a miss (kernel/sdf_trace.h). SDF objects never
  * emit: lights stay emissive triangles and delta lights.
  */
 #include <float.h>
@@ -20,16 +20,12 @@
 #include <stdio.h>
 #include <string.h>
 #include "core/alloc.h"
-#include "core/ray_box.h"
+#include "kernel/sdf_trace.h"
 #include "scene/scene_impl.h"
 
-#define FV_SDF_TRACE_STEPS 512
 /* Hit distance relative to the field's bounds diagonal; the scene's ray offset (1e-4 of the
  * whole scene's diagonal) is never smaller, so a ray leaving a surface starts outside the band. */
 #define FV_SDF_HIT_REL 1e-4f
-/* Newton-like steps along the ray after the hit, which put the point on the surface to float
- * precision for rays that are not grazing. */
-#define FV_SDF_REFINE 3
 
 static bool is_leaf(fv_sdf_kind k) { return k >= FV_SDF_SPHERE && k <= FV_SDF_HEIGHTFIELD; }
 
@@ -86,60 +82,14 @@ int fv_scene_sdf_material(const fv_object *o, fv_vec3 p)
     return m;
 }
 
-/* The box the tracer clips to: the field's bounds grown by a few hit distances, so a surface on
- * the box's face (a plane clipped by its own bounding box) is still reached from outside. */
-static void padded_box(const fv_object *o, fv_vec3 *lo, fv_vec3 *hi)
-{
-    fv_vec3 pad = fv_v3s(4.0f * o->sdf_eps);
-    *lo = fv_sub(o->lo, pad);
-    *hi = fv_add(o->hi, pad);
-}
+/* The box the tracer clips to and Embree bounds the field by (kernel/sdf_trace.h). */
+static void padded_box(const fv_object *o, fv_vec3 *lo, fv_vec3 *hi) { fv_sdf_padded_box(o->lo, o->hi, o->sdf_eps, lo, hi); }
 
-/* Sphere-traces o + t d for t in [tnear, tfar] (d need not be unit); the hit's t in *thit. */
+/* Sphere-traces o + t d for t in [tnear, tfar] (d need not be unit): the one tracer of fields,
+ * kernel/sdf_trace.h, which the portable and CUDA traversals run too. */
 static bool sdf_trace(const fv_object *ob, fv_vec3 o, fv_vec3 d, float tnear, float tfar, float *thit)
 {
-    fv_vec3 lo, hi;
-    padded_box(ob, &lo, &hi);
-    float t0 = tnear, t1 = tfar;
-    if (!fv_ray_box_clip(o, d, lo, hi, &t0, &t1)) return false;
-    float dl = fv_length(d);
-    if (!(dl > 0.0f) || !isfinite(dl)) return false;
-    const float eps = ob->sdf_eps, inv_dl = 1.0f / dl;
-
-    float t = t0;
-    float dist = fv_sdf_distance(ob->sdf, fv_madd(o, d, t), NULL);
-    /* A ray that starts on a surface (inside the hit band at its own origin, not where it enters
-     * the box) is leaving that surface: walk out of the band before looking for hits, or it would
-     * hit itself at t = tnear. Fields whose bound is loose (height fields, smooth unions) can
-     * leave a ray offset by the scene's epsilon still inside the band. */
-    int step = 0;
-    if (t0 == tnear && fabsf(dist) < eps) {
-        while (fabsf(dist) < eps) {
-            t += fmaxf(fabsf(dist), eps) * inv_dl;
-            if (t > t1 || ++step >= FV_SDF_TRACE_STEPS) return false;
-            dist = fv_sdf_distance(ob->sdf, fv_madd(o, d, t), NULL);
-        }
-    }
-    /* side: +1 when marching outside the solid, -1 inside (a refracted ray), so side * dist is
-     * the distance to the surface ahead either way, and < eps once the surface is reached or
-     * crossed. */
-    float side = dist >= 0.0f ? 1.0f : -1.0f;
-    for (; step < FV_SDF_TRACE_STEPS; step++) {
-        float ds = side * dist;
-        if (ds < eps) {
-            for (int k = 0; k < FV_SDF_REFINE; k++) {
-                t += ds * inv_dl;
-                ds = side * fv_sdf_distance(ob->sdf, fv_madd(o, d, t), NULL);
-            }
-            if (!(t >= tnear && t <= tfar)) return false;
-            *thit = t;
-            return true;
-        }
-        t += ds * inv_dl;
-        if (t > t1) return false;
-        dist = fv_sdf_distance(ob->sdf, fv_madd(o, d, t), NULL);
-    }
-    return false;
+    return fv_sdf_trace_field(ob->sdf, ob->sdf_eps, o, d, tnear, tfar, thit);
 }
 
 /* Embree's SOA packets of runtime size N (rtcore_ray.h gives accessors only to C++): ray fields
