@@ -96,13 +96,14 @@ static void methods_on(fv_device d, char *list, size_t n)
 
 fv_status fv_device_check(const char *method, const char *name, fv_device *out, fv_error *err)
 {
+    if (fv_technique_index(method) < 0) return fv_error_set(err, FV_ERR_INVALID, "unknown method '%s'", method ? method : "(null)");
     fv_status s = fv_device_parse(name, method, out, err);
     if (s != FV_OK) return s;
     if (!fv_technique_has_device(fv_technique_index(method), *out)) {
         char list[256];
         methods_on(*out, list, sizeof list);
-        return fv_error_set(err, FV_ERR_INVALID, "method '%s' does not run on device %s (methods that do: %s)", method ? method : "(null)",
-                            fv_device_name(*out), list);
+        return fv_error_set(err, FV_ERR_INVALID, "method '%s' does not run on device %s (methods that do: %s)", method, fv_device_name(*out),
+                            list);
     }
     char why[256];
     if (!fv_device_available(*out, why, sizeof why))

@@ -163,8 +163,12 @@ static void test_refusals(void **st)
     }
     fv_technique_destroy(t);
     fv_params_destroy(p);
-    /* auto: CUDA when it can run, else the CPU; a method without CUDA stays on the CPU. */
     fv_device d;
+    fv_test_expect_fail(fv_device_check("nope", "cpu", &d, &err), &err, FV_ERR_INVALID, "unknown method 'nope'", "device_check nope");
+    fv_test_expect_fail(fv_device_check(NULL, "cpu", &d, &err), &err, FV_ERR_INVALID, "unknown method '(null)'", "device_check NULL");
+    assert_int_equal(fv_device_check("fir", "cpu", &d, &err), FV_OK);
+    assert_int_equal(d, FV_DEVICE_CPU);
+    /* auto: CUDA when it can run, else the CPU; a method without CUDA stays on the CPU. */
     assert_int_equal(fv_device_parse("auto", "vpolar", &d, &err), FV_OK);
     assert_int_equal(d, FV_DEVICE_CPU);
     assert_int_equal(fv_device_parse("auto", "pt", &d, &err), FV_OK);
