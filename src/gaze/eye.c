@@ -1,16 +1,10 @@
-/* fovea — display/eye model: eccentricity of a pixel and the fovea / transition / periphery split.
- *
- * Foveated Photon Mapping, Eq. 7 gives the foveal radius in pixels as tan(e_f) * b * PPI with b the
- * pupil-to-lens distance; we read b * PPI as a viewing distance D in pixels and use the same
- * relation both ways (eccentricity = atan(d / D) for a pixel d pixels from the gaze point), so
- * radii given in degrees and eccentricities measured in degrees always agree. Eq. 6 gives the
- * transition blend weight. Foveated Instant Radiosity (Sec. 5) gives the radius as 25% of the
- * image width instead; FV_FOVEA_WIDTH covers it.
+/* fovea — display/eye model: its defaults and checks, and the public entry points of its geometry
+ * (eccentricity of a pixel, the fovea / transition / periphery split, the transition's blend),
+ * whose equations are kernel code (kernel/eye.h, which cites the papers).
  */
 #include <math.h>
 #include "fovea/gaze.h"
-
-#define MM_PER_INCH 25.4
+#include "kernel/eye.h"
 
 void fv_eye_model_default(int width, int height, fv_eye_model *m)
 {
@@ -62,35 +56,17 @@ void fv_eye_model_whole_screen(const fv_eye_model *m, fv_eye_model *out)
     out->fovea_frac = out->transition_frac = (float)fmin(frac, 4.0);
 }
 
-double fv_eye_view_dist_px(const fv_eye_model *m)
-{
-    if (m->fov_x_deg > 0.0f) return 0.5 * m->width / tan(0.5 * m->fov_x_deg * FV_PI_D / 180.0);
-    return (double)m->eye_dist_mm / MM_PER_INCH * m->ppi;
-}
+double fv_eye_view_dist_px(const fv_eye_model *m) { return fv_keye_view_dist_px(m); }
 
-double fv_eye_px_per_deg(const fv_eye_model *m) { return fv_eye_view_dist_px(m) * FV_PI_D / 180.0; }
+double fv_eye_px_per_deg(const fv_eye_model *m) { return fv_keye_view_dist_px(m) * FV_PI_D / 180.0; }
 
-double fv_eye_fovea_radius_px(const fv_eye_model *m)
-{
-    if (m->mode == FV_FOVEA_WIDTH) return (double)m->fovea_frac * m->width;
-    return tan(m->fovea_deg * FV_PI_D / 180.0) * fv_eye_view_dist_px(m);
-}
+double fv_eye_fovea_radius_px(const fv_eye_model *m) { return fv_keye_fovea_radius_px(m); }
 
-double fv_eye_transition_radius_px(const fv_eye_model *m)
-{
-    if (m->mode == FV_FOVEA_WIDTH) return (double)m->transition_frac * m->width;
-    return tan(m->transition_deg * FV_PI_D / 180.0) * fv_eye_view_dist_px(m);
-}
+double fv_eye_transition_radius_px(const fv_eye_model *m) { return fv_keye_transition_radius_px(m); }
 
-double fv_eye_gaze_dist_px(const fv_eye_model *m, fv_gaze g, double px, double py)
-{
-    return hypot(px - (double)g.x * m->width, py - (double)g.y * m->height);
-}
+double fv_eye_gaze_dist_px(const fv_eye_model *m, fv_gaze g, double px, double py) { return fv_keye_gaze_dist_px(m, g, px, py); }
 
-double fv_eye_eccentricity_deg(const fv_eye_model *m, fv_gaze g, double px, double py)
-{
-    return atan(fv_eye_gaze_dist_px(m, g, px, py) / fv_eye_view_dist_px(m)) * 180.0 / FV_PI_D;
-}
+double fv_eye_eccentricity_deg(const fv_eye_model *m, fv_gaze g, double px, double py) { return fv_keye_eccentricity_deg(m, g, px, py); }
 
 const char *fv_region_name(fv_region r)
 {
@@ -103,29 +79,17 @@ const char *fv_region_name(fv_region r)
     }
 }
 
-static fv_region classify(double d, double rf, double rt)
-{
-    return d <= rf ? FV_REGION_FOVEA : d <= rt ? FV_REGION_TRANSITION : FV_REGION_PERIPHERY;
-}
-
 fv_region fv_eye_region(const fv_eye_model *m, fv_gaze g, int x, int y)
 {
-    return classify(fv_eye_gaze_dist_px(m, g, x + 0.5, y + 0.5), fv_eye_fovea_radius_px(m), fv_eye_transition_radius_px(m));
+    return fv_keye_classify(fv_keye_gaze_dist_px(m, g, x + 0.5, y + 0.5), fv_keye_fovea_radius_px(m), fv_keye_transition_radius_px(m));
 }
 
 void fv_eye_region_labels(const fv_eye_model *m, fv_gaze g, uint8_t *labels)
 {
-    double rf = fv_eye_fovea_radius_px(m), rt = fv_eye_transition_radius_px(m);
+    double rf = fv_keye_fovea_radius_px(m), rt = fv_keye_transition_radius_px(m);
     for (int y = 0; y < m->height; y++)
         for (int x = 0; x < m->width; x++)
-            labels[(size_t)y * m->width + x] = (uint8_t)classify(fv_eye_gaze_dist_px(m, g, x + 0.5, y + 0.5), rf, rt);
+            labels[(size_t)y * m->width + x] = (uint8_t)fv_keye_classify(fv_keye_gaze_dist_px(m, g, x + 0.5, y + 0.5), rf, rt);
 }
 
-double fv_eye_blend(const fv_eye_model *m, fv_gaze g, double px, double py)
-{
-    double d = fv_eye_gaze_dist_px(m, g, px, py);
-    double rf = fv_eye_fovea_radius_px(m), rt = fv_eye_transition_radius_px(m);
-    if (d <= rf) return 0.0;
-    if (d >= rt || rt <= rf) return 1.0;
-    return (d - rf) / (rt - rf);
-}
+double fv_eye_blend(const fv_eye_model *m, fv_gaze g, double px, double py) { return fv_keye_blend(m, g, px, py); }
