@@ -66,6 +66,15 @@ SCRIPT
   >"$TMP/run2.out" 2>&1 || fail "the second scripted session failed: $(cat "$TMP/run2.out")"
 [ "$(grep -c '' "$TMP/fps.csv" 2>/dev/null)" = 11 ] || fail "--fps-log should hold a header and 10 frames: $(cat "$TMP/fps.csv" 2>/dev/null)"
 
+# --device: pt's frames from the portable backend (the GPU's kernel on the CPU) reach the window.
+cat >"$TMP/dev.txt" <<SCRIPT
+1 screenshot $TMP/dev.png
+2 quit
+SCRIPT
+(cd "$TMP" && xvfb-run -a "$VIEW" cornell --method pt --device portable --size 160x90 --threads 2 --script "$TMP/dev.txt") \
+  >"$TMP/dev.out" 2>&1 || fail "the session on --device portable failed: $(cat "$TMP/dev.out")"
+[ -s "$TMP/dev.png" ] || fail "the session on --device portable took no screenshot"
+
 # closing mid-frame: SDL turns SIGTERM into the same quit event as the window's close button; ir's
 # first 640x360 frame takes seconds, the progress callback sees the quit and cancels it: exit 0 at once
 xvfb-run -a sh -c '"$0" cornell-fir --method ir --fps-log "$1" & p=$!; sleep 2; t0=$(date +%s%N); kill -TERM $p; wait $p; rc=$?
