@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/csv.h"
+#include "core/fileio.h"
 
 fv_csv_kind fv_csv_line(const char *line, bool before_rows, double *v, int max, int *n)
 {
@@ -47,17 +48,23 @@ fv_csv_kind fv_csv_line(const char *line, bool before_rows, double *v, int max, 
 
 fv_status fv_csv_read(const char *path, const char *what, int max, const char *expect, fv_csv_row_fn row, void *ctx, fv_error *err)
 {
-    FILE *f = fopen(path, "r");
-    if (!f) return fv_error_set(err, FV_ERR_IO, "cannot open %s '%s': %s", what, path, strerror(errno));
+    FILE *f;
+    fv_status st = fv_file_open_read(path, what, &f, err);
+    if (st != FV_OK) return st;
     char *line = NULL;
     size_t cap = 0;
     int lineno = 0, rows = 0;
     bool before = true;
     double prev = 0.0, v[32];
     if (max > 32) max = 32;
-    fv_status st = FV_OK;
-    while (st == FV_OK && getline(&line, &cap, f) >= 0) {
+    long len;
+    while (st == FV_OK && (len = fv_file_getline(f, &line, &cap, FV_LINE_MAX)) != 0) {
         lineno++;
+        if (len < 0) {
+            st = len == -1 ? fv_error_set(err, FV_ERR_INVALID, "%s:%d: line longer than %d bytes", path, lineno, FV_LINE_MAX)
+                           : fv_error_set(err, FV_ERR_NOMEM, "out of memory reading '%s'", path);
+            break;
+        }
         int n = 0;
         fv_csv_kind kind = fv_csv_line(line, before, v, max, &n);
         if (kind == FV_CSV_SKIP) continue;

@@ -21,8 +21,10 @@ typedef fv_status (*fv_csv_row_fn)(void *ctx, const double *v, int n, const char
 
 /* Reads a trace file line by line: comments, blank lines and one header are skipped; a line that is
  * not a row of at most `max` numbers fails with "path:line: expected <expect>"; a time that is not
- * finite or does not increase fails too; so does a file without samples. `what` names the file
- * in messages ("gaze trace"). */
+ * finite or does not increase fails too; so does a file without samples, a line longer than
+ * FV_LINE_MAX bytes ("path:line: line longer than 65536 bytes") and anything but a regular file
+ * (fv_file_open_read: /dev/zero would read forever, a FIFO block). `what` names the file in
+ * messages ("gaze trace"). */
 fv_status fv_csv_read(const char *path, const char *what, int max, const char *expect, fv_csv_row_fn row, void *ctx, fv_error *err);
 
 #endif

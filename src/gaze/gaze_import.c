@@ -41,6 +41,16 @@ typedef struct writer {
     fv_gaze_import_info *info;
 } writer;
 
+/* The next line of the recording (at most FV_LINE_MAX bytes): true for a line; false at the end,
+ * on a read error (ferror tells) or with *st set for a line too long. */
+static bool next_line(FILE *in, const writer *w, char **line, size_t *cap, int lineno, fv_status *st, fv_error *err)
+{
+    long n = fv_file_getline(in, line, cap, FV_LINE_MAX);
+    if (n == -1) *st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: line longer than %d bytes", w->in, lineno, FV_LINE_MAX);
+    else if (n < 0) *st = fv_error_set(err, FV_ERR_NOMEM, "out of memory reading '%s'", w->in);
+    return n > 0;
+}
+
 static bool on_screen(double x, double y) { return x >= 0.0 && x <= 1.0 && y >= 0.0 && y <= 1.0; }
 
 /* One sample (time in seconds; an eye is missing when its coordinates are NaN). */
@@ -98,14 +108,20 @@ static fv_status import_asc(FILE *in, writer *w, fv_error *err)
     size_t cap = 0;
     double left = 0, top = 0, right = -1, bottom = -1;
     bool has_left = false, has_right = false, sized = false;
+    fv_status st = FV_OK;
+    int lineno = 0;
     /* First pass: the screen and the eyes. */
-    while (getline(&line, &cap, in) >= 0) {
+    while (next_line(in, w, &line, &cap, ++lineno, &st, err)) {
         const char *d = strstr(line, "DISPLAY_COORDS");
         if (starts_with(line, "MSG") && d && sscanf(d + 14, "%lf %lf %lf %lf", &left, &top, &right, &bottom) == 4) sized = true;
         if (starts_with(line, "START") || starts_with(line, "SAMPLES")) {
             has_left |= strstr(line, "LEFT") != NULL;
             has_right |= strstr(line, "RIGHT") != NULL;
         }
+    }
+    if (st != FV_OK || ferror(in)) {
+        free(line);
+        return st != FV_OK ? st : fv_error_set(err, FV_ERR_IO, "cannot read '%s': %s", w->in, strerror(errno));
     }
     if (w->info->width > 0 && w->info->height > 0) {
         left = top = 0;
@@ -129,7 +145,8 @@ static fv_status import_asc(FILE *in, writer *w, fv_error *err)
     /* Second pass: samples, with each eye's blinks. In a monocular recording the one eye's
      * samples come first whichever it is. */
     bool blink[2] = {false, false};
-    while (getline(&line, &cap, in) >= 0) {
+    lineno = 0;
+    while (next_line(in, w, &line, &cap, ++lineno, &st, err)) {
         if (!isdigit((unsigned char)line[0])) {
             char eye = 0;
             if (sscanf(line, "SBLINK %c", &eye) == 1 || sscanf(line, "EBLINK %c", &eye) == 1) {
@@ -152,7 +169,7 @@ static fv_status import_asc(FILE *in, writer *w, fv_error *err)
         put_sample(w, t / 1000.0, (xl - left) / sw, (yl - top) / sh, (xr - left) / sw, (yr - top) / sh);
     }
     free(line);
-    return FV_OK;
+    return st;
 }
 
 /* ---- Pupil Labs gaze_positions.csv ---- */
@@ -189,7 +206,8 @@ static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_error *er
     char *line = NULL;
     size_t cap = 0;
     int col_t = -1, col_c = -1, col_x = -1, col_y = -1;
-    if (getline(&line, &cap, in) >= 0) {
+    fv_status st = FV_OK;
+    if (next_line(in, w, &line, &cap, 1, &st, err)) {
         for (int k = 0;; k++) {
             size_t len;
             const char *f = csv_field(line, k, &len);
@@ -201,6 +219,10 @@ static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_error *er
             else if (len == 10 && !strncmp(f, "norm_pos_y", 10)) col_y = k;
         }
     }
+    if (st != FV_OK) {
+        free(line);
+        return st;
+    }
     if (col_t < 0 || col_c < 0 || col_x < 0 || col_y < 0) {
         free(line);
         return fv_error_set(err, FV_ERR_INVALID, "%s: the header lacks gaze_timestamp, confidence, norm_pos_x or norm_pos_y (is it Pupil's gaze_positions.csv?)",
@@ -208,8 +230,7 @@ static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_error *er
     }
     w->binocular = false;
     int lineno = 1;
-    fv_status st = FV_OK;
-    while (st == FV_OK && getline(&line, &cap, in) >= 0) {
+    while (st == FV_OK && next_line(in, w, &line, &cap, lineno + 1, &st, err)) {
         lineno++;
         if (line[strspn(line, " \t\r\n")] == '\0') continue;
         double t, c, x, y;
@@ -243,15 +264,19 @@ fv_status fv_gaze_import(const char *in_path, const char *out_path, const fv_gaz
     info->width = opts->width;
     info->height = opts->height;
     fv_gaze_format fmt = opts->format != FV_GAZE_FORMAT_AUTO ? opts->format : guess_format(in_path);
-    if (fmt != FV_GAZE_FORMAT_EYELINK_ASC && fmt != FV_GAZE_FORMAT_PUPIL_CSV)
-        return fv_error_set(err, FV_ERR_INVALID, "%s: unknown recording format (an EyeLink .asc or Pupil Labs gaze_positions .csv)", in_path);
     if (!(opts->min_confidence >= 0.0 && opts->min_confidence <= 1.0))
         return fv_error_set(err, FV_ERR_INVALID, "gaze import: confidence threshold %g is outside [0, 1]", opts->min_confidence);
-    FILE *in = fopen(in_path, "rb");
-    if (!in) return fv_error_set(err, FV_ERR_IO, "cannot open '%s': %s", in_path, strerror(errno));
+    /* A regular file only, whatever its name (core/fileio.h: /dev/zero reads forever). */
+    FILE *in;
+    fv_status st = fv_file_open_read(in_path, "recording", &in, err);
+    if (st != FV_OK) return st;
+    if (fmt != FV_GAZE_FORMAT_EYELINK_ASC && fmt != FV_GAZE_FORMAT_PUPIL_CSV) {
+        fclose(in);
+        return fv_error_set(err, FV_ERR_INVALID, "%s: unknown recording format (an EyeLink .asc or Pupil Labs gaze_positions .csv)", in_path);
+    }
     fv_atomic_file af;
     FILE *out = NULL;
-    fv_status st = fv_atomic_file_begin(out_path, &af, err);
+    st = fv_atomic_file_begin(out_path, &af, err);
     if (st != FV_OK) {
         fclose(in);
         return st;

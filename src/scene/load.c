@@ -6,6 +6,7 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include "core/fileio.h"
 #include "scene/load_impl.h"
 #include "scene/scene_impl.h"
 
@@ -55,11 +56,9 @@ fv_status fv_scene_open(const char *name, const fv_log *log, fv_scene **out, fv_
             }
             return fv_error_set(err, FV_ERR_IO, "cannot open scene '%s': %s", name, strerror(errno));
         }
-        if (S_ISDIR(sb.st_mode)) return fv_error_set(err, FV_ERR_IO, "cannot open scene '%s': it is a directory", name);
-        /* assimp reports an unreadable file as a format error; say what it is before. */
-        FILE *f = fopen(name, "rb");
-        if (!f) return fv_error_set(err, FV_ERR_IO, "cannot open scene '%s': %s", name, strerror(errno));
-        fclose(f);
+        /* assimp reports an unreadable file as a format error; say what it is before. Only a
+         * regular file: /dev/zero would read forever, a FIFO block the reader (core/fileio.h). */
+        if ((st = fv_file_check_read(name, "scene", err)) != FV_OK) return st;
         if (!has_ext(name, ".json") && !fv_load_assimp_supports(name))
             return fv_error_set(err, FV_ERR_INVALID,
                                 "scene '%s': unknown file type (use .json, or a mesh format assimp reads: .obj, .gltf, .glb, .ply, ...)", name);

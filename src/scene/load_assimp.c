@@ -33,6 +33,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "core/fileio.h"
 #include "core/alloc.h"
 #include "core/sandbox.h"
 #include "fovea/limits.h"
@@ -569,9 +570,13 @@ static fv_status check_header(const char *path, long long size, fv_error *err)
 fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const fv_import_opts *opts, const fv_log *log,
                          int *first_object, int *object_count, fv_error *err)
 {
+    /* A regular file only (core/fileio.h): the child would read /dev/zero until its limits, or
+     * block on a FIFO. */
+    fv_status st = fv_file_check_read(path, "scene", err);
+    if (st != FV_OK) return st;
     struct stat sb;
     if (stat(path, &sb) != 0) return fv_error_set(err, FV_ERR_IO, "cannot open scene '%s': %s", path, strerror(errno));
-    fv_status st = check_header(path, (long long)sb.st_size, err);
+    st = check_header(path, (long long)sb.st_size, err);
     if (st != FV_OK) return st;
     /* Limits for the child: room for meshes many times the file's size, at least 2 GiB (a .gltf
      * file may name large .bin buffers), and 10 s of CPU time plus 2 s per MB (assimp reads tens of MB a second). */

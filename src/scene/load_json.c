@@ -9,7 +9,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "core/alloc.h"
+#include "core/fileio.h"
 #include "fovea/film.h"
 #include "fovea/limits.h"
 #include "core/json_util.h"
@@ -83,6 +85,13 @@ static fv_status parse_material(const cJSON *o, const json_ctx *c, fv_error *err
         char path[8192], user[FV_NAME_MAX + 4200];
         snprintf(path, sizeof path, "%s%s%s", tex[0] == '/' ? "" : c->dir, tex[0] == '/' ? "" : "/", tex);
         snprintf(user, sizeof user, "%s: %s", c->file, where);
+        /* A missing file is left to the warning; one that is there must be a regular file (a
+         * FIFO would block the decoder, core/fileio.h). */
+        struct stat sb;
+        if (stat(path, &sb) == 0 && (st = fv_file_check_read(path, "texture", err)) != FV_OK) {
+            fv_error_prefix(err, "%s: %s.albedo_texture: ", c->file, where);
+            return st;
+        }
         if ((st = fv_texture_load_file(c->scene, path, user, c->log, &m.albedo_texture, err))) return st;
     }
     if ((st = fv_scene_add_material(c->scene, &m, NULL, err)) != FV_OK) fv_error_prefix(err, "%s: ", c->file);
@@ -549,9 +558,10 @@ static fv_status parse_object(const cJSON *o, const json_ctx *c, int index, fv_e
     if (mesh) {
         char path[8192];
         snprintf(path, sizeof path, "%s%s%s", mesh[0] == '/' ? "" : c->dir, mesh[0] == '/' ? "" : "/", mesh);
-        FILE *f = fopen(path, "rb");
-        if (!f) return fv_error_set(err, FV_ERR_IO, "%s: %s.mesh: cannot open '%s'", c->file, where, path);
-        fclose(f);
+        if ((st = fv_file_check_read(path, "mesh", err)) != FV_OK) {
+            fv_error_prefix(err, "%s: %s.mesh: ", c->file, where);
+            return st;
+        }
         char prefix[FV_NAME_MAX];
         snprintf(prefix, sizeof prefix, "%.30s/", oname);
         fv_import_opts io = {mat, &x, false, false, prefix};

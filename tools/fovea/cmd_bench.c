@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "cli.h"
+#include "core/fileio.h"
 
 static void usage(FILE *f)
 {
@@ -189,7 +190,10 @@ int fv_cmd_bench(int argc, char **argv)
     if (!quiet) opt.status = on_status;
     fv_error err;
     fv_error_clear(&err);
-    fv_status s = check ? fv_bench_check(path, opt.mode, &err) : fv_bench_run(path, &opt, &err);
+    /* A regular file only: the JSON reader opens it by name, and a FIFO would block it. */
+    fv_status s = fv_file_check_read(path, "scenario", &err);
+    if (s != FV_OK) return fv_cli_fail(cmd, s, err.msg);
+    s = check ? fv_bench_check(path, opt.mode, &err) : fv_bench_run(path, &opt, &err);
     if (s != FV_OK) return fv_cli_fail(cmd, s, err.msg);
     if (check) printf("%s: ok\n", path);
     else if (!quiet) fprintf(stderr, "fovea bench: wrote %s/\n", opt.out_dir);

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli.h"
+#include "core/fileio.h"
 
 static void usage(FILE *f)
 {
@@ -27,8 +28,11 @@ static void usage(FILE *f)
 
 static fv_status load(const char *path, fv_image *img, fv_error *err)
 {
-    fv_status s = fv_image_read(path, img, err);
-    /* Reading an image that is not there is the user's input problem, as a malformed one is. */
+    /* A regular file only (core/fileio.h): the image readers open it by name, and /dev/zero or a
+     * FIFO would hang them. Reading an image that is not there is the user's input problem, as a
+     * malformed one is. */
+    fv_status s = fv_file_check_read(path, "image", err);
+    if (s == FV_OK) s = fv_image_read(path, img, err);
     return s;
 }
 
