@@ -59,6 +59,7 @@
 #include <string.h>
 #include "core/alloc.h"
 #include "core/parallel.h"
+#include "filter/demod.h"
 #include "filter/svgf_impl.h"
 
 #define SVGF_ISA(name) fv_svgf_##name##_base
@@ -333,8 +334,9 @@ static void sweep_accumulate(fv_svgf *f, const fv_svgf_frame *fr, bool history, 
             }
             n_surface++;
             const float *c = &fr->color[3 * p], *a = &fr->albedo[3 * p];
-            float il[3];
-            for (int ch = 0; ch < 3; ch++) il[ch] = c[ch] / demod_albedo(a[ch]);
+            float il[3], d[3];
+            fv_demod_factors(a, d);
+            for (int ch = 0; ch < 3; ch++) il[ch] = c[ch] / d[ch];
             f->surf[p] = 1.0f;
             f->nx[0][p] = np[0], f->ny[0][p] = np[1], f->nz[0][p] = np[2], f->z[0][p] = fr->depth[p];
             float l = luminance(il[0], il[1], il[2]), m1 = l, m2 = l * l, n_len = 1.0f;
@@ -374,8 +376,9 @@ static void sweep_finish(fv_svgf *f, const fv_svgf_frame *fr, int cur, bool copy
             size_t p = (size_t)y * w + x;
             if (f->kind[p] != KIND_SURFACE) continue;
             const float il[3] = {v[V_R][p], v[V_G][p], v[V_B][p]};
-            const float *a = &fr->albedo[3 * p];
-            for (int ch = 0; ch < 3; ch++) fr->color[3 * p + ch] = il[ch] * demod_albedo(a[ch]);
+            float d[3];
+            fv_demod_factors(&fr->albedo[3 * p], d);
+            for (int ch = 0; ch < 3; ch++) fr->color[3 * p + ch] = il[ch] * d[ch];
             if (copy_hist) memcpy(&f->hist_illum[3 * p], il, sizeof il);
             memcpy(&f->hist_pos[3 * p], &fr->position[3 * p], 3 * sizeof(float));
             f->hist_id[p] = fr->id[p];

@@ -10,7 +10,6 @@
 #include "filter/svgf.h"
 
 #define LEN_MAX 256.0f
-#define MIN_ALBEDO 1e-3f
 #define HIST_MIN_WEIGHT 0.01f
 #define HIST_COS 0.9f           /* normals within ~25 degrees */
 #define HIST_POS_REL 0.05f      /* position tolerance, fraction of the depth */
@@ -89,7 +88,6 @@ static inline int imax(int a, int b) { return a > b ? a : b; }
 
 static inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
 
-static inline float demod_albedo(float a) { return a < MIN_ALBEDO ? 1.0f : a; }
 
 /* The denominator's floor of the depth term: differences below 1e-4 of the depth are rounding. */
 static inline float depth_eps(float z) { return DEPTH_EPS_REL * fabsf(z) + 1e-30f; }

@@ -63,6 +63,17 @@ FV_HD static inline bool fv_bsdf_is_smooth(const fv_material *m)
     return m->type == FV_MAT_DIFFUSE || m->type == FV_MAT_GLOSSY;
 }
 
+/* What a denoiser divides a first hit's colour by (filter/demod.h): the light the surface reflects
+ * per unit of light it receives, roughly, per channel. Diffuse: its albedo; glossy: albedo plus
+ * specular colour (F0), as its highlight is the specular colour's, not the albedo's; a mirror or
+ * glass: its specular tint. */
+FV_HD static inline fv_vec3 fv_bsdf_demod_reflectance(const fv_material *m)
+{
+    if (m->type == FV_MAT_DIFFUSE) return m->albedo;
+    if (m->type == FV_MAT_GLOSSY) return fv_add(m->albedo, m->specular);
+    return m->specular;
+}
+
 /* ---- the lobes ---- */
 
 FV_HD static inline fv_vec3 fv_sample_cosine_hemisphere(float u0, float u1)

@@ -24,6 +24,7 @@ typedef struct fv_path_first_hit {
     bool hit;
     float t;
     fv_vec3 p, n, albedo;
+    fv_vec3 reflectance; /* what a denoiser demodulates by: fv_bsdf_demod_reflectance */
     int obj;
 } fv_path_first_hit;
 

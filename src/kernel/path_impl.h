@@ -57,6 +57,7 @@ FV_PATH_QUAL fv_vec3 FV_PATH_FN(const FV_PATH_SCENE *s, const fv_path_opts *opt,
             first->n = h.ns;
             first->obj = h.obj;
             first->albedo = m->type == FV_MAT_DIFFUSE || m->type == FV_MAT_GLOSSY ? m->albedo : m->specular;
+            first->reflectance = fv_bsdf_demod_reflectance(m);
         }
         if (fv_max3(m->emission) > 0.0f) {
             fv_vec3 le = fv_klight_emitted(m, h.ng, wo);

@@ -13,6 +13,7 @@ static void eye_start(fv_pm_hit *out)
     out->first_t = INFINITY;
     out->first_obj = -1;
     out->albedo = fv_v3s(0.0f);
+    out->reflectance = fv_v3s(0.0f);
 }
 
 /* The two delta lobes of material m seen from wo (local frame), each with the weight it carries
@@ -51,6 +52,7 @@ static void eye_walk(const fv_scene *s, fv_vec3 o, fv_vec3 d, int depth, int max
             out->first_n = fv_dot(h.ns, wo) < 0.0f ? fv_neg(h.ns) : h.ns;
             out->first_obj = h.obj;
             out->albedo = fv_bsdf_is_smooth(m) ? m->albedo : m->specular;
+            out->reflectance = fv_bsdf_demod_reflectance(m);
         }
         if (fv_scene_object_dynamic(s, h.obj)) out->dynamic = true;
         if (fv_max3(m->emission) > 0.0f) out->emitted = fv_add(out->emitted, fv_mul(out->weight, fv_light_emitted(s, m, h.ng, wo)));

@@ -29,6 +29,7 @@ typedef struct fv_pm_hit {
     fv_vec3 first_p, first_n;
     int first_obj;
     fv_vec3 albedo;      /* of the first surface, for the auxiliary buffers */
+    fv_vec3 reflectance; /* of the first surface, what a filter demodulates by (fv_bsdf_demod_reflectance) */
 } fv_pm_hit;
 
 /* Follows a camera ray (o, d) through at most max_depth mirror/glass bounces, choosing between

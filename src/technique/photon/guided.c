@@ -31,6 +31,7 @@
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "filter/atrous.h"
+#include "filter/demod.h"
 #include "filter/lattice.h"
 #include "scene/light.h"
 #include "technique/class.h"
@@ -269,7 +270,7 @@ static void main_tile(void *ctx, const fv_tile *t)
                 continue;
             }
             /* The periphery: one path (the split's branches summed as one), gathered on the lattice. */
-            fv_vec3 E = zero, R = zero, A = h[0].albedo;
+            fv_vec3 E = zero, R = zero;
             bool hit = false;
             for (int j = 0; j < n; j++) {
                 E = fv_add(E, h[j].emitted);
@@ -283,11 +284,8 @@ static void main_tile(void *ctx, const fv_tile *t)
                     }
             /* Demodulated by the first surface's colour, so the fill carries light, not texture. */
             R = fv_kit_guard(R, &bad);
-            for (int k = 0; k < 3; k++) {
-                float a = (&A.x)[k];
-                st->alb[3 * pix + k] = a > 1e-3f ? a : 1.0f;
-                st->refl[3 * pix + k] = (&R.x)[k] / st->alb[3 * pix + k];
-            }
+            fv_demod_factors(&h[0].reflectance.x, &st->alb[3 * pix]);
+            for (int k = 0; k < 3; k++) st->refl[3 * pix + k] = (&R.x)[k] / st->alb[3 * pix + k];
             E = fv_kit_guard(E, &bad);
             memcpy(&st->emit[3 * pix], &E, sizeof E);
         }

@@ -69,7 +69,7 @@ static void free_buffers(fv_vp_pipeline *p)
     fv_space_destroy(p->space);
     fv_svgf_destroy(p->svgf);
     fv_phi_mips_destroy(p->mips);
-    free(p->g.color), free(p->g.albedo), free(p->g.normal), free(p->g.depth), free(p->g.position), free(p->g.id);
+    free(p->g.color), free(p->g.albedo), free(p->g.reflectance), free(p->g.normal), free(p->g.depth), free(p->g.position), free(p->g.id);
     free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm), free(p->lut), free(p->onscreen);
     free(p->coords);
     p->onscreen = NULL, p->coords = NULL;
@@ -100,6 +100,7 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
     size_t n = (size_t)g->w * g->h, ns = (size_t)sw * sh;
     p->g.color = fv_alloc_array(n, 3 * sizeof(float));
     p->g.albedo = fv_alloc_array(n, 3 * sizeof(float));
+    p->g.reflectance = fv_alloc_array(n, 3 * sizeof(float));
     p->g.normal = fv_alloc_array(n, 3 * sizeof(float));
     p->g.position = fv_alloc_array(n, 3 * sizeof(float));
     p->g.depth = fv_alloc_array(n, sizeof(float));
@@ -110,7 +111,7 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
     /* The largest radius from any gaze is the diagonal. */
     p->nlut = (int)(sqrt((double)sw * sw + (double)sh * sh) / LUT_STEP) + 3;
     p->lut = fv_alloc_array((size_t)p->nlut, 3 * sizeof(float));
-    if (!p->g.color || !p->g.albedo || !p->g.normal || !p->g.position || !p->g.depth || !p->g.id || !p->g.sampled ||
+    if (!p->g.color || !p->g.albedo || !p->g.reflectance || !p->g.normal || !p->g.position || !p->g.depth || !p->g.id || !p->g.sampled ||
         !p->prev_coord || !p->sigma || !p->lut) {
         free_buffers(p);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d sample grid", g->w, g->h);
@@ -119,6 +120,7 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
      * since the trace stage writes only the valid cells. */
     memset(p->g.color, 0, n * 3 * sizeof(float));
     memset(p->g.albedo, 0, n * 3 * sizeof(float));
+    memset(p->g.reflectance, 0, n * 3 * sizeof(float));
     memset(p->g.normal, 0, n * 3 * sizeof(float));
     memset(p->g.position, 0, n * 3 * sizeof(float));
     memset(p->g.id, 0, n * sizeof(uint32_t));
@@ -402,7 +404,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
                                        p->prev_view.gy == p->lut_gy};
             fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
         }
-        fv_svgf_frame fr = {p->g.color, p->g.albedo, p->g.normal, p->g.depth, p->g.position, p->g.id,
+        fv_svgf_frame fr = {p->g.color, p->g.reflectance, p->g.normal, p->g.depth, p->g.position, p->g.id,
                             hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
         if (p->o.blur && p->o.periphery_passes < p->o.svgf.iterations && fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
             /* The columns wholly beyond periphery_deg (by default where the blur reaches its full

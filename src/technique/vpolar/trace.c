@@ -23,6 +23,7 @@ static void store_miss(const fv_vp_gbuf *g, long i)
 {
     memset(&g->color[3 * i], 0, 3 * sizeof(float));
     memset(&g->albedo[3 * i], 0, 3 * sizeof(float));
+    memset(&g->reflectance[3 * i], 0, 3 * sizeof(float));
     memset(&g->normal[3 * i], 0, 3 * sizeof(float));
     memset(&g->position[3 * i], 0, 3 * sizeof(float));
     g->depth[i] = INFINITY;
@@ -84,6 +85,7 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
         g->color[3 * i] = L.x, g->color[3 * i + 1] = L.y, g->color[3 * i + 2] = L.z;
         if (first.hit) {
             g->albedo[3 * i] = first.albedo.x, g->albedo[3 * i + 1] = first.albedo.y, g->albedo[3 * i + 2] = first.albedo.z;
+            memcpy(&g->reflectance[3 * i], &first.reflectance, 3 * sizeof(float));
             g->normal[3 * i] = first.n.x, g->normal[3 * i + 1] = first.n.y, g->normal[3 * i + 2] = first.n.z;
             g->position[3 * i] = first.p.x, g->position[3 * i + 1] = first.p.y, g->position[3 * i + 2] = first.p.z;
             g->depth[i] = first.t;

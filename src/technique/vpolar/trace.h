@@ -27,6 +27,7 @@ typedef enum fv_vp_order { FV_VP_ORDER_GRID = 0, FV_VP_ORDER_RANDOM } fv_vp_orde
 /* Buffers on the grid's storage (w * h pixels). */
 typedef struct fv_vp_gbuf {
     float *color, *albedo, *normal, *depth, *position;
+    float *reflectance; /* what SVGF demodulates by (fv_bsdf_demod_reflectance); albedo is the film's */
     uint32_t *id;
     uint8_t *sampled;   /* 1 where a path was traced */
 } fv_vp_gbuf;
