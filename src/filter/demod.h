@@ -15,8 +15,13 @@
  * multiplied back, e.g. the full blue light of the surroundings on a brown texel (issue 25). With
  * the floor the channel is remodulated by at most FV_DEMOD_MIN, so the colour it can gain is at most
  * 1e-3 of the light, and its own contribution to its neighbours' light is a_k / max(a_k, 1e-3) <= 1
- * times theirs. Every channel of a material that is either black or at least 1e-3 everywhere (all of
- * the untextured scenes shipped) keeps the exact factors of the rule before (a, or 1).
+ * times theirs. An albedo either black or at least 1e-3 in every channel keeps the exact factors of
+ * the rule before (a, or 1).
+ *
+ * The callers pass what the surface reflects, not only its diffuse albedo: for a glossy surface the
+ * albedo plus its specular colour (fv_bsdf_demod_reflectance, kernel/bsdf.h), since its highlight is
+ * not proportional to the diffuse albedo (a dark-tinted glossy panel divided by (0, 0.04, 0.02)
+ * bled its highlight red and cyan into its surroundings: CesiumMilkTruck's windows).
  */
 #ifndef FV_FILTER_DEMOD_H
 #define FV_FILTER_DEMOD_H
