@@ -41,21 +41,28 @@ static bool label_ok(const char *s)
     return true;
 }
 
+/* A method's "params" into a new bag in *out; on failure *out is NULL (nothing to release). */
 static fv_status parse_params(const cJSON *obj, const char *file, const char *where, fv_params **out, fv_error *err)
 {
     fv_status st = fv_params_create(out, err);
     if (st != FV_OK || !obj) return st;
-    if (!cJSON_IsObject(obj)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s.params: expected an object", file, where);
-    for (const cJSON *it = obj->child; it; it = it->next) {
+    if (!cJSON_IsObject(obj)) st = fv_error_set(err, FV_ERR_INVALID, "%s: %s.params: expected an object", file, where);
+    for (const cJSON *it = st == FV_OK ? obj->child : NULL; it; it = it->next) {
         char text[128];
-        if (!fv_json_scalar_text(it, text, sizeof text))
-            return fv_error_set(err, FV_ERR_INVALID, "%s: %s.params.%s: expected a number, string or boolean", file, where, it->string);
+        if (!fv_json_scalar_text(it, text, sizeof text)) {
+            st = fv_error_set(err, FV_ERR_INVALID, "%s: %s.params.%s: expected a number, string or boolean", file, where, it->string);
+            break;
+        }
         if ((st = fv_params_set(*out, it->string, text, err)) != FV_OK) {
             fv_error_prefix(err, "%s: %s.params: ", file, where);
-            return st;
+            break;
         }
     }
-    return FV_OK;
+    if (st != FV_OK) {
+        fv_params_destroy(*out);
+        *out = NULL;
+    }
+    return st;
 }
 
 static fv_status parse_method(const cJSON *obj, const char *file, const char *where, bool need_label, fv_bench_method *m,

@@ -63,4 +63,12 @@ python3 -c 'import json,sys; r=json.load(open(sys.argv[1]))["results"][0]; asser
   || fail "a method identical to the reference measured zero error: the reference shares its random stream"
 printf '{"scene": "cornell", "reference": {"method": "pt"}, "extra_references": [{"label": "reference", "method": "pt"}], "methods": [{"method": "pt"}]}' > "$TMP/bad7.json"
 expect 2 "'reference' is taken" -- $B "$TMP/bad7.json" --out "$OUT"
+# A refused parameter of an extra reference, a method and the reference: one line each and, under
+# ASan (scripts/test's second pass), nothing leaked (issue 25, item 10).
+for where in '"extra_references": [{"label": "x", "method": "pt", "params": {"spp": [1]}}], "reference": {"method": "pt"}, "methods": [{"method": "pt"}]' \
+             '"reference": {"method": "pt", "params": {"spp": {"a": 1}}}, "methods": [{"method": "pt"}]' \
+             '"reference": {"method": "pt"}, "methods": [{"method": "pt", "params": {"spp": null}}]'; do
+  printf '{"scene": "cornell", %s}' "$where" > "$TMP/bad8.json"
+  expect 2 "expected a number, string or boolean" -- $B "$TMP/bad8.json" --check
+done
 finish
