@@ -57,6 +57,8 @@ static fv_status png_write(const char *path, const float *rgb, int w, int h, flo
     img.format = PNG_FORMAT_RGB;
     bool ok = png_image_write_to_stdio(&img, f, 0, px, 0, NULL) != 0;
     if (ok) s = fv_atomic_file_commit(&af, err);
+    /* libpng says only "Write Error" when the stream fails: the stream's own errno says why. */
+    else if (af.werr) s = fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, strerror(af.werr));
     else s = fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, img.message[0] ? img.message : "libpng failed");
     fv_atomic_file_abort(&af);
     png_image_free(&img);

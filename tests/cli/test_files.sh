@@ -92,5 +92,12 @@ rc=$?
 grep -qF "cannot write '$TMP/big.pfm': File too large" "$TMP/err" || fail "the failed PFM write lost its reason: $(cat "$TMP/err")"
 [ -e "$TMP/big.pfm" ] && fail "a failed write left big.pfm"
 ls "$TMP" | grep -q '\.tmp\.' && fail "a failed write left its temporary file"
+# the same for a PNG, which libpng alone would report as "Write Error"
+( trap '' XFSZ; ulimit -f 1; exec $FOVEA render cornell --size 256x256 --spp 1 --quiet --out "$TMP/big.png" ) >"$TMP/out" 2>"$TMP/err"
+rc=$?
+[ "$rc" = 2 ] || fail "a PNG write over the size limit exited $rc, expected 2: $(cat "$TMP/err")"
+grep -qF "cannot write '$TMP/big.png': File too large" "$TMP/err" || fail "the failed PNG write lost its reason: $(cat "$TMP/err")"
+[ -e "$TMP/big.png" ] && fail "a failed write left big.png"
+ls "$TMP" | grep -q '\.tmp\.' && fail "a failed PNG write left its temporary file"
 
 finish
