@@ -477,8 +477,23 @@ static int import_child(void *user, int fd)
 
 /* ---- before the child: counts a header declares against the file's size ---- */
 
-/* A PLY header must be whole and made of the lines the format has: assimp loops without end on
- * a header cut short or with a mangled line. Sets *elements to the sum of the element counts. */
+/* A PLY header must be whole, and its format, element and property lines well formed: assimp
+ * loops without end on a header cut short or with a mangled declaration. Any other line is skipped
+ * as the reader skips it (comment, obj_info, and free text such as Blender 2.47's "Created by
+ * Blender3D 247 ..." line): the check must not refuse what the format's reader takes. Sets
+ * *elements to the sum of the element counts. */
+/* True when a header line starts with one of the keywords that declare something (format,
+ * element, property): those must parse; the reader skips every other line. */
+static bool ply_declares(const char *line)
+{
+    static const char *const words[] = {"format", "element", "property", NULL};
+    for (int i = 0; words[i]; i++) {
+        size_t n = strlen(words[i]);
+        if (!strncmp(line, words[i], n) && (line[n] == '\0' || line[n] == ' ' || line[n] == '\t')) return true;
+    }
+    return false;
+}
+
 static bool ply_header_ok(const char *head, long double *elements, int *line_no)
 {
     static const char *const types[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "uint8",
@@ -501,7 +516,8 @@ static bool ply_header_ok(const char *head, long double *elements, int *line_no)
             if (strcmp(line, "ply")) return false;
         } else if (!strcmp(line, "end_header")) {
             return n > 1;
-        } else if (!strncmp(line, "comment", 7) || !strncmp(line, "obj_info", 8)) {
+        } else if (!ply_declares(line)) {
+            /* a comment, obj_info or free text: skipped */
         } else if (sscanf(line, "format %63s %63s %n", a, b, &k) == 2) {
             if (strcmp(a, "ascii") && strcmp(a, "binary_little_endian") && strcmp(a, "binary_big_endian")) return false;
         } else if (sscanf(line, "element %63s %Lf %n", a, &cnt, &k) == 2 && line[k] == '\0') {

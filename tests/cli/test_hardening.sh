@@ -97,6 +97,12 @@ expect 2 "oom.off': its header declares 1000000003 elements" -- $R "$TMP/oom.off
 # a PLY header cut short makes assimp loop: refused before it runs
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n' >"$TMP/cut.ply"
 expect 2 "cut.ply': PLY header line" -- $R "$TMP/cut.ply" $small
+# a free-text header line (Blender 2.47 wrote one without "comment"): the reader skips it, so
+# does the check (issue 25, item 3); a mangled declaration is still refused
+printf 'ply\nformat ascii 1.0\nCreated by a modeller, source file: \nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >"$TMP/text.ply"
+expect 0 "" -- $R "$TMP/text.ply" --size 8x8 --spp 1 --quiet --out "$TMP/text.png"
+printf 'ply\nformat ascii 1.0\nelement vertex three\nproperty float x\nend_header\n' >"$TMP/mangled.ply"
+expect 2 "mangled.ply': PLY header line 3" -- $R "$TMP/mangled.ply" $small
 # an OFF file cut short: assimp's own assertion aborts; the child process reports it
 printf 'OFF\n4 2 0\n0 0 0' >"$TMP/abort.off"
 expect 2 "abort.off': the mesh importer (assimp): crashed (signal 6" -- $R "$TMP/abort.off" $small
