@@ -38,6 +38,7 @@
 #include "core/sandbox.h"
 #include "fovea/limits.h"
 #include "scene/load_impl.h"
+#include "scene/scene_impl.h"
 #include "scene/texture.h"
 
 bool fv_load_assimp_supports(const char *path)
@@ -583,6 +584,26 @@ static fv_status check_header(const char *path, long long size, fv_error *err)
 
 /* ---- the parent: records into the scene ---- */
 
+/* Dropped triangles over a whole file. */
+typedef struct drop_tally {
+    long long tris, of; /* dropped, and the triangles of the meshes that dropped some */
+    int meshes;         /* meshes (instances) that dropped any */
+    char worst[FV_NAME_MAX];
+    int worst_n;
+} drop_tally;
+
+static void drop_add(drop_tally *t, const char *mesh, int dropped, int of)
+{
+    if (dropped <= 0) return;
+    t->tris += dropped;
+    t->of += of;
+    t->meshes++;
+    if (dropped > t->worst_n) {
+        t->worst_n = dropped;
+        snprintf(t->worst, sizeof t->worst, "%s", mesh);
+    }
+}
+
 fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const fv_import_opts *opts, const fv_log *log,
                          int *first_object, int *object_count, fv_error *err)
 {
@@ -604,6 +625,11 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
     if ((st = fv_sandbox_start(import_child, &c, mem, cpu, &box, err)) != FV_OK) return st;
 
     int *matmap = NULL, nmat = 0, cap = 0, first = -1, count = 0;
+    /* Triangles the scene refused, said once for the whole file: a CAD export can drop a few in
+     * each of dozens of meshes, and name the same mesh once per instance. */
+    drop_tally drops = {0};
+    char camera[FV_NAME_MAX] = ""; /* the file's camera the view took (the last one sent) */
+    int ncameras = 0;
     int *texmap = NULL, ntex = 0, captex = 0; /* the child's texture numbers -> the scene's ids (0: refused) */
     bool ended = false;
     char tag;
@@ -655,15 +681,16 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
                 char name[FV_NAME_MAX];
                 snprintf(name, sizeof name, "%.31s%.32s", opts->prefix, h.name);
                 fv_mesh_desc d = {name, pos, h.nv, nrm, idx, h.nt, NULL, mat, uv};
-                int id;
+                int id, dropped = 0;
                 if (mat < 0) {
                     st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': mesh '%s' uses material %d, which the file does not define", path,
                                       name, h.material);
-                } else if ((st = fv_scene_add_mesh(scene, &d, log, &id, err)) == FV_OK) {
+                } else if ((st = fv_scene_add_mesh_counted(scene, &d, &dropped, &id, err)) == FV_OK) {
                     if (count++ == 0) first = id;
+                    drop_add(&drops, name, dropped, h.nt);
                 } else if (strstr(err->msg, "no valid triangles")) {
                     /* A sub-mesh made only of degenerate or non-finite triangles is dropped like its triangles. */
-                    fv_log_warn(log, "%s: %s", path, err->msg);
+                    drop_add(&drops, name, h.nt, h.nt);
                     fv_error_clear(err);
                     st = FV_OK;
                 } else {
@@ -683,7 +710,11 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
             r.name[sizeof r.name - 1] = '\0';
             fv_camera_basis b;
             fv_error e2;
-            if (view && fv_camera_basis_make(&r.c, &b, &e2) == FV_OK) fv_view_set_camera(view, &r.c);
+            if (view && fv_camera_basis_make(&r.c, &b, &e2) == FV_OK) {
+                fv_view_set_camera(view, &r.c);
+                snprintf(camera, sizeof camera, "%s", r.name);
+                ncameras++;
+            }
             else if (view) fv_log_warn(log, "%s: ignoring camera '%s' (%s)", path, r.name, e2.msg);
         } else if (tag == REC_LIGHT) {
             light_rec r;
@@ -706,6 +737,14 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
             break;
         }
     }
+    if (ncameras > 0)
+        fv_log_warn(log, "%s: the view is the file's camera '%s'%s (--camera-pos, --camera-look, --camera-up and --fov override it)", path,
+                    camera, ncameras > 1 ? ", the last of its cameras" : "");
+    if (drops.meshes > 0)
+        fv_log_warn(log,
+                    "%s: dropped %lld of %lld triangles in %d mesh%s (degenerate, non-finite, beyond +-%g or bad index); the most in '%s' "
+                    "(%d)",
+                    path, drops.tris, drops.of, drops.meshes, drops.meshes == 1 ? "" : "es", FV_COORD_MAX, drops.worst, drops.worst_n);
     fv_error e2;
     char what[4200];
     snprintf(what, sizeof what, "scene '%s': the mesh importer (assimp)", path);

@@ -108,6 +108,16 @@ static bool triangle_ok(fv_vec3 a, fv_vec3 b, fv_vec3 c)
 
 fv_status fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, const fv_log *log, int *object_id, fv_error *err)
 {
+    int dropped = 0;
+    fv_status st = fv_scene_add_mesh_counted(s, m, &dropped, object_id, err);
+    if (st == FV_OK && dropped)
+        fv_log_warn(log, "mesh '%s': dropped %d of %d triangles (degenerate, non-finite, beyond +-%g or bad index)", m->name ? m->name : "mesh",
+                    dropped, m->triangle_count, FV_COORD_MAX);
+    return st;
+}
+
+fv_status fv_scene_add_mesh_counted(fv_scene *s, const fv_mesh_desc *m, int *dropped_out, int *object_id, fv_error *err)
+{
     fv_status st = check_open(s, err);
     if (st != FV_OK) return st;
     const char *name = m->name ? m->name : "mesh";
@@ -153,7 +163,7 @@ fv_status fv_scene_add_mesh(fv_scene *s, const fv_mesh_desc *m, const fv_log *lo
         free(o.mat);
         return fv_error_set(err, FV_ERR_INVALID, "mesh '%s': no valid triangles (%d dropped as degenerate, non-finite or beyond +-%g)", name, dropped, FV_COORD_MAX);
     }
-    if (dropped) fv_log_warn(log, "mesh '%s': dropped %d of %d triangles (degenerate, non-finite, beyond +-%g or bad index)", name, dropped, m->triangle_count, FV_COORD_MAX);
+    *dropped_out = dropped;
 
     /* +1 element: Embree reads vertex buffers with 16-byte loads. */
     o.pos = fv_alloc_array((size_t)o.nv + 1, sizeof(fv_vec3));

@@ -84,6 +84,10 @@ struct fv_scene {
     char embree_msg[256];      /* last message from Embree's error callback */
 };
 
+/* fv_scene_add_mesh without its warning: *dropped receives how many triangles were dropped, for a
+ * loader that adds many meshes and says it once (load_assimp.c). */
+fv_status fv_scene_add_mesh_counted(fv_scene *s, const fv_mesh_desc *m, int *dropped, int *object_id, fv_error *err);
+
 /* World bounds of the objects, dynamic ones over all their keys; valid before commit too. */
 void fv_scene_world_bounds(const fv_scene *s, fv_vec3 *lo, fv_vec3 *hi);
 

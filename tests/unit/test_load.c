@@ -93,8 +93,12 @@ static void test_gltf_pbr(void **state)
 {
     (void)state;
     fv_view *v;
-    fv_scene *s = load_ok(DATA("pbr.gltf"), NULL, &v);
+    fv_test_warnings w = {0};
+    fv_log log = {fv_test_warn, &w};
+    fv_scene *s = load_ok(DATA("pbr.gltf"), &log, &v);
     assert_int_equal(fv_scene_triangle_count(s), 10);
+    /* The view takes the file's camera, and says so in one line (issue 25, item 3). */
+    assert_non_null(strstr(w.all, "the view is the file's camera 'cam'"));
     fv_vec3 lo, hi;
     fv_scene_bounds(s, &lo, &hi);
     assert_float_equal(lo.x, 0.0f, 1e-5f);

@@ -119,6 +119,25 @@ static void test_nan_and_empty(void **st)
     assert_non_null(strstr(err.msg, "empty.obj"));
 }
 
+/* Triangles dropped in several meshes of one file are said once, with the totals (issue 25,
+ * item 3: a CAD model printed 40 lines, the same mesh up to four times). */
+static void test_drops_said_once(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_error err;
+    fv_test_warnings w = {0};
+    fv_log log = {fv_test_warn, &w};
+    assert_int_equal(fv_scene_load(DATA("drops.obj"), &log, &s, NULL, &err), FV_OK);
+    int drops = 0;
+    for (const char *p = w.all; (p = strstr(p, "dropped")); p++) drops++;
+    assert_int_equal(drops, 1);
+    assert_non_null(strstr(w.all, "dropped 4 of 6 triangles in 3 meshes"));
+    assert_non_null(strstr(w.all, "the most in 'second' (2)"));
+    assert_int_equal(fv_scene_triangle_count(s), 2); /* 'third' had no valid triangle: no object */
+    fv_scene_destroy(s);
+}
+
 static void test_json_scene(void **st)
 {
     (void)st;
@@ -211,7 +230,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_builtin_and_unknown), cmocka_unit_test(test_obj_materials), cmocka_unit_test(test_gltf_and_ply),
-        cmocka_unit_test(test_nan_and_empty),       cmocka_unit_test(test_json_scene),    cmocka_unit_test(test_json_errors),
+        cmocka_unit_test(test_nan_and_empty),       cmocka_unit_test(test_drops_said_once), cmocka_unit_test(test_json_scene),    cmocka_unit_test(test_json_errors),
         cmocka_unit_test(test_camera_trace),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
