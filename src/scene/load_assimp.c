@@ -738,7 +738,8 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
         }
     }
     if (ncameras > 0)
-        fv_log_warn(log, "%s: the view is the file's camera '%s'%s (--camera-pos, --camera-look, --camera-up and --fov override it)", path,
+        fv_log_warn(log, "%s: the view is the file's camera '%s'%s (--frame-view replaces it; --camera-pos, --camera-look, --camera-up and "
+                    "--fov override its fields)", path,
                     camera, ncameras > 1 ? ", the last of its cameras" : "");
     if (drops.meshes > 0)
         fv_log_warn(log,
