@@ -31,6 +31,10 @@ PY
 expect 2 "fov_fraction" -- $FOVEA render cornell-fpm --method fpm --param fov_fraction=1.5 --size 8x8 --out "$TMP/x.png"
 expect 2 "photons" -- $FOVEA render cornell --method pm --param photons=0 --size 8x8 --out "$TMP/x.png"
 expect 2 "radius" -- $FOVEA render cornell --method pm-t --param radius=-1 --size 8x8 --out "$TMP/x.png"
+# a radius beyond every coordinate the scene may have (issue 25, item 10), for each photon mapper
+for m in pm pm-t fpm fpm-guided ppm; do
+  expect 2 "parameter radius=1e30: out of range [0, 1e+09]" -- $FOVEA render cornell-fpm --method $m --param radius=1e30 --size 8x8 --out "$TMP/x.png"
+done
 expect 2 "fovea_spp" -- $FOVEA render cornell-fpm --method fpm-guided --param fovea_spp=0 --size 8x8 --out "$TMP/x.png"
 expect 2 "periphery_step" -- $FOVEA render cornell-fpm --method fpm-guided --param periphery_step=0 --size 8x8 --out "$TMP/x.png"
 expect 2 "fovea_spp" -- $FOVEA render cornell-fpm --method fpm-guided --spp 1000 --size 8x8 --out "$TMP/x.png"

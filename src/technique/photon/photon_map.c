@@ -9,6 +9,7 @@
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "core/params_read.h"
+#include "fovea/limits.h"
 #include "technique/photon/photon_map.h"
 
 void fv_photon_map_init(fv_photon_map *m) { memset(m, 0, sizeof *m); }
@@ -391,7 +392,8 @@ float fv_photon_radius_eq8(fv_vec3 lo, fv_vec3 hi, int width, int height)
 
 fv_status fv_photon_read_radius(struct fv_params *p, const char *what, double *radius, fv_error *err)
 {
-    fv_status s = fv_params_float(p, "radius", 0.0, 0.0, 1e30, radius, err);
+    /* A gather radius is a distance in the scene: bounded like every coordinate (fovea/limits.h). */
+    fv_status s = fv_params_float(p, "radius", 0.0, 0.0, FV_COORD_MAX, radius, err);
     if (s != FV_OK || !fv_params_has(p, "radius") || *radius > 0.0) return s;
     const char *v = "";
     for (int i = 0; i < fv_params_count(p); i++)
