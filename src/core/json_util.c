@@ -49,11 +49,36 @@ static fv_status check_duplicates(const cJSON *node, const char *file, const cha
     return FV_OK;
 }
 
+/* The line where objects and arrays first nest deeper than limit, 0 when they never do (strings
+ * skipped): cJSON refuses such text without saying why or where. */
+static int nesting_beyond(const char *text, int limit)
+{
+    int depth = 0, line = 1;
+    bool in_string = false;
+    for (const char *c = text; *c; c++) {
+        if (*c == '\n') line++;
+        if (in_string) {
+            if (*c == '\\' && c[1]) c++;
+            else if (*c == '"') in_string = false;
+        } else if (*c == '"') {
+            in_string = true;
+        } else if (*c == '{' || *c == '[') {
+            if (++depth > limit) return line;
+        } else if (*c == '}' || *c == ']') {
+            depth--;
+        }
+    }
+    return 0;
+}
+
 fv_status fv_json_parse_text(const char *name, const char *text, cJSON **out, fv_error *err)
 {
     const char *end = NULL;
     cJSON *root = cJSON_ParseWithOpts(text, &end, 1);
     if (!root) {
+        int deep = nesting_beyond(text, CJSON_NESTING_LIMIT);
+        if (deep)
+            return fv_error_set(err, FV_ERR_INVALID, "%s:%d: objects and arrays nested deeper than %d levels", name, deep, CJSON_NESTING_LIMIT);
         /* cJSON reports where it stopped; turn the offset into a line number and a short excerpt. */
         const char *at = end ? end : cJSON_GetErrorPtr();
         if (!at || at < text) at = text;

@@ -28,6 +28,9 @@ expect 2 "empty.obj" -- $R "$D/empty.obj" --size 8x8 --out "$OUT"
 expect 2 "bad_syntax.json:4:" -- $R "$D/bad_syntax.json" --size 8x8 --out "$OUT"
 expect 2 "unknown field 'albdo'" -- $R "$D/bad_field.json" --size 8x8 --out "$OUT"
 expect 2 "unknown material 'whte'" -- $R "$D/bad_material.json" --size 8x8 --out "$OUT"
+# a JSON nested beyond cJSON's limit is named as such, not "malformed" (issue 25, item 10)
+{ for i in $(seq 1800); do printf '{"a":'; done; printf '1'; for i in $(seq 1800); do printf '}'; done; } >"$TMP/deep.json"
+expect 2 "deep.json:1: objects and arrays nested deeper than 1000 levels" -- $R "$TMP/deep.json" --size 8x8 --out "$OUT"
 expect 2 "materials.white.emission" -- $R "$D/bad_inf.json" --size 8x8 --out "$OUT"
 expect 2 "lights[1].animation: animation of light 1: key times must increase" -- $R "$D/bad_light_anim.json" --size 8x8 --out "$OUT"
 expect 2 "unknown or incomplete option" -- $R cornell --frobnicate
