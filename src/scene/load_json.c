@@ -646,7 +646,8 @@ static fv_status parse_environment(const cJSON *root, const json_ctx *c, fv_erro
             (st = vec3(o, "up", -BIG, BIG, c, "environment", &e.up, err)))
             return st;
     }
-    if ((st = fv_scene_set_env(c->scene, &e, err)) != FV_OK) fv_error_prefix(err, "%s: environment: ", c->file);
+    /* fv_scene_set_env's messages start "environment: " already. */
+    if ((st = fv_scene_set_env(c->scene, &e, err)) != FV_OK) fv_error_prefix(err, "%s: ", c->file);
     return st;
 }
 
@@ -667,7 +668,12 @@ static fv_status parse_camera_key(const cJSON *o, const json_ctx *c, const char 
     k->fov_y = (float)fov;
     fv_camera cam = {k->pos, k->look, k->up, k->fov_y, 1, 1};
     fv_camera_basis b;
-    if ((st = fv_camera_basis_make(&cam, &b, err)) != FV_OK) fv_error_prefix(err, "%s: %s: ", c->file, where);
+    if ((st = fv_camera_basis_make(&cam, &b, err)) != FV_OK) {
+        /* camera.c names the camera "camera: "; where names it better ("camera_path[3]"). */
+        static const char own[] = "camera: ";
+        if (!strncmp(err->msg, own, sizeof own - 1)) memmove(err->msg, err->msg + sizeof own - 1, strlen(err->msg) - (sizeof own - 1) + 1);
+        fv_error_prefix(err, "%s: %s: ", c->file, where);
+    }
     return st;
 }
 

@@ -28,6 +28,13 @@ expect 2 "empty.obj" -- $R "$D/empty.obj" --size 8x8 --out "$OUT"
 expect 2 "bad_syntax.json:4:" -- $R "$D/bad_syntax.json" --size 8x8 --out "$OUT"
 expect 2 "unknown field 'albdo'" -- $R "$D/bad_field.json" --size 8x8 --out "$OUT"
 expect 2 "unknown material 'whte'" -- $R "$D/bad_material.json" --size 8x8 --out "$OUT"
+# a JSON scene's camera and environment are named once, not twice (issue 25, item 10)
+printf '{"materials": {"m": {"type": "diffuse"}}, "camera": {"pos": [0,0,5], "look": [0,0,5]}, "objects": [{"sphere": {"center": [0,0,0], "radius": 1}, "material": "m"}]}' >"$TMP/cam.json"
+expect 2 "cam.json: camera: look-at point equals the position" -- $R "$TMP/cam.json" --size 8x8 --out "$OUT"
+grep -q "camera: camera" "$TMP/err" && fail "doubled prefix: $(cat "$TMP/err")"
+printf '{"materials": {"m": {"type": "diffuse"}}, "environment": {"zenith": [1,1,1], "horizon": [1,1,1], "ground": [1,1,1], "up": [0,0,0]}, "objects": [{"sphere": {"center": [0,0,0], "radius": 1}, "material": "m"}]}' >"$TMP/env.json"
+expect 2 "env.json: environment: up must be finite and non-zero" -- $R "$TMP/env.json" --size 8x8 --out "$OUT"
+grep -q "environment: environment" "$TMP/err" && fail "doubled prefix: $(cat "$TMP/err")"
 # a JSON nested beyond cJSON's limit is named as such, not "malformed" (issue 25, item 10)
 { for i in $(seq 1800); do printf '{"a":'; done; printf '1'; for i in $(seq 1800); do printf '}'; done; } >"$TMP/deep.json"
 expect 2 "deep.json:1: objects and arrays nested deeper than 1000 levels" -- $R "$TMP/deep.json" --size 8x8 --out "$OUT"
