@@ -16,12 +16,49 @@
 #include "fovea/limits.h"
 #include "scene/texture.h"
 
+/* The size a PNG (IHDR) or JPEG (its first start-of-frame marker) header declares; false for
+ * anything else. stb_image refuses a huge image inside stbi_info and then reports the last format
+ * it tried ("unknown image type"), so the size is read here first to say what is wrong. */
+static bool header_size(const unsigned char *b, size_t n, long long *w, long long *h)
+{
+    static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (n >= 24 && !memcmp(b, png, 8) && !memcmp(b + 12, "IHDR", 4)) {
+        *w = ((long long)b[16] << 24) | (b[17] << 16) | (b[18] << 8) | b[19];
+        *h = ((long long)b[20] << 24) | (b[21] << 16) | (b[22] << 8) | b[23];
+        return true;
+    }
+    if (n < 4 || b[0] != 0xff || b[1] != 0xd8) return false;
+    for (size_t i = 2; i + 9 < n;) {
+        if (b[i] != 0xff) return false;
+        unsigned m = b[i + 1];
+        if (m == 0xff) { /* fill byte */
+            i++;
+            continue;
+        }
+        size_t len = ((size_t)b[i + 2] << 8) | b[i + 3];
+        /* SOF0..SOF15 except DHT (c4), JPG (c8) and DAC (cc): precision, height, width. */
+        if (m >= 0xc0 && m <= 0xcf && m != 0xc4 && m != 0xc8 && m != 0xcc) {
+            *h = ((long long)b[i + 5] << 8) | b[i + 6];
+            *w = ((long long)b[i + 7] << 8) | b[i + 8];
+            return true;
+        }
+        if (len < 2) return false;
+        i += 2 + len;
+    }
+    return false;
+}
+
 bool fv_texels_decode(const void *bytes, size_t n, fv_texels *out, char *why, size_t why_len)
 {
     memset(out, 0, sizeof *out);
     int w, h, ch;
     if (n > (size_t)INT32_MAX) {
         snprintf(why, why_len, "larger than 2 GiB");
+        return false;
+    }
+    long long hw, hh;
+    if (header_size(bytes, n, &hw, &hh) && hw * hh > FV_TEXTURE_MAX_TEXELS) {
+        snprintf(why, why_len, "%lldx%lld is more than the %d texels a texture may have", hw, hh, FV_TEXTURE_MAX_TEXELS);
         return false;
     }
     if (!stbi_info_from_memory(bytes, (int)n, &w, &h, &ch)) {

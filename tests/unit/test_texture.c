@@ -223,6 +223,23 @@ static void test_huge(void **st)
 }
 
 /* A JSON scene's "albedo_texture", relative to the scene file, and a missing one. */
+/* A header declaring more texels than a texture may have is refused by its size, for PNG and JPEG
+ * alike (issue 25, item 10: stb_image alone says "unknown image type"). The bytes after the
+ * header are not an image: the size must be read before any decoding. */
+static void test_huge_header(void **st)
+{
+    (void)st;
+    const unsigned char png[33] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R', 0, 1, 0x86, 0xa0, /* 100000 */
+                                   0, 1, 0x86, 0xa0, 8, 2, 0, 0, 0, 0, 0, 0, 0};
+    const unsigned char jpeg[] = {0xff, 0xd8, 0xff, 0xe0, 0, 4, 'J', 'F', 0xff, 0xc0, 0, 11, 8, 0xff, 0xff, 0xff, 0xff, 1, 1, 0x11, 0, 0, 0};
+    fv_texels t;
+    char why[256];
+    assert_false(fv_texels_decode(png, sizeof png, &t, why, sizeof why));
+    assert_non_null(strstr(why, "100000x100000 is more than the 16777216 texels"));
+    assert_false(fv_texels_decode(jpeg, sizeof jpeg, &t, why, sizeof why));
+    assert_non_null(strstr(why, "65535x65535 is more than the 16777216 texels"));
+}
+
 static void test_json(void **st)
 {
     (void)st;
@@ -341,7 +358,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_srgb_and_sampling), cmocka_unit_test(test_uv_at_hit), cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_gltf_embedded),     cmocka_unit_test(test_obj_map_kd), cmocka_unit_test(test_missing),
-        cmocka_unit_test(test_corrupt),           cmocka_unit_test(test_huge),      cmocka_unit_test(test_json),
+        cmocka_unit_test(test_corrupt),           cmocka_unit_test(test_huge),      cmocka_unit_test(test_huge_header),
+        cmocka_unit_test(test_json),
         cmocka_unit_test(test_default_render),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
