@@ -150,27 +150,44 @@ FV_API bool fv_gaze_missing_from_name(const char *name, fv_gaze_missing *out);
 /* ---- importing eye-tracker recordings (docs/gaze.md, "Importing") ---- */
 
 typedef enum fv_gaze_format {
-    FV_GAZE_FORMAT_AUTO = 0,     /* from the extension: .asc EyeLink, .csv Pupil Labs */
+    FV_GAZE_FORMAT_AUTO = 0,     /* from the extension (a trailing .gz aside): .asc EyeLink, .csv Pupil Labs */
     FV_GAZE_FORMAT_EYELINK_ASC,  /* EyeLink sample file (edf2asc) */
     FV_GAZE_FORMAT_PUPIL_CSV     /* Pupil Labs gaze_positions.csv (Pupil Player export) */
 } fv_gaze_format;
+
+/* Which eye's gaze a recording of both eyes becomes (docs/gaze.md, "Which eye"). */
+typedef enum fv_gaze_eyes {
+    FV_GAZE_EYES_DEFAULT = 0, /* the format's own: EyeLink EACH, Pupil BOTH */
+    FV_GAZE_EYES_LEFT,        /* the left eye's samples (a Pupil row of both eyes counts too) */
+    FV_GAZE_EYES_RIGHT,
+    FV_GAZE_EYES_BOTH,        /* one gaze: the mean of the two eyes' known samples, or the one known */
+    FV_GAZE_EYES_EACH         /* each eye its own gaze: a five-column trace (stereo renders) */
+} fv_gaze_eyes;
 
 typedef struct fv_gaze_import_opts {
     fv_gaze_format format;
     double min_confidence; /* Pupil: samples below this confidence are missing [0.6] */
     int width, height;     /* EyeLink: the screen in pixels, replacing DISPLAY_COORDS (0: from the file) */
+    fv_gaze_eyes eyes;     /* [FV_GAZE_EYES_DEFAULT] */
+    uint64_t max_inflated; /* a gzip-compressed recording may inflate to at most this many bytes [1 GiB] */
 } fv_gaze_import_opts;
 
 typedef struct fv_gaze_import_info {
     fv_gaze_format format;
     long samples, missing, dropped; /* written; of those missing; dropped (time not increasing) */
     double width, height;           /* EyeLink: the screen the coordinates were divided by */
-    bool binocular;
+    bool binocular;                 /* a five-column trace was written (each eye its own gaze) */
+    fv_gaze_eyes eyes;              /* the choice applied (after a successful import never DEFAULT) */
+    bool compressed;                /* the recording was gzip-compressed */
+    double rate;                    /* EyeLink: the sample rate in Hz the recording gave (0: none) */
+    long gaps;                      /* EyeLink: gaps between recording blocks, written as missing samples */
+    long paired;                    /* Pupil: samples made of one row per eye (both, each) */
 } fv_gaze_import_info;
 
 FV_API void fv_gaze_import_opts_init(fv_gaze_import_opts *o);
-/* Converts a recording into a gaze trace CSV at out_path (written whole or not at all), missing
- * samples as empty fields. info (may be NULL) says what was read. Errors name the file. */
+/* Converts a recording (or its gzip-compressed form) into a gaze trace CSV at out_path (written
+ * whole or not at all), missing samples as empty fields. info (may be NULL) says what was read.
+ * Errors name the file, and the line for malformed input. */
 FV_API fv_status fv_gaze_import(const char *in_path, const char *out_path, const fv_gaze_import_opts *opts, fv_gaze_import_info *info,
                                 fv_error *err);
 

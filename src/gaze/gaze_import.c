@@ -2,18 +2,30 @@
  *
  * EyeLink ASC (the text edf2asc writes): the screen size comes from the DISPLAY_COORDS message
  * ("MSG <t> DISPLAY_COORDS left top right bottom", pixels inclusive), which eyes were recorded from
- * the START or SAMPLES line (LEFT, RIGHT); sample lines are "<ms> <x> <y> <pupil>" per eye, "."
- * for a value the tracker lost. A sample is missing when its x or y is "." or lies off the screen,
- * or while that eye is in a blink (between its SBLINK and EBLINK events).
+ * the START and SAMPLES lines (LEFT, RIGHT), per recording block; sample lines are
+ * "<ms> <x> <y> <pupil>" per eye, "." for a value the tracker lost. A sample is missing when its x
+ * or y is "." or lies off the screen, or while that eye is in a blink (between its SBLINK and
+ * EBLINK events). The sample rate (SAMPLES ... RATE r, MSG ... RECCFG <mode> r, !MODE RECORD
+ * <mode> r) times samples that share a whole-millisecond stamp (2000 Hz written as whole ms: two
+ * samples per stamp, 0.5 ms apart). Between recording blocks (END ... START, a trial's break) the
+ * tracker records nothing: one missing sample at the block's end keeps the trace from
+ * interpolating across the break.
  *
- * Pupil Labs gaze_positions.csv (Pupil Player's export): columns gaze_timestamp (s), confidence,
- * norm_pos_x and norm_pos_y, found by name in the header; norm_pos has its origin at the bottom
- * left, fovea's at the top left, so y is flipped. A sample whose confidence is below the threshold
- * (0.6 by default, the value Pupil's own tools use) or whose position is off [0,1] is missing.
+ * Pupil Labs gaze_positions.csv (Pupil Player's export): columns gaze_timestamp (s; `timestamp` in
+ * older versions), confidence, norm_pos_x and norm_pos_y, found by name in the header (blank lines
+ * before it are skipped), and base_data, which says which eye a row comes from ("<t>-0" eye 0, the
+ * right eye; "<t>-1" eye 1, the left; both for a row Pupil mapped from both eyes). norm_pos has its
+ * origin at the bottom left, fovea's at the top left, so y is flipped. A sample whose confidence is
+ * below the threshold (0.6 by default, the value Pupil's own tools use) or whose position is off
+ * [0,1] is missing. A binocular export interleaves one row per eye a fraction of a millisecond
+ * apart, and the two eyes' estimates differ by a few percent of the screen: read in turn they make
+ * the trace zigzag, so rows of the two eyes closer than 5 ms are paired first.
  *
- * Times are written in seconds from the first sample. Samples whose time does not increase (a
- * Pupil export interleaves the two eyes' gaze) are dropped and counted. The output goes through
- * the atomic writer: on any error no file is left.
+ * Which eye (fv_gaze_eyes): left or right alone, both (the mean of the two eyes' known gaze, or the
+ * one known), or each (a five-column trace, each eye its own gaze for stereo renders).
+ *
+ * Times are written in seconds from the first sample. Samples whose time does not increase are
+ * dropped and counted. The output goes through the atomic writer: on any error no file is left.
  */
 #include <ctype.h>
 #include <errno.h>
@@ -22,21 +34,34 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
+#include <zlib.h>
+#include "core/alloc.h"
 #include "core/fileio.h"
 #include "fovea/gaze.h"
+
+/* Pupil: rows of the two eyes at most this far apart (s) are one binocular sample. Pupil's eye
+ * cameras run at 120-200 Hz (5-8 ms apart), and the two eyes' rows of one moment are well under a
+ * millisecond apart. */
+#define PUPIL_PAIR_S 0.005
+#define DEFAULT_MAX_INFLATED ((uint64_t)1 << 30)
 
 void fv_gaze_import_opts_init(fv_gaze_import_opts *o)
 {
     memset(o, 0, sizeof *o);
     o->format = FV_GAZE_FORMAT_AUTO;
     o->min_confidence = 0.6;
+    o->eyes = FV_GAZE_EYES_DEFAULT;
+    o->max_inflated = DEFAULT_MAX_INFLATED;
 }
 
 typedef struct writer {
     FILE *f;
     const char *in;
-    bool any, binocular;
-    long known[2]; /* samples with a known gaze, per eye */
+    fv_gaze_eyes eyes; /* resolved: never DEFAULT */
+    bool binocular;    /* five columns (eyes == EACH) */
+    bool any;
+    long known[2]; /* samples with a known gaze, per column pair */
     double t0, prev;
     fv_gaze_import_info *info;
 } writer;
@@ -53,8 +78,9 @@ static bool next_line(FILE *in, const writer *w, char **line, size_t *cap, int l
 
 static bool on_screen(double x, double y) { return x >= 0.0 && x <= 1.0 && y >= 0.0 && y <= 1.0; }
 
-/* One sample (time in seconds; an eye is missing when its coordinates are NaN). */
-static void put_sample(writer *w, double t, double xl, double yl, double xr, double yr)
+/* One line of the trace (time in seconds; a pair of coordinates is missing when NaN or off the
+ * screen; xr, yr only in a five-column trace). Returns false when dropped (time not increasing). */
+static bool put_sample(writer *w, double t, double xl, double yl, double xr, double yr)
 {
     /* The time as written (9 digits) must increase too: a jump to 1e19 s would print equal. */
     char tt[40];
@@ -62,7 +88,7 @@ static void put_sample(writer *w, double t, double xl, double yl, double xr, dou
     double shown = strtod(tt, NULL);
     if (!isfinite(t) || !isfinite(shown) || (w->any && !(shown > w->prev))) {
         w->info->dropped++;
-        return;
+        return false;
     }
     if (!w->any) w->t0 = t;
     w->any = true;
@@ -80,17 +106,125 @@ static void put_sample(writer *w, double t, double xl, double yl, double xr, dou
     fputc('\n', w->f);
     w->known[0] += !ml;
     w->known[1] += w->binocular && !mr;
+    return true;
+}
+
+/* One moment's gaze of each eye (NaN, or off the screen: missing or not recorded), written as the
+ * eye choice wants it. */
+static bool emit(writer *w, double t, double xl, double yl, double xr, double yr)
+{
+    bool kl = on_screen(xl, yl), kr = on_screen(xr, yr);
+    switch (w->eyes) {
+    case FV_GAZE_EYES_LEFT: return put_sample(w, t, xl, yl, NAN, NAN);
+    case FV_GAZE_EYES_RIGHT: return put_sample(w, t, xr, yr, NAN, NAN);
+    case FV_GAZE_EYES_BOTH:
+        if (kl && kr) return put_sample(w, t, 0.5 * (xl + xr), 0.5 * (yl + yr), NAN, NAN);
+        return kr ? put_sample(w, t, xr, yr, NAN, NAN) : put_sample(w, t, xl, yl, NAN, NAN);
+    default: return put_sample(w, t, xl, yl, xr, yr);
+    }
+}
+
+/* ---- gzip-compressed recordings ----
+ *
+ * A recording that starts with gzip's magic bytes (an EyeLink .asc.gz: a long recording is
+ * hundreds of MB of text and usually kept compressed) is inflated with zlib into an anonymous
+ * temporary file, which the readers then read like the plain file (two passes, fseek; bounded
+ * lines). zlib rather than `gzip -dc` in a sandbox child (core/sandbox.h): inflating is zlib's own
+ * code, which reports a corrupt or truncated stream as an error and never aborts or allocates
+ * without bound, so a child process would buy no safety, while it would add a gzip binary on the
+ * PATH, a pipe protocol and a second channel for errors; and zlib is in every build anyway
+ * (libpng needs it; CMakeLists.txt links it directly). The inflated size is bounded (opts.max_inflated, 1 GiB by default; a one-hour
+ * binocular 2000 Hz recording is about half that): a gzip bomb is refused, not written out. */
+static fv_status inflate_recording(const char *path, uint64_t max, FILE **io, bool *compressed, fv_error *err)
+{
+    FILE *f = *io;
+    unsigned char magic[2];
+    size_t n = fread(magic, 1, 2, f);
+    if (ferror(f)) return fv_error_set(err, FV_ERR_IO, "cannot read '%s': %s", path, strerror(errno));
+    if (n < 2 || magic[0] != 0x1f || magic[1] != 0x8b) {
+        *compressed = false;
+        if (fseek(f, 0, SEEK_SET) != 0) return fv_error_set(err, FV_ERR_IO, "cannot read '%s': %s", path, strerror(errno));
+        return FV_OK;
+    }
+    *compressed = true;
+    /* zlib reads the descriptor from the start (stdio has buffered past the magic). */
+    int fd = dup(fileno(f));
+    if (fd < 0 || lseek(fd, 0, SEEK_SET) != 0) {
+        int e = errno;
+        if (fd >= 0) close(fd);
+        return fv_error_set(err, FV_ERR_IO, "cannot read '%s': %s", path, strerror(e));
+    }
+    gzFile gz = gzdopen(fd, "rb");
+    if (!gz) {
+        close(fd);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory inflating '%s'", path);
+    }
+    FILE *tmp = tmpfile();
+    if (!tmp) {
+        int e = errno;
+        gzclose(gz);
+        return fv_error_set(err, FV_ERR_IO, "cannot create a temporary file to inflate '%s': %s", path, strerror(e));
+    }
+    fv_status st = FV_OK;
+    enum { CHUNK = 1 << 16 };
+    char *buf = malloc(CHUNK);
+    if (!buf) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory inflating '%s'", path);
+    uint64_t total = 0;
+    while (st == FV_OK) {
+        int k = gzread(gz, buf, CHUNK);
+        if (k <= 0) break;
+        total += (uint64_t)k;
+        if (total > max) {
+            st = fv_error_set(err, FV_ERR_INVALID, "%s: inflates to more than %llu bytes (the limit for a compressed recording)", path,
+                              (unsigned long long)max);
+            break;
+        }
+        if (fwrite(buf, 1, (size_t)k, tmp) != (size_t)k) {
+            st = fv_error_set(err, FV_ERR_IO, "cannot inflate '%s' into a temporary file: %s", path, strerror(errno));
+            break;
+        }
+    }
+    if (st == FV_OK) {
+        int zerr = Z_OK;
+        const char *why = gzerror(gz, &zerr);
+        if (zerr == Z_ERRNO) st = fv_error_set(err, FV_ERR_IO, "cannot read '%s': %s", path, strerror(errno));
+        else if (zerr == Z_BUF_ERROR) st = fv_error_set(err, FV_ERR_INVALID, "%s: the compressed data ends early (a truncated .gz file)", path);
+        else if (zerr != Z_OK) st = fv_error_set(err, FV_ERR_INVALID, "%s: not a readable gzip file (%s)", path, why && *why ? why : "corrupt data");
+    }
+    free(buf);
+    gzclose(gz);
+    if (st == FV_OK && (fflush(tmp) != 0 || fseek(tmp, 0, SEEK_SET) != 0))
+        st = fv_error_set(err, FV_ERR_IO, "cannot inflate '%s' into a temporary file: %s", path, strerror(errno));
+    if (st != FV_OK) {
+        fclose(tmp);
+        return st;
+    }
+    fclose(f);
+    *io = tmp;
+    return FV_OK;
 }
 
 /* ---- EyeLink ASC ---- */
 
 static bool starts_with(const char *s, const char *p) { return strncmp(s, p, strlen(p)) == 0; }
 
-/* A value of a sample line: a number, or "." for one the tracker lost (NaN). */
+/* A line that starts with the keyword word (followed by a blank or the end). */
+static bool keyword(const char *s, const char *word)
+{
+    size_t n = strlen(word);
+    return strncmp(s, word, n) == 0 && (s[n] == ' ' || s[n] == '\t' || s[n] == '\r' || s[n] == '\n' || s[n] == '\0');
+}
+
+/* The eyes a START or SAMPLES line names: bit 0 left, bit 1 right. */
+static int line_eyes(const char *line) { return (strstr(line, "LEFT") != NULL) | (strstr(line, "RIGHT") != NULL) << 1; }
+
+/* A value of a sample line: a number, or "." for one the tracker lost (NaN); not the flags
+ * column ("...", "....."). */
 static bool asc_value(const char **s, double *v)
 {
     while (**s == ' ' || **s == '\t') (*s)++;
-    if (**s == '.' && !isdigit((unsigned char)(*s)[1])) {
+    char after = (*s)[1];
+    if (**s == '.' && (after == ' ' || after == '\t' || after == '\r' || after == '\n' || after == '\0')) {
         (*s)++;
         *v = NAN;
         return true;
@@ -102,22 +236,37 @@ static bool asc_value(const char **s, double *v)
     return true;
 }
 
-static fv_status import_asc(FILE *in, writer *w, fv_error *err)
+/* The sample rate a SAMPLES line ("... RATE 2000.00 ...") or a RECCFG / !MODE RECORD message
+ * ("RECCFG CR 2000 2 1 LR") gives, or 0. */
+static double line_rate(const char *line)
+{
+    const char *p;
+    double r = 0;
+    char *end;
+    if (starts_with(line, "SAMPLES") && (p = strstr(line, "RATE"))) r = strtod(p + 4, &end);
+    else if (starts_with(line, "MSG") && ((p = strstr(line, "RECCFG")) || (p = strstr(line, "!MODE RECORD")))) {
+        p += *p == 'R' ? 6 : 12;
+        while (*p == ' ' || *p == '\t') p++;
+        while (*p && *p != ' ' && *p != '\t') p++; /* the tracking mode (CR, P) */
+        r = strtod(p, &end);
+    }
+    return isfinite(r) && r >= 1.0 && r <= 100000.0 ? r : 0.0;
+}
+
+static fv_status import_asc(FILE *in, writer *w, fv_gaze_eyes want, fv_error *err)
 {
     char *line = NULL;
     size_t cap = 0;
     double left = 0, top = 0, right = -1, bottom = -1;
-    bool has_left = false, has_right = false, sized = false;
+    int eyes = 0;
+    bool sized = false;
     fv_status st = FV_OK;
     int lineno = 0;
     /* First pass: the screen and the eyes. */
     while (next_line(in, w, &line, &cap, ++lineno, &st, err)) {
         const char *d = strstr(line, "DISPLAY_COORDS");
         if (starts_with(line, "MSG") && d && sscanf(d + 14, "%lf %lf %lf %lf", &left, &top, &right, &bottom) == 4) sized = true;
-        if (starts_with(line, "START") || starts_with(line, "SAMPLES")) {
-            has_left |= strstr(line, "LEFT") != NULL;
-            has_right |= strstr(line, "RIGHT") != NULL;
-        }
+        if (keyword(line, "START") || keyword(line, "SAMPLES")) eyes |= line_eyes(line);
     }
     if (st != FV_OK || ferror(in)) {
         free(line);
@@ -136,37 +285,90 @@ static fv_status import_asc(FILE *in, writer *w, fv_error *err)
     }
     w->info->width = sw;
     w->info->height = sh;
-    w->binocular = has_left && has_right;
-    w->info->binocular = w->binocular;
+    /* The eye choice. A file that names no eye has one, taken as whichever is asked for. */
+    if (eyes == 0) eyes = want == FV_GAZE_EYES_RIGHT ? 2 : 1;
+    if ((want == FV_GAZE_EYES_LEFT && !(eyes & 1)) || (want == FV_GAZE_EYES_RIGHT && !(eyes & 2))) {
+        free(line);
+        return fv_error_set(err, FV_ERR_INVALID, "%s: the recording has no %s-eye samples (it recorded the %s eye)", w->in,
+                            want == FV_GAZE_EYES_LEFT ? "left" : "right", want == FV_GAZE_EYES_LEFT ? "right" : "left");
+    }
+    if (eyes != 3) w->eyes = eyes == 1 ? FV_GAZE_EYES_LEFT : FV_GAZE_EYES_RIGHT;
+    else w->eyes = want == FV_GAZE_EYES_DEFAULT ? FV_GAZE_EYES_EACH : want;
+    w->binocular = w->eyes == FV_GAZE_EYES_EACH;
     if (fseek(in, 0, SEEK_SET) != 0) {
         free(line);
         return fv_error_set(err, FV_ERR_IO, "cannot read '%s' twice: %s", w->in, strerror(errno));
     }
-    /* Second pass: samples, with each eye's blinks. In a monocular recording the one eye's
-     * samples come first whichever it is. */
+    /* Second pass: samples, per recording block (the eyes its START / SAMPLES lines name), with
+     * each eye's blinks. */
     bool blink[2] = {false, false};
+    int block = eyes;
+    double rate = 0, last = NAN, end_ms = NAN;
+    bool gap = false;
     lineno = 0;
     while (next_line(in, w, &line, &cap, ++lineno, &st, err)) {
         if (!isdigit((unsigned char)line[0])) {
             char eye = 0;
-            if (sscanf(line, "SBLINK %c", &eye) == 1 || sscanf(line, "EBLINK %c", &eye) == 1) {
-                bool start = line[0] == 'S';
-                if (eye == 'L' || (!w->binocular && eye == 'R')) blink[0] = start;
-                if (w->binocular && eye == 'R') blink[1] = start;
+            double r = line_rate(line);
+            if (r > 0) rate = w->info->rate = r;
+            if (keyword(line, "START")) {
+                int e = line_eyes(line);
+                block = e ? e : eyes;
+                blink[0] = blink[1] = false;
+                gap |= isfinite(last);
+            } else if (keyword(line, "SAMPLES")) {
+                int e = line_eyes(line);
+                if (e) block = e;
+            } else if (keyword(line, "END")) {
+                char *end;
+                double t = strtod(line + 3, &end);
+                end_ms = end > line + 3 && isfinite(t) ? t : NAN;
+                gap |= isfinite(last);
+            } else if (sscanf(line, "SBLINK %c", &eye) == 1 || sscanf(line, "EBLINK %c", &eye) == 1) {
+                /* In a recording of one eye (or naming none), a blink is that eye's. */
+                int k = eyes == 1 ? 0 : eyes == 2 ? 1 : eye == 'R';
+                if (eye == 'L' || eye == 'R') blink[k] = line[0] == 'S';
             }
             continue;
         }
         const char *s = line;
         double t, v[6];
-        if (!asc_value(&s, &t)) continue;
-        int n = 0, want = w->binocular ? 6 : 3;
-        while (n < want && asc_value(&s, &v[n])) n++;
-        if (n < want) continue; /* not a sample line we know (a velocity or resolution column layout is still read: extra columns are ignored) */
-        double xl = v[0], yl = v[1], xr = NAN, yr = NAN;
-        if (w->binocular) xr = v[3], yr = v[4];
+        int n = 0, want_n = block == 3 ? 6 : 3;
+        if (asc_value(&s, &t))
+            while (n < want_n && asc_value(&s, &v[n])) n++;
+        if (n < want_n || !isfinite(t)) {
+            st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: expected a sample '<time> <x> <y> <pupil>'%s", w->in, lineno,
+                              block == 3 ? " for each eye (the block records both)" : "");
+            break;
+        }
+        /* Times: a stamp not above the last one (2000 Hz written in whole milliseconds: two
+         * samples per stamp) is the last time plus a sample period, as long as that stays within
+         * the stamp's millisecond; otherwise the sample is dropped. */
+        double period = rate > 0 ? 1000.0 / rate : 1.0;
+        if (isfinite(last) && !(t > last)) {
+            double c = last + period;
+            if (!(rate > 0 && c < t + 1.0 - 1e-6)) {
+                w->info->dropped++;
+                continue;
+            }
+            t = c;
+        }
+        /* A break between recording blocks: the gaze is unknown from the block's END (or a sample
+         * period after its last sample) until this sample. */
+        if (gap && isfinite(last) && t - last > 1.5 * period) {
+            double g = end_ms > last && end_ms < t ? end_ms : last + period;
+            if (emit(w, g / 1000.0, NAN, NAN, NAN, NAN)) w->info->gaps++;
+        }
+        gap = false;
+        end_ms = NAN;
+        last = t;
+        double xl = NAN, yl = NAN, xr = NAN, yr = NAN;
+        if (block == 3) xl = v[0], yl = v[1], xr = v[3], yr = v[4];
+        else if (block == 2) xr = v[0], yr = v[1];
+        else xl = v[0], yl = v[1];
         if (blink[0]) xl = yl = NAN;
         if (blink[1]) xr = yr = NAN;
-        put_sample(w, t / 1000.0, (xl - left) / sw, (yl - top) / sh, (xr - left) / sw, (yr - top) / sh);
+        emit(w, t / 1000.0, (xl - left) / sw, (yl - top) / sh, (xr - left) / sw, (yr - top) / sh);
     }
     free(line);
     return st;
@@ -174,82 +376,194 @@ static fv_status import_asc(FILE *in, writer *w, fv_error *err)
 
 /* ---- Pupil Labs gaze_positions.csv ---- */
 
-/* Field k (0-based) of a comma-separated line, or NULL; *len gets its length. */
-static const char *csv_field(const char *line, int k, size_t *len)
+#define CSV_MAX_FIELDS 256
+
+/* Splits a comma-separated line into at most CSV_MAX_FIELDS fields (a field in double quotes may
+ * hold commas; the quotes are left off). Returns the number of fields. */
+static int csv_split(const char *line, const char **f, size_t *len)
 {
+    int n = 0;
     const char *s = line;
-    for (int i = 0; i < k; i++) {
-        s = strchr(s, ',');
-        if (!s) return NULL;
+    for (;;) {
+        if (n == CSV_MAX_FIELDS) return n;
+        while (*s == ' ') s++;
+        if (*s == '"') {
+            const char *q = strchr(s + 1, '"');
+            f[n] = s + 1;
+            len[n] = q ? (size_t)(q - s - 1) : strcspn(s + 1, "\r\n");
+            s = q ? q + 1 : s + 1 + len[n];
+            s += strcspn(s, ",\r\n");
+        } else {
+            f[n] = s;
+            len[n] = strcspn(s, ",\r\n");
+            s += len[n];
+        }
+        while (len[n] && (f[n][len[n] - 1] == ' ' || f[n][len[n] - 1] == '\t')) len[n]--;
+        n++;
+        if (*s != ',') return n;
         s++;
     }
-    *len = strcspn(s, ",\r\n");
-    return s;
 }
 
-static bool field_number(const char *line, int k, double *v)
+static bool field_number(const char *s, size_t len, double *v)
 {
-    size_t len;
-    const char *s = csv_field(line, k, &len);
-    if (!s || len == 0 || len > 63) return false;
+    if (len == 0 || len > 63) return false;
     char tmp[64];
     memcpy(tmp, s, len);
     tmp[len] = '\0';
     char *end;
     *v = strtod(tmp, &end);
-    while (*end == ' ') end++;
     return end != tmp && *end == '\0';
 }
 
-static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_error *err)
+enum { EYE_COMBINED = 0, EYE_LEFT = 1, EYE_RIGHT = 2 };
+
+/* The eye a row comes from: its base_data names the pupil data it was mapped from, "<t>-0" from
+ * eye 0 (the right eye), "<t>-1" from eye 1 (the left); an eye_id column (0, 1) where there is no
+ * base_data. Both, or neither: a combined row. */
+static int row_eye(const char *base, size_t blen, const char *id, size_t ilen)
+{
+    int bits = 0;
+    for (size_t i = 0; i + 1 < blen; i++) {
+        if (base[i] != '-' || (base[i + 1] != '0' && base[i + 1] != '1')) continue;
+        char after = i + 2 < blen ? base[i + 2] : ' ';
+        if (isdigit((unsigned char)after) || after == '.') continue;
+        bits |= base[i + 1] == '0' ? EYE_RIGHT : EYE_LEFT;
+    }
+    if (!bits && id && ilen == 1 && (id[0] == '0' || id[0] == '1')) bits = id[0] == '0' ? EYE_RIGHT : EYE_LEFT;
+    return bits == 3 ? EYE_COMBINED : bits;
+}
+
+typedef struct pupil_row {
+    double t, x, y; /* x, y NaN when missing */
+    int eye, index; /* index: the order in the file, for a stable sort */
+} pupil_row;
+
+static int cmp_rows(const void *a, const void *b)
+{
+    const pupil_row *p = a, *q = b;
+    if (p->t != q->t) return p->t < q->t ? -1 : 1;
+    return (p->index > q->index) - (p->index < q->index);
+}
+
+static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_gaze_eyes want, fv_error *err)
 {
     char *line = NULL;
     size_t cap = 0;
-    int col_t = -1, col_c = -1, col_x = -1, col_y = -1;
+    int col_t = -1, col_old_t = -1, col_c = -1, col_x = -1, col_y = -1, col_base = -1, col_id = -1;
     fv_status st = FV_OK;
-    if (next_line(in, w, &line, &cap, 1, &st, err)) {
-        for (int k = 0;; k++) {
-            size_t len;
-            const char *f = csv_field(line, k, &len);
-            if (!f) break;
-            while (len && (f[len - 1] == ' ' || f[len - 1] == '\r')) len--;
-            if (len == 14 && !strncmp(f, "gaze_timestamp", 14)) col_t = k;
-            else if (len == 10 && !strncmp(f, "confidence", 10)) col_c = k;
-            else if (len == 10 && !strncmp(f, "norm_pos_x", 10)) col_x = k;
-            else if (len == 10 && !strncmp(f, "norm_pos_y", 10)) col_y = k;
+    int lineno = 0;
+    const char *f[CSV_MAX_FIELDS];
+    size_t len[CSV_MAX_FIELDS];
+    /* The header: the first line that is not blank (an export may start with one). */
+    while (next_line(in, w, &line, &cap, ++lineno, &st, err)) {
+        char *h = line;
+        if (!strncmp(h, "\xEF\xBB\xBF", 3)) h += 3; /* a byte order mark */
+        if (h[strspn(h, " \t\r\n")] == '\0') continue;
+        int n = csv_split(h, f, len);
+        for (int k = 0; k < n; k++) {
+#define IS(name) (len[k] == strlen(name) && !strncmp(f[k], name, len[k]))
+            if (IS("gaze_timestamp")) col_t = k;
+            else if (IS("timestamp")) col_old_t = k; /* Pupil before v1.x */
+            else if (IS("confidence")) col_c = k;
+            else if (IS("norm_pos_x")) col_x = k;
+            else if (IS("norm_pos_y")) col_y = k;
+            else if (IS("base_data")) col_base = k;
+            else if (IS("eye_id")) col_id = k;
+#undef IS
         }
+        break;
     }
     if (st != FV_OK) {
         free(line);
         return st;
     }
+    if (col_t < 0) col_t = col_old_t;
     if (col_t < 0 || col_c < 0 || col_x < 0 || col_y < 0) {
         free(line);
-        return fv_error_set(err, FV_ERR_INVALID, "%s: the header lacks gaze_timestamp, confidence, norm_pos_x or norm_pos_y (is it Pupil's gaze_positions.csv?)",
+        return fv_error_set(err, FV_ERR_INVALID,
+                            "%s: the header lacks gaze_timestamp (or timestamp), confidence, norm_pos_x or norm_pos_y (is it Pupil's gaze_positions.csv?)",
                             w->in);
     }
-    w->binocular = false;
-    int lineno = 1;
-    while (st == FV_OK && next_line(in, w, &line, &cap, lineno + 1, &st, err)) {
-        lineno++;
+    const char *tname = col_t == col_old_t ? "timestamp" : "gaze_timestamp";
+    pupil_row *rows = NULL;
+    int count = 0, rcap = 0;
+    long per_eye[3] = {0, 0, 0};
+    while (st == FV_OK && next_line(in, w, &line, &cap, ++lineno, &st, err)) {
         if (line[strspn(line, " \t\r\n")] == '\0') continue;
+        int n = csv_split(line, f, len);
         double t, c, x, y;
-        if (!field_number(line, col_t, &t) || !field_number(line, col_c, &c)) {
-            st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: expected numbers in gaze_timestamp and confidence", w->in, lineno);
+        if (col_t >= n || col_c >= n || !field_number(f[col_t], len[col_t], &t) || !field_number(f[col_c], len[col_c], &c)) {
+            st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: expected numbers in %s and confidence", w->in, lineno, tname);
             break;
         }
-        if (!field_number(line, col_x, &x) || !field_number(line, col_y, &y) || !(c >= min_conf)) x = y = NAN;
-        put_sample(w, t, x, 1.0 - y, NAN, NAN);
+        if (!isfinite(t)) {
+            w->info->dropped++;
+            continue;
+        }
+        if (col_x >= n || col_y >= n || !field_number(f[col_x], len[col_x], &x) || !field_number(f[col_y], len[col_y], &y) || !(c >= min_conf) ||
+            !on_screen(x, y))
+            x = y = NAN;
+        int eye = row_eye(col_base >= 0 && col_base < n ? f[col_base] : NULL, col_base >= 0 && col_base < n ? len[col_base] : 0,
+                          col_id >= 0 && col_id < n ? f[col_id] : NULL, col_id >= 0 && col_id < n ? len[col_id] : 0);
+        if (count == INT32_MAX || fv_grow((void **)&rows, &rcap, count + 1, sizeof *rows)) {
+            st = fv_error_set(err, FV_ERR_NOMEM, "out of memory reading '%s'", w->in);
+            break;
+        }
+        rows[count] = (pupil_row){t, x, 1.0 - y, eye, count};
+        count++;
+        per_eye[eye]++;
     }
     free(line);
-    return st;
+    if (st != FV_OK) {
+        free(rows);
+        return st;
+    }
+    /* The eye choice. Rows Pupil mapped from both eyes (or that name no eye) count for either. */
+    if ((want == FV_GAZE_EYES_LEFT || want == FV_GAZE_EYES_RIGHT) && per_eye[want == FV_GAZE_EYES_LEFT ? EYE_LEFT : EYE_RIGHT] + per_eye[EYE_COMBINED] == 0) {
+        free(rows);
+        return fv_error_set(err, FV_ERR_INVALID, "%s: no row is from the %s eye (base_data ending in -%d)", w->in,
+                            want == FV_GAZE_EYES_LEFT ? "left" : "right", want == FV_GAZE_EYES_LEFT ? 1 : 0);
+    }
+    w->eyes = want == FV_GAZE_EYES_DEFAULT ? FV_GAZE_EYES_BOTH : want;
+    if (w->eyes == FV_GAZE_EYES_BOTH || w->eyes == FV_GAZE_EYES_EACH) {
+        /* An export of one eye's rows is that eye's; one of combined rows only has nothing to pair. */
+        if (per_eye[EYE_COMBINED] == 0 && per_eye[EYE_RIGHT] == 0) w->eyes = FV_GAZE_EYES_LEFT;
+        else if (per_eye[EYE_COMBINED] == 0 && per_eye[EYE_LEFT] == 0) w->eyes = FV_GAZE_EYES_RIGHT;
+        else if (per_eye[EYE_LEFT] + per_eye[EYE_RIGHT] == 0) w->eyes = FV_GAZE_EYES_BOTH;
+    }
+    w->binocular = w->eyes == FV_GAZE_EYES_EACH;
+    qsort(rows, (size_t)count, sizeof *rows, cmp_rows);
+    bool pair = w->eyes == FV_GAZE_EYES_BOTH || w->eyes == FV_GAZE_EYES_EACH;
+    for (int i = 0; i < count; i++) {
+        const pupil_row *r = &rows[i];
+        if ((w->eyes == FV_GAZE_EYES_LEFT && r->eye == EYE_RIGHT) || (w->eyes == FV_GAZE_EYES_RIGHT && r->eye == EYE_LEFT)) continue;
+        double l[2] = {NAN, NAN}, rt[2] = {NAN, NAN}, t = r->t;
+        if (r->eye != EYE_RIGHT) l[0] = r->x, l[1] = r->y;
+        if (r->eye != EYE_LEFT) rt[0] = r->x, rt[1] = r->y;
+        const pupil_row *o = i + 1 < count ? &rows[i + 1] : NULL;
+        if (pair && r->eye != EYE_COMBINED && o && o->eye != EYE_COMBINED && o->eye != r->eye && o->t - r->t <= PUPIL_PAIR_S) {
+            if (o->eye == EYE_LEFT) l[0] = o->x, l[1] = o->y;
+            else rt[0] = o->x, rt[1] = o->y;
+            t = 0.5 * (r->t + o->t);
+            i++;
+            w->info->paired++;
+        }
+        emit(w, t, l[0], l[1], rt[0], rt[1]);
+    }
+    free(rows);
+    return FV_OK;
 }
 
+/* The format from the name: .asc EyeLink, .csv Pupil, either with .gz after it. */
 static fv_gaze_format guess_format(const char *path)
 {
-    const char *dot = strrchr(path, '.');
-    if (dot && strcasecmp(dot, ".asc") == 0) return FV_GAZE_FORMAT_EYELINK_ASC;
-    if (dot && strcasecmp(dot, ".csv") == 0) return FV_GAZE_FORMAT_PUPIL_CSV;
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    size_t n = strlen(base);
+    if (n > 3 && strcasecmp(base + n - 3, ".gz") == 0) n -= 3;
+    if (n > 4 && strncasecmp(base + n - 4, ".asc", 4) == 0) return FV_GAZE_FORMAT_EYELINK_ASC;
+    if (n > 4 && strncasecmp(base + n - 4, ".csv", 4) == 0) return FV_GAZE_FORMAT_PUPIL_CSV;
     return FV_GAZE_FORMAT_AUTO;
 }
 
@@ -266,13 +580,19 @@ fv_status fv_gaze_import(const char *in_path, const char *out_path, const fv_gaz
     fv_gaze_format fmt = opts->format != FV_GAZE_FORMAT_AUTO ? opts->format : guess_format(in_path);
     if (!(opts->min_confidence >= 0.0 && opts->min_confidence <= 1.0))
         return fv_error_set(err, FV_ERR_INVALID, "gaze import: confidence threshold %g is outside [0, 1]", opts->min_confidence);
+    if ((unsigned)opts->eyes > FV_GAZE_EYES_EACH) return fv_error_set(err, FV_ERR_INVALID, "gaze import: unknown eye choice %d", (int)opts->eyes);
     /* A regular file only, whatever its name (core/fileio.h: /dev/zero reads forever). */
     FILE *in;
     fv_status st = fv_file_open_read(in_path, "recording", &in, err);
     if (st != FV_OK) return st;
     if (fmt != FV_GAZE_FORMAT_EYELINK_ASC && fmt != FV_GAZE_FORMAT_PUPIL_CSV) {
         fclose(in);
-        return fv_error_set(err, FV_ERR_INVALID, "%s: unknown recording format (an EyeLink .asc or Pupil Labs gaze_positions .csv)", in_path);
+        return fv_error_set(err, FV_ERR_INVALID, "%s: unknown recording format (an EyeLink .asc or Pupil Labs gaze_positions .csv, or either .gz)",
+                            in_path);
+    }
+    if ((st = inflate_recording(in_path, opts->max_inflated ? opts->max_inflated : DEFAULT_MAX_INFLATED, &in, &info->compressed, err)) != FV_OK) {
+        fclose(in);
+        return st;
     }
     fv_atomic_file af;
     FILE *out = NULL;
@@ -287,11 +607,13 @@ fv_status fv_gaze_import(const char *in_path, const char *out_path, const fv_gaz
         return st;
     }
     info->format = fmt;
-    writer w = {out, in_path, false, false, {0, 0}, 0, 0, info};
+    writer w = {out, in_path, FV_GAZE_EYES_LEFT, false, false, {0, 0}, 0, 0, info};
     fprintf(out, "# gaze trace imported from %s by fovea gaze import (docs/gaze.md)\n", in_path);
-    st = fmt == FV_GAZE_FORMAT_EYELINK_ASC ? import_asc(in, &w, err) : import_pupil(in, &w, opts->min_confidence, err);
+    st = fmt == FV_GAZE_FORMAT_EYELINK_ASC ? import_asc(in, &w, opts->eyes, err) : import_pupil(in, &w, opts->min_confidence, opts->eyes, err);
     if (st == FV_OK && ferror(in)) st = fv_error_set(err, FV_ERR_IO, "cannot read '%s': %s", in_path, strerror(errno));
     fclose(in);
+    info->eyes = w.eyes;
+    info->binocular = w.binocular;
     /* A trace needs one known sample per eye (fv_gaze_path_load_csv). */
     if (st == FV_OK && (w.known[0] == 0 || (w.binocular && w.known[1] == 0)))
         st = fv_error_set(err, FV_ERR_INVALID, "%s: no usable gaze sample%s (%ld samples, all missing)", in_path,

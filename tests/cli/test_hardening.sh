@@ -124,8 +124,9 @@ grep -q '^0.002,0.999479,0.000000$' "$TMP/mono.csv" || fail "mono.csv: $(cat "$T
 expect 0 "" -- $G "$D/eyelink_bino.asc" --out "$TMP/bino.csv"
 grep -q '^0.008,0.250000,0.250000,,$' "$TMP/bino.csv" || fail "bino.csv: right eye in a blink at 28 ms: $(cat "$TMP/bino.csv")"
 expect 0 "" -- $G "$D/pupil_gaze_positions.csv" --out "$TMP/pupil.csv"
-grep -q "5 samples (2 missing, 1 dropped" "$TMP/err" || fail "pupil summary: $(cat "$TMP/err")"
-grep -q '^0.1,0.250000,0.250000$' "$TMP/pupil.csv" || fail "pupil.csv: y flipped: $(cat "$TMP/pupil.csv")"
+# the two eyes' rows at 100.1 s are one sample, their mean (docs/gaze.md, "Which eye"); y flipped
+grep -q "5 samples (2 missing), one gaze for both eyes (1 pair of rows" "$TMP/err" || fail "pupil summary: $(cat "$TMP/err")"
+grep -q '^0.1,0.255000,0.255000$' "$TMP/pupil.csv" || fail "pupil.csv: y flipped: $(cat "$TMP/pupil.csv")"
 expect 0 "" -- $G "$D/pupil_gaze_positions.csv" --out "$TMP/pupil2.csv" --confidence 0.05
 grep -q '^0.2,0.900000,0.100000$' "$TMP/pupil2.csv" || fail "a lower threshold keeps the 0.1-confidence sample"
 # the traces drive renders, with either policy
