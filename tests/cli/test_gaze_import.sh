@@ -1,0 +1,55 @@
+# `fovea gaze import` on the recordings of issue 25 (items 4 and 5), hand-made in tests/data:
+# Pupil exports with a leading blank line, the old `timestamp` header and one row per eye
+# (--eye), EyeLink at 2000 Hz in whole milliseconds, gzip-compressed, and with a break between
+# trials. tests/unit/test_gaze_import.c checks the values; this checks the tool's side.
+. "$(dirname "$0")/lib.sh"
+D=$SRC/tests/data
+G="$FOVEA gaze import"
+R="$FOVEA render cornell --size 8x8 --spp 1 --quiet"
+
+# ---- Pupil ----
+expect 0 "" -- $G "$D/pupil_blank_first.csv" --out "$TMP/blank.csv"
+grep -q "20 samples (1 missing), right eye" "$TMP/err" || fail "blank-first summary: $(cat "$TMP/err")"
+expect 0 "" -- $G "$D/pupil_old_header.csv" --out "$TMP/old.csv"
+grep -q '^0.19,0.390000,0.750000$' "$TMP/old.csv" || fail "old header: $(tail -n 2 "$TMP/old.csv")"
+expect 2 "pupil_old_header.csv: no row is from the left eye" -- $G "$D/pupil_old_header.csv" --eye left --out "$TMP/x.csv"
+# one row per eye: by default one gaze, the mean of the pair (moment 0: x 0.255 and 0.345)
+expect 0 "" -- $G "$D/pupil_binocular.csv" --out "$TMP/both.csv"
+grep -q "42 samples (1 missing), one gaze for both eyes (40 pairs of rows, one of each eye)" "$TMP/err" || fail "binocular summary: $(cat "$TMP/err")"
+grep -q '^0,0.300000,0.400000$' "$TMP/both.csv" || fail "both.csv: $(head -n 3 "$TMP/both.csv")"
+expect 0 "" -- $G "$D/pupil_binocular.csv" --eye left --out "$TMP/left.csv"
+grep -q "42 samples (2 missing), left eye" "$TMP/err" || fail "left summary: $(cat "$TMP/err")"
+grep -q '^0,0.345000,0.410000$' "$TMP/left.csv" || fail "left.csv: $(head -n 3 "$TMP/left.csv")"
+expect 0 "" -- $G "$D/pupil_binocular.csv" --eye right --out "$TMP/right.csv"
+grep -q '^0,0.255000,0.390000$' "$TMP/right.csv" || fail "right.csv: $(head -n 3 "$TMP/right.csv")"
+# each eye its own gaze: a five-column trace that a stereo render takes
+expect 0 "" -- $G "$D/pupil_binocular.csv" --eye each --out "$TMP/each.csv"
+grep -q '^0,0.345000,0.410000,0.255000,0.390000$' "$TMP/each.csv" || fail "each.csv: $(head -n 3 "$TMP/each.csv")"
+expect 0 "" -- $R --gaze-trace "$TMP/each.csv" --stereo 10 --frames 2 --fps 60 --out "$TMP/each.png"
+expect 0 "" -- $R --gaze-trace "$TMP/both.csv" --frames 2 --fps 60 --out "$TMP/both.png"
+expect 2 "--eye middle: expected left, right, both or each" -- $G "$D/pupil_binocular.csv" --eye middle --out "$TMP/x.csv"
+
+# ---- EyeLink ----
+expect 0 "" -- $G "$D/eyelink_2000hz.asc" --out "$TMP/2k.csv"
+grep -q "40 samples (0 missing), screen 1280x1024, right eye, 2000 Hz" "$TMP/err" || fail "2000 Hz summary: $(cat "$TMP/err")"
+grep -q '^0.0005,0.500391,0.500000$' "$TMP/2k.csv" || fail "2k.csv: $(head -n 3 "$TMP/2k.csv")"
+expect 0 "" -- $G "$D/eyelink_2000hz.asc.gz" --out "$TMP/2kgz.csv"
+grep -q "40 samples (0 missing), screen 1280x1024, right eye, 2000 Hz, gzip-compressed" "$TMP/err" || fail ".gz summary: $(cat "$TMP/err")"
+diff <(grep -v '^#' "$TMP/2k.csv") <(grep -v '^#' "$TMP/2kgz.csv") >/dev/null || fail "the .gz recording gives another trace"
+head -c 300 "$D/eyelink_2000hz.asc.gz" >"$TMP/cut.asc.gz"
+expect 2 "cut.asc.gz: the compressed data ends early" -- $G "$TMP/cut.asc.gz" --out "$TMP/x.csv"
+expect 0 "" -- $G "$D/eyelink_trials.asc" --out "$TMP/trials.csv"
+grep -q "21 samples (1 missing), screen 1000x1000, left eye, 500 Hz, 1 gap between recording blocks marked missing" "$TMP/err" ||
+  fail "trials summary: $(cat "$TMP/err")"
+grep -q '^0.02,,$' "$TMP/trials.csv" || fail "trials.csv: the break is not missing: $(sed -n 10,14p "$TMP/trials.csv")"
+# a frame in the break is rendered with the gaze unknown: widened, not at an interpolated point
+expect 0 "" -- $R --gaze-trace "$TMP/trials.csv" --gaze-missing widen --frames 1 --time 0.5 --out "$TMP/t.png"
+expect 0 "" -- $G "$D/eyelink_bino.asc" --eye both --out "$TMP/bboth.csv"
+grep -q '^0,0.506250,0.500000$' "$TMP/bboth.csv" || fail "bino --eye both: $(head -n 3 "$TMP/bboth.csv")"
+expect 2 "eyelink_mono.asc: the recording has no right-eye samples" -- $G "$D/eyelink_mono.asc" --eye right --out "$TMP/x.csv"
+printf 'MSG\t1 DISPLAY_COORDS 0 0 99 99\nSTART\t1 \tLEFT\tRIGHT\tSAMPLES\n1\t1\t2\t3\t...\n' >"$TMP/short.asc"
+expect 2 "short.asc:3: expected a sample" -- $G "$TMP/short.asc" --out "$TMP/x.csv"
+
+[ -e "$TMP/x.csv" ] && fail "a failed import left x.csv behind"
+ls "$TMP" | grep -q 'tmp\.' && fail "temporary files left in $TMP"
+finish
