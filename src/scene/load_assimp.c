@@ -169,6 +169,8 @@ typedef struct import_ctx {
     bool ok;
     tex_seen *seen;
     int nseen, capseen, ntex;
+    char said[4][160];    /* the importer's data-loss warnings passed on so far (each once) */
+    int nsaid;
 } import_ctx;
 
 static void put(import_ctx *c, char tag, const void *p, size_t n)
@@ -443,11 +445,34 @@ static int material_texture(import_ctx *c, const struct aiMaterial *am, const ch
     return c->seen[k].id;
 }
 
+/* assimp's log, in the child: the warnings that say the importer itself dropped data ("Some faces
+ * had out-of-range indices. Those faces were dropped.") are passed on, each once and at most four,
+ * since fovea cannot see that loss in what it receives; the importer's other chatter is not. */
+static void importer_log(const char *msg, char *user)
+{
+    import_ctx *c = (import_ctx *)user;
+    if (strncmp(msg, "Warn,", 5) != 0) return;
+    if (!strstr(msg, "dropped") && !strstr(msg, "out-of-range") && !strstr(msg, "out of range")) return;
+    const char *text = strchr(msg, ':'); /* "Warn,  T0: text" */
+    text = text ? text + 1 : msg + 5;
+    while (*text == ' ') text++;
+    char line[160];
+    snprintf(line, sizeof line, "%s", text);
+    for (size_t n = strlen(line); n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r'); n--) line[n - 1] = '\0';
+    for (int i = 0; i < c->nsaid; i++)
+        if (!strcmp(c->said[i], line)) return;
+    if (c->nsaid == (int)(sizeof c->said / sizeof c->said[0])) return;
+    snprintf(c->said[c->nsaid++], sizeof c->said[0], "%s", line);
+    put_text(c, REC_WARN, "the importer (assimp): %s", line);
+}
+
 static int import_child(void *user, int fd)
 {
     import_ctx *c = user;
     c->fd = fd;
     c->ok = true;
+    struct aiLogStream log_stream = {importer_log, (char *)c};
+    aiAttachLogStream(&log_stream);
     struct aiPropertyStore *props = aiCreatePropertyStore();
     /* Points and lines would only be dropped later; ask assimp not to produce them. */
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
@@ -472,6 +497,7 @@ static int import_child(void *user, int fd)
         put(c, REC_END, NULL, 0);
     }
     if (ai) aiReleaseImport(ai);
+    aiDetachAllLogStreams();
     free(c->seen);
     return c->ok ? 0 : 3;
 }
@@ -620,7 +646,12 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
     size_t mem = (size_t)2 << 30;
     if ((size_t)sb.st_size < ((size_t)64 << 30) / 64 && (size_t)sb.st_size * 64 > mem) mem = (size_t)sb.st_size * 64;
     int cpu = 10 + 2 * (int)(sb.st_size >> 20);
-    import_ctx c = {path, opts, NULL, -1, true, NULL, 0, 0, 0};
+    import_ctx c;
+    memset(&c, 0, sizeof c);
+    c.path = path;
+    c.opts = opts;
+    c.fd = -1;
+    c.ok = true;
     fv_sandbox *box;
     if ((st = fv_sandbox_start(import_child, &c, mem, cpu, &box, err)) != FV_OK) return st;
 

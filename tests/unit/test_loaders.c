@@ -138,6 +138,21 @@ static void test_drops_said_once(void **st)
     fv_scene_destroy(s);
 }
 
+/* An index past the vertices: assimp drops the face itself, and its warning is passed on (issue 25,
+ * item 10: the loss was silent). bad_index.gltf is quad.gltf with index 999 in its first triangle. */
+static void test_importer_drop_said(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_error err;
+    fv_test_warnings w = {0};
+    fv_log log = {fv_test_warn, &w};
+    assert_int_equal(fv_scene_load(DATA("bad_index.gltf"), &log, &s, NULL, &err), FV_OK);
+    assert_non_null(strstr(w.all, "the importer (assimp): Some faces had out-of-range indices"));
+    assert_int_equal(fv_scene_triangle_count(s), 1);
+    fv_scene_destroy(s);
+}
+
 static void test_json_scene(void **st)
 {
     (void)st;
@@ -230,7 +245,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_builtin_and_unknown), cmocka_unit_test(test_obj_materials), cmocka_unit_test(test_gltf_and_ply),
-        cmocka_unit_test(test_nan_and_empty),       cmocka_unit_test(test_drops_said_once), cmocka_unit_test(test_json_scene),    cmocka_unit_test(test_json_errors),
+        cmocka_unit_test(test_nan_and_empty),       cmocka_unit_test(test_drops_said_once), cmocka_unit_test(test_importer_drop_said),
+        cmocka_unit_test(test_json_scene),    cmocka_unit_test(test_json_errors),
         cmocka_unit_test(test_camera_trace),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
