@@ -41,7 +41,7 @@ FV_HD static inline void fv_kpt_pixel(const fv_kscene *s, const fv_kpt_frame *f,
     fv_path_first_hit first;
     first.hit = false;
     first.t = 0.0f;
-    first.p = first.n = first.albedo = fv_v3s(0.0f);
+    first.p = first.n = first.albedo = first.reflectance = fv_v3s(0.0f);
     first.obj = 0;
     for (int k = 0; k < f->opt.spp; k++) {
         fv_rng rng = fv_rng_stream(f->seed, FV_STREAM_CAMERA, (uint64_t)pix * 2 + (uint64_t)f->eye, (uint64_t)k, (uint64_t)f->frame);
