@@ -8,6 +8,13 @@ OUT=$TMP/out.png
 R="$FOVEA render cornell --size 32x36"
 
 expect 2 "reduction" -- $R --method vpolar --param reduction=0 --out "$OUT"
+# the denoiser's parameters are refused by the names a user types (issue 25, item 10: "alpha_color")
+for m in vpolar cartesian-full; do
+  expect 2 "parameter svgf_alpha=0 must be in (0, 1]" -- $R --method $m --param svgf_alpha=0 --out "$OUT"
+  expect 2 "parameter sigma_lum=0 must be > 0" -- $R --method $m --param sigma_lum=0 --out "$OUT"
+  expect 2 "parameter sigma_normal=0 must be > 0" -- $R --method $m --param sigma_normal=0 --out "$OUT"
+  expect 2 "parameter sigma_depth=0 must be > 0" -- $R --method $m --param sigma_depth=0 --out "$OUT"
+done
 expect 2 "reduction" -- $R --method vpolar --param reduction=1 --out "$OUT"
 expect 2 "reduction" -- $R --method vpolar --param reduction=1.5 --out "$OUT"
 expect 2 "reduction" -- $R --method cartesian --param reduction=-0.1 --out "$OUT"

@@ -23,14 +23,22 @@
 
 typedef enum vp_show { SHOW_SCREEN = 0, SHOW_SPACE, SHOW_DENSITY } vp_show;
 
+typedef enum vp_kind { K_VPOLAR, K_CARTESIAN, K_CARTESIAN_FULL, K_LINEAR_FALLOFF, K_LOGPOLAR } vp_kind;
+
 typedef struct vp_state {
     const char *name;
+    const fv_scene *scene;
+    vp_kind kind;
     fv_vp_opts o;
     vp_show show;
     fv_vp_pipeline *eye[2];
+    /* The foveated kinds (vpolar, linear-falloff, log-polar) while the frame's fovea covers the whole
+     * screen (a missing gaze under `widen`, docs/gaze.md): cartesian-full's pipeline with this
+     * method's path tracing and denoiser settings, made at the first such frame. in_full: which of
+     * the two rendered this eye's last frame (a switch starts the other's history afresh). */
+    fv_vp_pipeline *full[2];
+    bool in_full[2];
 } vp_state;
-
-typedef enum vp_kind { K_VPOLAR, K_CARTESIAN, K_CARTESIAN_FULL, K_LINEAR_FALLOFF, K_LOGPOLAR } vp_kind;
 
 #define VP_PERIPHERY_PASSES 3 /* vpolar's periphery_passes default */
 #define VP_PERIPHERY_DEG 20.0 /* and where they start (at most blur_ramp_deg) */
@@ -66,14 +74,18 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
         (s = fv_params_int(p, "svgf_iterations", o->svgf.iterations, 0, 10, &o->svgf.iterations, err)))
         return s;
     double v;
+    /* Each refused here by its own name: SVGF's validation would name its fields instead
+     * ("alpha_color"), which no user typed. */
     if ((s = fv_params_float(p, "svgf_alpha", o->svgf.alpha_color, 0.0, 1.0, &v, err))) return s;
+    if (!(v > 0.0)) return fv_error_set(err, FV_ERR_INVALID, "parameter svgf_alpha=%g must be in (0, 1]", v);
     o->svgf.alpha_color = o->svgf.alpha_moments = (float)v;
-    if ((s = fv_params_float(p, "sigma_lum", o->svgf.sigma_lum, 0.0, 1e6, &v, err))) return s;
-    o->svgf.sigma_lum = (float)v;
-    if ((s = fv_params_float(p, "sigma_normal", o->svgf.sigma_normal, 0.0, 1e6, &v, err))) return s;
-    o->svgf.sigma_normal = (float)v;
-    if ((s = fv_params_float(p, "sigma_depth", o->svgf.sigma_depth, 0.0, 1e6, &v, err))) return s;
-    o->svgf.sigma_depth = (float)v;
+    float *sigmas[3] = {&o->svgf.sigma_lum, &o->svgf.sigma_normal, &o->svgf.sigma_depth};
+    static const char *const sigma_keys[3] = {"sigma_lum", "sigma_normal", "sigma_depth"};
+    for (int i = 0; i < 3; i++) {
+        if ((s = fv_params_float(p, sigma_keys[i], *sigmas[i], 0.0, 1e6, &v, err))) return s;
+        if (!(v > 0.0)) return fv_error_set(err, FV_ERR_INVALID, "parameter %s=%g must be > 0", sigma_keys[i], v);
+        *sigmas[i] = (float)v;
+    }
     if ((s = fv_params_bool(p, "blur", blur_def, &o->blur, err)) ||
         (s = fv_params_float(p, "blur_sigma", 6.8, 0.0, 100.0, &o->blur_sigma, err)) ||
         (s = fv_params_float(p, "blur_fovea_deg", blur_fovea_def, 0.0, 180.0, &o->blur_fovea_deg, err)) ||
@@ -138,6 +150,8 @@ static fv_status create_kind(vp_kind kind, const char *name, const fv_scene *sce
     vp_state *st = calloc(1, sizeof *st);
     if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     st->name = name;
+    st->kind = kind;
+    st->scene = scene;
     fv_status s = read_opts(kind, params, &st->o, &st->show, err);
     for (int e = 0; s == FV_OK && e < 2; e++) s = fv_vp_pipeline_create(scene, &st->o, &st->eye[e], err);
     if (s != FV_OK) {
@@ -216,13 +230,46 @@ static fv_status show_density(const vp_state *st, const fv_vp_pipeline *p, fv_fi
     return FV_OK;
 }
 
+/* Whether the frame's fovea covers the whole screen for a method whose samples follow the gaze: it
+ * then renders as cartesian-full does, every pixel sampled and nothing blurred. */
+static bool whole_fovea(const vp_state *st, const fv_frame *frame)
+{
+    if (st->kind != K_VPOLAR && st->kind != K_LINEAR_FALLOFF && st->kind != K_LOGPOLAR) return false;
+    const fv_camera *cam = frame->camera;
+    fv_eye_model def;
+    return fv_frame_fovea_covers(frame, fv_frame_eye_model(frame, cam->width, cam->height, &def), cam->width, cam->height);
+}
+
+/* cartesian-full's options with this method's launch, path tracing and denoiser settings. */
+static fv_vp_opts full_opts(const fv_vp_opts *o)
+{
+    fv_vp_opts f = *o;
+    fv_space_opts_default(FV_SPACE_CARTESIAN, &f.space);
+    f.kill = false;
+    f.blur = false;
+    f.blur_follows_space = false;
+    f.periphery_passes = 10;
+    return f;
+}
+
 /* Each eye has its own pipeline: its history follows that eye's camera. */
 static fv_status vp_render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
     vp_state *st = state;
-    fv_vp_pipeline *p = st->eye[frame->eye];
-    fv_status s = fv_vp_pipeline_render(p, frame, film, stats, err);
+    const int e = frame->eye;
+    const bool full = whole_fovea(st, frame);
+    fv_status s;
+    if (full && !st->full[e]) {
+        const fv_vp_opts fo = full_opts(&st->o);
+        if ((s = fv_vp_pipeline_create(st->scene, &fo, &st->full[e], err)) != FV_OK) return s;
+    }
+    fv_vp_pipeline *p = full ? st->full[e] : st->eye[e];
+    /* The pipeline that did not render this eye's last frame holds an older history: not reused. */
+    fv_frame f = *frame;
+    if (full != st->in_full[e]) f.prev_camera = NULL;
+    s = fv_vp_pipeline_render(p, &f, film, stats, err);
     if (s != FV_OK) return s;
+    st->in_full[e] = full;
     if (st->show == SHOW_SPACE) show_space(p, film);
     if (st->show == SHOW_DENSITY) s = show_density(st, p, film, err);
     return s;
@@ -234,6 +281,8 @@ static void vp_destroy(void *state)
     if (!st) return;
     fv_vp_pipeline_destroy(st->eye[0]);
     fv_vp_pipeline_destroy(st->eye[1]);
+    fv_vp_pipeline_destroy(st->full[0]);
+    fv_vp_pipeline_destroy(st->full[1]);
     free(st);
 }
 
@@ -283,7 +332,7 @@ const fv_technique_class fv_technique_vpolar = {
                 "periphery_passes=int (3): SVGF passes for the columns beyond periphery_deg (svgf_iterations or more: all)\n"
                 "periphery_deg=float (20, at most blur_ramp_deg): eccentricity where periphery_passes starts, on the blur's profile\n",
     create_vpolar, vp_render, vp_destroy,
-    FURNACE_TEST, .spp_param = "spp",
+    FURNACE_TEST, .spp_param = "spp", .foveated = true,
 };
 
 const fv_technique_class fv_technique_cartesian = {
@@ -310,7 +359,7 @@ const fv_technique_class fv_technique_linear_falloff = {
                 "falloff_probability=float (0.2)\n"
                 "blur=bool (true): foveated blur (blur_fovea_deg default 10)\n",
     create_linear_falloff, vp_render, vp_destroy,
-    FURNACE_TEST, .spp_param = "spp",
+    FURNACE_TEST, .spp_param = "spp", .foveated = true,
 };
 
 const fv_technique_class fv_technique_logpolar = {
@@ -320,5 +369,5 @@ const fv_technique_class fv_technique_logpolar = {
                 "alpha=float (4): kernel exponent\n"
                 "blur=bool (false)\n",
     create_logpolar, vp_render, vp_destroy,
-    FURNACE_TEST, .spp_param = "spp",
+    FURNACE_TEST, .spp_param = "spp", .foveated = true,
 };
