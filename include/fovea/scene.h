@@ -179,8 +179,10 @@ FV_API bool fv_scene_env(const fv_scene *scene, fv_env_desc *out);
  * environment), adds the default lighting a mesh file without lights gets: a sky-gradient
  * environment and a point key light above and in front of the view's default camera (view may be
  * NULL: the scene's default framing), both scaled to the scene's bounding sphere; log receives
- * one line saying what was added. Call before fv_scene_commit; a no-op when the scene has a
- * light. *added (may be NULL) says whether anything was added. */
+ * one line saying what was added. Also added when the only lights are small emissive triangles
+ * (under 2% of the default lighting's power on the model, or none brighter than a white surface
+ * under it: docs/scene-format.md, "Default view and light"). Call before fv_scene_commit; a no-op
+ * when the scene has another light. *added (may be NULL) says whether anything was added. */
 FV_API fv_status fv_scene_add_default_lighting(fv_scene *scene, const fv_view *view, const fv_log *log, bool *added, fv_error *err);
 
 /* Validates the scene and builds the acceleration structures. A scene without any object (mesh

@@ -7,8 +7,14 @@
  * the left of the default camera, outside the bounding sphere, gives shape and shadows. Both scale
  * with the scene: the environment is at infinity, the key light's intensity is set so that it
  * gives a fixed irradiance at the centre of the bounds.
+ *
+ * A scene whose only lights are small emissive triangles (labels, screens, indicator LEDs: below,
+ * the rule) renders nearly black without it, so it gets the same lighting, said in its own line.
  */
+#include <stdio.h>
+#include <string.h>
 #include "fovea/limits.h"
+#include "scene/query.h"
 #include "scene/scene_impl.h"
 #include "scene/view_impl.h"
 
@@ -17,24 +23,60 @@
 static const fv_vec3 k_zenith = {0.40f, 0.50f, 0.65f}, k_horizon = {0.55f, 0.55f, 0.55f}, k_ground = {0.20f, 0.19f, 0.18f};
 static const float k_key_irradiance = 2.0f;
 
-static bool has_light(const fv_scene *s)
+/* What the default lighting gives the model: about k_key_irradiance from the key plus pi times the
+ * sky's upper mean luminance (~1.6) on an upward-facing surface, 3.6 W/m^2; a white diffuse surface
+ * under it has a radiance of that over pi, 1.16. */
+static float default_irradiance(void)
 {
-    if (s->ndelta > 0 || s->has_env) return true;
+    return k_key_irradiance + FV_PI * 0.5f * fv_luminance(fv_add(k_zenith, k_horizon));
+}
+
+/* The emissive triangles: how many, their area, their emitted power (W, luminance), the brightest
+ * one's luminance, and the area of all the triangles. */
+typedef struct emit_stats {
+    int n;
+    double area, power, total_area;
+    float max_lum;
+} emit_stats;
+
+static void emitters(const fv_scene *s, emit_stats *e)
+{
+    memset(e, 0, sizeof *e);
     for (int i = 0; i < s->nobj; i++)
-        for (int t = 0; t < s->objs[i].nt; t++)
-            if (fv_max3(s->mats[s->objs[i].mat[t]].emission) > 0.0f) return true;
-    return false;
+        for (int t = 0; t < s->objs[i].nt; t++) {
+            fv_vec3 a, b, c;
+            fv_scene_triangle(s, i, t, &a, &b, &c);
+            double area = 0.5 * (double)fv_length(fv_cross(fv_sub(b, a), fv_sub(c, a)));
+            if (!isfinite(area)) continue;
+            e->total_area += area;
+            const fv_material *m = &s->mats[s->objs[i].mat[t]];
+            if (!(fv_max3(m->emission) > 0.0f)) continue;
+            e->n++;
+            e->area += area;
+            e->max_lum = fv_maxf(e->max_lum, fv_luminance(m->emission));
+            e->power += FV_PI * (double)fv_luminance(m->emission) * area * (m->two_sided_emission ? 2.0 : 1.0);
+        }
 }
 
 fv_status fv_scene_add_default_lighting(fv_scene *s, const fv_view *view, const fv_log *log, bool *added, fv_error *err)
 {
     if (added) *added = false;
     if (s->committed) return fv_error_set(err, FV_ERR_INTERNAL, "scene already committed: it cannot be changed");
-    if (s->nobj == 0 || has_light(s)) return FV_OK;
+    if (s->nobj == 0 || s->ndelta > 0 || s->has_env) return FV_OK;
     fv_vec3 lo, hi;
     fv_scene_world_bounds(s, &lo, &hi);
     float R = 0.5f * fv_length(fv_sub(hi, lo));
     if (!(R > 0.0f) || !isfinite(R)) return FV_OK; /* fv_scene_commit says what is wrong */
+    /* Emissive triangles alone light the model unless they are small: emitting under 2% of the
+     * power the default lighting brings onto the model's cross-section (pi R^2 times its
+     * irradiance), or none of them brighter than a white surface under the default lighting (a
+     * glow such as glTF's emissiveFactor <= 1 on labels and screens: even filling a surface's
+     * whole view it would light it less than the default does). */
+    emit_stats em;
+    emitters(s, &em);
+    const double def_power = (double)default_irradiance() * FV_PI * (double)R * (double)R;
+    const bool dim = em.max_lum <= default_irradiance() / FV_PI;
+    if (em.n > 0 && !(em.power < 0.02 * def_power) && !dim) return FV_OK;
     fv_vec3 c = fv_scale(fv_add(lo, hi), 0.5f), up = fv_view_up_axis(view);
     fv_camera cam;
     fv_view_frame_bounds(view, lo, hi, 512, 512, &cam);
@@ -56,7 +98,14 @@ fv_status fv_scene_add_default_lighting(fv_scene *s, const fv_view *view, const 
     fv_env_desc env = {k_zenith, k_horizon, k_ground, up};
     fv_status st;
     if ((st = fv_scene_set_env(s, &env, err)) != FV_OK || (st = fv_scene_add_light(s, &key, err)) != FV_OK) return st;
-    fv_log_warn(log,
+    if (em.n > 0)
+        fv_log_warn(log,
+                    "scene's only lights are %d small emissive triangles (%.2g%% of the surface, %s): added the default sky "
+                    "environment and key point light too (--no-default-light turns this off)",
+                    em.n, em.total_area > 0.0 ? 100.0 * em.area / em.total_area : 0.0,
+                    dim ? "none brighter than a white surface under the default light" : "under 2% of the default light's power");
+    else
+        fv_log_warn(log,
                 "scene has no lights: added a sky environment (up %g,%g,%g) and a key point light at (%g, %g, %g) of intensity %g "
                 "(--env R,G,B sets the environment, --no-default-light turns this off)",
                 up.x, up.y, up.z, key.pos.x, key.pos.y, key.pos.z, key.intensity.x);

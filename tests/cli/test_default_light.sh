@@ -2,7 +2,8 @@
 # a sky and a key light, said in one line on stderr, and renders lit; --env sets a uniform
 # environment instead (a diffuse quad of albedo a under L has radiance a L); --no-default-light
 # keeps the old last-resort light; --frame-view frames from a named side; bad values exit 2 with
-# one line; every method family renders the closed box.
+# one line; a box whose only light is a small emissive label gets them too; every method family
+# renders the closed box.
 . "$(dirname "$0")/lib.sh"
 D=$SRC/tests/data
 OUT=$TMP/out.png
@@ -44,6 +45,17 @@ ALBEDO=0.6
 expect 0 "" -- $R "$D/box_closed.obj" --env 2,2,2 --frame-view front --size 32x24 --spp 64 --out "$TMP/env.pfm" --quiet
 m=$(pfm_mean "$TMP/env.pfm")
 python3 -c "import sys; sys.exit(0 if abs($m - 2 * $ALBEDO) < 0.02 * 2 * $ALBEDO else 1)" || fail "--env 2,2,2: front face radiance $m, expected $(python3 -c "print(2 * $ALBEDO)")"
+
+# only a small emitter (a 0.1 x 0.05 label of radiance 2 on the closed box): the default light is
+# added too, in one line; --no-default-light leaves the box dark around its label
+$R "$D/emissive_accent.obj" --size 32x24 --spp 4 --out "$TMP/accent.pfm" 2>"$TMP/err" >/dev/null || fail "emissive_accent.obj did not render"
+grep -q "only lights are 2 small emissive triangles" "$TMP/err" || fail "no note about the small emitters: $(cat "$TMP/err")"
+[ "$(grep -c warning "$TMP/err")" = 1 ] || fail "the note is not one line: $(cat "$TMP/err")"
+m=$(pfm_mean "$TMP/accent.pfm")
+python3 -c "import sys; sys.exit(0 if $m > 0.2 else 1)" || fail "emissive_accent.obj is dark by default (mean $m)"
+expect 0 "" -- $R "$D/emissive_accent.obj" --no-default-light --size 32x24 --spp 4 --out "$TMP/accent_dark.pfm"
+m=$(pfm_mean "$TMP/accent_dark.pfm")
+python3 -c "import sys; sys.exit(0 if $m < 0.05 else 1)" || fail "--no-default-light lit the box beyond its label (mean $m)"
 
 for v in front back left right top three-quarter; do
   expect 0 "" -- $R "$D/tray.gltf" --frame-view $v --size 16x12 --spp 1 --out "$TMP/v_$v.png" --quiet
