@@ -43,6 +43,12 @@ typedef struct fv_technique_class {
      * photon family): tests/unit/test_photon_leak.c checks that no light leaks through walls
      * thinner than the disc. */
     bool gathers_photons;
+    /* The method spends less effort away from the gaze (fovea/gaze.h's eye model, or a foveal
+     * parameter of its own). While the frame's fovea covers the whole screen (fv_frame_fovea_covers:
+     * a missing gaze under `--gaze-missing widen`, docs/gaze.md) it renders every pixel as it renders
+     * its fovea. The conformance suite checks that such a frame changes its image and makes it
+     * independent of the gaze, and that the eye model changes no other method's image. */
+    bool foveated;
 } fv_technique_class;
 
 /* The class of a registered method by index or name (NULL when unknown). */

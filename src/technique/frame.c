@@ -20,6 +20,16 @@ const fv_eye_model *fv_frame_eye_model(const fv_frame *frame, int width, int hei
     return def;
 }
 
+bool fv_frame_fovea_covers(const fv_frame *frame, const fv_eye_model *eye, int width, int height)
+{
+    /* the farthest pixel centre from any point is one of the four corner pixels' centres */
+    const double rf = fv_eye_fovea_radius_px(eye), xs[2] = {0.5, width - 0.5}, ys[2] = {0.5, height - 0.5};
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++)
+            if (!(fv_eye_gaze_dist_px(eye, frame->gaze, xs[i], ys[j]) <= rf)) return false;
+    return true;
+}
+
 fv_status fv_frame_camera(const fv_camera *cam, const fv_film *film, fv_camera_basis *out, fv_error *err)
 {
     fv_status s = fv_camera_basis_make(cam, out, err);

@@ -24,6 +24,12 @@ fv_status fv_frame_camera(const fv_camera *cam, const fv_film *film, fv_camera_b
 /* The frame's display/eye model, or when it has none the default one for a width x height film,
  * built in *def. */
 const fv_eye_model *fv_frame_eye_model(const fv_frame *frame, int width, int height, fv_eye_model *def);
+/* Whether the eye model's fovea, seen from the frame's gaze, holds every pixel centre of a width x
+ * height film: the frame of a gaze the driver marks missing under `--gaze-missing widen`
+ * (fv_eye_model_whole_screen, docs/gaze.md). A foveated method then spends on every pixel what it
+ * spends on its fovea, whatever its own foveal parameters say. False for every ordinary eye model
+ * (its fovea is a part of the screen). */
+bool fv_frame_fovea_covers(const fv_frame *frame, const fv_eye_model *eye, int width, int height);
 
 /* ---- seeding ---- */
 

@@ -17,6 +17,9 @@
  *               threads at once; a callback returning false (at its first call, or half-way)
  *               cancels with FV_ERR_CANCELLED and hears nothing more, and the cancelled frame,
  *               asked again, comes out bit-identical to an uninterrupted sequence's.
+ *   widen       a whole-screen fovea (fv_eye_model_whole_screen, `--gaze-missing widen`) changes
+ *               a foveated method's image (class.h, foveated) and leaves it independent of the
+ *               gaze; any other method's image is unchanged by the eye model and the gaze.
  * Once, for all: films of no size cannot be created, and the overflow scene overflows.
  * Renders are 40x32 and a few frames: about 3 s in all, small enough under sanitizers too.
  */
@@ -552,6 +555,59 @@ static void test_progress(void **st)
     fv_film_destroy(ref);
 }
 
+/* ---- 8. a fovea widened to the whole screen ---- */
+
+/* Frames 0 and 1 of cornell (or its SDF twin) with this eye model and gaze, by a new instance. */
+static void render_eye(const fv_technique_class *c, const fv_eye_model *eye, fv_gaze g, fv_film *f)
+{
+    fv_technique *t = create(c, suite_of(c)->cornell);
+    fv_frame fr = frame_at(&suite_of(c)->cornell_cam, 0, 0);
+    fr.eye_model = eye;
+    fr.gaze = g;
+    fv_test_render_frames(t, &fr, 2, f, NULL);
+    finite_mean(f, c->name);
+    fv_technique_destroy(t);
+}
+
+static bool same_image(const fv_film *a, const fv_film *b)
+{
+    return memcmp(fv_film_color_const(a), fv_film_color_const(b), NPIX * 3 * sizeof(float)) == 0;
+}
+
+/* What the driver gives a frame whose gaze a trace marks missing under `--gaze-missing widen`: the
+ * gaze at the centre and fv_eye_model_whole_screen. A foveated method (class.h) must react: its
+ * image differs from the ordinary eye model's at the same gaze. And it must render every pixel as
+ * its fovea: a fovea covering the screen from any gaze, with the gaze elsewhere, gives the very
+ * same image, so nothing anywhere is reduced by its distance from the gaze. (The periphery's error
+ * against a pt reference does not say more: at these sizes it is the estimators' bias, the same
+ * with either model, and a blurred periphery can be nearer than a sharp one.) Any other method
+ * ignores the eye model and the gaze: its image is bit-identical in all three cases. */
+static void test_widen(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    fv_eye_model normal, whole, any;
+    fv_eye_model_default(W, H, &normal);
+    fv_eye_model_whole_screen(&normal, &whole);
+    any = whole; /* from any gaze: the diagonal and a pixel */
+    any.fovea_frac = any.transition_frac = (float)((hypot(W, H) + 1.0) / W);
+    const fv_gaze centre = {0.5f, 0.5f}, off = {0.2f, 0.75f};
+    fv_film *a = film_new(W, H), *b = film_new(W, H), *o = film_new(W, H);
+    render_eye(c, &normal, centre, a);
+    render_eye(c, &whole, centre, b);
+    render_eye(c, &any, off, o);
+    if (!c->foveated) {
+        if (!same_image(a, b)) fail_msg("%s: not foveated, yet its image changes with a whole-screen fovea", c->name);
+        if (!same_image(a, o)) fail_msg("%s: not foveated, yet its image changes with the gaze and eye model", c->name);
+    } else {
+        if (same_image(a, b)) fail_msg("%s: a whole-screen fovea (widen) leaves its image as it was", c->name);
+        if (!same_image(b, o))
+            fail_msg("%s: with a fovea covering the screen its image still depends on the gaze (something is foveated)", c->name);
+    }
+    fv_film_destroy(a);
+    fv_film_destroy(b);
+    fv_film_destroy(o);
+}
+
 /* ---- the table: every check for every registered technique ---- */
 
 typedef struct check {
@@ -561,7 +617,7 @@ typedef struct check {
 
 static const check k_checks[] = {
     {"furnace", test_furnace}, {"params", test_params},     {"threads", test_threads},   {"stereo", test_stereo},
-    {"refusals", test_refusals}, {"overflow", test_overflow}, {"progress", test_progress},
+    {"refusals", test_refusals}, {"overflow", test_overflow}, {"progress", test_progress}, {"widen", test_widen},
 };
 #define N_CHECKS (sizeof k_checks / sizeof k_checks[0])
 

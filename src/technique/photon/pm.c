@@ -620,4 +620,5 @@ const fv_technique_class fv_technique_fpm = {
     .render = pm_render,
     .destroy = pm_destroy,
     FURNACE_TEST,
+    .foveated = true,
 };

@@ -454,6 +454,9 @@ static uint64_t build_mask(job *j, uint64_t *edge_pixels, uint64_t *refreshed)
     fv_pyramid_sobel(p->depth[0], low->w, low->h, p->o.edge, p->edge);
     fv_eye_model def;
     const fv_eye_model *eye = fv_frame_eye_model(f, w, h, &def);
+    /* a fovea widened to the whole screen (a missing gaze under `widen`): every pixel is traced
+     * at the target level, as ipr traces it, whatever fovea_deg says */
+    const bool whole = fv_frame_fovea_covers(f, eye, w, h);
     uint64_t masked = 0, edges = 0;
     memset(p->need, 0, (size_t)mid->w * mid->h);
     for (int y = 0; y < h; y++)
@@ -463,7 +466,7 @@ static uint64_t build_mask(job *j, uint64_t *edge_pixels, uint64_t *refreshed)
             int li = (x * S + S / 2) / low->f, lj = (y * S + S / 2) / low->f;
             bool e = p->edge[(size_t)lj * low->w + li] != 0;
             double ecc = fv_eye_eccentricity_deg(eye, f->gaze, x, y);
-            double prob = fv_pyramid_probability(ecc, p->o.fovea_deg, p->o.outer_deg, e);
+            double prob = whole ? 1.0 : fv_pyramid_probability(ecc, p->o.fovea_deg, p->o.outer_deg, e);
             fv_rng rng = fv_rng_stream(f->seed, FV_STREAM_MASK, pix * 2 + (uint64_t)f->eye, 0, (uint64_t)f->index);
             bool m = prob >= 1.0 || (prob > 0.0 && fv_rng_next(&rng) < prob);
             p->mask[pix] = m;

@@ -340,11 +340,12 @@ typedef struct par_ctx {
     const fv_frame *frame;
     const fv_camera_basis *cam;
     float gx, gy, R;
+    bool whole; /* the frame's fovea covers the screen (fv_frame_fovea_covers): candidates from all of it */
     uint64_t rays[FV_MAX_THREADS];
 } par_ctx;
 
-/* Sec. 3.1: candidate j from a uniform point of the foveal disc (Eq. 1) and one cosine-distributed
- * bounce from the surface seen there. */
+/* Sec. 3.1: candidate j from a uniform point of the foveal disc (Eq. 1), or of the screen when the
+ * fovea covers it, and one cosine-distributed bounce from the surface seen there. */
 static void candidates_range(void *ctx, int64_t b, int64_t e, int thread)
 {
     par_ctx *c = ctx;
@@ -356,7 +357,8 @@ static void candidates_range(void *ctx, int64_t b, int64_t e, int thread)
         float dx, dy;
         const float u = fv_rng_next(&rng), v = fv_rng_next(&rng);
         fv_vpl_polar_sample(u, v, &dx, &dy);
-        const float px = c->gx + c->R * dx, py = c->gy + c->R * dy;
+        float px = c->gx + c->R * dx, py = c->gy + c->R * dy;
+        if (c->whole) px = u * (float)st->vf.gb.width, py = v * (float)st->vf.gb.height;
         if (!(px >= 0.0f && py >= 0.0f && px < (float)st->vf.gb.width && py < (float)st->vf.gb.height)) continue;
         const fv_gpixel *g = &st->vf.gb.px[(size_t)py * (size_t)st->vf.gb.width + (size_t)px];
         if (!fv_gpixel_hit(g)) continue;
@@ -514,7 +516,13 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     pc.cam = cam;
     pc.gx = frame->gaze.x * (float)cam->width;
     pc.gy = frame->gaze.y * (float)cam->height;
-    pc.R = st->radius * (float)cam->width;
+    /* The foveal radius is the paper's fraction of the width (`radius`), unless the frame's eye
+     * model has a fovea covering the whole screen (a missing gaze under `widen`, docs/gaze.md):
+     * then every visible voxel has acuity 1 and candidates come from the whole screen. */
+    fv_eye_model def;
+    const fv_eye_model *eye = fv_frame_eye_model(frame, cam->width, cam->height, &def);
+    pc.whole = fv_frame_fovea_covers(frame, eye, cam->width, cam->height);
+    pc.R = pc.whole ? (float)fv_eye_fovea_radius_px(eye) : st->radius * (float)cam->width;
 
     /* Alg. 1 line 4: the dynamic objects at this frame's time; light injected when anything moved. */
     double t0 = fv_time_ms();
@@ -817,6 +825,7 @@ const fv_technique_class fv_technique_fir = {
     .create = fir_create,
     .render = fir_render,
     .destroy = fir_destroy,
+    .foveated = true,
     /* furnace: emitted 0.5 + direct 0.25 + the VPLs' two bounces 0.1875 = 0.9375; a first frame
      * measures 0.892: its few hundred VPLs' cells and their neighbours cover less of the sphere
      * than a full set's (0.546 of 0.5625 for the VPL term after three frames) */
