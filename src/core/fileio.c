@@ -10,6 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#if defined(__linux__)
+#include <sys/syscall.h>
+#endif
 #include <time.h>
 #include <unistd.h>
 #include "core/fileio.h"
@@ -245,16 +248,26 @@ static int close_temp(fv_atomic_file *af)
     return e;
 }
 
+/* A second descriptor on the temporary file, closed only once the file has been renamed or
+ * removed: so from begin to the end of commit or abort the temporary file is always open in this
+ * process, where fv_atomic_file_remove_open_temps finds it (a signal may stop the thread between
+ * the close and the rename). -1 when there is none; nothing depends on it. */
+static int hold_temp(const fv_atomic_file *af)
+{
+    int fd = af->fd >= 0 ? af->fd : af->stream ? fileno(af->stream) : -1;
+    return fd >= 0 ? fcntl(fd, F_DUPFD_CLOEXEC, 0) : -1;
+}
+
 fv_status fv_atomic_file_commit(fv_atomic_file *af, fv_error *err)
 {
     if (!af->active) return fv_error_set(err, FV_ERR_INTERNAL, "cannot write '%s': the file was not open", af->target);
     af->active = false;
+    int hold = hold_temp(af);
     int e = close_temp(af);
     if (!e && rename(af->path, af->dest) != 0) e = errno;
-    if (e) {
-        unlink(af->path);
-        return fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", af->target, e > 0 ? strerror(e) : "write failed");
-    }
+    if (e) unlink(af->path);
+    if (hold >= 0) close(hold);
+    if (e) return fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", af->target, e > 0 ? strerror(e) : "write failed");
     return FV_OK;
 }
 
@@ -262,9 +275,75 @@ void fv_atomic_file_abort(fv_atomic_file *af)
 {
     if (!af->active) return;
     af->active = false;
+    int hold = hold_temp(af);
     close_temp(af);
     unlink(af->path);
+    if (hold >= 0) close(hold);
 }
+
+#if defined(__linux__)
+/* ".tmp." and six hex digits at the end of name (len bytes): the names fv_atomic_file_begin makes. */
+static bool is_temp_name(const char *name, size_t len)
+{
+    if (len < 11 || memcmp(name + len - 11, ".tmp.", 5) != 0) return false;
+    for (size_t i = len - 6; i < len; i++) {
+        char c = name[i];
+        if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
+    }
+    return true;
+}
+
+/* The record getdents64 returns (the libc's struct dirent64 is not promised to match it). */
+struct fd_dirent {
+    uint64_t ino;
+    int64_t off;
+    unsigned short reclen;
+    unsigned char type;
+    char name[];
+};
+
+int fv_atomic_file_remove_open_temps(void)
+{
+    /* Only system calls and our own string handling: no stdio, malloc or opendir. */
+    int dir = open("/proc/self/fd", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dir < 0) return 0;
+    int removed = 0;
+    char buf[4096] __attribute__((aligned(8)));
+    for (;;) {
+        long n = syscall(SYS_getdents64, dir, buf, sizeof buf);
+        if (n <= 0) break;
+        for (long off = 0; off < n;) {
+            const struct fd_dirent *d = (const struct fd_dirent *)(buf + off);
+            off += d->reclen;
+            int fd = 0;
+            const char *c = d->name;
+            if (*c < '0' || *c > '9') continue;
+            for (; *c >= '0' && *c <= '9' && fd < 100000000; c++) fd = fd * 10 + (*c - '0');
+            if (*c || fd == dir) continue;
+            /* Our temporary files are open write-only; an input that happens to have such a name
+             * is open read-only and stays. */
+            int fl = fcntl(fd, F_GETFL);
+            if (fl < 0 || (fl & O_ACCMODE) != O_WRONLY) continue;
+            char link[32] = "/proc/self/fd/", target[4096];
+            size_t k = 14;
+            for (const char *q = d->name; q < c; q++) link[k++] = *q;
+            link[k] = '\0';
+            ssize_t len = readlink(link, target, sizeof target - 1);
+            if (len <= 0 || len >= (ssize_t)sizeof target - 1) continue;
+            target[len] = '\0';
+            /* A removed file reads as "<path> (deleted)" and does not match. */
+            if (is_temp_name(target, (size_t)len) && unlink(target) == 0) removed++;
+        }
+    }
+    close(dir);
+    return removed;
+}
+#else
+int fv_atomic_file_remove_open_temps(void)
+{
+    return 0;
+}
+#endif
 
 fv_status fv_file_write_atomic(const char *path, const void *data, size_t len, fv_error *err)
 {

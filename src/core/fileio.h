@@ -68,6 +68,15 @@ fv_status fv_atomic_file_commit(fv_atomic_file *af, fv_error *err);
 /* Closes and removes the temporary file; the target is untouched. */
 void fv_atomic_file_abort(fv_atomic_file *af);
 
+/* For a signal handler that is about to end the process (the CLI's, on SIGINT/SIGTERM): removes
+ * every temporary file of an atomic write that this process has open, and returns how many. From
+ * fv_atomic_file_begin to the end of commit or abort the temporary file is open (write-only) in the
+ * process, so when the handler runs on the thread that writes, having stopped it anywhere in
+ * between, this finds exactly the unfinished writes' files; a committed file is not touched (its
+ * descriptor then names the target). Async-signal-safe: system calls only (Linux reads
+ * /proc/self/fd; elsewhere it removes nothing and returns 0). The library installs no handler. */
+int fv_atomic_file_remove_open_temps(void);
+
 /* Writes len bytes to path whole or not at all (an fv_atomic_file). */
 fv_status fv_file_write_atomic(const char *path, const void *data, size_t len, fv_error *err);
 /* mkdir -p. */

@@ -6,6 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#if defined(__linux__)
+#include <sys/prctl.h>
+#endif
 #include <sys/wait.h>
 #include <unistd.h>
 #include "core/sandbox.h"
@@ -27,6 +30,7 @@ fv_status fv_sandbox_start(fv_sandbox_fn fn, void *user, size_t mem_bytes, int c
         free(sb);
         return fv_error_set(err, FV_ERR_INTERNAL, "cannot create a pipe: %s", strerror(errno));
     }
+    pid_t parent = getpid();
     pid_t pid = fork();
     if (pid < 0) {
         close(p[0]);
@@ -36,6 +40,22 @@ fv_status fv_sandbox_start(fv_sandbox_fn fn, void *user, size_t mem_bytes, int c
     }
     if (pid == 0) {
         close(p[0]);
+        /* The child dies with its parent, however the parent ends (killed, or a signal handler
+         * that exits at once: the CLI's on SIGINT/SIGTERM), instead of parsing on alone. Checked
+         * after the request, as the parent may have gone before it. Linux only; elsewhere the
+         * child ends at its first write to the closed pipe or at its CPU limit. */
+#if defined(__linux__)
+        if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != parent) _exit(127);
+#else
+        (void)parent;
+#endif
+        /* The parent's signal handlers are not the child's business: an interrupt from the
+         * terminal reaches the child too and simply ends it (an ignored signal stays ignored). */
+        const int sigs[2] = {SIGINT, SIGTERM};
+        for (int i = 0; i < 2; i++) {
+            struct sigaction was;
+            if (sigaction(sigs[i], NULL, &was) == 0 && was.sa_handler != SIG_IGN) signal(sigs[i], SIG_DFL);
+        }
         /* The library's own prints would add lines to our one-line messages; the parent reports. */
         int null = open("/dev/null", O_WRONLY);
         if (null >= 0) {

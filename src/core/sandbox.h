@@ -5,6 +5,11 @@
  * failure in the child cannot take fovea down: the child runs under an address-space and a CPU
  * time limit, streams its result back through a pipe, and the parent turns however it ended
  * (a signal, a limit, silence) into an error for the user. POSIX only (fork).
+ *
+ * The child never outlives the parent: on Linux it is killed (PR_SET_PDEATHSIG) when the thread
+ * that started it ends, so a parent stopped by a signal (the CLI exits at once on SIGINT/SIGTERM
+ * while a scene loads) leaves no importer running. It takes SIGINT and SIGTERM as the default
+ * action (the parent's handlers are reset). Start, read and finish a child on one thread.
  */
 #ifndef FV_CORE_SANDBOX_H
 #define FV_CORE_SANDBOX_H
