@@ -2,11 +2,110 @@
 #include <errno.h>
 #include <float.h>
 #include <math.h>
+#include <pthread.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 #include "cli.h"
+#include "core/fileio.h"
+
+/* ---- interruption (see cli.h) ----
+ *
+ * The only mutable globals of fovea: what the signal handler needs, which cannot be passed to it.
+ * The lines and the main thread are set before the handler is installed and only read after. */
+static volatile sig_atomic_t g_signal; /* the first SIGINT/SIGTERM received, 0 none */
+static volatile sig_atomic_t g_defer;  /* 1: the command stops at its next cancellation point */
+static volatile sig_atomic_t g_said;   /* 1: the line has been printed */
+static char g_line[2][160];            /* "fovea <cmd>: interrupted (SIGINT)\n", (SIGTERM) */
+static size_t g_line_len[2];
+static pthread_t g_main;
+
+static void say_interrupted(int sig)
+{
+    if (g_said) return;
+    g_said = 1;
+    int k = sig == SIGTERM;
+    const char *p = g_line[k];
+    size_t n = g_line_len[k];
+    while (n > 0) {
+        ssize_t w = write(STDERR_FILENO, p, n);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) break;
+        p += w;
+        n -= (size_t)w;
+    }
+}
+
+static void on_signal(int sig)
+{
+    int saved = errno;
+    if (!g_signal) g_signal = sig;
+    else g_defer = 0; /* a second signal: at once */
+    if (g_defer) {
+        errno = saved;
+        return;
+    }
+    /* Only the main thread writes files: stopped here, it leaves nothing half done that the
+     * sweep below does not see. */
+    if (!pthread_equal(pthread_self(), g_main)) {
+        pthread_kill(g_main, sig);
+        errno = saved;
+        return;
+    }
+    fv_atomic_file_remove_open_temps();
+    say_interrupted(g_signal);
+    _exit(128 + g_signal);
+}
+
+void fv_cli_interrupt_install(const char *cmd)
+{
+    static const char *names[2] = {"SIGINT", "SIGTERM"};
+    for (int k = 0; k < 2; k++) {
+        int n = snprintf(g_line[k], sizeof g_line[k], "fovea %.100s: interrupted (%s)\n", cmd, names[k]);
+        g_line_len[k] = n > 0 && (size_t)n < sizeof g_line[k] ? (size_t)n : strlen(g_line[k]);
+    }
+    g_main = pthread_self();
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    /* Restarted system calls: a deferred signal must not fail a write in progress. */
+    sa.sa_flags = SA_RESTART;
+    sigemptyset(&sa.sa_mask);
+    sigaddset(&sa.sa_mask, SIGINT);
+    sigaddset(&sa.sa_mask, SIGTERM);
+    const int sigs[2] = {SIGINT, SIGTERM};
+    for (int k = 0; k < 2; k++) {
+        struct sigaction was;
+        if (sigaction(sigs[k], NULL, &was) == 0 && was.sa_handler == SIG_IGN) continue;
+        sigaction(sigs[k], &sa, NULL);
+    }
+}
+
+void fv_cli_interrupt_defer(bool on)
+{
+    g_defer = on;
+}
+
+int fv_cli_interrupted(void)
+{
+    return g_signal;
+}
+
+int fv_cli_interrupt_exit(void)
+{
+    int sig = g_signal ? g_signal : SIGINT;
+    /* From here on the command only returns: a further signal waits (blocked), so the handler
+     * cannot cut this line short or end the process without it. */
+    sigset_t both;
+    sigemptyset(&both);
+    sigaddset(&both, SIGINT);
+    sigaddset(&both, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &both, NULL);
+    say_interrupted(sig);
+    return 128 + sig;
+}
 
 int fv_cli_exit_code(fv_status s)
 {
@@ -126,6 +225,7 @@ void fv_cli_progress_init(fv_cli_progress *p, bool quiet, int frames)
 bool fv_cli_progress_frame(void *user, double fraction)
 {
     fv_cli_progress *p = user;
+    if (g_signal) return false;
     if (!p->enabled) return true;
     double total = (p->frame + fraction) / p->frames;
     int percent = (int)(total * 100.0);

@@ -37,6 +37,33 @@ bool fv_cli_parse_size(const char *s, int *w, int *h);      /* "WxH" */
 /* Warning sink printing "fovea: warning: ..." on stderr (silenced when quiet). */
 fv_log fv_cli_log(bool *quiet);
 
+/* ---- interruption (SIGINT, SIGTERM) ----
+ *
+ * The CLI, not the library, handles the two signals (the library installs no handler and keeps no
+ * state). A command ends at once with one line on stderr, "fovea <cmd>: interrupted (SIGINT)",
+ * and exit status 128 + the signal (130, 143), leaving no temporary file of an unfinished write
+ * and no child process:
+ *  - at once by default: the handler runs on the main thread (another thread that receives the
+ *    signal passes it there), removes the temporary files of the atomic writes the process has
+ *    open (fv_atomic_file_remove_open_temps: whatever the main thread was doing, it never
+ *    resumes), prints the line and _exits. Sandbox children (assimp, image decoding) die with the
+ *    process (sandbox.h). Loading, bench and gaze import end this way: the library offers them
+ *    no cancellation point;
+ *  - at the next cancellation point while deferred (fv_cli_interrupt_defer): the handler only
+ *    records the signal, fv_cli_progress_frame then returns false (the render ends with
+ *    FV_ERR_CANCELLED), a write in progress completes, and the command checks
+ *    fv_cli_interrupted and returns fv_cli_interrupt_exit. A second signal ends it at once.
+ * A signal ignored when fovea starts (a background job of a shell without job control) stays
+ * ignored. */
+/* Installs the handler for command cmd (kept, not copied: a string literal or argv). */
+void fv_cli_interrupt_install(const char *cmd);
+/* Deferred (on) or at once (off, the default). */
+void fv_cli_interrupt_defer(bool on);
+/* The signal received (SIGINT or SIGTERM), 0 when none. */
+int fv_cli_interrupted(void);
+/* Prints the interruption line (once) and returns the exit status, 128 + the signal. */
+int fv_cli_interrupt_exit(void);
+
 /* A progress bar with ETA on stderr, drawn only when stderr is a terminal and not quiet. */
 typedef struct fv_cli_progress {
     bool enabled;
@@ -45,7 +72,7 @@ typedef struct fv_cli_progress {
     int last_percent;
 } fv_cli_progress;
 void fv_cli_progress_init(fv_cli_progress *p, bool quiet, int frames);
-bool fv_cli_progress_frame(void *user, double fraction); /* fv_progress_fn; never cancels */
+bool fv_cli_progress_frame(void *user, double fraction); /* fv_progress_fn; cancels once interrupted */
 void fv_cli_progress_done(fv_cli_progress *p);
 
 /* The method check every rendering command makes before loading anything: an unknown name fails

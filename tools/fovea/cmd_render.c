@@ -44,7 +44,8 @@ static void help(void)
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
            "  --stats               print every counter of each frame (rays, steps, ...) after its timings\n"
            "  --quiet               no progress bar, warnings or per-frame lines\n"
-           "Exit status: 0 ok, 1 internal error, 2 bad input (the message names it).\n");
+           "Exit status: 0 ok, 1 internal error, 2 bad input (the message names it), 130/143 interrupted by\n"
+           "SIGINT/SIGTERM (frames already written stay; no partial or temporary file).\n");
 }
 
 /* "dir/name.ext" + tag -> "dir/name<tag>.ext" */
@@ -309,9 +310,12 @@ int fv_cmd_render(int argc, char **argv)
             goto done;
         }
 
+    /* From here a signal stops the render at its next cancellation point (the progress callback
+     * cancels) or after the frame's files are written, not at once (cli.h). */
     fv_cli_progress prog;
     fv_cli_progress_init(&prog, o.quiet, o.frames);
-    for (int f = 0; f < o.frames; f++) {
+    fv_cli_interrupt_defer(true);
+    for (int f = 0; f < o.frames && !fv_cli_interrupted(); f++) {
         fv_stats stats;
         fv_stats_clear(&stats);
         prog.frame = f;
@@ -349,8 +353,10 @@ int fv_cmd_render(int argc, char **argv)
             }
         }
     }
+    fv_cli_interrupt_defer(false);
     fv_cli_progress_done(&prog);
-    if (s != FV_OK) rc = fv_cli_fail(cmd, s, err.msg);
+    if (fv_cli_interrupted()) rc = fv_cli_interrupt_exit();
+    else if (s != FV_OK) rc = fv_cli_fail(cmd, s, err.msg);
 done:
     fv_driver_destroy(driver);
     fv_gaze_path_destroy(trace);

@@ -1,4 +1,5 @@
 /* fovea — command-line entry point: dispatches to one subcommand per file (cmd_*.c). */
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 #include "cli.h"
@@ -25,7 +26,8 @@ static void usage(FILE *f)
     for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
         fprintf(f, "  %-9s %s\n", k_commands[i].name, k_commands[i].summary);
     fprintf(f, "\nfovea renders global illumination where the effort follows the viewer's gaze.\n"
-               "Exit status: 0 success, 1 internal error, 2 bad input (the message names it).\n");
+               "Exit status: 0 success, 1 internal error, 2 bad input (the message names it), 130/143 interrupted\n"
+               "(SIGINT/SIGTERM: no temporary or partial file is left).\n");
 }
 
 int main(int argc, char **argv)
@@ -43,7 +45,13 @@ int main(int argc, char **argv)
         return FV_EXIT_OK;
     }
     for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
-        if (!strcmp(argv[1], k_commands[i].name)) return k_commands[i].run(argc - 1, argv + 1);
+        if (!strcmp(argv[1], k_commands[i].name)) {
+            /* SIGINT/SIGTERM end any command in one line with 130/143 and leave no temporary
+             * file or child behind (cli.h); the line names the command as its errors do. */
+            bool import = !strcmp(argv[1], "gaze") && argc > 2 && !strcmp(argv[2], "import");
+            fv_cli_interrupt_install(import ? "gaze import" : argv[1]);
+            return k_commands[i].run(argc - 1, argv + 1);
+        }
     fprintf(stderr, "fovea: unknown command '%s' (try fovea --help)\n", argv[1]);
     return FV_EXIT_USAGE;
 }
