@@ -10,8 +10,9 @@
  *  - images: simd on and off bit-identical for every method, super-sampling changing only edges,
  *    the min filter keeping thin objects, ipr matching sdf-gt for fewer steps and never stopping
  *    inside a solid, the image independent of the hit distance, fipr's mask, its counters, its
- *    refresh phases and its fovea (ipr's, pixel for pixel), and the shading against sdf-furnace's
- *    exact 1 and pt's direct light.
+ *    refresh phases and its fovea (ipr's, pixel for pixel), the whole image ipr's under a
+ *    whole-screen fovea (`--gaze-missing widen`), and the shading against sdf-furnace's exact 1
+ *    and pt's direct light.
  * Renders are small (at most 160x128): a few seconds in Release.
  */
 #include <math.h>
@@ -969,6 +970,48 @@ static void test_fipr_fovea(void **st)
     fv_scene_destroy(s);
 }
 
+/* A missing gaze under `--gaze-missing widen` (docs/gaze.md): the driver's whole-screen eye model
+ * puts every pixel in the mask, whatever fovea_deg, outer_deg, the edges and the blur say, so
+ * fipr's image is ipr's bit for bit, every frame, with every pixel traced at the target level. */
+static void test_fipr_widened(void **st)
+{
+    (void)st;
+    fv_camera cam;
+    fv_scene *s = load("sdf-primitives", FW, FH, &cam);
+    fv_eye_model normal, whole;
+    fv_eye_model_default(FW, FH, &normal);
+    fv_eye_model_whole_screen(&normal, &whole);
+    fv_error err;
+    fv_params *pf = fv_test_params_str("refresh=4 blur=true fovea_deg=2 outer_deg=10"), *pi = fv_test_params_str("");
+    fv_technique *tf = NULL, *ti = NULL;
+    assert_int_equal(fv_technique_create("fipr", s, pf, NULL, &tf, &err), FV_OK);
+    assert_int_equal(fv_technique_create("ipr", s, pi, NULL, &ti, &err), FV_OK);
+    fv_film *a = NULL, *b = NULL;
+    assert_int_equal(fv_film_create(FW, FH, 0, &a, &err), FV_OK);
+    assert_int_equal(fv_film_create(FW, FH, 0, &b, &err), FV_OK);
+    for (int i = 0; i < 3; i++) {
+        fv_frame fr;
+        fv_frame_init(&fr, &cam);
+        fr.index = i;
+        fr.prev_camera = i > 0 ? &cam : NULL;
+        fr.eye_model = &whole;
+        fv_stats sf, si;
+        fv_test_render_frames(tf, &fr, 1, a, &sf);
+        fv_test_render_frames(ti, &fr, 1, b, &si);
+        assert_true(fv_stats_get_count(&sf, "mask_pixels") == FW * FH);
+        assert_true(fv_stats_get_count(&sf, "rays_level2") == FW * FH);
+        if (memcmp(fv_film_color_const(a), fv_film_color_const(b), (size_t)3 * FW * FH * sizeof(float)) != 0)
+            fail_msg("frame %d: widened fipr differs from ipr", i);
+    }
+    fv_film_destroy(a);
+    fv_film_destroy(b);
+    fv_technique_destroy(tf);
+    fv_technique_destroy(ti);
+    fv_params_destroy(pf);
+    fv_params_destroy(pi);
+    fv_scene_destroy(s);
+}
+
 /* ======================================================================================== */
 /* 10. The shading's normalisation                                                           */
 /* ======================================================================================== */
@@ -1079,8 +1122,8 @@ int main(void)
         cmocka_unit_test(test_probability),      cmocka_unit_test(test_march_sphere),     cmocka_unit_test(test_march_relaxed_and_wide),
         cmocka_unit_test(test_simd_identical),   cmocka_unit_test(test_spp_edges),        cmocka_unit_test(test_thin_min_filter),
         cmocka_unit_test(test_ipr_vs_gt),        cmocka_unit_test(test_fipr_mask),        cmocka_unit_test(test_fipr_refresh),
-        cmocka_unit_test(test_fipr_fovea),       cmocka_unit_test(test_furnace_exact),    cmocka_unit_test(test_shading_vs_pt),
-        cmocka_unit_test(test_shadow_reuse),
+        cmocka_unit_test(test_fipr_fovea),       cmocka_unit_test(test_fipr_widened),     cmocka_unit_test(test_furnace_exact),
+        cmocka_unit_test(test_shading_vs_pt),    cmocka_unit_test(test_shadow_reuse),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

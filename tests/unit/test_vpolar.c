@@ -2,7 +2,8 @@
  * the thread count do not change the image (same samples), the map stage's kept coordinates give
  * the image computed afresh and a moved gaze is mapped afresh, sample counts follow each method's
  * distribution, the denoised sequence converges towards the converged one-bounce path tracer in
- * the fovea, stereo renders both eyes, the space and density views show the layout, and bad
+ * the fovea, stereo renders both eyes, the space and density views show the layout, a whole-screen
+ * fovea (`--gaze-missing widen`) renders the foveated methods as cartesian-full, and bad
  * parameters are refused naming the key. */
 #include <math.h>
 #include <setjmp.h>
@@ -66,6 +67,56 @@ static float *render(const char *method, const char *const *kv, int frames, int 
 }
 
 static const fv_gaze k_centre = {0.5f, 0.5f};
+
+/* A missing gaze under `--gaze-missing widen` (docs/gaze.md): with the driver's whole-screen eye
+ * model the three foveated methods render as cartesian-full, bit for bit (the same defaults for
+ * the path tracing and SVGF), and their own sample space takes over again afterwards. Sequence:
+ * frames 0-1 at the gaze, 2-3 widened, 4 at the gaze again; frames 2-3 must be cartesian-full's
+ * frames 2-3 of a sequence whose history starts at frame 2, and frame 4 must be the method's own
+ * frame 4 rendered without history. */
+static void test_widened_is_cartesian_full(void **st)
+{
+    (void)st;
+    fv_eye_model normal, whole;
+    fv_eye_model_default(W, H, &normal);
+    fv_eye_model_whole_screen(&normal, &whole);
+    fv_camera cam;
+    fv_view_camera(g_view, g_scene, 0.0, W, H, &cam);
+    const char *const methods[] = {"vpolar", "linear-falloff", "log-polar"};
+    fv_error err;
+    fv_params *p = fv_test_params_str("");
+    fv_film *a, *b;
+    assert_int_equal(fv_film_create(W, H, 0, &a, &err), FV_OK);
+    assert_int_equal(fv_film_create(W, H, 0, &b, &err), FV_OK);
+    for (int m = 0; m < 3; m++) {
+        fv_technique *t, *full, *fresh;
+        assert_int_equal(fv_technique_create(methods[m], g_scene, p, NULL, &t, &err), FV_OK);
+        assert_int_equal(fv_technique_create("cartesian-full", g_scene, p, NULL, &full, &err), FV_OK);
+        assert_int_equal(fv_technique_create(methods[m], g_scene, p, NULL, &fresh, &err), FV_OK);
+        for (int i = 0; i < 5; i++) {
+            fv_frame fr;
+            fv_frame_init(&fr, &cam);
+            fr.index = i;
+            fr.prev_camera = i > 0 ? &cam : NULL;
+            fr.gaze = (fv_gaze){0.3f, 0.6f};
+            fr.eye_model = &normal;
+            if (i == 2 || i == 3) fr.gaze = k_centre, fr.eye_model = &whole;
+            fv_test_render_frames(t, &fr, 1, a, NULL);
+            if (i < 2) continue;
+            fv_frame other = fr;
+            if (i == 2 || i == 4) other.prev_camera = NULL; /* where that pipeline's history starts */
+            fv_test_render_frames(i < 4 ? full : fresh, &other, 1, b, NULL);
+            if (memcmp(fv_film_color_const(a), fv_film_color_const(b), sizeof(float) * 3 * W * H) != 0)
+                fail_msg("%s frame %d differs from %s", methods[m], i, i < 4 ? "cartesian-full's" : "its own without history");
+        }
+        fv_technique_destroy(t);
+        fv_technique_destroy(full);
+        fv_technique_destroy(fresh);
+    }
+    fv_film_destroy(a);
+    fv_film_destroy(b);
+    fv_params_destroy(p);
+}
 
 /* Sec. 6's random launch traces the very same samples: only the order (and the coherence) differs.
  * The thread count does not matter either. */
@@ -382,7 +433,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_order_and_threads), cmocka_unit_test(test_sample_counts),
-        cmocka_unit_test(test_history_follows_gaze),
+        cmocka_unit_test(test_history_follows_gaze), cmocka_unit_test(test_widened_is_cartesian_full),
         cmocka_unit_test(test_offscreen_skip_same_image), cmocka_unit_test(test_converges),
         cmocka_unit_test(test_map_keeps_coords_while_gaze_stays), cmocka_unit_test(test_show_modes),        cmocka_unit_test(test_stereo),        cmocka_unit_test(test_bad_params),
     };
