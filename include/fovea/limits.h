@@ -33,6 +33,9 @@ extern "C" {
 
 #define FV_COORD_MAX 1.0e9       /* largest |coordinate| of a position, extent or offset */
 #define FV_INTENSITY_MAX 1.0e20  /* largest light intensity (W/sr) or emission */
+/* The environment's radiance: its power is pi R^2 times 2 pi times the radiance for a bounding
+ * sphere of radius R (up to about 1.7e9), so 1e9 keeps it within float with room to spare. */
+#define FV_RADIANCE_MAX 1.0e9
 /* Textures are kept as linear float RGB, 12 bytes a texel: one of 4096 x 4096 takes 192 MiB, and
  * all of a scene's together at most four times that. Their decoders refuse a larger image before
  * reading its pixels (a PNG header may claim 2^31 x 2^31). */

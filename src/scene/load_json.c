@@ -603,7 +603,9 @@ static fv_status parse_light(const cJSON *o, const json_ctx *c, int index, fv_er
     d.dir = fv_v3(0, -1, 0);
     d.intensity = fv_v3s(1.0f);
     double inner = 20, outer = 30;
-    if (st || (st = fv_json_string(o, "type", c->file, where, &type, err)) || (st = fv_json_require(o, "pos", c->file, where, err)) ||
+    if (st || (st = fv_json_string(o, "type", c->file, where, &type, err)) ||
+        (strcmp(type, "directional") != 0 && (st = fv_json_require(o, "pos", c->file, where, err))) ||
+        (strcmp(type, "directional") == 0 && (st = fv_json_require(o, "dir", c->file, where, err))) ||
         (st = coord3(o, "pos", c, where, &d.pos, err)) || (st = coord3(o, "dir", c, where, &d.dir, err)) ||
         (st = intensity3(o, "intensity", c, where, &d.intensity, err)) ||
         (st = fv_json_number(o, "inner_deg", 0, 89.9, c->file, where, &inner, err)) ||
@@ -611,7 +613,8 @@ static fv_status parse_light(const cJSON *o, const json_ctx *c, int index, fv_er
         return st;
     if (strcmp(type, "point") == 0) d.type = FV_LIGHT_POINT;
     else if (strcmp(type, "spot") == 0) d.type = FV_LIGHT_SPOT;
-    else return fv_error_set(err, FV_ERR_INVALID, "%s: %s.type: unknown light type '%s' (point, spot; area lights are emissive materials)", c->file, where, type);
+    else if (strcmp(type, "directional") == 0) d.type = FV_LIGHT_DIRECTIONAL;
+    else return fv_error_set(err, FV_ERR_INVALID, "%s: %s.type: unknown light type '%s' (point, spot, directional; area lights are emissive materials)", c->file, where, type);
     d.inner_deg = (float)inner;
     d.outer_deg = (float)outer;
     if ((st = fv_scene_add_light(c->scene, &d, err)) != FV_OK) {
@@ -635,14 +638,15 @@ static fv_status parse_environment(const cJSON *root, const json_ctx *c, fv_erro
     if (!cJSON_IsArray(o) && !cJSON_IsObject(o))
         return fv_error_set(err, FV_ERR_INVALID, "%s: environment: expected [r, g, b] or an object with horizon, zenith, ground, up", c->file);
     if (cJSON_IsArray(o)) {
-        if ((st = vec3(root, "environment", 0, BIG, c, "", &e.horizon, err)) != FV_OK) return st;
+        if ((st = vec3(root, "environment", 0, FV_RADIANCE_MAX, c, "", &e.horizon, err)) != FV_OK) return st;
         e.zenith = e.ground = e.horizon;
     } else {
         if ((st = fv_json_check_keys(o, keys, c->file, "environment", err)) || (st = fv_json_require(o, "horizon", c->file, "environment", err)) ||
-            (st = vec3(o, "horizon", 0, BIG, c, "environment", &e.horizon, err)))
+            (st = vec3(o, "horizon", 0, FV_RADIANCE_MAX, c, "environment", &e.horizon, err)))
             return st;
         e.zenith = e.ground = e.horizon;
-        if ((st = vec3(o, "zenith", 0, BIG, c, "environment", &e.zenith, err)) || (st = vec3(o, "ground", 0, BIG, c, "environment", &e.ground, err)) ||
+        if ((st = vec3(o, "zenith", 0, FV_RADIANCE_MAX, c, "environment", &e.zenith, err)) ||
+            (st = vec3(o, "ground", 0, FV_RADIANCE_MAX, c, "environment", &e.ground, err)) ||
             (st = vec3(o, "up", -BIG, BIG, c, "environment", &e.up, err)))
             return st;
     }

@@ -240,7 +240,7 @@ fv_status fv_scene_add_light(fv_scene *s, const fv_light_desc *l, fv_error *err)
 {
     fv_status st = check_open(s, err);
     if (st != FV_OK) return st;
-    if (l->type != FV_LIGHT_POINT && l->type != FV_LIGHT_SPOT)
+    if (l->type != FV_LIGHT_POINT && l->type != FV_LIGHT_SPOT && l->type != FV_LIGHT_DIRECTIONAL)
         return fv_error_set(err, FV_ERR_INVALID, "light: unknown type %d", (int)l->type);
     if ((st = fv_limit_vec3("light: position", l->pos, err)) != FV_OK || (st = fv_limit_intensity3("light: intensity", l->intensity, err)) != FV_OK)
         return st;
@@ -250,6 +250,10 @@ fv_status fv_scene_add_light(fv_scene *s, const fv_light_desc *l, fv_error *err)
         if (!(fv_length(l->dir) > 0.0f)) return fv_error_set(err, FV_ERR_INVALID, "spot light: direction must be non-zero");
         if (!(l->outer_deg > 0.0f && l->outer_deg < 90.0f && l->inner_deg >= 0.0f && l->inner_deg <= l->outer_deg))
             return fv_error_set(err, FV_ERR_INVALID, "spot light: need 0 <= inner (%g) <= outer (%g) < 90 degrees", l->inner_deg, l->outer_deg);
+        c.dir = fv_normalize(l->dir);
+    } else if (l->type == FV_LIGHT_DIRECTIONAL) {
+        if ((st = fv_limit_vec3("directional light: direction", l->dir, err)) != FV_OK) return st;
+        if (!(fv_length(l->dir) > 0.0f)) return fv_error_set(err, FV_ERR_INVALID, "directional light: direction must be non-zero");
         c.dir = fv_normalize(l->dir);
     }
     if (fv_grow((void **)&s->delta, &s->capdelta, s->ndelta + 1, sizeof *s->delta))
@@ -269,13 +273,13 @@ static fv_xform anim_eval(const fv_object *o, double t)
 }
 
 /* Delta light entry l at time t: the key's transform moves the light's position, its rotation
- * turns a spot's axis (a scale would otherwise tilt it). */
+ * turns a spot's axis or a directional light's direction (a scale would otherwise tilt it). */
 static void light_move(const fv_delta *d, fv_light *l, double t)
 {
     fv_anim_key k = fv_anim_at(&d->anim, t);
     fv_xform x = fv_anim_key_xform(&k);
     l->desc.pos = fv_xform_point(&x, d->desc.pos);
-    if (d->desc.type == FV_LIGHT_SPOT) {
+    if (d->desc.type == FV_LIGHT_SPOT || d->desc.type == FV_LIGHT_DIRECTIONAL) {
         fv_xform r = fv_xform_trs(fv_v3s(0.0f), k.rotate, fv_v3s(1.0f));
         l->desc.dir = fv_normalize(fv_xform_vector(&r, d->desc.dir));
     }
@@ -303,8 +307,9 @@ fv_status fv_scene_set_env(fv_scene *s, const fv_env_desc *e, fv_error *err)
     if (st != FV_OK) return st;
     const fv_vec3 c[3] = {e->zenith, e->horizon, e->ground};
     for (int i = 0; i < 3; i++)
-        if (!fv_is_finite3(c[i]) || fv_min3(c[i]) < 0.0f)
-            return fv_error_set(err, FV_ERR_INVALID, "environment: radiance (%g, %g, %g) must be finite and >= 0", c[i].x, c[i].y, c[i].z);
+        if (!fv_is_finite3(c[i]) || fv_min3(c[i]) < 0.0f || fv_max3(c[i]) > (float)FV_RADIANCE_MAX)
+            return fv_error_set(err, FV_ERR_INVALID, "environment: radiance (%g, %g, %g) must be within [0, %g]", c[i].x, c[i].y, c[i].z,
+                                FV_RADIANCE_MAX);
     if (!fv_is_finite3(e->up) || !(fv_length(e->up) > 0.0f) || !isfinite(fv_length(e->up)))
         return fv_error_set(err, FV_ERR_INVALID, "environment: up must be finite and non-zero");
     s->env = *e;
@@ -394,6 +399,9 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
     if (!s->lights || !s->light_cdf || !s->tri_light) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building lights");
     int k = 0;
     s->lights_move = false;
+    /* The bounding sphere: where the environment's and directional lights' photons start. */
+    s->klights.env_c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
+    s->klights.env_r = 0.5f * fv_length(fv_sub(s->hi, s->lo));
     for (int i = 0; i < s->ndelta; i++) {
         fv_light *l = &s->lights[k];
         l->kind = FV_KLIGHT_DELTA;
@@ -402,6 +410,9 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
         float lum = fv_luminance(l->desc.intensity);
         if (l->desc.type == FV_LIGHT_POINT) {
             l->power = 4.0f * FV_PI * lum;
+        } else if (l->desc.type == FV_LIGHT_DIRECTIONAL) {
+            /* its photons leave a disc of the bounding sphere's radius, like the environment's */
+            l->power = FV_PI * s->klights.env_r * s->klights.env_r * lum;
         } else {
             float ci = cosf(fv_radians(l->desc.inner_deg)), co = cosf(fv_radians(l->desc.outer_deg));
             l->power = 2.0f * FV_PI * (1.0f - 0.5f * (ci + co)) * lum;
@@ -446,8 +457,6 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
         /* Its photons leave a disc of the bounding sphere's radius (light.c), so its power is
          * pi R^2 times the integral of the radiance over the sphere of directions: 2 pi times the
          * two hemispheres' mean radiances, (horizon + zenith) / 2 and (horizon + ground) / 2. */
-        s->klights.env_c = fv_scale(fv_add(s->lo, s->hi), 0.5f);
-        s->klights.env_r = 0.5f * fv_length(fv_sub(s->hi, s->lo));
         float up = 0.5f * fv_luminance(fv_add(s->env.horizon, s->env.zenith));
         float down = 0.5f * fv_luminance(fv_add(s->env.horizon, s->env.ground));
         s->klights.env_p_up = up + down > 0.0f ? up / (up + down) : 0.5f;

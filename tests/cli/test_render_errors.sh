@@ -28,6 +28,9 @@ expect 2 "empty.obj" -- $R "$D/empty.obj" --size 8x8 --out "$OUT"
 expect 2 "bad_syntax.json:4:" -- $R "$D/bad_syntax.json" --size 8x8 --out "$OUT"
 expect 2 "unknown field 'albdo'" -- $R "$D/bad_field.json" --size 8x8 --out "$OUT"
 expect 2 "unknown material 'whte'" -- $R "$D/bad_material.json" --size 8x8 --out "$OUT"
+# --env within the range a JSON environment has; a --param given twice (issue 25, item 10)
+expect 2 "--env 1e30,1,1: expected R,G,B radiances in [0, 1e+09]" -- $R cornell --env 1e30,1,1 --size 8x8 --out "$OUT"
+expect 2 "--param spp=3: spp is already set (to 2); give each parameter once" -- $R cornell --param spp=2 --param spp=3 --size 8x8 --out "$OUT"
 # a JSON scene's camera and environment are named once, not twice (issue 25, item 10)
 printf '{"materials": {"m": {"type": "diffuse"}}, "camera": {"pos": [0,0,5], "look": [0,0,5]}, "objects": [{"sphere": {"center": [0,0,0], "radius": 1}, "material": "m"}]}' >"$TMP/cam.json"
 expect 2 "cam.json: camera: look-at point equals the position" -- $R "$TMP/cam.json" --size 8x8 --out "$OUT"

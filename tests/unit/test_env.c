@@ -233,6 +233,8 @@ static void test_api(void **st)
     fv_test_expect_fail(fv_scene_set_env(s, &e, &err), &err, FV_ERR_INVALID, "environment", "negative radiance");
     e = fv_env_uniform(fv_v3(1, NAN, 0));
     fv_test_expect_fail(fv_scene_set_env(s, &e, &err), &err, FV_ERR_INVALID, "environment", "NaN radiance");
+    e = fv_env_uniform(fv_v3(1e30f, 1, 1)); /* beyond FV_RADIANCE_MAX, as the CLI and JSON bound it */
+    fv_test_expect_fail(fv_scene_set_env(s, &e, &err), &err, FV_ERR_INVALID, "must be within [0, 1e+09]", "radiance 1e30");
     e = fv_env_uniform(fv_v3s(1.0f));
     e.up = fv_v3(0, 0, 0);
     fv_test_expect_fail(fv_scene_set_env(s, &e, &err), &err, FV_ERR_INVALID, "up", "zero up");

@@ -302,8 +302,9 @@ int fv_cli_scene_option(const char *cmd, int c, const char *arg, fv_cli_scene_op
 
 int fv_cli_opt_env(const char *cmd, const char *arg, fv_cli_scene_opts *o)
 {
-    if (!fv_cli_parse_floats(arg, 3, o->env) || o->env[0] < 0 || o->env[1] < 0 || o->env[2] < 0)
-        return fv_cli_usage_error(cmd, "--env %s: expected R,G,B radiances >= 0", arg);
+    bool ok = fv_cli_parse_floats(arg, 3, o->env);
+    for (int i = 0; i < 3 && ok; i++) ok = o->env[i] >= 0 && o->env[i] <= FV_RADIANCE_MAX; /* as a JSON scene's environment */
+    if (!ok) return fv_cli_usage_error(cmd, "--env %s: expected R,G,B radiances in [0, %g]", arg, FV_RADIANCE_MAX);
     o->has_env = true;
     return 0;
 }
@@ -352,6 +353,22 @@ int fv_cli_opt_vec3(const char *cmd, const char *opt, const char *arg, float out
     int rc = limit_fail(cmd, opt, arg, fv_limit_coords, v, 3);
     for (int i = 0; i < 3 && rc == 0; i++) out[i] = (float)v[i];
     return rc;
+}
+
+int fv_cli_opt_param(const char *cmd, const char *arg, fv_params *params)
+{
+    fv_error err;
+    fv_error_clear(&err);
+    const char *eq = strchr(arg, '=');
+    size_t n = eq ? (size_t)(eq - arg) : 0;
+    for (int i = 0; eq && i < fv_params_count(params); i++) {
+        const char *k = fv_params_key(params, i);
+        if (strlen(k) == n && !strncmp(k, arg, n))
+            return fv_cli_usage_error(cmd, "--param %s: %.*s is already set (to %s); give each parameter once", arg, (int)n, arg,
+                                      fv_params_value(params, i));
+    }
+    if (fv_params_parse(params, arg, &err) != FV_OK) return fv_cli_fail(cmd, err.status, err.msg);
+    return 0;
 }
 
 int fv_cli_opt_light(const char *cmd, const char *arg, float out[6])

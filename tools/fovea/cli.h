@@ -32,6 +32,8 @@ int fv_cli_opt_stereo(const char *cmd, const char *arg, double *sep);
  * x,y,z,r,g,b. */
 int fv_cli_opt_vec3(const char *cmd, const char *opt, const char *arg, float out[3]);
 int fv_cli_opt_light(const char *cmd, const char *arg, float out[6]);
+/* --param KEY=VALUE into params; a key given twice is refused (the last would silently win). */
+int fv_cli_opt_param(const char *cmd, const char *arg, fv_params *params);
 bool fv_cli_parse_size(const char *s, int *w, int *h);      /* "WxH" */
 
 /* Warning sink printing "fovea: warning: ..." on stderr (silenced when quiet). */

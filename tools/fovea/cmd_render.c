@@ -95,7 +95,6 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
     long l;
     double d;
     int rc;
-    fv_error err;
     opterr = 0;
     optind = 1;
     int c;
@@ -178,7 +177,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             o->stereo = d;
             break;
         case O_PARAM:
-            if (fv_params_parse(params, optarg, &err) != FV_OK) return fv_cli_fail(cmd, err.status, err.msg);
+            if ((rc = fv_cli_opt_param(cmd, optarg, params))) return rc;
             break;
         case O_QUIET: o->quiet = true; break;
         case O_STATS: o->show_stats = true; break;

@@ -38,7 +38,6 @@ int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
     long l;
     double d;
     int rc;
-    fv_error err;
     opterr = 0;
     optind = 1;
     int c;
@@ -51,7 +50,7 @@ int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
         case O_METHOD: a->method = optarg; break;
         case O_DEVICE: a->device = optarg; break;
         case O_PARAM:
-            if (fv_params_parse(a->params, optarg, &err) != FV_OK) return fv_cli_fail(cmd, err.status, err.msg);
+            if ((rc = fv_cli_opt_param(cmd, optarg, a->params))) return rc;
             break;
         case O_SIZE:
             if ((rc = fv_cli_opt_size(cmd, optarg, &a->width, &a->height))) return rc;
