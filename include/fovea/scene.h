@@ -59,14 +59,15 @@ FV_API fv_status fv_material_validate(const fv_material *m, fv_error *err);
 FV_API bool fv_material_type_from_name(const char *name, fv_material_type *out);
 FV_API const char *fv_material_type_name(fv_material_type type);
 
-typedef enum fv_light_type { FV_LIGHT_POINT = 0, FV_LIGHT_SPOT } fv_light_type;
+typedef enum fv_light_type { FV_LIGHT_POINT = 0, FV_LIGHT_SPOT, FV_LIGHT_DIRECTIONAL } fv_light_type;
 
-/* Delta lights. Area lights are emissive triangles (see fv_material.emission). */
+/* Delta lights. Area lights are emissive triangles (see fv_material.emission). A directional light
+ * (the sun) is at infinity: parallel light along `dir`, `pos` unused. */
 typedef struct fv_light_desc {
     fv_light_type type;
     fv_vec3 pos;
-    fv_vec3 dir;         /* SPOT: axis the light points along */
-    fv_vec3 intensity;   /* radiant intensity, W/sr */
+    fv_vec3 dir;         /* SPOT: axis the light points along; DIRECTIONAL: the way its light travels */
+    fv_vec3 intensity;   /* radiant intensity, W/sr; DIRECTIONAL: irradiance on a surface facing it, W/m^2 */
     float inner_deg;     /* SPOT: full intensity inside this half-angle */
     float outer_deg;     /* SPOT: zero outside this half-angle, smooth in between */
 } fv_light_desc;
@@ -154,7 +155,7 @@ FV_API fv_status fv_scene_add_sdf(fv_scene *scene, const char *name, const fv_sd
 FV_API fv_status fv_scene_animate_object(fv_scene *scene, int object_id, const fv_anim_key *keys, int count,
                                   fv_error *err);
 
-/* Adds a point or spot light. The scene numbers its lights 0, 1, 2, ... in the order of these
+/* Adds a point, spot or directional light. The scene numbers its lights 0, 1, 2, ... in the order of these
  * calls: that number is fv_scene_animate_light's light_index. */
 FV_API fv_status fv_scene_add_light(fv_scene *scene, const fv_light_desc *light, fv_error *err);
 

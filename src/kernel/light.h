@@ -9,7 +9,9 @@
  * environment is sampled by direction: a hemisphere about its up axis in proportion to the
  * hemisphere's mean luminance, then uniformly within it, so a uniform environment is sampled
  * uniformly over the sphere (density 1/(4 pi)). Spot lights fall off smoothly (smoothstep in cos)
- * between the inner and outer cone; point lights are isotropic.
+ * between the inner and outer cone; point lights are isotropic. A directional light (desc.dir the
+ * way its light travels, desc.intensity the irradiance E it gives a surface facing it) is a delta
+ * light at infinity: sampled as arriving along -dir from a point beyond the scene, li = E.
  */
 #ifndef FV_KERNEL_LIGHT_H
 #define FV_KERNEL_LIGHT_H
@@ -45,14 +47,14 @@ typedef struct fv_klights {
     int env_light;                /* index of the environment in light[], -1: none */
     fv_env_desc env;
     float env_p_up;               /* probability of sampling the environment's upper hemisphere */
-    fv_vec3 env_c;                /* the bounding sphere the environment's photons are aimed at */
+    fv_vec3 env_c;                /* the bounding sphere the environment's and directional lights' photons are aimed at */
     float env_r;
 } fv_klights;
 
 typedef struct fv_light_sample {
     fv_vec3 wi;      /* unit direction from the shading point to the light */
-    float dist;      /* distance to the sampled point (environment: a point beyond the scene's bounds) */
-    fv_vec3 li;      /* incident radiance (area, environment) or intensity / dist^2 (delta) */
+    float dist;      /* distance to the sampled point (environment, directional: a point beyond the scene's bounds) */
+    fv_vec3 li;      /* incident radiance (area, environment) or intensity / dist^2 (delta; directional: its irradiance) */
     float pdf;       /* solid-angle density including the light pick (area, environment); pick probability (delta) */
     bool delta;
 } fv_light_sample;
@@ -163,6 +165,14 @@ FV_HD static inline bool fv_klights_sample_li(const fv_klights *L, fv_vec3 p, fl
     float pmf;
     const struct fv_light *l = &L->light[fv_klights_pick(L, u0, &pmf)];
     if (!(pmf > 0.0f)) return false;
+    if (l->kind == FV_KLIGHT_DELTA && l->desc.type == FV_LIGHT_DIRECTIONAL) {
+        out->wi = fv_neg(l->desc.dir);
+        out->dist = 2.0f * (fv_kenv_radius(L) + fv_length(fv_sub(p, L->env_c)));
+        out->li = l->desc.intensity;
+        out->pdf = pmf;
+        out->delta = true;
+        return true;
+    }
     if (l->kind == FV_KLIGHT_DELTA) {
         fv_vec3 d = fv_sub(l->desc.pos, p);
         float d2 = fv_dot(d, d);

@@ -8,6 +8,16 @@ static int pick_light(const fv_scene *s, float u, float *pmf) { return fv_klight
 
 static float env_radius(const fv_scene *s) { return fv_kenv_radius(&s->klights); }
 
+/* A point uniform on the disc of radius R facing unit w (its normal) at distance R from the
+ * bounding sphere's centre along w. */
+static fv_vec3 disc_point(const fv_scene *s, fv_vec3 w, float R, float u0, float u1)
+{
+    fv_vec3 t, b;
+    fv_basis(w, &t, &b);
+    float r = R * sqrtf(u0), phi = 2.0f * FV_PI * u1;
+    return fv_add(fv_madd(s->klights.env_c, w, R), fv_add(fv_scale(t, r * cosf(phi)), fv_scale(b, r * sinf(phi))));
+}
+
 fv_vec3 fv_light_env_radiance(const fv_scene *s, fv_vec3 w) { return fv_klights_env_radiance(&s->klights, w); }
 
 float fv_light_env_pdf(const fv_scene *s, fv_vec3 w) { return fv_klights_env_pdf(&s->klights, w); }
@@ -55,6 +65,17 @@ bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *orig
     float pmf;
     const fv_light *l = &s->lights[pick_light(s, u[0], &pmf)];
     if (!(pmf > 0.0f)) return false;
+    if (l->kind == FV_KLIGHT_DELTA && l->desc.type == FV_LIGHT_DIRECTIONAL) {
+        /* Parallel light through a disc of the bounding sphere's radius facing it, just outside
+         * the sphere (the environment's disc for one direction): flux E pi R^2. */
+        float R = env_radius(s);
+        fv_vec3 w = l->desc.dir;
+        *origin = disc_point(s, fv_neg(w), R, u[3], u[4]);
+        *dir = w;
+        *normal = fv_v3s(0.0f);
+        *power = fv_scale(l->desc.intensity, FV_PI * R * R / pmf);
+        return true;
+    }
     if (l->kind == FV_KLIGHT_DELTA) {
         *origin = l->desc.pos;
         *normal = fv_v3s(0.0f);
@@ -112,7 +133,12 @@ bool fv_light_pick_point(const fv_scene *s, fv_rng *rng, fv_light_point *out)
     if (!(out->pmf > 0.0f)) return false;
     const fv_light *l = &s->lights[out->light];
     out->delta = l->kind == FV_KLIGHT_DELTA;
-    if (out->delta) {
+    out->directional = out->delta && l->desc.type == FV_LIGHT_DIRECTIONAL;
+    if (out->directional) {
+        float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng);
+        out->p = disc_point(s, fv_neg(l->desc.dir), env_radius(s), u0, u1);
+        out->n = l->desc.dir;
+    } else if (out->delta) {
         out->p = l->desc.pos;
         out->n = fv_v3s(0.0f);
     } else if (l->kind == FV_KLIGHT_ENV) {
@@ -131,6 +157,12 @@ bool fv_light_pick_point(const fv_scene *s, fv_rng *rng, fv_light_point *out)
 bool fv_light_point_power(const fv_scene *s, const fv_light_point *lp, fv_vec3 dir, float pdf, fv_vec3 *power)
 {
     const fv_light *l = &s->lights[lp->light];
+    if (lp->directional) { /* the disc of fv_light_pick_point, area pi R^2, along lp->n only */
+        float R = env_radius(s);
+        if (!(fv_dot(dir, lp->n) > 0.9999f)) return false;
+        *power = fv_scale(l->desc.intensity, FV_PI * R * R / pdf);
+        return true;
+    }
     if (lp->delta) {
         *power = fv_scale(fv_light_delta_intensity(l, dir), 1.0f / pdf);
         return true;
@@ -156,8 +188,16 @@ fv_vec3 fv_light_delta_pos(const fv_light *l) { return l->desc.pos; }
 
 bool fv_scene_lights_move(const fv_scene *s) { return s->lights_move; }
 
+bool fv_light_delta_directional(const fv_light *l, fv_vec3 *dir)
+{
+    if (l->desc.type != FV_LIGHT_DIRECTIONAL) return false;
+    if (dir) *dir = l->desc.dir;
+    return true;
+}
+
 fv_vec3 fv_light_delta_intensity(const fv_light *l, fv_vec3 w)
 {
+    if (l->desc.type == FV_LIGHT_DIRECTIONAL) return l->desc.intensity;
     float fall = l->desc.type == FV_LIGHT_SPOT ? fv_klight_spot_falloff(&l->desc, w) : 1.0f;
     return fv_scale(l->desc.intensity, fall);
 }
@@ -174,6 +214,8 @@ fv_vec3 fv_light_total_power(const fv_scene *s)
             p = fv_add(p, fv_scale(l->emission, FV_PI * l->area * (l->two_sided ? 2.0f : 1.0f)));
         } else if (l->desc.type == FV_LIGHT_POINT) {
             p = fv_add(p, fv_scale(l->desc.intensity, 4.0f * FV_PI));
+        } else if (l->desc.type == FV_LIGHT_DIRECTIONAL) {
+            p = fv_add(p, fv_scale(l->desc.intensity, FV_PI * env_radius(s) * env_radius(s)));
         } else {
             float ci = cosf(fv_radians(l->desc.inner_deg)), co = cosf(fv_radians(l->desc.outer_deg));
             p = fv_add(p, fv_scale(l->desc.intensity, 2.0f * FV_PI * (1.0f - 0.5f * (ci + co))));

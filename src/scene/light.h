@@ -67,26 +67,32 @@ typedef struct fv_light_point {
     int light;
     float pmf;
     bool delta;
+    bool directional; /* a directional light: p is on a disc of the bounding sphere's radius facing
+                         it, outside the sphere, and its walks leave along n (its direction) only */
     fv_vec3 p, n;
 } fv_light_point;
 bool fv_light_pick_point(const fv_scene *s, fv_rng *rng, fv_light_point *out);
 /* Power carried by a walk leaving the picked point along unit dir, divided by `pdf` (the pick
  * probability times the direction's density): intensity / pdf for a delta light, emission |cos|
- * area / pdf for an area light. False when an area light does not emit towards dir. */
+ * area / pdf for an area light. False when an area light does not emit towards dir. A directional
+ * light emits along lp->n alone: dir must be that and pdf the pick probability; power E pi R^2 / pdf. */
 bool fv_light_point_power(const fv_scene *s, const fv_light_point *lp, fv_vec3 dir, float pdf, fv_vec3 *power);
 
 /* ---- delta lights one by one, for techniques that shade point lights themselves (the SDF
  * sphere tracers) rather than sample them. fv_light stays opaque: these accessors are all there
  * is. ---- */
 
-/* The point and spot lights that emit (intensity > 0), in the order the scene added them. */
+/* The point, spot and directional lights that emit (intensity > 0), in the order the scene added them. */
 int fv_light_delta_count(const fv_scene *s);
 /* Delta light i in [0, fv_light_delta_count); NULL outside. Valid as long as the scene. */
 const fv_light *fv_light_delta_at(const fv_scene *s, int i);
-/* Its position at the scene's current time. */
+/* Its position at the scene's current time (meaningless for a directional light). */
 fv_vec3 fv_light_delta_pos(const fv_light *l);
+/* True for a directional light, with the way its light travels (unit, at the scene's current
+ * time) in *dir (may be NULL): it lights p from -dir, unblocked beyond the scene's bounds. */
+bool fv_light_delta_directional(const fv_light *l, fv_vec3 *dir);
 /* Radiant intensity of delta light l towards unit direction w (spot fall-off applied, the spot's
- * axis at the scene's current time). */
+ * axis at the scene's current time); a directional light's irradiance E whatever w. */
 fv_vec3 fv_light_delta_intensity(const fv_light *l, fv_vec3 w);
 
 /* True when some light moves with time (fv_scene_animate_light): what a technique computed from

@@ -11,7 +11,7 @@
  * The node hierarchy is flattened: each mesh instance becomes one object with its node's
  * transform baked in. Materials map onto ours as documented in docs/scene-format.md (MTL: Kd, Ks,
  * Ns, Ni, d, illum, Ke, map_Kd; glTF: base colour and its texture, metallic/roughness,
- * transmission, emissive). A file's first camera and its point/spot lights are taken when asked.
+ * transmission, emissive). A file's first camera and its point/spot/directional lights are taken when asked.
  * Base-colour textures (glTF baseColorTexture embedded in a .glb, in a data URI or in a file next
  * to the model; MTL map_Kd) are decoded in the child too (scene/texture.h) and sent once each;
  * one that cannot be read is a warning and its material keeps the constant colour. Only the first
@@ -338,8 +338,8 @@ static void put_camera_and_lights(import_ctx *c, const fv_xform *base)
     if (!c->opts->import_lights) return;
     for (unsigned i = 0; i < ai->mNumLights && c->ok; i++) {
         const struct aiLight *l = ai->mLights[i];
-        if (l->mType != aiLightSource_POINT && l->mType != aiLightSource_SPOT) {
-            put_text(c, REC_WARN, "ignoring light '%.63s' (only point and spot lights are imported)", l->mName.data);
+        if (l->mType != aiLightSource_POINT && l->mType != aiLightSource_SPOT && l->mType != aiLightSource_DIRECTIONAL) {
+            put_text(c, REC_WARN, "ignoring light '%.63s' (only point, spot and directional lights are imported)", l->mName.data);
             continue;
         }
         fv_xform x = *base;
@@ -347,7 +347,7 @@ static void put_camera_and_lights(import_ctx *c, const fv_xform *base)
         light_rec r;
         memset(&r, 0, sizeof r);
         fv_light_desc *d = &r.d;
-        d->type = l->mType == aiLightSource_POINT ? FV_LIGHT_POINT : FV_LIGHT_SPOT;
+        d->type = l->mType == aiLightSource_POINT ? FV_LIGHT_POINT : l->mType == aiLightSource_SPOT ? FV_LIGHT_SPOT : FV_LIGHT_DIRECTIONAL;
         d->pos = fv_xform_point(&x, fv_v3(l->mPosition.x, l->mPosition.y, l->mPosition.z));
         d->dir = fv_xform_vector(&x, fv_v3(l->mDirection.x, l->mDirection.y, l->mDirection.z));
         d->intensity = fv_v3(l->mColorDiffuse.r, l->mColorDiffuse.g, l->mColorDiffuse.b);

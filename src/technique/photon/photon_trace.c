@@ -210,6 +210,10 @@ static bool dyn_sample(const fv_scene *s, const fv_dyn_dirs *d, fv_rng *rng, fv_
     if (d->n == 0 || !fv_light_pick_point(s, rng, &lp)) return false;
     float pmf_l = lp.pmf;
     *o = lp.p;
+    if (lp.directional) { /* parallel light from its disc: no cone to aim */
+        *dir = lp.n;
+        return fv_light_point_power(s, &lp, *dir, pmf_l, power) && fv_max3(*power) > 0.0f;
+    }
     enum { MAXO = 64 };
     float cosm[MAXO], omega[MAXO], total = 0.0f;
     fv_vec3 axis[MAXO];

@@ -86,7 +86,7 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
         int ns = 0, nl = 0;
         for (int k = 0; k < nh; k++) {
             fv_vec3 o = fv_madd(pos[k], nrm[k], 2.0f * hd[k]);
-            fv_vec3 to = fv_sub(L->pos, o);
+            fv_vec3 to = L->directional ? fv_scale(L->dir, -L->far) : fv_sub(L->pos, o);
             float dist = fv_length(to);
             if (!(dist > 0.0f) || fv_dot(nrm[k], to) <= 0.0f) continue;
             uint32_t known = vis_in && bits ? vis_in[idx[k]] : FV_SDF_VIS_UNKNOWN;
@@ -127,10 +127,10 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
             if (bits) vis[k] |= 1u << li;
             if (!color) continue;
             fv_vec3 o = fv_madd(pos[k], nrm[k], 2.0f * hd[k]);
-            fv_vec3 wi = fv_normalize(fv_sub(L->pos, o)), wo = fv_neg(rays[i].d);
+            fv_vec3 wi = L->directional ? fv_neg(L->dir) : fv_normalize(fv_sub(L->pos, o)), wo = fv_neg(rays[i].d);
             float cos_i = fv_dot(nrm[k], wi);
             fv_vec3 to = fv_sub(L->pos, pos[k]);
-            float d2 = fv_dot(to, to);
+            float d2 = L->directional ? 1.0f : fv_dot(to, to); /* a directional light's I is its irradiance */
             if (!(cos_i > 0.0f) || !(d2 > 0.0f)) continue;
             fv_vec3 I = fv_light_delta_intensity(L->light, fv_neg(wi));
             const lobe lb = lobes[k];

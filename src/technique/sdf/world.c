@@ -71,6 +71,8 @@ fv_status fv_sdf_world_build(fv_sdf_world *w, const fv_scene *s, fv_error *err)
         const fv_light *l = fv_light_delta_at(s, i);
         w->lights[i].light = l;
         w->lights[i].pos = fv_light_delta_pos(l);
+        w->lights[i].directional = fv_light_delta_directional(l, &w->lights[i].dir);
+        w->lights[i].far = 2.0f * fv_length(fv_sub(w->hi, w->lo));
     }
     w->light_count = nl;
     return FV_OK;

@@ -30,6 +30,9 @@ typedef struct fv_sdf_world_object {
 typedef struct fv_sdf_point_light {
     const fv_light *light;
     fv_vec3 pos;
+    bool directional; /* a directional light: light along dir, from beyond the world's box (pos unused) */
+    fv_vec3 dir;
+    float far;        /* directional: a distance that leaves the world's box from anywhere in it */
 } fv_sdf_point_light;
 
 typedef struct fv_sdf_world {

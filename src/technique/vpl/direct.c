@@ -10,6 +10,18 @@ fv_vec3 fv_vpl_direct_irradiance(const fv_scene *s, fv_vec3 p, fv_vec3 n, fv_vec
     const int nd = fv_light_delta_count(s);
     for (int i = 0; i < nd; i++) {
         const fv_light *l = fv_light_delta_at(s, i);
+        fv_vec3 sun;
+        if (fv_light_delta_directional(l, &sun)) { /* irradiance E from -sun, unblocked past the bounds */
+            float c = -fv_dot(n, sun);
+            if (c <= 0.0f) continue;
+            fv_vec3 lo, hi;
+            fv_scene_bounds(s, &lo, &hi);
+            (*rays)++;
+            if (!fv_scene_visible(s, FV_TRACE_ALL, p, ng, fv_madd(p, sun, -2.0f * fv_length(fv_sub(hi, lo)) - fv_length(fv_sub(p, lo)))))
+                continue;
+            e = fv_add(e, fv_scale(fv_light_delta_intensity(l, sun), c));
+            continue;
+        }
         fv_vec3 lp = fv_light_delta_pos(l);
         fv_vec3 d = fv_sub(lp, p);
         float d2 = fv_dot(d, d);
