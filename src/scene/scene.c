@@ -230,7 +230,7 @@ fv_status fv_scene_animate_light(fv_scene *s, int index, const fv_anim_key *keys
     fv_status st = check_open(s, err);
     if (st != FV_OK) return st;
     if (index < 0 || index >= s->ndelta)
-        return fv_error_set(err, FV_ERR_INVALID, "animation: light %d does not exist (the scene has %d point/spot lights)", index, s->ndelta);
+        return fv_error_set(err, FV_ERR_INVALID, "animation: light %d does not exist (the scene has %d point, spot and directional lights)", index, s->ndelta);
     char who[32];
     snprintf(who, sizeof who, "light %d", index);
     return fv_anim_set(&s->delta[index].anim, who, keys, count, err);

@@ -90,7 +90,7 @@ static fv_status create_method(fv_sdf_method m, const fv_scene *scene, fv_params
                    meshes, meshes == 1 ? " is" : "s are");
     fv_env_desc env;
     if (fv_scene_env(scene, &env))
-        fv_log_warn(log, "the environment light is not shaded: this method shades point and spot lights only (ambient=A adds a constant term; pt sees it)");
+        fv_log_warn(log, "the environment light is not shaded: this method shades point, spot and directional lights only (ambient=A adds a constant term; pt sees it)");
     family_state *st = calloc(1, sizeof *st);
     if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if ((s = fv_sdf_pipeline_create(scene, &o, &st->pipe, err)) != FV_OK) {

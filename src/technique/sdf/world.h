@@ -1,5 +1,5 @@
 /* fovea — what the sphere tracers of the SDF family see of a scene at one frame: the union of its
- * signed distance field objects as one field, the box around them, and the point and spot lights.
+ * signed distance field objects as one field, the box around them, and the point, spot and directional lights.
  *
  * Polychronakis, Koulieris and Mania (EG 2023, Sec. 2.1 and 3) march one implicit scene; a fovea
  * scene may hold several SDF objects, some moving. The world evaluates them as one field, the
