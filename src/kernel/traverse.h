@@ -104,28 +104,73 @@ FV_HD static inline bool fv_kleaf_tris(const fv_kscene *s, int32_t c, fv_vec3 o,
     return false;
 }
 
+/* The walk's state: the farther children put aside, with their entry distances. */
+typedef struct fv_kwalk {
+    int32_t node[FV_KSTACK];
+    float t[FV_KSTACK];
+    int sp;
+} fv_kwalk;
+
+/* Node n's two children against the ray (inverse direction inv, up to tmax): whether each box is
+ * hit, in the order to visit them (the nearer first), with their indices and entry distances. */
+FV_HD static inline void fv_knode_children(const fv_knode *n, fv_vec3 o, fv_vec3 inv, float tmax, bool *ha, bool *hb, int32_t *ca,
+                                           int32_t *cb, float *ta, float *tb)
+{
+    *ha = fv_kbox(n->l0, n->h0, o, inv, tmax, ta);
+    *hb = fv_kbox(n->l1, n->h1, o, inv, tmax, tb);
+    *ca = n->c0;
+    *cb = n->c1;
+    if (*ha && *hb && *tb < *ta) { /* nearer child first */
+        int32_t c = *ca;
+        *ca = *cb;
+        *cb = c;
+        float t = *ta;
+        *ta = *tb;
+        *tb = t;
+    }
+}
+
+/* The next inner node to visit once a node's leaves were intersected (ha, hb: the inner children
+ * still to enter, nearer first): the nearer, putting the farther aside; with neither, the next one
+ * put aside that is still nearer than the closest hit tbest. False when the walk is over. */
+FV_HD static inline bool fv_kwalk_next(fv_kwalk *w, bool ha, bool hb, int32_t ca, int32_t cb, float tb, float tbest, int32_t *ni)
+{
+    if (ha && hb) {
+        if (w->sp < FV_KSTACK) {
+            w->node[w->sp] = cb;
+            w->t[w->sp] = tb;
+            w->sp++;
+        }
+        *ni = ca;
+        return true;
+    }
+    if (ha || hb) {
+        *ni = ha ? ca : cb;
+        return true;
+    }
+    while (w->sp > 0) {
+        w->sp--;
+        if (w->t[w->sp] <= tbest) {
+            *ni = w->node[w->sp];
+            return true;
+        }
+    }
+    return false;
+}
+
 /* One bottom-level BVH from node `root` with the ray in its space. Closest hit into *b, or with
  * any, true at the first hit. */
 FV_HD static inline bool fv_kblas(const fv_kscene *s, int root, fv_vec3 o, fv_vec3 d, bool any, fv_kbest *b)
 {
     const fv_vec3 inv = fv_kinv_dir(d);
-    int32_t stack[FV_KSTACK];
-    float stack_t[FV_KSTACK];
-    int sp = 0;
+    fv_kwalk w;
+    w.sp = 0;
     int32_t ni = root;
     for (;;) {
-        const fv_knode *n = &s->nodes[ni];
+        bool ha, hb;
+        int32_t ca, cb;
         float ta, tb;
-        bool ha = fv_kbox(n->l0, n->h0, o, inv, b->t, &ta), hb = fv_kbox(n->l1, n->h1, o, inv, b->t, &tb);
-        int32_t ca = n->c0, cb = n->c1;
-        if (ha && hb && tb < ta) { /* nearer child first */
-            int32_t c = ca;
-            ca = cb;
-            cb = c;
-            float tt = ta;
-            ta = tb;
-            tb = tt;
-        }
+        fv_knode_children(&s->nodes[ni], o, inv, b->t, &ha, &hb, &ca, &cb, &ta, &tb);
         if (ha && ca < 0) {
             if (fv_kleaf_tris(s, ca, o, d, any, b)) return true;
             ha = false;
@@ -134,34 +179,7 @@ FV_HD static inline bool fv_kblas(const fv_kscene *s, int root, fv_vec3 o, fv_ve
             if (fv_kleaf_tris(s, cb, o, d, any, b)) return true;
             hb = false;
         }
-        if (ha && hb) {
-            if (sp < FV_KSTACK) {
-                stack[sp] = cb;
-                stack_t[sp] = tb;
-                sp++;
-            }
-            ni = ca;
-            continue;
-        }
-        if (ha) {
-            ni = ca;
-            continue;
-        }
-        if (hb) {
-            ni = cb;
-            continue;
-        }
-        /* Pop the next child still nearer than the closest hit. */
-        bool next = false;
-        while (sp > 0) {
-            sp--;
-            if (stack_t[sp] <= b->t) {
-                ni = stack[sp];
-                next = true;
-                break;
-            }
-        }
-        if (!next) return false;
+        if (!fv_kwalk_next(&w, ha, hb, ca, cb, tb, b->t, &ni)) return false;
     }
 }
 
@@ -207,23 +225,14 @@ FV_HD static inline bool fv_ktlas(const fv_kscene *s, fv_vec3 o, fv_vec3 d, bool
 {
     if (s->ntnodes <= 0) return false;
     const fv_vec3 inv = fv_kinv_dir(d);
-    int32_t stack[FV_KSTACK];
-    float stack_t[FV_KSTACK];
-    int sp = 0;
+    fv_kwalk w;
+    w.sp = 0;
     int32_t ni = 0;
     for (;;) {
-        const fv_knode *n = &s->tnodes[ni];
+        bool ha, hb;
+        int32_t ca, cb;
         float ta, tb;
-        bool ha = fv_kbox(n->l0, n->h0, o, inv, b->t, &ta), hb = fv_kbox(n->l1, n->h1, o, inv, b->t, &tb);
-        int32_t ca = n->c0, cb = n->c1;
-        if (ha && hb && tb < ta) {
-            int32_t c = ca;
-            ca = cb;
-            cb = c;
-            float tt = ta;
-            ta = tb;
-            tb = tt;
-        }
+        fv_knode_children(&s->tnodes[ni], o, inv, b->t, &ha, &hb, &ca, &cb, &ta, &tb);
         if (ha && ca < 0) {
             if (fv_kleaf_inst(s, ca, o, d, any, b)) return true;
             ha = false;
@@ -233,33 +242,7 @@ FV_HD static inline bool fv_ktlas(const fv_kscene *s, fv_vec3 o, fv_vec3 d, bool
             if (tb <= b->t && fv_kleaf_inst(s, cb, o, d, any, b)) return true;
             hb = false;
         }
-        if (ha && hb) {
-            if (sp < FV_KSTACK) {
-                stack[sp] = cb;
-                stack_t[sp] = tb;
-                sp++;
-            }
-            ni = ca;
-            continue;
-        }
-        if (ha) {
-            ni = ca;
-            continue;
-        }
-        if (hb) {
-            ni = cb;
-            continue;
-        }
-        bool next = false;
-        while (sp > 0) {
-            sp--;
-            if (stack_t[sp] <= b->t) {
-                ni = stack[sp];
-                next = true;
-                break;
-            }
-        }
-        if (!next) return false;
+        if (!fv_kwalk_next(&w, ha, hb, ca, cb, tb, b->t, &ni)) return false;
     }
 }
 
