@@ -533,7 +533,7 @@ static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_gaze_eyes
         else if (per_eye[EYE_LEFT] + per_eye[EYE_RIGHT] == 0) w->eyes = FV_GAZE_EYES_BOTH;
     }
     w->binocular = w->eyes == FV_GAZE_EYES_EACH;
-    qsort(rows, (size_t)count, sizeof *rows, cmp_rows);
+    if (count > 1) qsort(rows, (size_t)count, sizeof *rows, cmp_rows); /* rows is NULL when there are none */
     bool pair = w->eyes == FV_GAZE_EYES_BOTH || w->eyes == FV_GAZE_EYES_EACH;
     for (int i = 0; i < count; i++) {
         const pupil_row *r = &rows[i];

@@ -52,4 +52,9 @@ expect 2 "short.asc:3: expected a sample" -- $G "$TMP/short.asc" --out "$TMP/x.c
 
 [ -e "$TMP/x.csv" ] && fail "a failed import left x.csv behind"
 ls "$TMP" | grep -q 'tmp\.' && fail "temporary files left in $TMP"
+# a Pupil export with its header and no row: refused in one line (the fuzzer found a sort of
+# nothing here, which UBSan reports)
+head -n 1 "$SRC/tests/data/pupil_gaze_positions.csv" >"$TMP/gaze_positions.csv"
+expect 2 "no usable gaze sample" -- $FOVEA gaze import "$TMP/gaze_positions.csv" --out "$TMP/empty.csv"
+[ -e "$TMP/empty.csv" ] && fail "a refused import wrote empty.csv"
 finish
