@@ -15,27 +15,6 @@
 #include "fovea/fovea.h"
 #include "../unit/testkit.h"
 
-static fv_film *render(const fv_scene *s, const fv_camera *cam, const char *params, double time, int frames)
-{
-    fv_params *p = fv_test_params_str(params);
-    fv_technique *t = NULL;
-    fv_error err;
-    if (fv_technique_create("pt", s, p, NULL, &t, &err) != FV_OK) fail_msg("pt %s: %s", params, err.msg);
-    fv_film *film = NULL;
-    if (fv_film_create(cam->width, cam->height, FV_AUX_DEPTH | FV_AUX_ID | FV_AUX_ALBEDO, &film, &err) != FV_OK) fail_msg("%s", err.msg);
-    fv_frame f;
-    fv_frame_init(&f, cam);
-    f.seed = 11;
-    f.time = time;
-    fv_stats stats;
-    fv_test_render_frames(t, &f, frames, film, &stats);
-    if (fv_stats_get_count(&stats, "rays") <= 0.0) fail_msg("pt %s counted no rays", params);
-    if (fv_stats_get_count(&stats, "nan_samples") != 0.0) fail_msg("pt %s: %g non-finite samples", params, fv_stats_get_count(&stats, "nan_samples"));
-    fv_technique_destroy(t);
-    fv_params_destroy(p);
-    return film;
-}
-
 static void compare_scene(const char *name, int w, int h, double time, int frames)
 {
     fv_scene *s = NULL;
@@ -45,9 +24,9 @@ static void compare_scene(const char *name, int w, int h, double time, int frame
     if (fv_scene_set_time(s, time, &err) != FV_OK) fail_msg("%s", err.msg);
     fv_camera cam;
     fv_view_camera(v, s, time, w, h, &cam);
-    fv_film *p = render(s, &cam, "spp=4 device=portable", time, frames);
-    fv_film *c1 = render(s, &cam, "spp=4 device=cuda", time, frames);
-    fv_film *c2 = render(s, &cam, "spp=4 device=cuda", time, frames);
+    fv_film *p = fv_test_render_pt(s, &cam, "spp=4 device=portable", time, frames, 11);
+    fv_film *c1 = fv_test_render_pt(s, &cam, "spp=4 device=cuda", time, frames, 11);
+    fv_film *c2 = fv_test_render_pt(s, &cam, "spp=4 device=cuda", time, frames, 11);
     fv_test_agreement r = fv_test_agree(p, c1, 1e-3);
     printf("%s: portable (%.4f %.4f %.4f) cuda (%.4f %.4f %.4f): largest mean difference %.3g%%, %.2f%% of pixels equal within 1e-3, "
            "RMS %.3g%% of the mean\n",

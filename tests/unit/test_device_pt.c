@@ -25,27 +25,6 @@
 #include "fovea/fovea.h"
 #include "testkit.h"
 
-static fv_film *render(const fv_scene *s, const fv_camera *cam, const char *params, double time, int frames, uint64_t seed)
-{
-    fv_params *p = fv_test_params_str(params);
-    fv_technique *t = NULL;
-    fv_error err;
-    if (fv_technique_create("pt", s, p, NULL, &t, &err) != FV_OK) fail_msg("pt %s: %s", params, err.msg);
-    fv_film *film = NULL;
-    if (fv_film_create(cam->width, cam->height, FV_AUX_DEPTH | FV_AUX_NORMAL | FV_AUX_ALBEDO | FV_AUX_ID, &film, &err) != FV_OK)
-        fail_msg("%s", err.msg);
-    fv_frame f;
-    fv_frame_init(&f, cam);
-    f.seed = seed;
-    f.time = time;
-    fv_stats stats;
-    fv_test_render_frames(t, &f, frames, film, &stats);
-    if (fv_stats_get_count(&stats, "rays") <= 0.0) fail_msg("pt %s counted no rays", params);
-    fv_technique_destroy(t);
-    fv_params_destroy(p);
-    return film;
-}
-
 /* Renders scene `name` (at `time`, after `frames` frames) on both devices and checks the bounds
  * of the banner. */
 static void compare_scene(const char *name, int w, int h, double time, int frames, const char *extra)
@@ -60,8 +39,8 @@ static void compare_scene(const char *name, int w, int h, double time, int frame
     char pc[128], pp[128];
     snprintf(pc, sizeof pc, "spp=16 device=cpu %s", extra);
     snprintf(pp, sizeof pp, "spp=16 device=portable %s", extra);
-    fv_film *a = render(s, &cam, pc, time, frames, 7), *b = render(s, &cam, pp, time, frames, 7);
-    fv_film *other = render(s, &cam, pc, time, frames, 8);
+    fv_film *a = fv_test_render_pt(s, &cam, pc, time, frames, 7), *b = fv_test_render_pt(s, &cam, pp, time, frames, 7);
+    fv_film *other = fv_test_render_pt(s, &cam, pc, time, frames, 8);
     fv_test_agreement r = fv_test_agree(a, b, 1e-3), noise = fv_test_agree(a, other, 1e-3);
     printf("%s: means cpu (%.4f %.4f %.4f) portable (%.4f %.4f %.4f), largest mean difference %.3g%%, %.1f%% of pixels equal, "
            "RMS difference %.3g%% of the mean (two CPU seeds: %.3g%%)\n",

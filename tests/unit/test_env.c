@@ -23,6 +23,7 @@
 #include "scene/scene_impl.h"
 #include "transport/path.h"
 #include "testkit.h"
+#include "pathkit.h"
 
 /* An empty scene with one diffuse material of albedo a (its id in *mat). */
 static fv_scene *diffuse_scene(float a, int *mat)
@@ -152,18 +153,6 @@ static void test_pdf(void **st)
     fv_scene_destroy(s);
 }
 
-/* Mean of n pt estimates from o along d (max_depth vertices). */
-static double pt_mean(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, int n, uint64_t seed)
-{
-    fv_path_opts opt = {1, max_depth, 3};
-    double sum = 0.0;
-    for (int k = 0; k < n; k++) {
-        fv_rng rng = fv_rng_stream(seed, 1, (uint64_t)k, 0, 0);
-        sum += fv_path_trace(s, &opt, o, d, &rng, NULL, NULL).y;
-    }
-    return sum / n;
-}
-
 static void test_furnace_pt(void **st)
 {
     (void)st;
@@ -175,21 +164,21 @@ static void test_furnace_pt(void **st)
     const fv_vec3 dirs[3] = {{0, 0, -1}, {0, -1, 0}, {0.6f, 0.0f, -0.8f}};
     for (int i = 0; i < 3; i++) {
         fv_vec3 o = fv_scale(dirs[i], -4.0f);
-        assert_float_equal(pt_mean(s, o, dirs[i], 8, 20000, 3 + (uint64_t)i), 1.0, 0.01);
-        assert_float_equal(pt_mean(s, o, dirs[i], 1, 80000, 9 + (uint64_t)i), 1.0, 0.01); /* half the samples face away */
+        assert_float_equal(fv_test_pt_mean(s, o, dirs[i], 8, 20000, 3 + (uint64_t)i), 1.0, 0.01);
+        assert_float_equal(fv_test_pt_mean(s, o, dirs[i], 1, 80000, 9 + (uint64_t)i), 1.0, 0.01); /* half the samples face away */
     }
-    assert_float_equal(pt_mean(s, fv_v3(0, 0, 4), fv_v3(0, 1, 0), 8, 10, 1), 2.0, 1e-6);
+    assert_float_equal(fv_test_pt_mean(s, fv_v3(0, 0, 4), fv_v3(0, 1, 0), 8, 10, 1), 2.0, 1e-6);
     fv_scene_destroy(s);
     /* The sky gradient on the quad, seen from above: a (h + 2 (z - h) / 3) in each channel, here
      * 0.5 (1 + 2 (0.5) / 3) = 0.66667 in green; the ground does not reach the top face. Light
      * sampling here draws the lower hemisphere 1/6 of the time, uselessly: MIS must still agree. */
     s = quad_under(&k_sky, 0.5f);
     double want = 0.5 * (k_sky.horizon.y + 2.0 * (k_sky.zenith.y - k_sky.horizon.y) / 3.0);
-    assert_float_equal(pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 8, 40000, 5), want, 0.01 * want);
-    assert_float_equal(pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 1, 40000, 6), want, 0.01 * want);
+    assert_float_equal(fv_test_pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 8, 40000, 5), want, 0.01 * want);
+    assert_float_equal(fv_test_pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 1, 40000, 6), want, 0.01 * want);
     /* and from below: a (h + 2 (g - h) / 3) = 0.5 (0.5 - 0.26667) = 0.116667 */
     want = 0.5 * (k_sky.horizon.y + 2.0 * (k_sky.ground.y - k_sky.horizon.y) / 3.0);
-    assert_float_equal(pt_mean(s, fv_v3(0.1f, -3, 0.2f), fv_v3(0, 1, 0), 8, 40000, 7), want, 0.01 * want);
+    assert_float_equal(fv_test_pt_mean(s, fv_v3(0.1f, -3, 0.2f), fv_v3(0, 1, 0), 8, 40000, 7), want, 0.01 * want);
     fv_scene_destroy(s);
 }
 

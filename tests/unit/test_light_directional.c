@@ -26,6 +26,7 @@
 #include "technique/class.h"
 #include "transport/path.h"
 #include "testkit.h"
+#include "pathkit.h"
 
 /* A 2 x 2 diffuse quad at y = 0 facing +y, albedo a, lit by a directional light (dir, E); committed. */
 static fv_scene *quad_under_sun(float a, fv_vec3 dir, float E)
@@ -47,32 +48,20 @@ static fv_scene *quad_under_sun(float a, fv_vec3 dir, float E)
     return s;
 }
 
-/* Mean of n pt estimates from o along d (max_depth vertices). */
-static double pt_mean(const fv_scene *s, fv_vec3 o, fv_vec3 d, int max_depth, int n, uint64_t seed)
-{
-    fv_path_opts opt = {1, max_depth, 3};
-    double sum = 0.0;
-    for (int k = 0; k < n; k++) {
-        fv_rng rng = fv_rng_stream(seed, 1, (uint64_t)k, 0, 0);
-        sum += fv_path_trace(s, &opt, o, d, &rng, NULL, NULL).y;
-    }
-    return sum / n;
-}
-
 static void test_analytic_pt(void **st)
 {
     (void)st;
     /* normal incidence: L = 0.5 / pi * 3 */
     fv_scene *s = quad_under_sun(0.5f, fv_v3(0, -1, 0), 3.0f);
     double want = 0.5 / FV_PI * 3.0;
-    assert_float_equal(pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 1, 100, 1), want, 1e-4 * want);
-    assert_float_equal(pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 8, 100, 2), want, 1e-4 * want);
+    assert_float_equal(fv_test_pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 1, 100, 1), want, 1e-4 * want);
+    assert_float_equal(fv_test_pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 8, 100, 2), want, 1e-4 * want);
     /* from below, the quad's back: a one-sided diffuse quad is lit from its front only */
-    assert_float_equal(pt_mean(s, fv_v3(0.1f, -3, 0.2f), fv_v3(0, 1, 0), 8, 100, 3), 0.0, 1e-6);
+    assert_float_equal(fv_test_pt_mean(s, fv_v3(0.1f, -3, 0.2f), fv_v3(0, 1, 0), 8, 100, 3), 0.0, 1e-6);
     fv_scene_destroy(s);
     /* 60 degrees from the normal: half that, unscaled by the light's distance (there is none) */
     s = quad_under_sun(0.5f, fv_v3(sinf(fv_radians(60.0f)), -cosf(fv_radians(60.0f)), 0), 3.0f);
-    assert_float_equal(pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 1, 100, 4), 0.5 * want, 1e-3 * want);
+    assert_float_equal(fv_test_pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 1, 100, 4), 0.5 * want, 1e-3 * want);
     fv_scene_destroy(s);
 }
 
@@ -235,7 +224,7 @@ static void test_api_and_files(void **st)
     assert_true(fv_light_delta_directional(fv_light_delta_at(s, 0), &dir));
     assert_float_equal(dir.y, -1.0f, 1e-6f);
     double want = 0.5 / FV_PI * 3.0;
-    assert_float_equal(pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 8, 100, 5), want, 1e-4 * want);
+    assert_float_equal(fv_test_pt_mean(s, fv_v3(0.1f, 3, 0.2f), fv_v3(0, -1, 0), 8, 100, 5), want, 1e-4 * want);
     fv_scene_destroy(s);
 
     /* glTF KHR_lights_punctual: a directional light (colour (1, .5, .25) x 4 lux, taken as W/m^2)
@@ -249,7 +238,7 @@ static void test_api_and_files(void **st)
     assert_float_equal(dir.y, -1.0f, 1e-5f);
     assert_float_equal(fv_light_delta_intensity(fv_light_delta_at(s, 0), dir).y, 2.0f, 1e-6f);
     want = 0.5 / FV_PI * 2.0;
-    assert_float_equal(pt_mean(s, fv_v3(0.5f, 3, 0.5f), fv_v3(0, -1, 0), 8, 100, 6), want, 1e-4 * want);
+    assert_float_equal(fv_test_pt_mean(s, fv_v3(0.5f, 3, 0.5f), fv_v3(0, -1, 0), 8, 100, 6), want, 1e-4 * want);
     fv_scene_destroy(s);
 
     const char *duck = "/usr/share/assimp/models/Collada/duck.dae";

@@ -157,6 +157,32 @@ static inline fv_film *fv_test_render_once(const char *method, const char *list,
     return film;
 }
 
+/* One frame of `pt` (parameters as fv_test_params_str: spp, device, ...) in scene s through cam
+ * at `time` after `frames` frames, with the first hit's depth, normal, albedo and id, into a new
+ * film the caller destroys. Fails the test on any error, when no ray was counted, or on a
+ * non-finite sample. */
+static inline fv_film *fv_test_render_pt(const fv_scene *s, const fv_camera *cam, const char *params, double time, int frames, uint64_t seed)
+{
+    fv_params *p = fv_test_params_str(params);
+    fv_technique *t = NULL;
+    fv_error err;
+    if (fv_technique_create("pt", s, p, NULL, &t, &err) != FV_OK) fail_msg("pt %s: %s", params, err.msg);
+    fv_film *film = NULL;
+    if (fv_film_create(cam->width, cam->height, FV_AUX_DEPTH | FV_AUX_NORMAL | FV_AUX_ALBEDO | FV_AUX_ID, &film, &err) != FV_OK)
+        fail_msg("%s", err.msg);
+    fv_frame f;
+    fv_frame_init(&f, cam);
+    f.seed = seed;
+    f.time = time;
+    fv_stats stats;
+    fv_test_render_frames(t, &f, frames, film, &stats);
+    if (fv_stats_get_count(&stats, "rays") <= 0.0) fail_msg("pt %s counted no rays", params);
+    if (fv_stats_get_count(&stats, "nan_samples") != 0.0) fail_msg("pt %s: %g non-finite samples", params, fv_stats_get_count(&stats, "nan_samples"));
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+    return film;
+}
+
 /* ---- two renders of the same estimator ----
  *
  * How two films that drew the same random numbers differ (pt on the CPU, the portable backend and
