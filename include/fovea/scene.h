@@ -49,6 +49,9 @@ typedef struct fv_material {
     int albedo_texture; /* 0: none; else an id from fv_scene_add_texture: the albedo at a point is
                            this texture's (linear) colour there times `albedo`, on meshes with UVs
                            (fv_mesh_desc.uvs); elsewhere (no UVs, SDF objects) `albedo` alone */
+    int emission_texture; /* 0: none; else a texture id: the emitted radiance at a point is this
+                             texture's colour there times `emission` (glTF emissiveTexture, MTL
+                             map_Ke), on meshes with UVs; elsewhere `emission` alone */
 } fv_material;
 
 /* A default material of the given type (grey diffuse, white mirror, ...), to be adjusted. */

@@ -18,6 +18,7 @@
 
 #include <stdbool.h>
 #include "fovea/scene.h"
+#include "kernel/texture.h"
 
 enum { FV_KLIGHT_DELTA = 0, FV_KLIGHT_TRIANGLE = 1, FV_KLIGHT_ENV = 2 };
 
@@ -32,7 +33,10 @@ struct fv_light {
     fv_vec3 a, b, c;     /* emissive triangle: its world vertices */
     float area;
     fv_vec3 n;           /* unit geometric normal of the triangle */
-    fv_vec3 emission;
+    fv_vec3 emission;    /* its material's emission (times the texture at a point, below) */
+    int emission_texture; /* its material's emission texture id in the table's tex (0: none) */
+    fv_vec2 ta, tb, tc;  /* texture coordinates of a, b, c (with an emission texture) */
+    fv_vec3 emission_mean; /* emission times the texture's mean over the triangle (untextured: emission) */
     bool two_sided;
     float power;         /* selection weight ~ emitted power */
 };
@@ -49,6 +53,8 @@ typedef struct fv_klights {
     float env_p_up;               /* probability of sampling the environment's upper hemisphere */
     fv_vec3 env_c;                /* the bounding sphere the environment's and directional lights' photons are aimed at */
     float env_r;
+    const struct fv_ktexture *tex; /* the scene's textures (emission textures are read from them), ntex */
+    int ntex;
 } fv_klights;
 
 typedef struct fv_light_sample {
@@ -83,12 +89,37 @@ FV_HD static inline float fv_klight_spot_falloff(const fv_light_desc *d, fv_vec3
     return t * t * (3.0f - 2.0f * t);
 }
 
+/* The point uniform by area that two uniform numbers pick on a triangle, as its weights on the
+ * vertices a, b, c (b's and c's are a hit's barycentrics u, v). */
+FV_HD static inline void fv_klight_triangle_bary(float u0, float u1, float w[3])
+{
+    float su = sqrtf(u0);
+    w[0] = 1.0f - su;
+    w[1] = u1 * su;
+    w[2] = 1.0f - w[0] - w[1];
+}
+
+FV_HD static inline fv_vec3 fv_klight_triangle_at(const struct fv_light *l, const float w[3])
+{
+    return fv_add(fv_add(fv_scale(l->a, w[0]), fv_scale(l->b, w[1])), fv_scale(l->c, w[2]));
+}
+
 /* A point uniform by area on an emissive triangle. */
 FV_HD static inline fv_vec3 fv_klight_triangle_point(const struct fv_light *l, float u0, float u1)
 {
-    float su = sqrtf(u0);
-    float ba = 1.0f - su, bb = u1 * su;
-    return fv_add(fv_add(fv_scale(l->a, ba), fv_scale(l->b, bb)), fv_scale(l->c, 1.0f - ba - bb));
+    float w[3];
+    fv_klight_triangle_bary(u0, u1, w);
+    return fv_klight_triangle_at(l, w);
+}
+
+/* Emitted radiance of triangle light l at the point with vertex weights w: its emission, times
+ * its emission texture there when it has one (the same lookup as a hit's material). */
+FV_HD static inline fv_vec3 fv_klight_triangle_emission(const fv_klights *L, const struct fv_light *l, const float w[3])
+{
+    const fv_ktexture *t = fv_ktexture_id(L->tex, L->ntex, l->emission_texture);
+    if (!t) return l->emission;
+    fv_vec2 st = {w[0] * l->ta.x + w[1] * l->tb.x + w[2] * l->tc.x, w[0] * l->ta.y + w[1] * l->tb.y + w[2] * l->tc.y};
+    return fv_mul(l->emission, fv_ktexture_sample(t, st));
 }
 
 /* ---- the environment ---- */
@@ -196,7 +227,9 @@ FV_HD static inline bool fv_klights_sample_li(const fv_klights *L, fv_vec3 p, fl
         out->delta = false;
         return fv_max3(out->li) > 0.0f;
     }
-    fv_vec3 q = fv_klight_triangle_point(l, u1, u2);
+    float bw[3];
+    fv_klight_triangle_bary(u1, u2, bw);
+    fv_vec3 q = fv_klight_triangle_at(l, bw);
     fv_vec3 d = fv_sub(q, p);
     float d2 = fv_dot(d, d);
     if (!(d2 > 0.0f)) return false;
@@ -204,7 +237,7 @@ FV_HD static inline bool fv_klights_sample_li(const fv_klights *L, fv_vec3 p, fl
     out->wi = fv_scale(d, 1.0f / out->dist);
     float cos_l = fv_dot(l->n, out->wi); /* emitter faces p when negative */
     if (!(cos_l < 0.0f || (l->two_sided && cos_l > 0.0f))) return false;
-    out->li = l->emission;
+    out->li = fv_klight_triangle_emission(L, l, bw);
     out->pdf = pmf * d2 / (fabsf(cos_l) * l->area);
     out->delta = false;
     return true;

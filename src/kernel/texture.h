@@ -40,16 +40,25 @@ FV_HD static inline fv_vec3 fv_ktexture_sample(const fv_ktexture *t, fv_vec2 uv)
                  w00 * a[2] + w10 * b[2] + w01 * c[2] + w11 * d[2]);
 }
 
-/* Material m with its albedo read from texture t at barycentrics (u, v) of a triangle whose
- * vertices carry texture coordinates ta, tb, tc: a copy in *buf, returned. */
-FV_HD static inline const fv_material *fv_kmaterial_textured(const fv_material *m, const fv_ktexture *t, fv_vec2 ta, fv_vec2 tb,
+/* Material m with its albedo read from texture ta_tex and its emission from te_tex (either NULL:
+ * that one untextured) at barycentrics (u, v) of a triangle whose vertices carry texture
+ * coordinates ta, tb, tc: a copy in *buf, returned. */
+FV_HD static inline const fv_material *fv_kmaterial_textured(const fv_material *m, const fv_ktexture *albedo_tex,
+                                                             const fv_ktexture *emission_tex, fv_vec2 ta, fv_vec2 tb,
                                                              fv_vec2 tc, float u, float v, fv_material *buf)
 {
     float w = 1.0f - u - v;
     fv_vec2 st = {w * ta.x + u * tb.x + v * tc.x, w * ta.y + u * tb.y + v * tc.y};
     *buf = *m;
-    buf->albedo = fv_mul(m->albedo, fv_ktexture_sample(t, st));
+    if (albedo_tex) buf->albedo = fv_mul(m->albedo, fv_ktexture_sample(albedo_tex, st));
+    if (emission_tex) buf->emission = fv_mul(m->emission, fv_ktexture_sample(emission_tex, st));
     return buf;
+}
+
+/* Texture id (1-based; 0 none) of a table of n as a pointer; NULL when it names none. */
+FV_HD static inline const fv_ktexture *fv_ktexture_id(const fv_ktexture *tex, int n, int id)
+{
+    return tex && id >= 1 && id <= n ? &tex[id - 1] : NULL;
 }
 
 #endif

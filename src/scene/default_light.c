@@ -12,10 +12,13 @@
  * the rule) renders nearly black without it, so it gets the same lighting, said in its own line.
  */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include "core/alloc.h"
 #include "fovea/limits.h"
 #include "scene/query.h"
 #include "scene/scene_impl.h"
+#include "scene/texture.h"
 #include "scene/view_impl.h"
 
 /* The sky: a blue-grey zenith, a light grey horizon and a dark ground (radiance); the key light's
@@ -39,9 +42,29 @@ typedef struct emit_stats {
     float max_lum;
 } emit_stats;
 
-static void emitters(const fv_scene *s, emit_stats *e)
+/* What material id emits at most (its largest luminance) and on average (colour): its emission,
+ * times its emission texture's largest and mean texel when it has one. */
+static void material_emission(const fv_scene *s, int id, fv_vec3 *mean, float *max_lum)
+{
+    const fv_material *m = &s->mats[id];
+    fv_vec3 tmean;
+    float tmax;
+    fv_texture_stats(s, m->emission_texture, &tmean, &tmax); /* no texture: white, 1 */
+    *mean = fv_mul(m->emission, tmean);
+    *max_lum = fv_luminance(m->emission) * tmax;
+}
+
+static fv_status emitters(const fv_scene *s, emit_stats *e, fv_error *err)
 {
     memset(e, 0, sizeof *e);
+    fv_vec3 *mean = fv_alloc_array((size_t)s->nmat + 1, sizeof *mean);
+    float *max_lum = fv_alloc_array((size_t)s->nmat + 1, sizeof *max_lum);
+    if (!mean || !max_lum) {
+        free(mean);
+        free(max_lum);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    }
+    for (int m = 0; m < s->nmat; m++) material_emission(s, m, &mean[m], &max_lum[m]);
     for (int i = 0; i < s->nobj; i++)
         for (int t = 0; t < s->objs[i].nt; t++) {
             fv_vec3 a, b, c;
@@ -49,13 +72,17 @@ static void emitters(const fv_scene *s, emit_stats *e)
             double area = 0.5 * (double)fv_length(fv_cross(fv_sub(b, a), fv_sub(c, a)));
             if (!isfinite(area)) continue;
             e->total_area += area;
-            const fv_material *m = &s->mats[s->objs[i].mat[t]];
+            int id = s->objs[i].mat[t];
+            const fv_material *m = &s->mats[id];
             if (!(fv_max3(m->emission) > 0.0f)) continue;
             e->n++;
             e->area += area;
-            e->max_lum = fv_maxf(e->max_lum, fv_luminance(m->emission));
-            e->power += FV_PI * (double)fv_luminance(m->emission) * area * (m->two_sided_emission ? 2.0 : 1.0);
+            e->max_lum = fv_maxf(e->max_lum, max_lum[id]);
+            e->power += FV_PI * (double)fv_luminance(mean[id]) * area * (m->two_sided_emission ? 2.0 : 1.0);
         }
+    free(mean);
+    free(max_lum);
+    return FV_OK;
 }
 
 fv_status fv_scene_add_default_lighting(fv_scene *s, const fv_view *view, const fv_log *log, bool *added, fv_error *err)
@@ -73,7 +100,8 @@ fv_status fv_scene_add_default_lighting(fv_scene *s, const fv_view *view, const 
      * glow such as glTF's emissiveFactor <= 1 on labels and screens: even filling a surface's
      * whole view it would light it less than the default does). */
     emit_stats em;
-    emitters(s, &em);
+    fv_status st = emitters(s, &em, err);
+    if (st != FV_OK) return st;
     const double def_power = (double)default_irradiance() * FV_PI * (double)R * (double)R;
     const bool dim = em.max_lum <= default_irradiance() / FV_PI;
     if (em.n > 0 && !(em.power < 0.02 * def_power) && !dim) return FV_OK;
@@ -96,7 +124,6 @@ fv_status fv_scene_add_default_lighting(fv_scene *s, const fv_view *view, const 
     const float I = fv_minf(k_key_irradiance * dist * dist, (float)FV_INTENSITY_MAX);
     fv_light_desc key = {FV_LIGHT_POINT, fv_madd(c, key_dir, dist), fv_neg(key_dir), fv_v3s(I), 0, 0};
     fv_env_desc env = {k_zenith, k_horizon, k_ground, up};
-    fv_status st;
     if ((st = fv_scene_set_env(s, &env, err)) != FV_OK || (st = fv_scene_add_light(s, &key, err)) != FV_OK) return st;
     if (em.n > 0)
         fv_log_warn(log,

@@ -507,6 +507,7 @@ static fv_status copy_arrays(fv_scene_export *x, const fv_scene *s, fv_error *er
         }
     }
     k->tex = x->tex, k->ntex = s->ntex;
+    k->lights.tex = x->tex, k->lights.ntex = s->ntex; /* emission textures, read by light samples */
     k->eps = s->eps;
     k->time = s->time;
     return FV_OK;

@@ -101,7 +101,9 @@ bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *orig
         *power = fv_scale(L, FV_PI * R * R / (pdf_w * pmf));
         return fv_max3(L) > 0.0f;
     }
-    *origin = fv_klight_triangle_point(l, u[1], u[2]);
+    float bw[3];
+    fv_klight_triangle_bary(u[1], u[2], bw);
+    *origin = fv_klight_triangle_at(l, bw);
     fv_vec3 n = l->n, t, b;
     float side = 1.0f;
     float uu = u[3];
@@ -115,7 +117,7 @@ bool fv_light_sample_emission(const fv_scene *s, const float u[5], fv_vec3 *orig
     *dir = fv_from_local(w, t, b, n);
     *normal = n;
     /* L cos / (pmf * (1/A) * cos/pi * side prob) = L pi A / (pmf * side prob) */
-    *power = fv_scale(l->emission, FV_PI * l->area * (l->two_sided ? 2.0f : 1.0f) / pmf);
+    *power = fv_scale(fv_klight_triangle_emission(&s->klights, l, bw), FV_PI * l->area * (l->two_sided ? 2.0f : 1.0f) / pmf);
     return true;
 }
 
@@ -147,9 +149,11 @@ bool fv_light_pick_point(const fv_scene *s, fv_rng *rng, fv_light_point *out)
         out->p = fv_madd(s->klights.env_c, d, env_radius(s));
         out->n = fv_neg(d);
     } else {
-        float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng);
-        out->p = fv_klight_triangle_point(l, u0, u1);
+        float u0 = fv_rng_next(rng), u1 = fv_rng_next(rng), bw[3];
+        fv_klight_triangle_bary(u0, u1, bw);
+        out->p = fv_klight_triangle_at(l, bw);
         out->n = l->n;
+        out->le = fv_klight_triangle_emission(&s->klights, l, bw);
     }
     return true;
 }
@@ -175,7 +179,7 @@ bool fv_light_point_power(const fv_scene *s, const fv_light_point *lp, fv_vec3 d
     }
     float c = fv_dot(l->n, dir);
     if (!(c > 0.0f || (l->two_sided && c < 0.0f))) return false;
-    *power = fv_scale(l->emission, fabsf(c) * l->area / pdf);
+    *power = fv_scale(lp->le, fabsf(c) * l->area / pdf);
     return true;
 }
 
@@ -211,7 +215,7 @@ fv_vec3 fv_light_total_power(const fv_scene *s)
             fv_vec3 sum = fv_add(fv_add(fv_scale(s->env.horizon, 2.0f), s->env.zenith), s->env.ground); /* 2 x the two means */
             p = fv_add(p, fv_scale(sum, FV_PI * env_radius(s) * env_radius(s) * FV_PI));
         } else if (l->kind == FV_KLIGHT_TRIANGLE) {
-            p = fv_add(p, fv_scale(l->emission, FV_PI * l->area * (l->two_sided ? 2.0f : 1.0f)));
+            p = fv_add(p, fv_scale(l->emission_mean, FV_PI * l->area * (l->two_sided ? 2.0f : 1.0f)));
         } else if (l->desc.type == FV_LIGHT_POINT) {
             p = fv_add(p, fv_scale(l->desc.intensity, 4.0f * FV_PI));
         } else if (l->desc.type == FV_LIGHT_DIRECTIONAL) {

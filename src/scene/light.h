@@ -70,6 +70,7 @@ typedef struct fv_light_point {
     bool directional; /* a directional light: p is on a disc of the bounding sphere's radius facing
                          it, outside the sphere, and its walks leave along n (its direction) only */
     fv_vec3 p, n;
+    fv_vec3 le;       /* an area light: its emitted radiance at p (its emission texture read there) */
 } fv_light_point;
 bool fv_light_pick_point(const fv_scene *s, fv_rng *rng, fv_light_point *out);
 /* Power carried by a walk leaving the picked point along unit dir, divided by `pdf` (the pick

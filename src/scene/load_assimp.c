@@ -10,12 +10,13 @@
  *
  * The node hierarchy is flattened: each mesh instance becomes one object with its node's
  * transform baked in. Materials map onto ours as documented in docs/scene-format.md (MTL: Kd, Ks,
- * Ns, Ni, d, illum, Ke, map_Kd; glTF: base colour and its texture, metallic/roughness,
- * transmission, emissive). A file's first camera and its point/spot/directional lights are taken when asked.
- * Base-colour textures (glTF baseColorTexture embedded in a .glb, in a data URI or in a file next
- * to the model; MTL map_Kd) are decoded in the child too (scene/texture.h) and sent once each;
- * one that cannot be read is a warning and its material keeps the constant colour. Only the first
- * UV channel is read. Limits: other texture kinds are ignored; lines and points are skipped.
+ * Ns, Ni, d, illum, Ke, map_Kd, map_Ke; glTF: base colour and its texture, metallic/roughness,
+ * transmission, emissive and its texture). A file's first camera and its point/spot/directional
+ * lights are taken when asked. Base-colour and emission textures (glTF baseColorTexture and
+ * emissiveTexture embedded in a .glb, in a data URI or in a file next to the model; MTL map_Kd and
+ * map_Ke) are decoded in the child too (scene/texture.h) and sent once each; one that cannot be
+ * read is a warning and its material keeps the constant colour or emission. Only the first UV
+ * channel is read. Limits: other texture kinds are ignored; lines and points are skipped.
  */
 #include <assimp/cimport.h>
 #include <assimp/version.h>
@@ -413,15 +414,22 @@ static bool texels_of(const import_ctx *c, const char *tp, fv_texels *t, char *w
     return fv_texels_decode_file(full, t, why, n);
 }
 
-/* The id the base-colour texture of material am (named mat_name) was sent with, sending it the
- * first time it is asked for; 0 when it has none, or when it cannot be read: then a warning
- * names the file and the material. */
-static int material_texture(import_ctx *c, const struct aiMaterial *am, const char *mat_name)
+/* The path of material am's texture of kind `type` (or else of `alt`), false when it has none. */
+static bool texture_path(const struct aiMaterial *am, enum aiTextureType type, enum aiTextureType alt, struct aiString *p)
+{
+    return (aiGetMaterialString(am, AI_MATKEY_TEXTURE(type, 0), p) == AI_SUCCESS && p->length > 0) ||
+           (aiGetMaterialString(am, AI_MATKEY_TEXTURE(alt, 0), p) == AI_SUCCESS && p->length > 0);
+}
+
+/* The id the texture of material am (named mat_name) of kind `type` (or else `alt`: a glTF base
+ * colour, else an MTL map_Kd) was sent with, sending it the first time it is asked for; 0 when it
+ * has none, or when it cannot be read: then a warning names the file, the material and what the
+ * material does instead (`instead`). */
+static int material_texture(import_ctx *c, const struct aiMaterial *am, const char *mat_name, enum aiTextureType type,
+                            enum aiTextureType alt, const char *instead)
 {
     struct aiString p;
-    if ((aiGetMaterialString(am, AI_MATKEY_TEXTURE(aiTextureType_BASE_COLOR, 0), &p) != AI_SUCCESS || p.length == 0) &&
-        (aiGetMaterialString(am, AI_MATKEY_TEXTURE(aiTextureType_DIFFUSE, 0), &p) != AI_SUCCESS || p.length == 0))
-        return 0;
+    if (!texture_path(am, type, alt, &p)) return 0;
     int k = 0;
     while (k < c->nseen && strcmp(c->seen[k].path, p.data) != 0) k++;
     if (k == c->nseen) {
@@ -441,7 +449,7 @@ static int material_texture(import_ctx *c, const struct aiMaterial *am, const ch
         }
     }
     if (c->seen[k].id == 0)
-        put_text(c, REC_WARN, "texture '%.200s' of material '%s': %s; using the constant colour", c->seen[k].path, mat_name, c->seen[k].why);
+        put_text(c, REC_WARN, "texture '%.200s' of material '%s': %s; %s", c->seen[k].path, mat_name, c->seen[k].why, instead);
     return c->seen[k].id;
 }
 
@@ -488,7 +496,14 @@ static int import_child(void *user, int fd)
     } else {
         for (unsigned i = 0; c->ok && i < ai->mNumMaterials && c->opts->material_override < 0; i++) {
             fv_material m = map_material(ai->mMaterials[i], (int)i);
-            m.albedo_texture = material_texture(c, ai->mMaterials[i], m.name); /* the child's numbering */
+            const struct aiMaterial *am = ai->mMaterials[i];
+            /* the child's numbering */
+            m.albedo_texture = material_texture(c, am, m.name, aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE, "using the constant colour");
+            m.emission_texture = material_texture(c, am, m.name, aiTextureType_EMISSIVE, aiTextureType_EMISSION_COLOR, "using the constant emission");
+            /* An emission texture with no emissive colour: glTF defines emissiveFactor's default as
+             * 0 (nothing emitted, whatever the texture); an MTL map_Ke without Ke is the texture
+             * alone, as the exporters that write it mean (Ke 1). */
+            if (m.emission_texture && !(fv_max3(m.emission) > 0.0f) && !is_gltf(c->path)) m.emission = fv_v3s(1.0f);
             put(c, REC_MATERIAL, &m, sizeof m);
         }
         fv_xform base = c->opts->xform ? *c->opts->xform : fv_xform_identity();
@@ -688,6 +703,7 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
             fv_material m;
             if (!fv_sandbox_read(box, &m, sizeof m)) break;
             m.albedo_texture = m.albedo_texture >= 1 && m.albedo_texture <= ntex ? texmap[m.albedo_texture - 1] : 0;
+            m.emission_texture = m.emission_texture >= 1 && m.emission_texture <= ntex ? texmap[m.emission_texture - 1] : 0;
             char name[FV_NAME_MAX];
             m.name[FV_NAME_MAX - 1] = '\0';
             snprintf(name, sizeof name, "%.31s%.32s", opts->prefix, m.name);
@@ -761,7 +777,13 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
             /* Our messages are one line (status.c escapes control bytes); drop assimp's trailing ones. */
             while (n > 0 && (msg[n - 1] == '\n' || msg[n - 1] == '\r' || msg[n - 1] == ' ')) msg[--n] = '\0';
             if (tag == REC_WARN) fv_log_warn(log, "%s: %s", path, msg);
-            else st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': %s", path, msg);
+            else {
+                /* assimp names neither the file nor the line of a bad number in a material
+                 * library: find it, so that the message points at the .mtl, not the .obj */
+                char where[FV_ERROR_MSG_MAX];
+                if (fv_mtl_find_fault(path, where, sizeof where)) st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': %s", path, where);
+                else st = fv_error_set(err, FV_ERR_INVALID, "scene '%s': %s", path, msg);
+            }
         } else if (tag == REC_END) {
             ended = true;
         } else {

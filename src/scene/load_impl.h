@@ -23,6 +23,10 @@ fv_status fv_load_assimp(const char *path, fv_scene *scene, fv_view *view, const
                          int *first_object, int *object_count, fv_error *err);
 /* True when assimp can import files with this path's extension. */
 bool fv_load_assimp_supports(const char *path);
+/* After a failed import of OBJ file obj_path: the first statement of a material library it names
+ * whose numbers do not parse, as "material library 'x.mtl', line N: ..." in why; false when none
+ * is found (or the path is not an OBJ). mtl_check.c. */
+bool fv_mtl_find_fault(const char *obj_path, char *why, size_t n);
 
 /* A fovea JSON scene file: geometry, materials and lights into scene, the view blocks into view
  * (not NULL). */

@@ -51,9 +51,29 @@ static fv_status limited3(const cJSON *o, const char *key, fv_json_limit_fn chec
 #define coord3(o, key, c, where, out, err) limited3(o, key, fv_limit_coords, c, where, out, err)
 #define intensity3(o, key, c, where, out, err) limited3(o, key, fv_limit_intensity, c, where, out, err)
 
+/* A material's texture named by key (a file relative to the scene file): its id in *id, 0 when
+ * the key is absent. An unreadable image is a warning (texture.h), not an error. */
+static fv_status json_texture(const cJSON *o, const char *key, const json_ctx *c, const char *where, int *id, fv_error *err)
+{
+    const char *tex = NULL;
+    fv_status st = fv_json_string(o, key, c->file, where, &tex, err);
+    if (st != FV_OK || !tex) return st;
+    char path[8192], user[FV_NAME_MAX + 4200];
+    snprintf(path, sizeof path, "%s%s%s", tex[0] == '/' ? "" : c->dir, tex[0] == '/' ? "" : "/", tex);
+    snprintf(user, sizeof user, "%s: %s", c->file, where);
+    /* A missing file is left to the warning; one that is there must be a regular file (a FIFO
+     * would block the decoder, core/fileio.h). */
+    struct stat sb;
+    if (stat(path, &sb) == 0 && (st = fv_file_check_read(path, "texture", err)) != FV_OK) {
+        fv_error_prefix(err, "%s: %s.%s: ", c->file, where, key);
+        return st;
+    }
+    return fv_texture_load_file(c->scene, path, user, c->log, id, err);
+}
+
 static fv_status parse_material(const cJSON *o, const json_ctx *c, fv_error *err)
 {
-    static const char *const keys[] = {"type", "albedo", "albedo_texture", "specular", "roughness", "ior", "emission", "two_sided", NULL};
+    static const char *const keys[] = {"type", "albedo", "albedo_texture", "specular", "roughness", "ior", "emission", "emission_texture", "two_sided", NULL};
     char where[FV_NAME_MAX + 16];
     snprintf(where, sizeof where, "materials.%s", o->string);
     if (strlen(o->string) >= FV_NAME_MAX)
@@ -78,22 +98,11 @@ static fv_status parse_material(const cJSON *o, const json_ctx *c, fv_error *err
         return st;
     m.roughness = (float)rough;
     m.ior = (float)ior;
-    const char *tex = NULL;
-    if ((st = fv_json_string(o, "albedo_texture", c->file, where, &tex, err))) return st;
-    if (tex) {
-        /* Relative to the scene file; an unreadable image is a warning (texture.h), not an error. */
-        char path[8192], user[FV_NAME_MAX + 4200];
-        snprintf(path, sizeof path, "%s%s%s", tex[0] == '/' ? "" : c->dir, tex[0] == '/' ? "" : "/", tex);
-        snprintf(user, sizeof user, "%s: %s", c->file, where);
-        /* A missing file is left to the warning; one that is there must be a regular file (a
-         * FIFO would block the decoder, core/fileio.h). */
-        struct stat sb;
-        if (stat(path, &sb) == 0 && (st = fv_file_check_read(path, "texture", err)) != FV_OK) {
-            fv_error_prefix(err, "%s: %s.albedo_texture: ", c->file, where);
-            return st;
-        }
-        if ((st = fv_texture_load_file(c->scene, path, user, c->log, &m.albedo_texture, err))) return st;
-    }
+    if ((st = json_texture(o, "albedo_texture", c, where, &m.albedo_texture, err)) ||
+        (st = json_texture(o, "emission_texture", c, where, &m.emission_texture, err)))
+        return st;
+    /* An emission texture alone means the texture is the emitted radiance (emission 1). */
+    if (m.emission_texture && !cJSON_GetObjectItemCaseSensitive(o, "emission")) m.emission = fv_v3s(1.0f);
     if ((st = fv_scene_add_material(c->scene, &m, NULL, err)) != FV_OK) fv_error_prefix(err, "%s: ", c->file);
     return st;
 }

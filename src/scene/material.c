@@ -50,6 +50,8 @@ fv_status fv_material_validate(const fv_material *m, fv_error *err)
         return fv_error_set(err, FV_ERR_INVALID, "material '%s': ior %g outside (1, 10)", m->name, m->ior);
     if (m->albedo_texture < 0)
         return fv_error_set(err, FV_ERR_INVALID, "material '%s': albedo_texture %d is not a texture id (0: none)", m->name, m->albedo_texture);
+    if (m->emission_texture < 0)
+        return fv_error_set(err, FV_ERR_INVALID, "material '%s': emission_texture %d is not a texture id (0: none)", m->name, m->emission_texture);
     char what[FV_NAME_MAX + 32];
     snprintf(what, sizeof what, "material '%s': emission", m->name);
     return fv_limit_intensity3(what, m->emission, err);

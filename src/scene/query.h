@@ -83,8 +83,8 @@ void fv_scene_object_world_to_local(const fv_scene *s, int obj, fv_xform *out);
 void fv_scene_object_bounds(const fv_scene *s, int obj, fv_vec3 *lo, fv_vec3 *hi);
 /* ---- the material at a surface point (texture.c) ----
  *
- * The one place a surface's albedo is read: a material with an albedo_texture has its albedo
- * looked up at the point (texture coordinates interpolated with the hit's barycentrics, the
+ * The one place a surface's albedo and emission are read: a material with an albedo_texture has
+ * its albedo looked up at the point (and one with an emission_texture its emission, the same way) (texture coordinates interpolated with the hit's barycentrics, the
  * texture sampled bilinearly and multiplied by the material's constant albedo). An untextured
  * material, or a point without texture coordinates (a mesh without UVs, an SDF object), gets the
  * scene's own material, not a copy: the untextured path costs one test. A textured one is copied
@@ -99,7 +99,7 @@ const fv_material *fv_material_textured(const fv_scene *s, const fv_material *m,
 static inline const fv_material *fv_material_at(const fv_scene *s, int mat, int obj, int prim, float u, float v, fv_material *buf)
 {
     const fv_material *m = fv_scene_material(s, mat);
-    return m->albedo_texture ? fv_material_textured(s, m, obj, prim, u, v, buf) : m;
+    return m->albedo_texture || m->emission_texture ? fv_material_textured(s, m, obj, prim, u, v, buf) : m;
 }
 
 /* The material of a hit (its mat id) at the hit. */

@@ -11,6 +11,7 @@
 #include "core/alloc.h"
 #include "fovea/limits.h"
 #include "scene/scene_impl.h"
+#include "scene/texture.h"
 
 static void embree_error(void *user, enum RTCError code, const char *str)
 {
@@ -60,6 +61,7 @@ void fv_scene_destroy(fv_scene *s)
     free(s->delta);
     free(s->lights);
     free(s->light_cdf);
+    free(s->ktex);
     free(s);
 }
 
@@ -74,6 +76,8 @@ fv_status fv_scene_add_material(fv_scene *s, const fv_material *m, int *id, fv_e
     if (st != FV_OK || (st = fv_material_validate(m, err)) != FV_OK) return st;
     if (m->albedo_texture > s->ntex)
         return fv_error_set(err, FV_ERR_INVALID, "material '%s': albedo_texture %d does not exist", m->name, m->albedo_texture);
+    if (m->emission_texture > s->ntex)
+        return fv_error_set(err, FV_ERR_INVALID, "material '%s': emission_texture %d does not exist", m->name, m->emission_texture);
     if (fv_grow((void **)&s->mats, &s->capmat, s->nmat + 1, sizeof *s->mats))
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory adding material '%s'", m->name);
     s->mats[s->nmat] = *m;
@@ -445,7 +449,19 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
             l->n = fv_normalize(fv_cross(fv_sub(b, a), fv_sub(c, a)));
             l->emission = m->emission;
             l->two_sided = m->two_sided_emission;
-            l->power = FV_PI * fv_luminance(m->emission) * area * (l->two_sided ? 2.0f : 1.0f);
+            /* A textured emitter is picked by its mean emission over the triangle; the radiance
+             * itself is read at each sampled point (kernel/light.h), so the pick weight only has
+             * to be positive where it emits: a floor keeps dark-but-not-black triangles. */
+            fv_vec3 mean = fv_v3s(1.0f);
+            l->emission_texture = o->uv && m->emission_texture >= 1 && m->emission_texture <= s->ntex ? m->emission_texture : 0;
+            if (l->emission_texture) {
+                const uint32_t *ix = &o->idx[3 * t];
+                l->ta = o->uv[ix[0]], l->tb = o->uv[ix[1]], l->tc = o->uv[ix[2]];
+                mean = fv_texture_triangle_mean(s, l->emission_texture, i, t);
+            }
+            l->emission_mean = fv_mul(m->emission, mean);
+            fv_vec3 floored = fv_v3(fv_maxf(mean.x, 1e-3f), fv_maxf(mean.y, 1e-3f), fv_maxf(mean.z, 1e-3f));
+            l->power = FV_PI * fv_luminance(fv_mul(m->emission, floored)) * area * (l->two_sided ? 2.0f : 1.0f);
             if (!isfinite(l->power))
                 return fv_error_set(err, FV_ERR_INVALID, "object '%s', triangle %d: material '%s' emits more power than a float holds (emission too large)",
                                     o->name, t, m->name);
@@ -478,6 +494,12 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
     s->klights.light = s->lights;
     s->klights.cdf = s->light_cdf;
     s->klights.env = s->env;
+    if (s->ntex > 0 && !s->ktex) {
+        if (!(s->ktex = fv_calloc_array((size_t)s->ntex, sizeof *s->ktex))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        for (int i = 0; i < s->ntex; i++) s->ktex[i] = (fv_ktexture){s->tex[i].w, s->tex[i].h, s->tex[i].rgb};
+    }
+    s->klights.tex = s->ktex;
+    s->klights.ntex = s->ntex;
     return FV_OK;
 }
 

@@ -72,6 +72,7 @@ struct fv_scene {
                                   the environment */
     float *light_cdf;          /* klights.n + 1 entries, light_cdf[n] = 1 */
     fv_klights klights;        /* the table as kernels read it: lights, light_cdf, counts, the environment */
+    fv_ktexture *ktex;         /* ntex views of tex as kernels read them (klights.tex) */
     bool lights_move;          /* some delta light has keys */
     int **tri_light;           /* per object: per triangle light index or -1 (NULL: none) */
     RTCDevice dev;

@@ -8,6 +8,7 @@
 #include "fovea/film.h"
 #include "fovea/limits.h"
 #include "scene/scene_impl.h"
+#include "kernel/light.h"
 #include "kernel/texture.h"
 #include "scene/texture.h"
 
@@ -56,12 +57,62 @@ fv_vec3 fv_texture_sample(const fv_texture *t, fv_vec2 uv)
     return fv_ktexture_sample(&k, uv);
 }
 
+/* The kernel's view of texture id (0 or out of range: NULL), in *k. */
+static const fv_ktexture *kview(const fv_scene *s, int id, fv_ktexture *k)
+{
+    if (id < 1 || id > s->ntex) return NULL;
+    const fv_texture *t = &s->tex[id - 1];
+    *k = (fv_ktexture){t->w, t->h, t->rgb};
+    return k;
+}
+
 const fv_material *fv_material_textured(const fv_scene *s, const fv_material *m, int obj, int prim, float u, float v, fv_material *buf)
 {
     const fv_object *o = obj >= 0 && obj < s->nobj ? &s->objs[obj] : NULL;
-    if (!o || !o->uv || prim < 0 || prim >= o->nt || m->albedo_texture < 1 || m->albedo_texture > s->ntex) return m;
+    if (!o || !o->uv || prim < 0 || prim >= o->nt) return m;
+    fv_ktexture ka, ke;
+    const fv_ktexture *ta = kview(s, m->albedo_texture, &ka), *te = kview(s, m->emission_texture, &ke);
+    if (!ta && !te) return m;
     const uint32_t *ix = &o->idx[3 * prim];
-    const fv_texture *t = &s->tex[m->albedo_texture - 1];
-    fv_ktexture k = {t->w, t->h, t->rgb};
-    return fv_kmaterial_textured(m, &k, o->uv[ix[0]], o->uv[ix[1]], o->uv[ix[2]], u, v, buf);
+    return fv_kmaterial_textured(m, ta, te, o->uv[ix[0]], o->uv[ix[1]], o->uv[ix[2]], u, v, buf);
+}
+
+void fv_texture_stats(const fv_scene *s, int id, fv_vec3 *mean, float *max_lum)
+{
+    *mean = fv_v3s(1.0f);
+    *max_lum = 1.0f;
+    if (id < 1 || id > s->ntex) return;
+    const fv_texture *t = &s->tex[id - 1];
+    double sum[3] = {0.0, 0.0, 0.0};
+    float mx = 0.0f;
+    size_t n = (size_t)t->w * (size_t)t->h;
+    for (size_t i = 0; i < n; i++) {
+        const float *p = &t->rgb[3 * i];
+        for (int c = 0; c < 3; c++) sum[c] += p[c];
+        mx = fv_maxf(mx, fv_luminance(fv_v3(p[0], p[1], p[2])));
+    }
+    *mean = fv_v3((float)(sum[0] / (double)n), (float)(sum[1] / (double)n), (float)(sum[2] / (double)n));
+    *max_lum = mx;
+}
+
+fv_vec3 fv_texture_triangle_mean(const fv_scene *s, int id, int obj, int prim)
+{
+    fv_ktexture k;
+    const fv_ktexture *t = kview(s, id, &k);
+    const fv_object *o = obj >= 0 && obj < s->nobj ? &s->objs[obj] : NULL;
+    if (!t || !o || !o->uv || prim < 0 || prim >= o->nt) return fv_v3s(1.0f);
+    const uint32_t *ix = &o->idx[3 * prim];
+    fv_vec2 ta = o->uv[ix[0]], tb = o->uv[ix[1]], tc = o->uv[ix[2]];
+    /* The same points fv_klight_triangle_point draws, on an 8 x 8 grid of its numbers: uniform
+     * by area, so the mean is the triangle's average texel as area-sampling sees it. */
+    enum { G = 8 };
+    fv_vec3 sum = fv_v3s(0.0f);
+    for (int i = 0; i < G; i++)
+        for (int j = 0; j < G; j++) {
+            float w[3];
+            fv_klight_triangle_bary(((float)i + 0.5f) / G, ((float)j + 0.5f) / G, w);
+            fv_vec2 st = {w[0] * ta.x + w[1] * tb.x + w[2] * tc.x, w[0] * ta.y + w[1] * tb.y + w[2] * tc.y};
+            sum = fv_add(sum, fv_ktexture_sample(t, st));
+        }
+    return fv_scale(sum, 1.0f / (G * G));
 }

@@ -21,6 +21,14 @@
 struct fv_texture;
 fv_vec3 fv_texture_sample(const struct fv_texture *tex, fv_vec2 uv);
 
+/* The mean linear colour of texture id over all its texels and the largest texel luminance
+ * (an id that names no texture: white, 1), for what a material emits in all (default_light.c). */
+void fv_texture_stats(const fv_scene *s, int id, fv_vec3 *mean, float *max_lum);
+/* The mean colour of texture id over triangle prim of object obj, as a point drawn uniformly by
+ * area sees it (an 8 x 8 grid of fv_klight_triangle_point's numbers): the weight with which the
+ * light table picks an emissive triangle whose emission is textured. White without UVs or id. */
+fv_vec3 fv_texture_triangle_mean(const fv_scene *s, int id, int obj, int prim);
+
 /* ---- decoding (texture_decode.c) ---- */
 
 /* Decoded 8-bit texels (free px with free(): stb_image allocates with malloc). */

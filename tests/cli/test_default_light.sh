@@ -57,6 +57,14 @@ expect 0 "" -- $R "$D/emissive_accent.obj" --no-default-light --size 32x24 --spp
 m=$(pfm_mean "$TMP/accent_dark.pfm")
 python3 -c "import sys; sys.exit(0 if $m < 0.05 else 1)" || fail "--no-default-light lit the box beyond its label (mean $m)"
 
+# the same when the glow is an emission texture (MTL map_Ke, glTF emissiveTexture): a screen whose
+# texture is black but for a 2 x 2 corner of white texels; its brightest texel decides "dim"
+$R "$D/emissive_tex/screen.obj" --size 32x24 --spp 4 --out "$TMP/screen.pfm" 2>"$TMP/err" >/dev/null || fail "emissive_tex/screen.obj did not render"
+grep -q "only lights are 2 small emissive triangles" "$TMP/err" || fail "screen.obj: no note about the small emitters: $(cat "$TMP/err")"
+m=$(pfm_mean "$TMP/screen.pfm")
+python3 -c "import sys; sys.exit(0 if $m > 0.1 else 1)" || fail "emissive_tex/screen.obj is dark by default (mean $m)"
+expect 0 "" -- $R "$D/emissive_tex/nofactor.gltf" --size 32x24 --spp 4 --out "$TMP/nofactor.pfm" --quiet
+
 for v in front back left right top three-quarter; do
   expect 0 "" -- $R "$D/tray.gltf" --frame-view $v --size 16x12 --spp 1 --out "$TMP/v_$v.png" --quiet
 done

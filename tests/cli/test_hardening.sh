@@ -148,4 +148,14 @@ printf 'gaze_timestamp,confidence,norm_pos_x,norm_pos_y\n1,0.1,0.5,0.5\n' >"$TMP
 expect 2 "lowconf.csv: no usable gaze sample" -- $G "$TMP/lowconf.csv" --out "$TMP/x.csv"
 [ -e "$TMP/x.csv" ] && fail "a failed import left x.csv behind"
 ls "$TMP" | grep -q 'tmp\.' && fail "temporary files left in $TMP"
+# a material library with bytes where numbers belong: assimp's error names neither file nor line;
+# the message names the .mtl and its line, with the bytes escaped (item 10)
+printf 'mtllib g.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n' >"$TMP/m.obj"
+printf 'newmtl x\nKd 0.5 0.5 0.5\nKs \377\376\001 garbage\n' >"$TMP/g.mtl"
+expect 2 "scene '$TMP/m.obj': material library 'g.mtl', line 3: Ks wants a number, not '\xff\xfe\x01'" -- $R "$TMP/m.obj" $small
+printf 'newmtl x\nNs 10\nKd spectral some.rfl\n' >"$TMP/g.mtl"
+expect 2 "material library 'g.mtl', line 3: Kd wants a number, not 'spectral'" -- $R "$TMP/m.obj" $small
+printf 'newmtl x\nNs 10\nKd 1 1 1\n' >"$TMP/g.mtl"
+expect 0 "" -- $R "$TMP/m.obj" $small
+
 finish

@@ -97,6 +97,15 @@ static void test_textured_mesh(void **st)
     compare_scene(fv_test_data("textured/box.glb", path, sizeof path), 48, 48, 0.0, 1, "");
 }
 
+/* A floor lit only by a panel whose emission is a texture: the light table's emission texture
+ * (kernel/light.h) read through the exported scene's textures. */
+static void test_emission_texture(void **st)
+{
+    (void)st;
+    char path[512];
+    compare_scene(fv_test_data("emissive_tex/lit.json", path, sizeof path), 48, 36, 0.0, 1, "");
+}
+
 static void test_sdf_scene(void **st)
 {
     (void)st;
@@ -164,6 +173,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cornell),       cmocka_unit_test(test_city),      cmocka_unit_test(test_moving_object),
         cmocka_unit_test(test_textured_mesh), cmocka_unit_test(test_sdf_scene), cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_emission_texture),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

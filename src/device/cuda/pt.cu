@@ -111,6 +111,7 @@ static fv_status upload_scene(fv_cuda_pt *c, const fv_kscene *h, fv_error *err)
         }
         if ((s = upload(c, c->tex_host, (size_t)h->ntex, sizeof(fv_ktexture), &p, err)) != FV_OK) return s;
         c->dev.tex = (const fv_ktexture *)p;
+        c->dev.lights.tex = c->dev.tex; /* emission textures, read by light samples */
     }
     return FV_OK;
 }

@@ -34,6 +34,7 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "filter/atrous.h"
+#include "filter/demod.h"
 #include "scene/light.h"
 #include "technique/class.h"
 #include "technique/kit.h"
@@ -69,8 +70,9 @@ typedef struct pm_state {
     bool lights_move;     /* the scene's lights move: nothing lit by them is kept across frames */
     fv_foveated *fov;
     int fov_w, fov_h;
-    /* first-hit buffers of the left eye: normal, position, object id (filter, stereo) */
-    float *nbuf, *pbuf;
+    /* first-hit buffers of the left eye: normal, position, what it reflects, object id (filter,
+     * stereo) */
+    float *nbuf, *pbuf, *rbuf;
     int32_t *obuf;
     size_t bufn;
     /* the left eye of a stereo frame, for the right eye (Sec. 3.3) */
@@ -149,6 +151,7 @@ static void pm_destroy(void *state)
     fv_foveated_destroy(st->fov);
     free(st->nbuf);
     free(st->pbuf);
+    free(st->rbuf);
     free(st->obuf);
     free(st->left_color);
     free(st);
@@ -176,7 +179,7 @@ typedef struct render_ctx {
     double eta;
     int pass;
     fv_film_views out;       /* colour accumulates over passes */
-    float *nbuf, *pbuf;
+    float *nbuf, *pbuf, *rbuf;
     int32_t *obuf;
     bool right;              /* shading the right eye: reproject from the left first */
     px_sums *sums;           /* fpm, left eye: gathered sums per pixel */
@@ -291,8 +294,10 @@ static void render_tile(void *ctx, const fv_tile *tile)
             fv_vec3 zero = fv_v3s(0.0f), n = any ? h.first_n : zero, p = any ? h.first_p : zero;
             fv_film_store_first_hit(&c->out, pix, any, h.first_t, h.first_p, h.first_n, h.albedo, h.first_obj);
             if (!c->right) {
+                fv_vec3 r = any ? h.reflectance : zero;
                 memcpy(&c->nbuf[3 * pix], &n, sizeof n);
                 memcpy(&c->pbuf[3 * pix], &p, sizeof p);
+                memcpy(&c->rbuf[3 * pix], &r, sizeof r);
                 c->obuf[pix] = h.first_obj;
             }
         }
@@ -310,11 +315,13 @@ static fv_status ensure_buffers(pm_state *st, int w, int h, fv_error *err)
     if (st->bufn == n) return FV_OK;
     free(st->nbuf);
     free(st->pbuf);
+    free(st->rbuf);
     free(st->obuf);
     st->nbuf = fv_alloc_array(n, 3 * sizeof(float));
     st->pbuf = fv_alloc_array(n, 3 * sizeof(float));
+    st->rbuf = fv_alloc_array(n, 3 * sizeof(float));
     st->obuf = fv_alloc_array(n, sizeof(int32_t));
-    st->bufn = st->nbuf && st->pbuf && st->obuf ? n : 0;
+    st->bufn = st->nbuf && st->pbuf && st->rbuf && st->obuf ? n : 0;
     return st->bufn ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory for %dx%d photon mapping buffers", w, h);
 }
 
@@ -404,14 +411,31 @@ static fv_status finish_fpm(render_ctx *c, fv_film *film, fv_stats *stats, fv_er
     return FV_OK;
 }
 
-static fv_status filter_film(pm_state *st, fv_film *film, float gamma, fv_stats *stats, fv_error *err)
+static fv_status filter_film(pm_state *st, fv_film *film, float gamma, int threads, fv_stats *stats, fv_error *err)
 {
     if (!st->o.filter) return FV_OK;
     double t0 = fv_time_ms();
     fv_atrous_opts ao;
     fv_atrous_opts_default(&ao);
     ao.sigma_position = 2.0f * gamma; /* surfaces further apart than the gather disc do not mix */
-    fv_status rc = fv_atrous_filter(fv_film_color(film), st->nbuf, st->pbuf, fv_film_width(film), fv_film_height(film), &ao, err);
+    /* Light is filtered, not colour: each pixel divided by what its first surface reflects and
+     * multiplied back after (filter/demod.h, as SVGF does), so that a texture's cells keep their
+     * colour instead of taking their neighbours' (issue 25). */
+    float *col = fv_film_color(film);
+    const long long n = (long long)fv_film_width(film) * fv_film_height(film);
+    #pragma omp parallel for schedule(static) num_threads(fv_thread_count(threads))
+    for (long long i = 0; i < n; i++) {
+        float d[3];
+        fv_demod_factors(&st->rbuf[3 * i], d);
+        for (int k = 0; k < 3; k++) col[3 * i + k] /= d[k];
+    }
+    fv_status rc = fv_atrous_filter(col, st->nbuf, st->pbuf, fv_film_width(film), fv_film_height(film), &ao, err);
+    #pragma omp parallel for schedule(static) num_threads(fv_thread_count(threads))
+    for (long long i = 0; i < n; i++) {
+        float d[3];
+        fv_demod_factors(&st->rbuf[3 * i], d);
+        for (int k = 0; k < 3; k++) col[3 * i + k] *= d[k];
+    }
     fv_stats_add_ms(stats, "filter", fv_time_ms() - t0);
     return rc;
 }
@@ -512,7 +536,7 @@ static fv_status render_left(pm_state *st, render_ctx *c, fv_film *film, fv_stat
         free(c->sums);
         c->sums = NULL;
     }
-    if (rc == FV_OK) rc = filter_film(st, film, c->gamma, stats, err);
+    if (rc == FV_OK) rc = filter_film(st, film, c->gamma, frame->threads, stats, err);
     return rc;
 }
 
@@ -530,6 +554,7 @@ static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv
     c->eye = fv_frame_eye_model(frame, w, h, &def);
     c->nbuf = st->nbuf;
     c->pbuf = st->pbuf;
+    c->rbuf = st->rbuf;
     c->obuf = st->obuf;
     bool reuse_left = frame->eye == 1 && frame->left_camera && st->left_valid && st->left_index == frame->index;
     if (rc == FV_OK) rc = reuse_left ? render_right(st, c, film, stats, err) : render_left(st, c, film, stats, err);
