@@ -399,8 +399,16 @@ static fv_status method_end(method_run *mr, fv_error *err)
         res->ms_max = fmax(res->ms_max, res->ms[r]);
     }
     fv_stats_clear(&res->stages);
-    for (int q = 0; q < mr->stage_names.n_stages; q++)
-        fv_stats_add_ms(&res->stages, mr->stage_names.stage[q].name, median(mr->stage_per_rep + (size_t)q * reps, reps));
+    fv_stats_clear(&res->stages_min);
+    fv_stats_clear(&res->stages_max);
+    for (int q = 0; q < mr->stage_names.n_stages; q++) {
+        const double *v = mr->stage_per_rep + (size_t)q * reps;
+        double lo = v[0], hi = v[0];
+        for (int r = 1; r < reps; r++) lo = fmin(lo, v[r]), hi = fmax(hi, v[r]);
+        fv_stats_add_ms(&res->stages, mr->stage_names.stage[q].name, median(v, reps));
+        fv_stats_add_ms(&res->stages_min, mr->stage_names.stage[q].name, lo);
+        fv_stats_add_ms(&res->stages_max, mr->stage_names.stage[q].name, hi);
+    }
     fv_stats_clear(&res->counters);
     for (int k = 0; k < c->counter_sum.n_counters; k++)
         fv_stats_add_count(&res->counters, c->counter_sum.counter[k].name, c->counter_sum.counter[k].value / sc->frames);

@@ -5,7 +5,7 @@
 . "$(dirname "$0")/lib.sh"
 SCN="$SRC/scenes/showroom.json"
 expect 0 "" -- "$FOVEA" render "$SCN" --method fpm --param photons=20000 --size 48x32 --frames 2 --fps 10 --time 0.5 --seed 3 \
-  --quiet --out "$TMP/r.png"
+  --quiet --no-metadata --out "$TMP/r.png"
 cat >"$TMP/same.json" <<JSON
 {"scene": "$SCN", "size": [48, 32], "frames": 2, "fps": 10, "start_time": 0.5, "seed": 3, "repeats": 1,
  "reference": {"method": "pt", "params": {"spp": 1}},
@@ -13,7 +13,7 @@ cat >"$TMP/same.json" <<JSON
 JSON
 expect 0 "" -- "$FOVEA" bench "$TMP/same.json" --out "$TMP/bench" --quiet
 [ -s "$TMP/bench/same/fpm.png" ] || fail "the bench wrote no image of the last frame"
-cmp -s "$TMP/r_0001.png" "$TMP/bench/same/fpm.png" || fail "fovea render and fovea bench rendered different frames"
+cmp -s "$TMP/r_0001.png" "$TMP/bench/same/fpm.png" || fail "fovea render and fovea bench rendered different frames (render --no-metadata writes the bench's bytes)"
 # The gaze both took is the scene file's trace (scenes/gaze-sweep.csv) at t = 0.5 + 1/10 = 0.6:
 # x = 0.25 + 0.6 * 0.25 = 0.40, y = 0.50 - 0.6 * 0.05 = 0.47, not the centre.
 grep -q "gaze (0.40, 0.47) at the last frame" "$TMP/bench/same.md" || fail "the bench did not take the scene file's gaze: $(grep -o 'gaze ([^)]*)' "$TMP/bench/same.md")"

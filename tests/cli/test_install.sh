@@ -27,7 +27,7 @@ if readelf -d "$LIB/libfovea.so" 2>/dev/null | grep -q 'libasan'; then SAN="-fsa
 is_png() { [ "$(head -c 8 "$1" 2>/dev/null | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ]; }
 
 # The reference: the installed tool renders what the example does (same scene, method, spp, seed).
-"$P/bin/fovea" render cornell --method pt --spp 4 --size 64x64 --seed 1 --gaze 0.5,0.5 --out "$TMP/ref.png" --quiet ||
+"$P/bin/fovea" render cornell --method pt --spp 4 --size 64x64 --seed 1 --gaze 0.5,0.5 --no-metadata --out "$TMP/ref.png" --quiet ||
   fail "installed fovea render failed"
 
 # pkg-config, from a copy of examples/ outside the source tree.
