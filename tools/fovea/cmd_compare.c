@@ -13,8 +13,8 @@ static void usage(FILE *f)
                "Compares TEST against REF (PNG, PFM or EXR) over the whole image and per region around the gaze.\n\n"
                "  --gaze X,Y              gaze point in [0,1] screen coordinates [the gaze TEST's metadata records\n"
                "                          (fovea render writes it), else REF's, else 0.5,0.5]\n"
-               "  --allow-gaze-mismatch   compare even when REF and TEST record different gazes and one of them\n"
-               "                          was rendered by a foveated method (refused otherwise)\n"
+               "  --allow-gaze-mismatch   compare even when REF and TEST were both rendered by foveated methods for\n"
+               "                          different gazes (refused otherwise)\n"
                "  --json                  print JSON instead of a table\n"
                "  --heatmap FILE          write a PNG heat map of the per-pixel error\n"
                "  --heatmap-metric M      flip | mse | e [flip]\n"
@@ -165,20 +165,23 @@ int fv_cmd_compare(int argc, char **argv)
     }
     int w = ref.width, h = ref.height;
     /* The gaze the images were rendered for, from their metadata: two foveated renders for
-     * different gazes have their detail in different places, and no one region fits both. */
+     * different gazes have their detail in different places, and no one region fits both. A
+     * non-foveated image (pt as the reference) looks the same for any gaze: the other's counts. */
     {
         float gr[2], gt[2];
         bool fr = false, ft = false;
         bool hr = recorded_gaze(ref_path, gr, &fr), ht = recorded_gaze(test_path, gt, &ft);
-        if (hr && ht && (fr || ft) && !allow_mismatch && (fabsf(gr[0] - gt[0]) > 1e-4f || fabsf(gr[1] - gt[1]) > 1e-4f)) {
+        if (hr && ht && fr && ft && !allow_mismatch && (fabsf(gr[0] - gt[0]) > 1e-4f || fabsf(gr[1] - gt[1]) > 1e-4f)) {
             rc = fv_cli_usage_error(cmd, "%s was rendered for gaze %g,%g and %s for gaze %g,%g: pass --allow-gaze-mismatch to compare them anyway",
                                     ref_path, gr[0], gr[1], test_path, gt[0], gt[1]);
             goto done;
         }
+        /* TEST's gaze, unless only REF depends on its gaze. */
+        bool from_test = ht && (ft || !(hr && fr));
         if (!has_gaze && (ht || hr)) {
-            gaze[0] = ht ? gt[0] : gr[0];
-            gaze[1] = ht ? gt[1] : gr[1];
-            fprintf(stderr, "fovea compare: gaze %g,%g from the metadata of %s (--gaze overrides)\n", gaze[0], gaze[1], ht ? test_path : ref_path);
+            gaze[0] = from_test ? gt[0] : gr[0];
+            gaze[1] = from_test ? gt[1] : gr[1];
+            fprintf(stderr, "fovea compare: gaze %g,%g from the metadata of %s (--gaze overrides)\n", gaze[0], gaze[1], from_test ? test_path : ref_path);
         }
     }
     fv_eye_model eye;
