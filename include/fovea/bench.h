@@ -33,6 +33,10 @@ typedef struct fv_bench_options {
     /* "cpu", "portable", "cuda", "auto" or NULL: the device of every measured method that has it
      * and whose parameters name none (fovea/device.h); references stay where the scenario puts them. */
     const char *device;
+    /* Called once when the run has written its reports, with the main result table (Markdown,
+     * one row per method: time, speed-up, errors per region) for the caller to show; may be NULL.
+     * Gets status_user. */
+    void (*table)(void *user, const char *text);
 } fv_bench_options;
 
 /* Runs the scenario file at `path`. Bad scenario -> FV_ERR_INVALID naming file and field. Writes

@@ -266,7 +266,8 @@ static void sweep_stem(const fv_scenario *sc, int k, char *out, size_t n)
     else snprintf(out, n, "%s-sweep", sc->name);
 }
 
-static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
+/* *table: a copy of the main table (NULL when out of memory), for fv_bench_options.table. */
+static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_result *res, int n, char **table, fv_error *err)
 {
     const fv_scenario *sc = info->sc;
     text t = {0};
@@ -295,6 +296,7 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
                 "Errors are means over frames on display values (exposure %g, sRGB); MSE' is the temporal error "
                 "(Foveated Photon Mapping Eq. 9).\n\n",
             reps, sc->baseline, sc->exposure);
+    size_t table_at = t.len;
     tprintf(&t, "| method | params | ms/frame | ms min–max | speed-up | MSE fovea | MSE transition | MSE periphery | SSIM fovea | FLIP fovea | "
                 "FLIP all | MSE' fovea | MSE' periphery |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int i = 0; i < n; i++) {
@@ -309,6 +311,7 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
                 sci(g, r->has_temporal ? r->temporal_mse[FV_REGION_FOVEA] : NAN),
                 sci(h, r->has_temporal ? r->temporal_mse[FV_REGION_PERIPHERY] : NAN));
     }
+    if (!t.oom && t.s) *table = strdup(t.s + table_at);
     /* Ray throughput where a method counts its rays: one camera ray per sample is primary, the
      * rest (bounces and shadow rays) secondary. */
     bool rays = false;
@@ -423,8 +426,12 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
 
 fv_status fv_bench_write_reports(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
 {
+    char *table = NULL;
     fv_status st = write_json(info, res, n, err);
-    if (st == FV_OK) st = write_markdown(info, res, n, err);
+    if (st == FV_OK) st = write_markdown(info, res, n, &table, err);
     for (int k = 0; k < info->sc->nsweeps && st == FV_OK; k++) st = write_sweep(info, res, n, k, err);
+    /* Shown only once every file is written. */
+    if (st == FV_OK && table && info->opt->table) info->opt->table(info->opt->status_user, table);
+    free(table);
     return st;
 }

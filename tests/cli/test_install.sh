@@ -79,7 +79,8 @@ check_tool() { # $1 = prefix
   grep -qxF "$bench:" "$TMP/list.txt" || fail "bench --list does not show $bench: $(head -c 300 "$TMP/list.txt")"
   grep -qF "$SRC" "$TMP/list.txt" && fail "bench --list of an installed tool shows the source tree"
   for j in "$SRC"/bench/*.json; do
-    grep -qx "  $(basename "$j" .json)" "$TMP/list.txt" || fail "bench --list lacks $(basename "$j" .json)"
+    # each scenario with the first sentence of its description
+    grep -qE "^  $(basename "$j" .json) +[A-Z\`]" "$TMP/list.txt" || fail "bench --list lacks $(basename "$j" .json) or its description"
   done
   (cd "$TMP/elsewhere" && "$1/bin/fovea" bench fpm-showroom --check) >"$TMP/check.txt" 2>&1 ||
     fail "installed bench fpm-showroom --check: $(head -c 300 "$TMP/check.txt")"
@@ -101,7 +102,8 @@ done
 mkdir -p "$TMP/mine"
 cp "$SRC/bench/pt-cornell.json" "$TMP/mine/my-scenario.json"
 (cd "$TMP/elsewhere" && FOVEA_BENCH_DIR="$TMP/mine" "$P/bin/fovea" bench --list) >"$TMP/list.txt" 2>&1
-[ "$(head -n 2 "$TMP/list.txt")" = "$(printf '%s:\n  my-scenario' "$TMP/mine")" ] ||
+[ "$(head -n 1 "$TMP/list.txt")" = "$TMP/mine:" ] &&
+  sed -n 2p "$TMP/list.txt" | grep -q "^  my-scenario  *The reference path tracer at increasing samples per pixel" ||
   fail "FOVEA_BENCH_DIR is not listed first: $(head -n 3 "$TMP/list.txt")"
 
 # Relocated: the whole prefix moved elsewhere still works.

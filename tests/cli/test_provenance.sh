@@ -12,6 +12,11 @@ cat >"$TMP/tiny.json" <<JSON
  "quick": {"size": [32, 24], "repeats": 2}}
 JSON
 OMP_NUM_THREADS=3 expect 0 "" -- "$FOVEA" bench "$TMP/tiny.json" --quick --out "$OUT" --quiet
+# The result table on stdout when the run ends, even with --quiet: one row per method.
+[ "$(grep -c '^| p[mt] | ' "$TMP/out")" = 2 ] || fail "bench printed no result table: $(head -c 300 "$TMP/out")"
+# --list: each scenario with the first sentence of its description.
+FOVEA_BENCH_DIR="$TMP" "$FOVEA" bench --list >"$TMP/list.txt" 2>&1
+grep -q "^  tiny  *Two pm settings at 64x48.$" "$TMP/list.txt" || fail "bench --list: $(head -n 3 "$TMP/list.txt")"
 python3 - "$OUT/tiny.json" <<'PY' || fail "tiny.json lacks provenance or typed parameters"
 import json, re, sys
 d = json.load(open(sys.argv[1]))

@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "cli.h"
+#include "core/json_util.h"
 #include "core/fileio.h"
 
 static void usage(FILE *f)
@@ -100,6 +101,27 @@ static int is_json(const struct dirent *e)
     return n > 5 && strcmp(e->d_name + n - 5, ".json") == 0;
 }
 
+/* The first sentence of a scenario's "description" (at most 100 characters), or "" when it has
+ * none or cannot be read: --list shows it beside the name. */
+static void one_line(const char *dir, const char *file, char *out, size_t n)
+{
+    out[0] = 0;
+    char path[PATH_MAX + 256];
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    cJSON *root = NULL;
+    fv_error err;
+    if (fv_json_parse_file(path, &root, &err) != FV_OK) return;
+    const cJSON *d = cJSON_GetObjectItemCaseSensitive(root, "description");
+    if (cJSON_IsString(d) && d->valuestring) {
+        /* A sentence ends at ". " after 40 characters at least: "Figs. 5" or "Eq. 8" end none. */
+        const char *t = d->valuestring, *stop = strlen(t) > 40 ? strstr(t + 40, ". ") : NULL;
+        size_t len = stop ? (size_t)(stop - t) + 1 : strlen(t);
+        if (len > 100) snprintf(out, n, "%.97s...", t);
+        else snprintf(out, n, "%.*s", (int)len, t);
+    }
+    cJSON_Delete(root);
+}
+
 static void list_scenarios(void)
 {
     const char *dirs[4];
@@ -122,11 +144,21 @@ static void list_scenarios(void)
         if (nn < 0) continue;
         printf("%s:\n", dirs[i]);
         for (int k = 0; k < nn; k++) {
-            printf("  %.*s\n", (int)(strlen(names[k]->d_name) - 5), names[k]->d_name);
+            char line[128];
+            one_line(dirs[i], names[k]->d_name, line, sizeof line);
+            printf("  %-22.*s %s\n", (int)(strlen(names[k]->d_name) - 5), names[k]->d_name, line);
             free(names[k]);
         }
         free(names);
     }
+}
+
+/* The result table on stdout, whatever --quiet says: it is the command's output. */
+static void on_table(void *user, const char *text)
+{
+    (void)user;
+    fputs(text, stdout);
+    fflush(stdout);
 }
 
 static void on_status(void *user, const char *line)
@@ -188,6 +220,7 @@ int fv_cmd_bench(int argc, char **argv)
     fv_log log = fv_cli_log(&quiet);
     opt.log = &log;
     if (!quiet) opt.status = on_status;
+    opt.table = on_table;
     fv_error err;
     fv_error_clear(&err);
     /* A regular file only: the JSON reader opens it by name, and a FIFO would block it. */
