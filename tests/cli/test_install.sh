@@ -80,7 +80,7 @@ check_tool() { # $1 = prefix
   grep -qF "$SRC" "$TMP/list.txt" && fail "bench --list of an installed tool shows the source tree"
   for j in "$SRC"/bench/*.json; do
     # each scenario with the first sentence of its description
-    grep -qE "^  $(basename "$j" .json) +[A-Z\`]" "$TMP/list.txt" || fail "bench --list lacks $(basename "$j" .json) or its description"
+    grep -qE "^  $(basename "$j" .json) +[^ ]" "$TMP/list.txt" || fail "bench --list lacks $(basename "$j" .json) or its description"
   done
   (cd "$TMP/elsewhere" && "$1/bin/fovea" bench fpm-showroom --check) >"$TMP/check.txt" 2>&1 ||
     fail "installed bench fpm-showroom --check: $(head -c 300 "$TMP/check.txt")"
