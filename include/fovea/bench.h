@@ -47,6 +47,12 @@ FV_API fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_
 /* Only parses and validates the scenario (for `fovea bench --check`). */
 FV_API fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err);
 
+/* The same for a scenario given as JSON text (`fovea bench --scene ...` builds one): `label`
+ * stands for its file name (messages, and the report's name when the text has no "name"), `dir`
+ * for its folder (relative scene and gaze-trace paths resolve against it). */
+FV_API fv_status fv_bench_run_text(const char *json, const char *label, const char *dir, const fv_bench_options *opt, fv_error *err);
+FV_API fv_status fv_bench_check_text(const char *json, const char *label, const char *dir, fv_bench_mode mode, fv_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -653,11 +653,10 @@ static fv_status validate(const fv_scenario *sc, const char *path, const fv_log 
     return st;
 }
 
-fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err)
+/* Validates a loaded scenario (destroyed here); path names it in messages. */
+static fv_status check_loaded(fv_scenario *sc, const char *path, fv_error *err)
 {
-    fv_scenario *sc;
-    fv_status st = fv_scenario_load(path, mode, &sc, err);
-    if (st != FV_OK) return st;
+    fv_status st;
     fv_scene *scene = NULL;
     fv_view *view = NULL;
     st = validate(sc, path, NULL, &scene, &view, err);
@@ -687,9 +686,23 @@ static fv_status apply_device(fv_scenario *sc, const char *device, fv_error *err
     return st;
 }
 
-fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *err)
+fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err)
 {
-    fv_scenario *sc = NULL;
+    fv_scenario *sc;
+    fv_status st = fv_scenario_load(path, mode, &sc, err);
+    return st == FV_OK ? check_loaded(sc, path, err) : st;
+}
+
+fv_status fv_bench_check_text(const char *json, const char *label, const char *dir, fv_bench_mode mode, fv_error *err)
+{
+    fv_scenario *sc;
+    fv_status st = fv_scenario_load_text(json, label, dir, mode, &sc, err);
+    return st == FV_OK ? check_loaded(sc, label, err) : st;
+}
+
+/* Runs a loaded scenario (destroyed here); path names it in messages. */
+static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_options *opt, fv_error *err)
+{
     fv_scene *scene = NULL;
     fv_view *view = NULL;
     frame_setup *frames = NULL;
@@ -698,8 +711,7 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
     int nrows = 0;
     fv_bench_run_info info;
     memset(&info, 0, sizeof info);
-    fv_status st = fv_scenario_load(path, opt->mode, &sc, err);
-    if (st != FV_OK) return st;
+    fv_status st = FV_OK;
     info.sc = sc;
     info.opt = opt;
     info.threads = opt->threads;
@@ -795,4 +807,18 @@ done:
     fv_scene_destroy(scene);
     fv_scenario_destroy(sc);
     return st;
+}
+
+fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *err)
+{
+    fv_scenario *sc;
+    fv_status st = fv_scenario_load(path, opt->mode, &sc, err);
+    return st == FV_OK ? run_loaded(sc, path, opt, err) : st;
+}
+
+fv_status fv_bench_run_text(const char *json, const char *label, const char *dir, const fv_bench_options *opt, fv_error *err)
+{
+    fv_scenario *sc;
+    fv_status st = fv_scenario_load_text(json, label, dir, opt->mode, &sc, err);
+    return st == FV_OK ? run_loaded(sc, label, opt, err) : st;
 }
