@@ -19,6 +19,7 @@
 #include "core/params_read.h"
 #include "fovea/device.h"
 #include "core/rng.h"
+#include "drive/frame_meta.h"
 #include "fovea/fovea.h"
 #include "scene/edit.h"
 
@@ -436,7 +437,14 @@ static fv_status method_end(method_run *mr, fv_error *err)
     snprintf(res->heat, sizeof res->heat, "%s/%s-flip.png", sc->name, label);
     snprintf(res->crop, sizeof res->crop, "%s/%s-fovea.png", sc->name, label);
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->img);
-    fv_status st = fv_image_write(path, c->last, sc->width, sc->height, sc->exposure, err);
+    /* The frame says how it was made, as `fovea render`'s images do (drive/frame_meta.h). */
+    fv_frame_views v;
+    fv_driver_views(info->driver, sc->frames - 1, &v);
+    fv_frame_meta_run run = {res->m->method, sc->scene, res->m->params, sc->width, sc->height, info->threads, sc->seed, sc->exposure};
+    fv_params *meta = NULL;
+    fv_status st = fv_frame_meta(&run, sc->frames - 1, &v, 0, res->ms_median, &meta, err);
+    if (st == FV_OK) st = fv_image_write_meta(path, c->last, sc->width, sc->height, sc->exposure, meta, err);
+    fv_params_destroy(meta);
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->heat);
     if (st == FV_OK) st = fv_heatmap_write(path, c->flip_map, sc->width, sc->height, 1.0f, &sc->eye, lf->gaze, err);
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->crop);
@@ -770,7 +778,15 @@ static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_op
     {
         char p[4096 + 160];
         snprintf(p, sizeof p, "%s/%s", info.out_dir, info.ref_img);
-        if ((st = fv_image_write(p, frames[sc->frames - 1].ref[0], sc->width, sc->height, sc->exposure, err)) != FV_OK) goto done;
+        fv_frame_views v;
+        fv_driver_views(info.ref_driver, sc->frames - 1, &v);
+        fv_frame_meta_run run = {sc->reference.method, sc->scene, sc->reference.params, sc->width, sc->height, info.threads,
+                                 fv_seed_reference(sc->seed), sc->exposure};
+        fv_params *meta = NULL;
+        st = fv_frame_meta(&run, sc->frames - 1, &v, 0, info.ref_ms > 0 ? info.ref_ms : -1.0, &meta, err);
+        if (st == FV_OK) st = fv_image_write_meta(p, frames[sc->frames - 1].ref[0], sc->width, sc->height, sc->exposure, meta, err);
+        fv_params_destroy(meta);
+        if (st != FV_OK) goto done;
     }
 
     nrows = sc->nmethods + sc->nmatches;

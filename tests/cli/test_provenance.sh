@@ -48,6 +48,12 @@ for r in d["results"]:
         assert s["min"] <= s["median"] <= s["max"], (name, s)
         assert s["median"] == r["stages_ms"][name]
 PY
+# The bench's images carry the same metadata as fovea render's: compare finds their gaze (the
+# scene's own, the centre here) and the reference says it is pt, not foveated.
+expect 0 "" -- "$FOVEA" compare "$OUT/tiny/reference.png" "$OUT/tiny/pm.png"
+grep -q "gaze 0.5,0.5 from the metadata of $OUT/tiny/pm.png" "$TMP/err" || fail "bench images carry no gaze: $(cat "$TMP/err")"
+LC_ALL=C grep -aq "fovea:foveated" "$OUT/tiny/reference.png" && LC_ALL=C grep -aq '{"spp":4}' "$OUT/tiny/reference.png" ||
+  fail "the bench's reference image does not say how it was made"
 grep -q "^Made by fovea .*commit" "$OUT/tiny.md" || fail "tiny.md does not say which build made it"
 grep -q "This quick run: scene \`cornell\`, 32x24" "$OUT/tiny.md" || fail "tiny.md does not state the quick run's settings"
 grep -q "The scenario (its default run): Two pm settings at 64x48." "$OUT/tiny.md" || fail "tiny.md presents the default run's description as this run's"

@@ -314,7 +314,7 @@ int fv_cmd_render(int argc, char **argv)
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
     }
-    fv_render_record_run rec = {o.method, o.scene, params, o.width, o.height, o.threads, o.seed, (float)o.exposure};
+    fv_frame_meta_run rec = {o.method, o.scene, params, o.width, o.height, o.threads, o.seed, (float)o.exposure};
     if (o.stats_json && (s = fv_stats_log_create(&rec, &slog, &err)) != FV_OK) {
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
@@ -358,7 +358,7 @@ int fv_cmd_render(int argc, char **argv)
             /* Each image says how it was made (method, parameters, camera, gaze of its eye, ...). */
             fv_params_destroy(meta);
             meta = NULL;
-            if (!o.no_meta) s = fv_render_meta(&rec, f, &views, e, ms, &meta, &err);
+            if (!o.no_meta) s = fv_frame_meta(&rec, f, &views, e, ms, &meta, &err);
             if (s == FV_OK) s = fv_film_write_meta(film[e], path, (float)o.exposure, meta, &err);
         }
         if (s != FV_OK) break;
