@@ -15,7 +15,7 @@
 #include "core/provenance.h"
 #include "core/rng.h"
 #include "fovea/fovea.h"
-#include "technique/params_json.h"
+#include "drive/params_json.h"
 
 /* A growable text buffer for the Markdown and CSV files. */
 typedef struct text {

@@ -11,7 +11,7 @@
 #include <cmocka.h>
 #include "core/provenance.h"
 #include "fovea/fovea.h"
-#include "technique/params_json.h"
+#include "drive/params_json.h"
 
 typedef struct fixture {
     char dir[64];
@@ -155,6 +155,14 @@ static void typed_parameters(void **state)
     assert_true(cJSON_GetObjectItemCaseSensitive(j, "photons")->valuedouble == 20000.0);
     cJSON_Delete(j);
     fv_params_destroy(p);
+    /* The flag image metadata records: fpm and fir spend less effort away from the gaze; pt and pm
+     * do not; no method is out of range. */
+    assert_true(fv_technique_foveated(fv_technique_index("fpm")));
+    assert_true(fv_technique_foveated(fv_technique_index("fir")));
+    assert_false(fv_technique_foveated(fv_technique_index("pt")));
+    assert_false(fv_technique_foveated(fv_technique_index("pm")));
+    assert_false(fv_technique_foveated(-1));
+    assert_false(fv_technique_foveated(fv_technique_count()));
 }
 
 static void build_and_host(void **state)

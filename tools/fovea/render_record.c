@@ -6,7 +6,7 @@
 #include "core/fileio.h"
 #include "core/provenance.h"
 #include "render_record.h"
-#include "technique/params_json.h"
+#include "drive/params_json.h"
 
 struct fv_stats_log {
     cJSON *root, *frames;

@@ -1,7 +1,7 @@
 /* fovea — a method's parameters as typed JSON for reports and metadata: numbers as numbers,
  * switches as true/false, names as strings. */
-#ifndef FV_TECHNIQUE_PARAMS_JSON_H
-#define FV_TECHNIQUE_PARAMS_JSON_H
+#ifndef FV_DRIVE_PARAMS_JSON_H
+#define FV_DRIVE_PARAMS_JSON_H
 
 #include <cjson/cJSON.h>
 #include "fovea/params.h"

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include "technique/params_json.h"
+#include "drive/params_json.h"
 #include "fovea/technique.h"
 
 typedef enum ptype { P_UNKNOWN, P_NUMBER, P_BOOL, P_TEXT } ptype;
