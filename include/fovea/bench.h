@@ -37,6 +37,9 @@ typedef struct fv_bench_options {
      * one row per method: time, speed-up, errors per region) for the caller to show; may be NULL.
      * Gets status_user. */
     void (*table)(void *user, const char *text);
+    /* The command that ran this, recorded in the reports as it is (e.g. "fovea bench pt-cornell
+     * --quick"); may be NULL. */
+    const char *command;
 } fv_bench_options;
 
 /* Runs the scenario file at `path`. Bad scenario -> FV_ERR_INVALID naming file and field. Writes

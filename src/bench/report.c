@@ -182,7 +182,9 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     cJSON_AddStringToObject(root, "run_description", settings.s ? settings.s : "");
     free(settings.s);
     cJSON_AddStringToObject(root, "fovea_version", FOVEA_VERSION_STRING);
-    cJSON_AddItemToObject(root, "provenance", fv_provenance_json(info->threads));
+    cJSON *prov = fv_provenance_json(info->threads);
+    if (prov && info->opt->command) cJSON_AddStringToObject(prov, "command", info->opt->command);
+    cJSON_AddItemToObject(root, "provenance", prov);
     cJSON_AddStringToObject(root, "scene", sc->scene);
     /* The scene edits, only when asked for (reports of other scenarios stay as they were). */
     if (sc->diffuse) cJSON_AddBoolToObject(root, "diffuse", true);
@@ -283,7 +285,9 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
         fv_host_info host;
         fv_host_info_get(&host);
         fv_utc_now(date, sizeof date);
-        tprintf(&t, "Made by %s on %s (%d cores, %s), %d thread(s), %s.\n\n", line, host.cpu, host.cores, host.os, fv_threads_used(info->threads), date);
+        tprintf(&t, "Made by %s on %s (%d cores, %s), %d thread(s), %s", line, host.cpu, host.cores, host.os, fv_threads_used(info->threads), date);
+        if (info->opt->command) tprintf(&t, ", with `%s`", info->opt->command);
+        tprintf(&t, ".\n\n");
     }
     tprintf(&t, "Scene `%s`, %dx%d, %d frame(s) at %g fps (errors from frame %d on), gaze (%.2f, %.2f) at the last frame, fovea radius %.0f px, "
                 "transition %.0f px. Reference: `%s`",

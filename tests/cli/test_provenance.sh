@@ -58,6 +58,12 @@ grep -q "^Made by fovea .*commit" "$OUT/tiny.md" || fail "tiny.md does not say w
 grep -q "This quick run: scene \`cornell\`, 32x24" "$OUT/tiny.md" || fail "tiny.md does not state the quick run's settings"
 grep -q "The scenario (its default run): Two pm settings at 64x48." "$OUT/tiny.md" || fail "tiny.md presents the default run's description as this run's"
 
+grep -q "^Made by fovea .*, with \`fovea bench $TMP/tiny.json --quick --out $OUT --quiet\`.$" "$OUT/tiny.md" || fail "tiny.md does not give the command"
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); sys.exit(0 if d["provenance"]["command"].startswith("fovea bench ") and d["provenance"]["command"].endswith(" --quick --out "+sys.argv[2]+" --quiet") else 1)' "$OUT/tiny.json" "$OUT" ||
+  fail "tiny.json does not give the command"
+# fovea --version names the build.
+"$FOVEA" --version | grep -qE "^fovea [0-9.]+, commit ([0-9a-f]{12}|unknown)" || fail "fovea --version: $("$FOVEA" --version)"
+
 # Rendered images carry their metadata: two renders for different gazes, one PNG, one EXR.
 R="$FOVEA render cornell --size 32x24 --quiet"
 expect 0 "" -- $R --method fpm --param photons=2000 --gaze 0.25,0.75 --seed 7 --out "$TMP/a.png" --stats-json "$TMP/a.json"

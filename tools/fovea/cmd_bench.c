@@ -180,6 +180,16 @@ static void on_status(void *user, const char *line)
 
 /* --scene: the scenario built from the command line is checked first, then saved (--save-scenario:
  * nothing is written for bad input), then run as a scenario file would be. */
+/* argv as one line for the reports: "fovea bench ARG..." (arguments with spaces quoted). */
+static void command_line(int argc, char **argv, char *out, size_t n)
+{
+    size_t len = (size_t)snprintf(out, n, "fovea bench");
+    for (int i = 1; i < argc && len < n; i++) {
+        bool quote = strpbrk(argv[i], " \t'\"") != NULL;
+        len += (size_t)snprintf(out + len, n - len, quote ? " '%s'" : " %s", argv[i]);
+    }
+}
+
 static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check, bool quiet, fv_bench_options *opt)
 {
     const char *cmd = "bench";
@@ -218,6 +228,10 @@ int fv_cmd_bench(int argc, char **argv)
     fv_bench_options opt;
     memset(&opt, 0, sizeof opt);
     opt.out_dir = "bench-out";
+    /* Before getopt_long, which reorders argv. */
+    char command[2048];
+    command_line(argc, argv, command, sizeof command);
+    opt.command = command;
     bool check = false, quiet = false, list = false, cmdline = false;
     fv_bench_cmdline cl;
     memset(&cl, 0, sizeof cl);
