@@ -8,8 +8,8 @@
 #include <stdlib.h>
 #include "core/provenance.h"
 #include "drive/frame_meta.h"
-#include "fovea/technique.h"
 #include "drive/params_json.h"
+#include "fovea/technique.h"
 
 /* A cJSON tree as compact text into the bag under key; takes the tree. */
 static fv_status set_json(fv_params *p, const char *key, cJSON *j, fv_error *err)
@@ -53,7 +53,7 @@ fv_status fv_frame_meta(const fv_frame_meta_run *run, int frame, const fv_frame_
     st = fv_params_set(p, "method", run->method, err);
     if (st == FV_OK) st = set_json(p, "params", fv_params_typed_json(run->method, run->params), err);
     /* Whether the image depends on the gaze at all: `fovea compare` refuses two images rendered
-     * for different gazes only when one of them does. */
+     * for different gazes only when both do. */
     SET("foveated", "%s", fv_technique_foveated(fv_technique_index(run->method)) ? "true" : "false");
     if (st == FV_OK) st = fv_params_set(p, "scene", run->scene, err);
     if (st == FV_OK) st = set_json(p, "camera", camera_json(&v->camera[eye]), err);

@@ -54,11 +54,13 @@ static void png_on_error(png_structp png, png_const_charp msg)
 
 static void png_on_warning(png_structp png, png_const_charp msg) { (void)png, (void)msg; }
 
-/* True when every byte is printable Latin-1 (what a tEXt chunk may hold); else iTXt (UTF-8). */
-static bool latin1_text(const char *v)
+/* True when the text is printable ASCII, the same in tEXt's Latin-1 and in UTF-8; anything else
+ * goes into an iTXt chunk, whose text is UTF-8 (PNG 1.2, 11.3.4), so other readers see the same
+ * characters. */
+static bool ascii_text(const char *v)
 {
     for (const unsigned char *c = (const unsigned char *)v; *c; c++)
-        if ((*c < 32 && *c != '\n') || (*c >= 127 && *c < 161)) return false;
+        if ((*c < 32 && *c != '\n') || *c >= 127) return false;
     return true;
 }
 
@@ -111,7 +113,7 @@ static fv_status png_write(const char *path, const float *rgb, int w, int h, flo
         texts[nt].key = keys[nt];
         texts[nt].text = (png_charp)v;
         texts[nt].text_length = strlen(v);
-        texts[nt].compression = latin1_text(v) ? PNG_TEXT_COMPRESSION_NONE : PNG_ITXT_COMPRESSION_NONE;
+        texts[nt].compression = ascii_text(v) ? PNG_TEXT_COMPRESSION_NONE : PNG_ITXT_COMPRESSION_NONE;
         nt++;
     }
     fv_atomic_file af;
