@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "cli.h"
+#include "render_record.h"
 
 #define MAX_LIGHTS 64
 
@@ -43,6 +44,10 @@ static void help(void)
            "  --stereo SEP          render a stereo pair with eye separation SEP: OUT_left.ext, OUT_right.ext\n"
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
            "  --stats               print every counter of each frame (rays, steps, ...) after its timings\n"
+           "  --no-metadata         write images without the metadata that says how they were made (method,\n"
+           "                        parameters, camera, gaze, build, date: docs/metrics.md), byte-reproducible\n"
+           "  --stats-json FILE     write every frame's stage timings and counters, with the method, its\n"
+           "                        parameters and the build, as JSON (written whole at the end)\n"
            "  --quiet               no progress bar, warnings or per-frame lines\n"
            "Exit status: 0 ok, 1 internal error, 2 bad input (the message names it), 130/143 interrupted by\n"
            "SIGINT/SIGTERM (frames already written stay; no partial or temporary file).\n");
@@ -70,8 +75,8 @@ typedef struct render_opts {
     int width, height, frames, threads, spp;
     double fps, time0, exposure, stereo;
     unsigned long long seed;
-    bool quiet, show_stats, has_pos, has_look, has_up, has_fov, has_gaze;
-    const char *gaze_trace, *camera_trace;
+    bool quiet, show_stats, no_meta, has_pos, has_look, has_up, has_fov, has_gaze;
+    const char *gaze_trace, *camera_trace, *stats_json;
     fv_gaze_missing missing;
     float pos[3], look[3], up[3], fov, gaze[2];
     int nlights;
@@ -83,13 +88,13 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
     enum { O_METHOD = 256, O_SPP, O_DEVICE, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
            O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP,
-           O_MISSING };
+           O_MISSING, O_STATS_JSON, O_NO_META };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"device", 1, 0, O_DEVICE}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
         {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
         {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE}, {"gaze-missing", 1, 0, O_MISSING},
-        {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"help", 0, 0, O_HELP},
+        {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"stats-json", 1, 0, O_STATS_JSON}, {"no-metadata", 0, 0, O_NO_META}, {"help", 0, 0, O_HELP},
         FV_CLI_SCENE_LONGOPTS, {0, 0, 0, 0}};
     const char *cmd = "render";
     long l;
@@ -181,6 +186,8 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             break;
         case O_QUIET: o->quiet = true; break;
         case O_STATS: o->show_stats = true; break;
+        case O_STATS_JSON: o->stats_json = optarg; break;
+        case O_NO_META: o->no_meta = true; break;
         case O_HELP:
         case 'h': help(); return -1;
         default:
@@ -216,6 +223,8 @@ int fv_cmd_render(int argc, char **argv)
     fv_film *film[2] = {NULL, NULL};
     fv_gaze_path *trace = NULL;
     fv_camera_path ctrace = {NULL, 0};
+    fv_stats_log *slog = NULL;
+    fv_params *meta = NULL;
     int rc = FV_EXIT_OK;
     fv_status s;
 
@@ -237,6 +246,10 @@ int fv_cmd_render(int argc, char **argv)
     }
     if (!dir_writable(o.out)) {
         rc = fv_cli_usage_error(cmd, "--out %s: cannot write there (%s)", o.out, strerror(errno));
+        goto done;
+    }
+    if (o.stats_json && (!o.stats_json[0] || !dir_writable(o.stats_json))) {
+        rc = fv_cli_usage_error(cmd, "--stats-json %s: cannot write there (%s)", o.stats_json, o.stats_json[0] ? strerror(errno) : "empty path");
         goto done;
     }
     if ((rc = fv_cli_check_method(cmd, o.method)) != 0) goto done;
@@ -301,6 +314,11 @@ int fv_cmd_render(int argc, char **argv)
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
     }
+    fv_frame_meta_run rec = {o.method, o.scene, params, o.width, o.height, o.threads, o.seed, (float)o.exposure};
+    if (o.stats_json && (s = fv_stats_log_create(&rec, &slog, &err)) != FV_OK) {
+        rc = fv_cli_fail(cmd, s, err.msg);
+        goto done;
+    }
     unsigned aux = fmt == FV_IMG_EXR ? FV_AUX_ALL : 0;
     int neyes = fv_driver_eye_count(driver);
     for (int e = 0; e < neyes; e++)
@@ -321,6 +339,9 @@ int fv_cmd_render(int argc, char **argv)
         double t0 = fv_time_ms();
         if ((s = fv_driver_render(driver, tech, f, f > 0, film, &stats, fv_cli_progress_frame, &prog, &err)) != FV_OK) break;
         double ms = fv_time_ms() - t0;
+        fv_frame_views views;
+        fv_driver_views(driver, f, &views);
+        if (slog) s = fv_stats_log_add(slog, f, &views, ms, &stats, &err);
         for (int e = 0; e < neyes && s == FV_OK; e++) {
             char path[4096], tmp[4096];
             snprintf(path, sizeof path, "%s", o.out);
@@ -334,7 +355,11 @@ int fv_cmd_render(int argc, char **argv)
                 tagged_path(path, tag, tmp, sizeof tmp);
                 snprintf(path, sizeof path, "%s", tmp);
             }
-            s = fv_film_write(film[e], path, (float)o.exposure, &err);
+            /* Each image says how it was made (method, parameters, camera, gaze of its eye, ...). */
+            fv_params_destroy(meta);
+            meta = NULL;
+            if (!o.no_meta) s = fv_frame_meta(&rec, f, &views, e, ms, &meta, &err);
+            if (s == FV_OK) s = fv_film_write_meta(film[e], path, (float)o.exposure, meta, &err);
         }
         if (s != FV_OK) break;
         if (!o.quiet) {
@@ -354,9 +379,17 @@ int fv_cmd_render(int argc, char **argv)
     }
     fv_cli_interrupt_defer(false);
     fv_cli_progress_done(&prog);
+    /* The log of the frames that were rendered, also after an interruption ("complete": false). */
+    if (slog) {
+        fv_error werr;
+        fv_status ws = fv_stats_log_write(slog, o.stats_json, s == FV_OK && !fv_cli_interrupted(), &werr);
+        if (ws != FV_OK && s == FV_OK) s = ws, err = werr;
+    }
     if (fv_cli_interrupted()) rc = fv_cli_interrupt_exit();
     else if (s != FV_OK) rc = fv_cli_fail(cmd, s, err.msg);
 done:
+    fv_stats_log_destroy(slog);
+    fv_params_destroy(meta);
     fv_driver_destroy(driver);
     fv_gaze_path_destroy(trace);
     fv_camera_keys_free(ctrace.keys);
