@@ -1,0 +1,47 @@
+/* fovea — how a `fovea render` job is split over MPI ranks (docs/distributed.md): a still's sample
+ * blocks (still.c) and a sequence's frames (frames.c). */
+#ifndef FV_DIST_SPLIT_H
+#define FV_DIST_SPLIT_H
+
+#include <stdbool.h>
+#include "dist/dist.h"
+#include "fovea/drive.h"
+#include "fovea/film.h"
+#include "fovea/params.h"
+#include "fovea/stats.h"
+
+/* ---- a still ---- */
+typedef struct fv_dist_still_job {
+    const char *method;      /* the method's name */
+    const fv_params *params; /* its parameters (cloned per range; the bag is not changed) */
+    const fv_scene *scene;
+    const fv_log *log;
+    fv_driver *driver;       /* frame 0 of it is the still */
+    int spp;                 /* the method's samples per pixel */
+    bool other_device;       /* a device other than the cpu was asked for */
+    fv_progress_fn progress; /* rank 0's bar (optional) */
+    void *progress_user;
+} fv_dist_still_job;
+
+/* True when the still is split over `size` ranks: pt on the cpu with more than one sample block.
+ * Otherwise rank 0 renders it alone. */
+bool fv_dist_still_splits(const fv_dist_still_job *job, int size);
+/* Renders the still over all ranks into film (mono). On rank 0 the film then holds the image, bit
+ * for bit the one-process image; elsewhere it holds nothing to write. Stats on rank 0 count every
+ * rank's rays and samples. Ends with the job's status on every rank (*print_it: this rank prints
+ * err's line). */
+fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film, fv_stats *stats, bool *print_it, fv_error *err);
+
+/* ---- a sequence ---- */
+/* Rank `rank` of `size` writes frames [*first, *end) of `frames`, contiguous blocks in rank order;
+ * a method with temporal state renders from *start = first - warmup (not before 0) without writing
+ * the warm-up frames, so each block's history is rebuilt as the method needs. */
+void fv_dist_frames(int frames, int rank, int size, int warmup, int *start, int *first, int *end);
+/* The warm-up frames a method needs before its first written frame: 0 for a method without
+ * temporal state (its frames do not depend on the ones before), else the class's own count. */
+int fv_dist_warmup(const char *method);
+/* Rank 0 writes how the sequence was split (ranks, each block, the warm-up) as JSON next to the
+ * frames, whole or not at all. */
+fv_status fv_dist_frames_manifest(const char *path, const char *method, int frames, int size, int warmup, fv_error *err);
+
+#endif
