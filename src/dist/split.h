@@ -17,14 +17,14 @@ typedef struct fv_dist_still_job {
     const fv_scene *scene;
     const fv_log *log;
     fv_driver *driver;       /* frame 0 of it is the still */
-    int spp;                 /* the method's samples per pixel */
+    int spp;                 /* the method's samples per pixel (pt) or passes (ppm); 0: its default */
     bool other_device;       /* a device other than the cpu was asked for */
     fv_progress_fn progress; /* rank 0's bar (optional) */
     void *progress_user;
 } fv_dist_still_job;
 
-/* True when the still is split over `size` ranks: pt on the cpu with more than one sample block.
- * Otherwise rank 0 renders it alone. */
+/* True when the still is split over `size` ranks: pt on the cpu or ppm with more than one block
+ * of samples or passes. Otherwise rank 0 renders it alone. */
 bool fv_dist_still_splits(const fv_dist_still_job *job, int size);
 /* Renders the still over all ranks into film (mono). On rank 0 the film then holds the image, bit
  * for bit the one-process image; elsewhere it holds nothing to write. Stats on rank 0 count every

@@ -1,5 +1,5 @@
-/* fovea — one still over MPI ranks (docs/distributed.md, "A still"): pt's sample blocks
- * (core/blocks.h) dealt to ranks as contiguous ranges, each range rendered as the tree nodes that
+/* fovea — one still over MPI ranks (docs/distributed.md, "A still"): pt's sample blocks or ppm's
+ * blocks of passes (core/blocks.h) dealt to ranks as contiguous ranges, each range rendered as the tree nodes that
  * cover it, their double sums sent to rank 0, which evaluates the rest of the tree in its fixed
  * order. The image is therefore the one-process image bit for bit, whatever the number of ranks
  * (the one-process render sums the same nodes in the same order, only on one machine).
@@ -41,7 +41,9 @@ static bool on_progress(void *user, double f)
 
 bool fv_dist_still_splits(const fv_dist_still_job *job, int size)
 {
-    return size > 1 && job->spp > FV_SAMPLE_BLOCK && strcmp(job->method, "pt") == 0 && !job->other_device;
+    /* the methods whose estimate is core/blocks.h's sum: pt's samples, ppm's passes */
+    const bool blocked = strcmp(job->method, "pt") == 0 || strcmp(job->method, "ppm") == 0;
+    return size > 1 && job->spp > FV_SAMPLE_BLOCK && blocked && !job->other_device;
 }
 
 static fv_status render_node(const fv_dist_still_job *job, int lo, int hi, fv_film *film, fv_stats *stats, node_progress *prog,

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# `mpirun -n N fovea render` (docs/distributed.md): a split still is the one-process image bit for
-# bit (shared memory and TCP), a split sequence writes the one-process frames (fipr after its
+# `mpirun -n N fovea render` (docs/distributed.md): a split still (pt's samples, ppm's passes) is
+# the one-process image bit for bit (shared memory and TCP), a split sequence writes the one-process frames (fipr after its
 # stated warm-up), a failed job says one line and leaves no output, a killed rank ends the job.
 # Skipped (exit 77) where fovea was built without MPI or mpirun is missing.
 . "$(dirname "$0")/lib.sh"
@@ -31,6 +31,14 @@ cmp -s one.exr half.exr && fail "two of four blocks gave the whole image"
 "$FOVEA" render cornell --size 40x32 --spp 8 --quiet --out small1.pfm
 $MPI -n 2 "$FOVEA" render cornell --size 40x32 --spp 8 --quiet --out small2.pfm
 same small1.pfm small2.pfm "a one-block still"
+
+# A ppm reference of 150 passes (three blocks of passes) over 2 ranks: the one-process image.
+P="render cornell --method ppm --param passes=150 --param photons=2000 --size 32x24 --threads 1 --quiet"
+"$FOVEA" $P --out ppm1.exr || fail "one-process ppm"
+$MPI -n 2 "$FOVEA" $P --out ppm2.exr || fail "2-rank ppm"
+same ppm1.exr ppm2.exr "ppm over 2 ranks"
+"$FOVEA" $P --param block_first=1 --out ppmpart.exr || fail "ppm's last two blocks"
+cmp -s ppm1.exr ppmpart.exr && fail "two of three blocks of passes gave the whole ppm image"
 
 # A sequence of a method without temporal state along a camera trace: every frame as one process.
 S="render cornell --size 32x24 --spp 4 --frames 5 --threads 1 --quiet --camera-trace $SRC/tests/data/camera.csv --fps 2"

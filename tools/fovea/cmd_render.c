@@ -290,7 +290,6 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_params *params
         const char *spp_key = fv_technique_spp_param(fv_technique_index(o->method));
         for (int i = 0; spp_key && i < fv_params_count(params); i++)
             if (!strcmp(fv_params_key(params, i), spp_key)) job.spp = atoi(fv_params_value(params, i));
-        if (!job.spp && !strcmp(o->method, "pt")) job.spp = 16; /* pt's default */
         for (int i = 0; i < fv_params_count(params); i++)
             if (!strcmp(fv_params_key(params, i), "device") && strcmp(fv_params_value(params, i), "cpu")) job.other_device = true;
         if (neyes == 1 && fv_dist_still_splits(&job, size)) {
