@@ -69,6 +69,10 @@ EOS
 expect 2 "rank 1: fovea render: cannot open scene 'missing.json'" -- $MPI -n 2 bash onebad.sh
 ls bad.* .bad* >/dev/null 2>&1 && fail "a failed job left output: $(ls -a | grep bad)"
 
+# The bench is not split yet: said once, no report.
+expect 2 "not split over MPI ranks yet" -- $MPI -n 2 "$FOVEA" bench pt-spp --quick --out benchout
+[ -e benchout ] && fail "a refused bench left $(ls benchout)"
+
 # A rank killed mid-render: the job ends within seconds, nonzero, with no image and no temporary.
 cat >killme.sh <<EOS
 echo \$\$ >"pid.\$OMPI_COMM_WORLD_RANK"
