@@ -16,11 +16,12 @@
 #include "dist/split.h"
 #include "film/film_sums.h"
 
-/* Each rank's share of nb blocks: [lo, hi). */
+/* Each rank's share of nb blocks: [lo, hi), rounded up so that rank 0 always holds block 0 (and
+ * with it the auxiliary buffers) even with more ranks than blocks. */
 static void share(int nb, int rank, int size, int *lo, int *hi)
 {
-    *lo = (int)((long long)nb * rank / size);
-    *hi = (int)((long long)nb * (rank + 1) / size);
+    *lo = (int)(((long long)nb * rank + size - 1) / size);
+    *hi = (int)(((long long)nb * (rank + 1) + size - 1) / size);
 }
 
 /* Progress of rank 0's own nodes as the job's (all ranks render equal shares at the same pace),

@@ -23,6 +23,8 @@ $MPI -n 3 "$FOVEA" $R --out three.exr || fail "3-rank still"
 $MPI -n 2 --mca btl tcp,self "$FOVEA" $R --out tcp.exr || fail "2-rank still over TCP"
 same one.exr two.exr "2 ranks (colour and every auxiliary layer)"
 same one.exr three.exr "3 ranks"
+$MPI -n 5 "$FOVEA" $R --out five.exr || fail "5-rank still (more ranks than blocks)"
+same one.exr five.exr "5 ranks for 4 blocks"
 same one.exr tcp.exr "2 ranks over TCP"
 # The split is real: rank 1 alone would give another image (its blocks only).
 "$FOVEA" $R --param block_first=2 --param block_count=2 --out half.exr || fail "half the blocks"
