@@ -29,8 +29,9 @@ bool fv_dist_still_splits(const fv_dist_still_job *job, int size);
 /* Renders the still over all ranks into film (mono). On rank 0 the film then holds the image, bit
  * for bit the one-process image; elsewhere it holds nothing to write. Stats on rank 0 count every
  * rank's rays and samples. Ends with the job's status on every rank (*print_it: this rank prints
- * err's line). */
-fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film, fv_stats *stats, bool *print_it, fv_error *err);
+ * err's line, starting "rank R: " when *name_rank; fv_dist_agree). */
+fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film, fv_stats *stats, bool *print_it, bool *name_rank,
+                        fv_error *err);
 
 /* ---- a sequence ---- */
 /* Rank `rank` of `size` writes frames [*first, *end) of `frames`, contiguous blocks in rank order;

@@ -64,7 +64,8 @@ static fv_status render_node(const fv_dist_still_job *job, int lo, int hi, fv_fi
     return s;
 }
 
-fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film, fv_stats *stats, bool *print_it, fv_error *err)
+fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film, fv_stats *stats, bool *print_it, bool *name_rank,
+                        fv_error *err)
 {
     const int rank = fv_dist_rank(d), size = fv_dist_size(d);
     const int nb = fv_blocks_count(job->spp);
@@ -72,7 +73,7 @@ fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film,
     int (*nodes)[2] = NULL, *owner = NULL, *ops = NULL;
     double **vals = NULL;
     int nnodes = 0, mine0 = -1, mine1 = -1;
-    *print_it = false;
+    *print_it = *name_rank = false;
     fv_status s = FV_OK;
 
     /* Every rank lists every rank's nodes: the same cover, so the plan is known everywhere. */
@@ -110,14 +111,8 @@ fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film,
     }
 
     /* Nothing moves until every rank has its nodes. */
-    bool name_rank = false;
-    s = fv_dist_agree(d, s, print_it, &name_rank, err);
+    s = fv_dist_agree(d, s, print_it, name_rank, err);
     const bool agreed = s == FV_OK;
-    if (s != FV_OK && *print_it && name_rank) {
-        char msg[sizeof err->msg];
-        snprintf(msg, sizeof msg, "%s", err->msg);
-        fv_error_set(err, s, "rank %d: %.*s", rank, (int)sizeof msg - 16, msg);
-    }
     /* The job's counters: every rank's rays and samples (order-free sums of integers). */
     static const char *const counted[] = {"rays", "samples", "nan_samples"};
     double mine[3], total[3];
@@ -150,13 +145,8 @@ fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film,
             fv_stats_add_count(stats, "nan_samples", bad);
         }
     }
-    if (agreed && s != FV_OK) {
-        /* a transfer failed after the agreement: said by the rank it happened on */
-        char msg[sizeof err->msg];
-        snprintf(msg, sizeof msg, "%s", err->msg);
-        fv_error_set(err, s, "rank %d: %.*s", rank, (int)sizeof msg - 16, msg);
-        *print_it = true;
-    }
+    /* a transfer failed after the agreement: said by the rank it happened on */
+    if (agreed && s != FV_OK) *print_it = *name_rank = true;
     for (int k = 0; vals && k < nnodes; k++) free(vals[k]);
     free(vals);
     free(ops);

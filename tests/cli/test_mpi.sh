@@ -70,6 +70,14 @@ exec "$FOVEA" render "\$s" --size 32x32 --spp 200 --quiet --out bad.png
 EOS
 expect 2 "rank 1: fovea render: cannot open scene 'missing.json'" -- $MPI -n 2 bash onebad.sh
 ls bad.* .bad* >/dev/null 2>&1 && fail "a failed job left output: $(ls -a | grep bad)"
+# A write failing on rank 1 in the middle of a sequence (its first frame's name is a folder): one
+# line naming rank 1 and the cause, and rank 0 stops at once rather than rendering its 10 frames.
+mkdir w_0010.pfm
+expect 2 "rank 1: fovea render: cannot write 'w_0010.pfm': not a regular file" -- \
+  $MPI -n 2 "$FOVEA" render cornell --size 32x32 --spp 256 --frames 20 --threads 1 --quiet --out w.pfm
+n=$(ls w_*.pfm 2>/dev/null | grep -vc w_0010)
+[ "$n" -lt 10 ] || fail "rank 0 went on to write $n frames after rank 1 failed"
+[ -e w_ranks.json ] && fail "a failed sequence wrote its manifest"
 
 # The bench is not split yet: said once, no report.
 expect 2 "not split over MPI ranks yet" -- $MPI -n 2 "$FOVEA" bench pt-spp --quick --out benchout

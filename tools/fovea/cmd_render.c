@@ -240,7 +240,6 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
     return 0;
 }
 
-
 #ifdef FOVEA_HAVE_MPI
 /* ---- over MPI ranks (docs/distributed.md; the split itself is src/dist's) ---- */
 
@@ -257,11 +256,12 @@ static bool on_dist_progress(void *user, double f)
     return fv_cli_progress_frame(p->bar, f);
 }
 
-/* The one line of a failed job, on the rank the agreement chose. */
+/* The one line of a failed job, on the rank the agreement chose: "rank R: fovea render: ..." when
+ * not every rank failed (as the held messages of the set-up are replayed), else as one process. */
 static int dist_fail(fv_dist *d, fv_status s, bool print_it, bool name_rank, const char *msg)
 {
     if (print_it) {
-        if (name_rank && strncmp(msg, "rank ", 5) != 0) fprintf(stderr, "rank %d: ", fv_dist_rank(d));
+        if (name_rank) fprintf(stderr, "rank %d: ", fv_dist_rank(d));
         return fv_cli_fail("render", s, msg);
     }
     return fv_cli_exit_code(s);
@@ -293,7 +293,7 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_params *params
         for (int i = 0; i < fv_params_count(params); i++)
             if (!strcmp(fv_params_key(params, i), "device") && strcmp(fv_params_value(params, i), "cpu")) job.other_device = true;
         if (neyes == 1 && fv_dist_still_splits(&job, size)) {
-            s = fv_dist_still(d, &job, film[0], &stats, &print_it, &err);
+            s = fv_dist_still(d, &job, film[0], &stats, &print_it, &name_rank, &err);
         } else {
             /* Not split (docs/distributed.md says which stills are): rank 0 renders it alone. */
             if (rank == 0) s = fv_driver_render(driver, tech, 0, false, film, &stats, on_dist_progress, &dp, &err);
@@ -322,7 +322,8 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_params *params
         double f0 = fv_time_ms();
         s = fv_driver_render(driver, tech, f, f > start, film, &stats, on_dist_progress, &dp, &err);
         if (s == FV_OK && f >= first) s = write_frame(o->out, o->frames, neyes, (float)o->exposure, film, f, &err);
-        if (s != FV_OK) fv_dist_tell_failure(d); /* the others stop at their next progress step */
+        /* the others stop at their next progress step (unless this rank only stopped for another) */
+        if (s != FV_OK && !fv_dist_poll(d)) fv_dist_tell_failure(d);
         else if (!o->quiet && rank == 0) {
             fv_cli_progress_done(&bar);
             if (f < first) fprintf(stderr, "(warm-up) ");
