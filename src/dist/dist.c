@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 #include "fovea/stats.h"
 #include "dist/dist.h"
@@ -142,6 +143,21 @@ bool fv_dist_poll(fv_dist *d)
     return d->peer_failed;
 }
 
+/* Every rank's pair of ints. A rank that arrives early waits without spinning (MPI's blocking
+ * collectives busy-poll, which takes a core from a rank still rendering on the same host): the
+ * non-blocking gather is tested every millisecond. */
+static int wait_all(int mine[2], int *all)
+{
+    MPI_Request q;
+    int rc = MPI_Iallgather(mine, 2, MPI_INT, all, 2, MPI_INT, MPI_COMM_WORLD, &q);
+    int done = 0;
+    while (rc == MPI_SUCCESS && !done) {
+        rc = MPI_Test(&q, &done, MPI_STATUS_IGNORE);
+        if (rc == MPI_SUCCESS && !done) nanosleep(&(struct timespec){0, 1000000}, NULL);
+    }
+    return rc;
+}
+
 fv_status fv_dist_agree(fv_dist *d, fv_status s, bool *print_it, bool *name_rank, fv_error *err)
 {
     *print_it = *name_rank = false;
@@ -152,7 +168,7 @@ fv_status fv_dist_agree(fv_dist *d, fv_status s, bool *print_it, bool *name_rank
     }
     int *all = malloc(sizeof(int) * 2 * (size_t)d->size);
     double t0 = fv_time_ms();
-    int rc = all ? MPI_Allgather(mine, 2, MPI_INT, all, 2, MPI_INT, MPI_COMM_WORLD) : MPI_ERR_NO_MEM;
+    int rc = all ? wait_all(mine, all) : MPI_ERR_NO_MEM;
     d->wait_s += (fv_time_ms() - t0) * 1e-3;
     if (rc != MPI_SUCCESS) {
         /* no agreement to be had: this rank speaks for itself */
