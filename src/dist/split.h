@@ -26,12 +26,13 @@ typedef struct fv_dist_still_job {
 /* True when the still is split over `size` ranks: pt on the cpu or ppm with more than one block
  * of samples or passes. Otherwise rank 0 renders it alone. */
 bool fv_dist_still_splits(const fv_dist_still_job *job, int size);
-/* Renders the still over all ranks into film (mono). On rank 0 the film then holds the image, bit
- * for bit the one-process image; elsewhere it holds nothing to write. Stats on rank 0 count every
+/* Renders the still over all ranks into films (one per eye: both eyes of a stereo still are split
+ * by the same sample blocks). On rank 0 the films then hold the images, bit for bit the one-process
+ * images; elsewhere they hold nothing to write. Stats on rank 0 count every
  * rank's rays and samples. Ends with the job's status on every rank (*print_it: this rank prints
  * err's line, starting "rank R: " when *name_rank; fv_dist_agree). */
-fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film, fv_stats *stats, bool *print_it, bool *name_rank,
-                        fv_error *err);
+fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *const *films, int neyes, fv_stats *stats, bool *print_it,
+                        bool *name_rank, fv_error *err);
 
 /* ---- a sequence ---- */
 /* Rank `rank` of `size` writes frames [*first, *end) of `frames`, contiguous blocks in rank order;

@@ -47,8 +47,8 @@ bool fv_dist_still_splits(const fv_dist_still_job *job, int size)
     return size > 1 && job->spp > FV_SAMPLE_BLOCK && blocked && !job->other_device;
 }
 
-static fv_status render_node(const fv_dist_still_job *job, int lo, int hi, fv_film *film, fv_stats *stats, node_progress *prog,
-                             fv_error *err)
+static fv_status render_node(const fv_dist_still_job *job, int lo, int hi, fv_film *const *films, fv_stats *stats,
+                             node_progress *prog, fv_error *err)
 {
     fv_params *p = NULL;
     fv_technique *t = NULL;
@@ -57,19 +57,19 @@ static fv_status render_node(const fv_dist_still_job *job, int lo, int hi, fv_fi
     if (s == FV_OK) snprintf(v, sizeof v, "%d", lo), s = fv_params_set(p, "block_first", v, err);
     if (s == FV_OK) snprintf(v, sizeof v, "%d", hi - lo), s = fv_params_set(p, "block_count", v, err);
     if (s == FV_OK) s = fv_technique_create(job->method, job->scene, p, job->log, &t, err);
-    fv_film *films[2] = {film, NULL};
     if (s == FV_OK) s = fv_driver_render(job->driver, t, 0, false, films, stats, on_progress, prog, err);
     fv_technique_destroy(t);
     fv_params_destroy(p);
     return s;
 }
 
-fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film, fv_stats *stats, bool *print_it, bool *name_rank,
-                        fv_error *err)
+fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *const *films, int neyes, fv_stats *stats, bool *print_it,
+                        bool *name_rank, fv_error *err)
 {
     const int rank = fv_dist_rank(d), size = fv_dist_size(d);
     const int nb = fv_blocks_count(job->spp);
-    const size_t npix = (size_t)fv_film_width(film) * (size_t)fv_film_height(film);
+    /* a node's sums: every eye's image, eye after eye */
+    const size_t npix = (size_t)fv_film_width(films[0]) * (size_t)fv_film_height(films[0]), nval = (size_t)neyes * npix * 3;
     int (*nodes)[2] = NULL, *owner = NULL, *ops = NULL;
     double **vals = NULL;
     int nnodes = 0, mine0 = -1, mine1 = -1;
@@ -91,7 +91,7 @@ fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film,
         nnodes += k;
         if (r == rank) mine1 = nnodes;
     }
-    if (s == FV_OK && fv_film_want_sums(film, err) != FV_OK) s = FV_ERR_NOMEM;
+    for (int e = 0; e < neyes && s == FV_OK; e++) s = fv_film_want_sums(films[e], err);
 
     /* This rank's nodes in block order (only block 0's range writes the auxiliary buffers). */
     int my_blocks = 0;
@@ -101,13 +101,13 @@ fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film,
         int k = mine0 + i;
         int n = nodes[k][1] - nodes[k][0];
         prog.span = my_blocks > 0 ? (double)n / my_blocks : 1.0;
-        if ((s = render_node(job, nodes[k][0], nodes[k][1], film, stats, &prog, err)) != FV_OK) break;
+        if ((s = render_node(job, nodes[k][0], nodes[k][1], films, stats, &prog, err)) != FV_OK) break;
         prog.base += prog.span;
-        if (!(vals[k] = fv_alloc_array(npix, 3 * sizeof(double)))) {
+        if (!(vals[k] = fv_alloc_array(nval, sizeof(double)))) {
             s = fv_error_set(err, FV_ERR_NOMEM, "out of memory keeping %d sample blocks of a %zu-pixel image", n, npix);
             break;
         }
-        memcpy(vals[k], fv_film_sums(film), npix * 3 * sizeof(double));
+        for (int e = 0; e < neyes; e++) memcpy(vals[k] + (size_t)e * npix * 3, fv_film_sums(films[e]), npix * 3 * sizeof(double));
     }
 
     /* Nothing moves until every rank has its nodes. */
@@ -120,12 +120,12 @@ fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film,
     if (s == FV_OK && (s = fv_dist_sum(d, total, 3, err)) == FV_OK)
         for (int i = 0; i < 3; i++) fv_stats_add_count(stats, counted[i], total[i] - mine[i]);
     if (s == FV_OK && rank != 0) {
-        for (int k = mine0; k < mine1 && s == FV_OK; k++) s = fv_dist_send(d, 0, vals[k], npix * 3, err);
+        for (int k = mine0; k < mine1 && s == FV_OK; k++) s = fv_dist_send(d, 0, vals[k], nval, err);
     } else if (s == FV_OK) {
         for (int k = 0; k < nnodes && s == FV_OK; k++) {
             if (owner[k] == 0) continue;
-            if (!(vals[k] = fv_alloc_array(npix, 3 * sizeof(double)))) s = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-            else s = fv_dist_recv(d, owner[k], vals[k], npix * 3, err);
+            if (!(vals[k] = fv_alloc_array(nval, sizeof(double)))) s = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+            else s = fv_dist_recv(d, owner[k], vals[k], nval, err);
         }
         int nops = 0;
         if (s == FV_OK) {
@@ -134,16 +134,16 @@ fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *film,
             else if ((nops = fv_blocks_plan(nb, (const int(*)[2])nodes, nnodes, ops, opcap)) < 0)
                 s = fv_error_set(err, FV_ERR_INTERNAL, "the ranks' sample blocks do not cover the tree");
         }
-        if (s == FV_OK) {
-            float *color = fv_film_color(film);
-            double bad = 0.0;
+        double bad = 0.0;
+        for (int e = 0; e < neyes && s == FV_OK; e++) {
+            float *color = fv_film_color(films[e]);
             for (size_t i = 0; i < npix; i++) {
                 double t[3];
-                fv_blocks_run(ops, nops, (const double *const *)vals, i, t);
+                fv_blocks_run(ops, nops, (const double *const *)vals, (size_t)e * npix + i, t);
                 bad += fv_blocks_pixel(t, job->spp, color + 3 * i);
             }
-            fv_stats_add_count(stats, "nan_samples", bad);
         }
+        if (s == FV_OK) fv_stats_add_count(stats, "nan_samples", bad);
     }
     /* a transfer failed after the agreement: said by the rank it happened on */
     if (agreed && s != FV_OK) *print_it = *name_rank = true;

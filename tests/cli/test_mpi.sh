@@ -26,6 +26,10 @@ same one.exr three.exr "3 ranks"
 $MPI -n 5 "$FOVEA" $R --out five.exr || fail "5-rank still (more ranks than blocks)"
 same one.exr five.exr "5 ranks for 4 blocks"
 same one.exr tcp.exr "2 ranks over TCP"
+# A stereo still: both eyes split by the same blocks, each eye the one-process eye.
+"$FOVEA" $R --stereo 0.1 --out st1.exr && $MPI -n 2 "$FOVEA" $R --stereo 0.1 --out st2.exr || fail "stereo still"
+same st1_left.exr st2_left.exr "a stereo still's left eye over 2 ranks"
+same st1_right.exr st2_right.exr "a stereo still's right eye over 2 ranks"
 # The split is real: rank 1 alone would give another image (its blocks only).
 "$FOVEA" $R --param block_first=2 --param block_count=2 --out half.exr || fail "half the blocks"
 cmp -s one.exr half.exr && fail "two of four blocks gave the whole image"

@@ -292,8 +292,8 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_params *params
             if (!strcmp(fv_params_key(params, i), spp_key)) job.spp = atoi(fv_params_value(params, i));
         for (int i = 0; i < fv_params_count(params); i++)
             if (!strcmp(fv_params_key(params, i), "device") && strcmp(fv_params_value(params, i), "cpu")) job.other_device = true;
-        if (neyes == 1 && fv_dist_still_splits(&job, size)) {
-            s = fv_dist_still(d, &job, film[0], &stats, &print_it, &name_rank, &err);
+        if (fv_dist_still_splits(&job, size)) {
+            s = fv_dist_still(d, &job, film, neyes, &stats, &print_it, &name_rank, &err);
         } else {
             /* Not split (docs/distributed.md says which stills are): rank 0 renders it alone. */
             if (rank == 0) s = fv_driver_render(driver, tech, 0, false, film, &stats, on_dist_progress, &dp, &err);
