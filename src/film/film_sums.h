@@ -1,7 +1,7 @@
 /* fovea — a film's double-precision sums (library-internal): the unnormalised sample sums of a
  * range of sample blocks (core/blocks.h), which a still split over processes sends to the process
- * that adds them along the blocks' tree (src/dist). Only pt fills them, only when asked; the
- * float colour is written as always. */
+ * that adds them along the blocks' tree (src/dist). Only pt and ppm fill them, only when asked;
+ * the float colour is written as always. */
 #ifndef FV_FILM_SUMS_H
 #define FV_FILM_SUMS_H
 
