@@ -322,9 +322,10 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_params *params
         double f0 = fv_time_ms();
         s = fv_driver_render(driver, tech, f, f > start, film, &stats, on_dist_progress, &dp, &err);
         if (s == FV_OK && f >= first) s = write_frame(o->out, o->frames, neyes, (float)o->exposure, film, f, &err);
-        /* the others stop at their next progress step (unless this rank only stopped for another) */
-        if (s != FV_OK && !fv_dist_poll(d)) fv_dist_tell_failure(d);
-        else if (!o->quiet && rank == 0) {
+        if (s != FV_OK) {
+            /* the others stop at their next progress step (unless this rank only stopped for another) */
+            if (!fv_dist_poll(d)) fv_dist_tell_failure(d);
+        } else if (!o->quiet && rank == 0) {
             fv_cli_progress_done(&bar);
             if (f < first) fprintf(stderr, "(warm-up) ");
             print_frame(f, fv_time_ms() - f0, &stats, o->show_stats);
