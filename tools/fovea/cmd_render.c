@@ -520,6 +520,7 @@ done:
     }
 #else
     (void)dist;
+    (void)setup_agreed;
 #endif
     fv_driver_destroy(driver);
     fv_gaze_path_destroy(trace);
