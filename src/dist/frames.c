@@ -35,13 +35,11 @@ fv_status fv_dist_frames_manifest(const char *path, const char *method, int fram
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory writing '%s'", path);
     }
     bool ok = true;
-    {
-        cJSON_AddStringToObject(root, "method", method);
-        cJSON_AddNumberToObject(root, "frames", frames);
-        cJSON_AddNumberToObject(root, "ranks", size);
-        cJSON_AddNumberToObject(root, "warmup_frames", warmup);
-        cJSON_AddItemToObject(root, "blocks", blocks);
-    }
+    cJSON_AddStringToObject(root, "method", method);
+    cJSON_AddNumberToObject(root, "frames", frames);
+    cJSON_AddNumberToObject(root, "ranks", size);
+    cJSON_AddNumberToObject(root, "warmup_frames", warmup);
+    cJSON_AddItemToObject(root, "blocks", blocks);
     for (int r = 0; ok && r < size; r++) {
         int start, first, end;
         fv_dist_frames(frames, r, size, warmup, &start, &first, &end);
