@@ -28,8 +28,8 @@ typedef struct fv_dist_still_job {
 bool fv_dist_still_splits(const fv_dist_still_job *job, int size);
 /* Renders the still over all ranks into films (one per eye: both eyes of a stereo still are split
  * by the same sample blocks). On rank 0 the films then hold the images, bit for bit the one-process
- * images; elsewhere they hold nothing to write. Stats on rank 0 count every
- * rank's rays and samples. Ends with the job's status on every rank (*print_it: this rank prints
+ * images; elsewhere they hold nothing to write. Stats on rank 0 count every rank's rays and
+ * samples. Ends with the job's status on every rank (*print_it: this rank prints
  * err's line, starting "rank R: " when *name_rank; fv_dist_agree). */
 fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *const *films, int neyes, fv_stats *stats, bool *print_it,
                         bool *name_rank, fv_error *err);

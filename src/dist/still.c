@@ -1,7 +1,7 @@
 /* fovea — one still over MPI ranks (docs/distributed.md, "A still"): pt's sample blocks or ppm's
- * blocks of passes (core/blocks.h) dealt to ranks as contiguous ranges, each range rendered as the tree nodes that
- * cover it, their double sums sent to rank 0, which evaluates the rest of the tree in its fixed
- * order. The image is therefore the one-process image bit for bit, whatever the number of ranks
+ * blocks of passes (core/blocks.h) dealt to ranks as contiguous ranges, each range rendered as the
+ * tree nodes that cover it, their double sums sent to rank 0, which evaluates the rest of the tree
+ * in its fixed order. The image is therefore the one-process image bit for bit, whatever the number of ranks
  * (the one-process render sums the same nodes in the same order, only on one machine).
  *
  * Rank 0 always holds block 0, whose first samples give the auxiliary buffers (depth, normal,
