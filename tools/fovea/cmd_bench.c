@@ -213,8 +213,33 @@ static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check,
     return FV_EXIT_OK;
 }
 
+#ifdef FOVEA_HAVE_MPI
+#include "dist/dist.h"
+/* Under an MPI launcher with several ranks the bench is not split yet (docs/distributed.md, "Not
+ * done yet"): rather than N copies of the same scenario writing the same report, every rank stops
+ * and one says why. Returns the exit status, or -1 to run the bench as usual. */
+static int refuse_ranks(void)
+{
+    if (!fv_dist_launched()) return -1;
+    fv_dist *d = NULL;
+    fv_error err;
+    fv_error_clear(&err);
+    if (fv_dist_start(NULL, NULL, &d, &err) != FV_OK) return fv_cli_fail("bench", FV_ERR_IO, err.msg);
+    int size = fv_dist_size(d), rank = fv_dist_rank(d);
+    fv_dist_end(d);
+    if (size == 1) return -1;
+    if (rank == 0)
+        fv_cli_usage_error("bench", "not split over MPI ranks yet (%d ranks): run `fovea bench` in one process (docs/distributed.md)", size);
+    return FV_EXIT_USAGE;
+}
+#endif
+
 int fv_cmd_bench(int argc, char **argv)
 {
+#ifdef FOVEA_HAVE_MPI
+    int refused = refuse_ranks();
+    if (refused >= 0) return refused;
+#endif
     enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_CHECK, O_LIST, O_QUIET, O_HELP, O_SCENE, O_METHODS,
            O_REFERENCE, O_GAZE, O_GAZE_TRACE, O_FRAMES, O_SIZE, O_SAVE };
     static const struct option longs[] = {{"out", 1, 0, O_OUT},       {"device", 1, 0, O_DEVICE},   {"cache", 1, 0, O_CACHE},     {"quick", 0, 0, O_QUICK},
