@@ -18,13 +18,14 @@ MPIENV=()
 if [ "${FOVEA_SANITIZED:-0}" = 1 ]; then
   MPIENV=(env "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0")
 fi
+# Images are compared byte for byte, so written without metadata (which holds render times).
 # Ranks on whatever cores there are; -q keeps mpirun's own banners out of the messages checked.
 MPI="${MPIENV[*]} mpirun -q --oversubscribe --bind-to none"
 cd "$TMP" || exit 1
 same() { cmp -s "$1" "$2" || fail "$3: $1 and $2 differ"; }
 
 # A still of 200 spp: four sample blocks, split over 2 and 3 ranks, over shared memory and TCP.
-R="render cornell --size 40x32 --spp 200 --threads 1 --quiet"
+R="render cornell --size 40x32 --spp 200 --threads 1 --quiet --no-metadata"
 "$FOVEA" $R --out one.exr || fail "one-process still"
 $MPI -n 2 "$FOVEA" $R --out two.exr || fail "2-rank still"
 $MPI -n 3 "$FOVEA" $R --out three.exr || fail "3-rank still"
@@ -42,12 +43,12 @@ same st1_right.exr st2_right.exr "a stereo still's right eye over 2 ranks"
 "$FOVEA" $R --param block_first=2 --param block_count=2 --out half.exr || fail "half the blocks"
 cmp -s one.exr half.exr && fail "two of four blocks gave the whole image"
 # One block (64 spp or fewer) is not split: rank 0 renders it, the same image.
-"$FOVEA" render cornell --size 40x32 --spp 8 --quiet --out small1.pfm
-$MPI -n 2 "$FOVEA" render cornell --size 40x32 --spp 8 --quiet --out small2.pfm
+"$FOVEA" render cornell --size 40x32 --spp 8 --quiet --no-metadata --out small1.pfm
+$MPI -n 2 "$FOVEA" render cornell --size 40x32 --spp 8 --quiet --no-metadata --out small2.pfm
 same small1.pfm small2.pfm "a one-block still"
 
 # A ppm reference of 150 passes (three blocks of passes) over 2 ranks: the one-process image.
-P="render cornell --method ppm --param passes=150 --param photons=2000 --size 32x24 --threads 1 --quiet"
+P="render cornell --method ppm --param passes=150 --param photons=2000 --size 32x24 --threads 1 --quiet --no-metadata"
 "$FOVEA" $P --out ppm1.exr || fail "one-process ppm"
 $MPI -n 2 "$FOVEA" $P --out ppm2.exr || fail "2-rank ppm"
 same ppm1.exr ppm2.exr "ppm over 2 ranks"
@@ -55,7 +56,7 @@ same ppm1.exr ppm2.exr "ppm over 2 ranks"
 cmp -s ppm1.exr ppmpart.exr && fail "two of three blocks of passes gave the whole ppm image"
 
 # A sequence of a method without temporal state along a camera trace: every frame as one process.
-S="render cornell --size 32x24 --spp 4 --frames 5 --threads 1 --quiet --camera-trace $SRC/tests/data/camera.csv --fps 2"
+S="render cornell --size 32x24 --spp 4 --frames 5 --threads 1 --quiet --no-metadata --camera-trace $SRC/tests/data/camera.csv --fps 2"
 "$FOVEA" $S --out s.pfm || fail "one-process sequence"
 $MPI -n 2 "$FOVEA" $S --out d.pfm || fail "2-rank sequence"
 for f in 0000 0001 0002 0003 0004; do same "s_$f.pfm" "d_$f.pfm" "sequence frame $f"; done
