@@ -10,6 +10,7 @@
 #include <math.h>
 #include <stdbool.h>
 #include <stdlib.h>
+#include <string.h>
 #include "core/alloc.h"
 #include "sdf/sdf_impl.h"
 
@@ -18,8 +19,14 @@
 
 typedef struct box3 {
     float lo[3], hi[3];
-    float c; /* d >= c dist(p, box) outside the box */
+    float c;    /* d >= c dist(p, box) outside the box */
+    bool upper; /* d <= the distance to the box's farthest point (a surface lies in the box) */
+    float mag;  /* magnitude of the coordinates and constants the node's evaluation works with */
 } box3;
+
+/* A union of at least this many children is compiled as a culled chain (sdf_impl.h); smaller ones
+ * keep the plain fold, where a box test would cost about what it saves. */
+#define FV_SDF_CULL_MIN 4
 
 typedef struct compiler {
     const fv_sdf_node *nodes;
@@ -145,10 +152,22 @@ static fv_status check_node(const fv_sdf_node *nodes, int count, int i, fv_error
 
 /* ---- bounds ---- */
 
+/* A primitive's box: exact fields, so d >= dist(p, box) (c = 1) and d <= the farthest point's
+ * distance (upper) whenever the box is finite. */
 static box3 box_sym(float x, float y, float z)
 {
-    box3 b = {{-x, -y, -z}, {x, y, z}, 1.0f};
+    box3 b = {{-x, -y, -z}, {x, y, z}, 1.0f, isfinite(x) && isfinite(y) && isfinite(z), 0.0f};
     return b;
+}
+
+/* The largest finite coordinate of the box, at least m. */
+static float box_mag(const box3 *b, float m)
+{
+    for (int k = 0; k < 3; k++) {
+        if (isfinite(b->lo[k])) m = fmaxf(m, fabsf(b->lo[k]));
+        if (isfinite(b->hi[k])) m = fmaxf(m, fabsf(b->hi[k]));
+    }
+    return m;
 }
 
 static box3 box_union(box3 a, box3 b)
@@ -159,6 +178,9 @@ static box3 box_union(box3 a, box3 b)
         r.hi[k] = fmaxf(a.hi[k], b.hi[k]);
     }
     r.c = fminf(a.c, b.c);
+    /* min(a, b) <= the bounded child's value <= its farthest point's distance <= the union box's */
+    r.upper = a.upper || b.upper;
+    r.mag = fmaxf(a.mag, b.mag);
     return r;
 }
 
@@ -243,7 +265,7 @@ static fv_status compile_leaf(compiler *cc, int i, box3 *out)
         op->f[6] = l2 > 0.0f ? 1.0f / l2 : 0.0f;
         op->f[7] = p[0];
         fv_vec3 lo = fv_vmin(n->v[0], n->v[1]), hi = fv_vmax(n->v[0], n->v[1]);
-        *out = (box3){{lo.x - p[0], lo.y - p[0], lo.z - p[0]}, {hi.x + p[0], hi.y + p[0], hi.z + p[0]}, 1.0f};
+        *out = (box3){{lo.x - p[0], lo.y - p[0], lo.z - p[0]}, {hi.x + p[0], hi.y + p[0], hi.z + p[0]}, 1.0f, true, 0.0f};
         break;
     }
     case FV_SDF_CYLINDER:
@@ -292,7 +314,131 @@ static fv_status compile_leaf(compiler *cc, int i, box3 *out)
     default: return fv_error_set(cc->err, FV_ERR_INTERNAL, "sdf node %d: not a leaf", i);
     }
     op->material = n->material;
+    float m = 0.0f;
+    for (int k = 0; k < 13; k++) m = fmaxf(m, fabsf(op->f[k]));
+    out->mag = box_mag(out, m);
     return FV_OK;
+}
+
+/* A CULL_DATA op from a child's box (sdf_impl.h); infinite sides become +-1e30, which the kernel's
+ * box distance handles without inf - inf. */
+static void cull_data(fv_sdf_op *op, const box3 *b)
+{
+    for (int k = 0; k < 3; k++) {
+        op->f[k] = fmaxf(b->lo[k], -1e30f);
+        op->f[3 + k] = fminf(b->hi[k], 1e30f);
+    }
+    op->f[6] = b->c;
+    op->material = b->upper ? 1 : 0;
+}
+
+/* Emits the union of nc children, child(cc, ctx, k, box) emitting child k's program: the plain
+ * fold (c0 c1 UNION c2 UNION ...) below FV_SDF_CULL_MIN children, which is what a recursive
+ * compile gives; from there on a culled chain (sdf_impl.h): the same children and UNIONs in the
+ * same order, in consecutive groups of about sqrt(n), each child and each group behind a CULL
+ * whose box lets the kernel jump past it (kernel.h shows why the result stays the same). */
+typedef fv_status (*chain_child_fn)(compiler *cc, void *ctx, int k, box3 *out);
+
+static fv_status emit_chain(compiler *cc, int node, int nc, chain_child_fn child, void *ctx, box3 *out)
+{
+    box3 acc, b;
+    memset(&acc, 0, sizeof acc);
+    memset(&b, 0, sizeof b);
+    fv_status st;
+    if (nc < FV_SDF_CULL_MIN) {
+        if ((st = child(cc, ctx, 0, &acc))) return st;
+        for (int k = 1; k < nc; k++) {
+            if ((st = child(cc, ctx, k, &b))) return st;
+            if (!emit(cc, FV_OP_UNION, node)) return cc->err->status;
+            acc = box_union(acc, b);
+        }
+        *out = acc;
+        return FV_OK;
+    }
+    int gsize = (int)ceil(sqrt((double)nc)), ng = (nc + gsize - 1) / gsize;
+    int begin = cc->n_ops;
+    fv_sdf_op *op;
+    if (!(op = emit(cc, FV_OP_CULL_BEGIN, node))) return cc->err->status;
+    op->ia = ng;
+    op->ib = ng + nc;
+    int data = cc->n_ops;
+    for (int k = 0; k < ng + nc; k++)
+        if (!emit(cc, FV_OP_CULL_DATA, node)) return cc->err->status;
+    for (int g = 0; g < ng; g++) {
+        int first = g * gsize, last = first + gsize < nc ? first + gsize : nc;
+        int gcull = cc->n_ops;
+        if (!(op = emit(cc, FV_OP_CULL, node))) return cc->err->status;
+        op->ib = data + g;
+        box3 gb;
+        memset(&gb, 0, sizeof gb);
+        for (int k = first; k < last; k++) {
+            int mcull = cc->n_ops;
+            if (!(op = emit(cc, FV_OP_CULL, node))) return cc->err->status;
+            op->ib = data + ng + k;
+            if ((st = child(cc, ctx, k, &b))) return st;
+            if (!emit(cc, FV_OP_UNION, node)) return cc->err->status;
+            cc->ops[mcull].ia = cc->n_ops; /* ops may have moved: indices, not pointers */
+            cull_data(&cc->ops[data + ng + k], &b);
+            gb = k == first ? b : box_union(gb, b);
+            acc = k == 0 ? b : box_union(acc, b);
+        }
+        cc->ops[gcull].ia = cc->n_ops;
+        op = &cc->ops[data + g];
+        cull_data(op, &gb);
+        op->ia = data + ng + first;
+        op->ib = last - first; /* > 0: marks a group's data (fv_sdf_union_create relocates ia) */
+    }
+    if (!emit(cc, FV_OP_CULL_END, node)) return cc->err->status;
+    cc->ops[begin].f[0] = acc.mag;
+    *out = acc;
+    return FV_OK;
+}
+
+/* The children of a chain of UNION nodes, for emit_chain. */
+typedef struct union_chain {
+    const int *chain;
+    int len, depth;
+} union_chain;
+
+static fv_status union_child(compiler *cc, void *ctx, int k, box3 *out)
+{
+    const union_chain *u = ctx;
+    int holder = u->chain[u->len - (k == 0 ? 1 : k)];
+    const fv_sdf_node *h = &cc->nodes[holder];
+    return compile_child(cc, holder, k == 0 ? 'a' : 'b', k == 0 ? h->a : h->b, u->depth, out);
+}
+
+/* A UNION node and every UNION below it through child a: the left fold u(u(c0, c1), c2) ... of a
+ * flat list, which is how the scene loader builds a "union" of many children. Its children (c0, the
+ * last node's a, then each node's b from the bottom up) are one level below the chain however long
+ * it is: a flat list is not nesting, so only the children count towards FV_SDF_MAX_DEPTH. */
+static fv_status compile_union(compiler *cc, int i, int depth, box3 *out)
+{
+    int *chain = NULL, len = 0, cap = 0;
+    fv_status st = FV_OK;
+    for (int u = i;;) {
+        if (fv_grow((void **)&chain, &cap, len + 1, sizeof *chain)) {
+            st = fv_error_set(cc->err, FV_ERR_NOMEM, "sdf: out of memory compiling node %d (union)", i);
+            break;
+        }
+        chain[len++] = u;
+        cc->on_path[u] = 1;
+        int a = cc->nodes[u].a;
+        if (cc->nodes[a].kind != FV_SDF_UNION) break;
+        if (cc->on_path[a]) {
+            st = fv_error_set(cc->err, FV_ERR_INVALID, "sdf node %d (union): child a = %d forms a cycle", u, a);
+            break;
+        }
+        u = a;
+    }
+    if (st == FV_OK) {
+        union_chain u = {chain, len, depth};
+        st = emit_chain(cc, i, len + 1, union_child, &u, out);
+    }
+    if (st == FV_OK)
+        for (int k = 0; k < len; k++) cc->on_path[chain[k]] = 0;
+    free(chain);
+    return st;
 }
 
 static fv_status compile_node(compiler *cc, int i, int depth, box3 *out)
@@ -300,6 +446,7 @@ static fv_status compile_node(compiler *cc, int i, int depth, box3 *out)
     const fv_sdf_node *n = &cc->nodes[i];
     const char *kn = kind_names[n->kind];
     if (n->kind <= FV_SDF_HEIGHTFIELD) return compile_leaf(cc, i, out);
+    if (n->kind == FV_SDF_UNION) return compile_union(cc, i, depth, out);
     fv_status st;
     fv_sdf_op *op;
     box3 ba, bb;
@@ -317,7 +464,11 @@ static fv_status compile_node(compiler *cc, int i, int depth, box3 *out)
             *out = box_union(ba, bb);
         } else if (n->kind == FV_SDF_SUBTRACT) {
             *out = ba; /* max(a, -b) >= a */
+            out->upper = false; /* b may remove all of a */
+            out->mag = fmaxf(ba.mag, bb.mag);
         } else if (n->kind == FV_SDF_INTERSECT) {
+            out->upper = false; /* the intersection may be empty */
+            out->mag = fmaxf(ba.mag, bb.mag);
             for (int k = 0; k < 3; k++) {
                 out->lo[k] = fmaxf(ba.lo[k], bb.lo[k]);
                 out->hi[k] = fminf(ba.hi[k], bb.hi[k]);
@@ -340,6 +491,7 @@ static fv_status compile_node(compiler *cc, int i, int depth, box3 *out)
                 out->hi[k] += grow;
             }
             out->c = c / sqrtf(3.0f);
+            out->mag += n->p[0]; /* the result stays below min(a, b): upper is kept */
         }
         break;
     }
@@ -372,6 +524,9 @@ static fv_status compile_node(compiler *cc, int i, int depth, box3 *out)
             out->hi[r] = v3_get(n->v[0], r) + hi;
         }
         out->c = ba.c;
+        /* s d(R^-1 (x - t) / s) is the distance of the moved surface, which stays in the moved box */
+        out->upper = ba.upper;
+        out->mag = box_mag(out, fmaxf(fabsf(n->v[0].x), fmaxf(fabsf(n->v[0].y), fabsf(n->v[0].z))) + s * ba.mag);
         break;
     }
     case FV_SDF_REPEAT: {
@@ -382,6 +537,7 @@ static fv_status compile_node(compiler *cc, int i, int depth, box3 *out)
         float margin = INFINITY;
         *out = ba;
         out->c = 0.0f; /* only a lower bound between copies (kernel.h) */
+        out->upper = false;
         for (int k = 0; k < 3; k++) {
             float c = v3_get(n->v[0], k), lim = v3_get(n->v[1], k);
             op->f[k] = c;
@@ -398,6 +554,7 @@ static fv_status compile_node(compiler *cc, int i, int depth, box3 *out)
             out->lo[k] = lim > 0.0f ? ba.lo[k] - lim * c : -INFINITY;
             out->hi[k] = lim > 0.0f ? ba.hi[k] + lim * c : INFINITY;
         }
+        out->mag = box_mag(out, ba.mag);
         EMIT(op, FV_OP_REPEAT_POP);
         op->f[0] = isfinite(margin) ? margin : 0.0f;
         for (int k = 0; k < 3; k++) {
@@ -448,6 +605,9 @@ fv_status fv_sdf_create(const fv_sdf_node *nodes, int count, int root, fv_sdf **
     s->count = cc.n_ops;
     s->lo = fv_v3(b.lo[0], b.lo[1], b.lo[2]);
     s->hi = fv_v3(b.hi[0], b.hi[1], b.hi[2]);
+    s->c = b.c;
+    s->upper = b.upper ? 1 : 0;
+    s->mag = b.mag;
     s->normal_h = 1e-4f * fv_length(fv_sub(s->hi, s->lo));
     if (!(s->normal_h > 0.0f)) s->normal_h = 1e-6f;
     *out = s;
@@ -466,3 +626,61 @@ void fv_sdf_bounds(const fv_sdf *sdf, fv_vec3 *lo, fv_vec3 *hi)
     if (lo) *lo = sdf->lo;
     if (hi) *hi = sdf->hi;
 }
+
+/* ---- the union of compiled fields (sdf_eval.h) ---- */
+
+typedef struct merge_parts {
+    const fv_sdf *const *parts;
+} merge_parts;
+
+/* Copies part k's program, moving its CULL jump targets and data indices by where it lands. */
+static fv_status merge_child(compiler *cc, void *ctx, int k, box3 *out)
+{
+    const fv_sdf *p = ((const merge_parts *)ctx)->parts[k];
+    int base = cc->n_ops;
+    for (int j = 0; j < p->count; j++) {
+        fv_sdf_op *op = emit(cc, p->ops[j].code, k);
+        if (!op) return cc->err->status;
+        *op = p->ops[j];
+        if (op->code == FV_OP_CULL) op->ia += base, op->ib += base;
+        if (op->code == FV_OP_CULL_DATA && op->ib > 0) op->ia += base; /* a group's first member */
+    }
+    const float lo[3] = {p->lo.x, p->lo.y, p->lo.z}, hi[3] = {p->hi.x, p->hi.y, p->hi.z};
+    for (int a = 0; a < 3; a++) out->lo[a] = lo[a], out->hi[a] = hi[a];
+    out->c = p->c;
+    out->upper = p->upper != 0;
+    out->mag = p->mag;
+    return FV_OK;
+}
+
+fv_status fv_sdf_union_create(const fv_sdf *const *parts, int n, fv_sdf **out, fv_error *err)
+{
+    fv_error_clear(err);
+    if (!out) return fv_error_set(err, FV_ERR_INVALID, "fv_sdf_union_create: out is NULL");
+    *out = NULL;
+    if (!parts || n < 1) REFUSE("sdf union: %d fields (need at least 1)", n);
+    fv_error local;
+    compiler cc = {NULL, 0, NULL, NULL, 0, 0, err ? err : &local};
+    fv_sdf *s = calloc(1, sizeof *s);
+    if (!s) return fv_error_set(err, FV_ERR_NOMEM, "sdf union: out of memory");
+    merge_parts mp = {parts};
+    box3 b;
+    fv_status st = emit_chain(&cc, 0, n, merge_child, &mp, &b);
+    if (st != FV_OK) {
+        free(cc.ops);
+        free(s);
+        return st;
+    }
+    s->ops = cc.ops;
+    s->count = cc.n_ops;
+    s->lo = fv_v3(b.lo[0], b.lo[1], b.lo[2]);
+    s->hi = fv_v3(b.hi[0], b.hi[1], b.hi[2]);
+    s->c = b.c;
+    s->upper = b.upper ? 1 : 0;
+    s->mag = b.mag;
+    s->normal_h = 1e-4f * fv_length(fv_sub(s->hi, s->lo));
+    if (!(s->normal_h > 0.0f)) s->normal_h = 1e-6f;
+    return *out = s, FV_OK;
+}
+
+float fv_sdf_bound_c(const fv_sdf *sdf) { return sdf->c; }
