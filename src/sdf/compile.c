@@ -7,6 +7,7 @@
  * (k / (4c)) — a child known only to be a lower bound (c small, c = 0 for repetition) would need an
  * unbounded margin. The rules and their derivations are in docs/sdf.md.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdlib.h>
@@ -35,6 +36,7 @@ typedef struct compiler {
     fv_sdf_op *ops;
     int n_ops, cap;
     fv_error *err;
+    int max_ops; /* FV_SDF_MAX_OPS for a tree; a merge of compiled fields only adds their lengths */
 } compiler;
 
 static const char *const kind_names[FV_SDF_KIND_COUNT] = {
@@ -195,10 +197,10 @@ static bool box_finite(const box3 *b)
 
 static fv_sdf_op *emit(compiler *cc, int code, int node)
 {
-    if (cc->n_ops >= FV_SDF_MAX_OPS) {
+    if (cc->n_ops >= cc->max_ops) {
         fv_error_set(cc->err, FV_ERR_INVALID,
                      "sdf node %d: the compiled tree exceeds %d instructions (shared nodes are expanded once per use)", node,
-                     FV_SDF_MAX_OPS);
+                     cc->max_ops);
         return NULL;
     }
     if (fv_grow((void **)&cc->ops, &cc->cap, cc->n_ops + 1, sizeof *cc->ops)) {
@@ -580,7 +582,7 @@ fv_status fv_sdf_create(const fv_sdf_node *nodes, int count, int root, fv_sdf **
     fv_status st;
     for (int i = 0; i < count; i++)
         if ((st = check_node(nodes, count, i, err))) return st;
-    compiler cc = {nodes, count, fv_calloc_array((size_t)count, 1), NULL, 0, 0, err};
+    compiler cc = {nodes, count, fv_calloc_array((size_t)count, 1), NULL, 0, 0, err, FV_SDF_MAX_OPS};
     fv_error local;
     if (!err) cc.err = &local;
     fv_sdf *s = calloc(1, sizeof *s);
@@ -660,7 +662,7 @@ fv_status fv_sdf_union_create(const fv_sdf *const *parts, int n, fv_sdf **out, f
     *out = NULL;
     if (!parts || n < 1) REFUSE("sdf union: %d fields (need at least 1)", n);
     fv_error local;
-    compiler cc = {NULL, 0, NULL, NULL, 0, 0, err ? err : &local};
+    compiler cc = {NULL, 0, NULL, NULL, 0, 0, err ? err : &local, INT_MAX / 2};
     fv_sdf *s = calloc(1, sizeof *s);
     if (!s) return fv_error_set(err, FV_ERR_NOMEM, "sdf union: out of memory");
     merge_parts mp = {parts};
