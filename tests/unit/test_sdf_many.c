@@ -4,7 +4,7 @@
  * the nearest are skipped. These tests check that the skipping changes nothing and that a flat list
  * is not nesting:
  *  - a union of 150 mixed children (rotated, scaled, smooth unions, subtractions, an intersection
- *    with a plane, a limited repetition, a nested union) gives at 20 000 points, far and near,
+ *    with a plane, a limited repetition, a nested union) gives at 12 000 points, far and near,
  *    exactly the fold of its children's own fields (value and material bit for bit), through the
  *    scalar evaluator, both eight-lane builds and the kernel's (kernel/sdf_trace.h);
  *  - fv_sdf_union_create (how the SDF world merges its static objects) gives the same fold, also
@@ -200,13 +200,13 @@ static fv_vec3 sample_point(fv_rng *r, const fv_sdf *u, fv_sdf *const *parts, in
 
 static bool same_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
 
-/* Checks field u against the fold of parts at 20 000 points through every evaluator. */
+/* Checks field u against the fold of parts at 12 000 points through every evaluator. */
 static void check_against_fold(const fv_sdf *u, fv_sdf *const *parts, int n, uint64_t seed)
 {
     fv_rng r = fv_rng_make(seed, 1, 0, 0);
     const bool avx2 = __builtin_cpu_supports("avx2");
     int near = 0;
-    for (int b = 0; b < 2500; b++) {
+    for (int b = 0; b < 1500; b++) {
         float x[8], y[8], z[8], d8[8], da[8], ref[8];
         int m8[8], ma[8], mref[8];
         for (int k = 0; k < 8; k++) {
@@ -230,7 +230,8 @@ static void check_against_fold(const fv_sdf *u, fv_sdf *const *parts, int n, uin
         }
     }
     /* the near points are what the culling could get wrong: there must be many */
-    assert_true(near > 2000);
+    printf("%d of 12000 points within 0.3 of a surface\n", near);
+    assert_true(near > 1500);
 }
 
 /* ---- the culled union equals the fold ---- */
@@ -301,7 +302,7 @@ static void test_spheres_exact(void **st)
     }
     fv_sdf *u = compile(&t, acc);
     double worst = 0.0;
-    for (int i = 0; i < 20000; i++) {
+    for (int i = 0; i < 10000; i++) {
         fv_vec3 p = i % 2 ? fv_v3(uni(&r, -18, 18), uni(&r, -18, 18), uni(&r, -18, 18))
                           : fv_add(c[i % N], fv_v3(uni(&r, -1.5f, 1.5f), uni(&r, -1.5f, 1.5f), uni(&r, -1.5f, 1.5f)));
         double truth = INFINITY;
@@ -313,7 +314,7 @@ static void test_spheres_exact(void **st)
         worst = fmax(worst, fabs(d - truth));
         if (!(d <= truth + 1e-5 * 30.0)) fail_msg("(%g %g %g): %.9g exceeds the distance %.9g", p.x, p.y, p.z, d, truth);
     }
-    printf("200 spheres: largest |field - distance| %.3g over 20000 points\n", worst);
+    printf("200 spheres: largest |field - distance| %.3g over 10000 points\n", worst);
     assert_true(worst <= 1e-5 * 30.0);
     fv_sdf_destroy(u);
     free(t.n);
@@ -329,7 +330,7 @@ static void test_mixed_lipschitz(void **st)
     fv_sdf *u = compile(&t, mixed_union(&t, N_MIXED, kids, 37));
     fv_sdf *parts[1] = {u};
     fv_rng r = fv_rng_make(6, 0, 0, 0);
-    for (int i = 0; i < 20000; i++) {
+    for (int i = 0; i < 10000; i++) {
         fv_vec3 p = sample_point(&r, u, parts, 1, i);
         fv_vec3 q = fv_add(p, fv_scale(fv_v3(uni(&r, -1, 1), uni(&r, -1, 1), uni(&r, -1, 1)), 0.05f));
         float dp = fv_sdf_distance(u, p, NULL), dq = fv_sdf_distance(u, q, NULL);
