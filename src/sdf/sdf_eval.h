@@ -20,7 +20,7 @@ void fv_sdf_distance8_avx2(const fv_sdf *sdf, const float x[8], const float y[8]
 float fv_sdf_distance1(const fv_sdf *sdf, float x, float y, float z, int *mat);
 
 /* One field that is the union of n compiled fields, parts[0] first (compile.c): the program a
- * "union" of their trees compiles to, culled from four parts on, so it gives their fold's values
+ * "union" of their trees compiles to, culled from eight cullable parts on, so it gives their fold's values
  * and materials bit for bit (the SDF family's world merges its static objects with it). The parts
  * stay owned by the caller; the result is released with fv_sdf_destroy. FV_ERR_INVALID, NOMEM. */
 fv_status fv_sdf_union_create(const fv_sdf *const *parts, int n, fv_sdf **out, fv_error *err);

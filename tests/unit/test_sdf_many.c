@@ -4,7 +4,7 @@
  * the nearest are skipped. These tests check that the skipping changes nothing and that a flat list
  * is not nesting:
  *  - a union of 150 mixed children (rotated, scaled, smooth unions, subtractions, an intersection
- *    with a plane, a limited repetition, a nested union) gives at 12 000 points, far and near,
+ *    with a plane, a limited repetition, nested unions of ten) gives at 12 000 points, far and near,
  *    exactly the fold of its children's own fields (value and material bit for bit), through the
  *    scalar evaluator, both eight-lane builds and the kernel's (kernel/sdf_trace.h);
  *  - fv_sdf_union_create (how the SDF world merges its static objects) gives the same fold, also
@@ -138,9 +138,9 @@ static int mixed_child(tree *t, fv_rng *r, int k)
         c = add(t, rp);
         break;
     }
-    case 8: { /* a union of six inside: its own culled chain */
+    case 8: { /* a union of ten inside: its own culled chain */
         c = placed(t, primitive(t, 0, mat), fv_v3(-1, 0, 0), (fv_quat){0, 0, 0, 1}, 0.5f);
-        for (int j = 1; j < 6; j++) c = op2(t, FV_SDF_UNION, c, placed(t, primitive(t, j, mat + 100 * j), fv_v3(-1.0f + 0.4f * j, 0, 0), (fv_quat){0, 0, 0, 1}, 0.5f));
+        for (int j = 1; j < 10; j++) c = op2(t, FV_SDF_UNION, c, placed(t, primitive(t, j, mat + 100 * j), fv_v3(-1.0f + 0.25f * j, 0, 0), (fv_quat){0, 0, 0, 1}, 0.5f));
         break;
     }
     default: c = primitive(t, k, mat);
@@ -200,6 +200,33 @@ static fv_vec3 sample_point(fv_rng *r, const fv_sdf *u, fv_sdf *const *parts, in
 
 static bool same_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
 
+/* How many culled chains the program holds, after checking their structure (sdf_impl.h): each
+ * CULL names a CULL_DATA op and jumps forward to just after a UNION; each group's data names a run
+ * of member data ops; each CULL_BEGIN is followed by its data. A jump or index left unmoved when a
+ * program is copied into another (fv_sdf_union_create, the compiler's layout) fails here. */
+static int culled_chains(const fv_sdf *u)
+{
+    int n = 0;
+    const fv_sdf_op *o = u->ops;
+    for (int i = 0; i < u->count; i++) {
+        if (o[i].code == FV_OP_CULL_BEGIN) {
+            n++;
+            assert_true(o[i].ia >= 1 && o[i].ib > o[i].ia && i + o[i].ib < u->count);
+            for (int k = 1; k <= o[i].ib; k++) assert_int_equal(o[i + k].code, FV_OP_CULL_DATA);
+            for (int g = 0; g < o[i].ia; g++) {
+                const fv_sdf_op *gd = &o[i + 1 + g];
+                assert_true(gd->ib > 0 && gd->ia > i + o[i].ia && gd->ia + gd->ib <= i + 1 + o[i].ib);
+                for (int k = 0; k < gd->ib; k++) assert_int_equal(o[gd->ia + k].ib, 0); /* members, not groups */
+            }
+        }
+        if (o[i].code == FV_OP_CULL) {
+            assert_true(o[i].ib >= 0 && o[i].ib < i && o[o[i].ib].code == FV_OP_CULL_DATA);
+            assert_true(o[i].ia > i + 1 && o[i].ia < u->count && o[o[i].ia - 1].code == FV_OP_UNION);
+        }
+    }
+    return n;
+}
+
 /* Checks field u against the fold of parts at 12 000 points through every evaluator. */
 static void check_against_fold(const fv_sdf *u, fv_sdf *const *parts, int n, uint64_t seed)
 {
@@ -246,9 +273,12 @@ static void test_union_equals_fold(void **st)
     int root = mixed_union(&t, N_MIXED, kids, 29);
     fv_sdf *u = compile(&t, root), *parts[N_MIXED];
     for (int k = 0; k < N_MIXED; k++) parts[k] = compile(&t, kids[k]);
+    /* the outer union and each nested union of ten (every ninth child) are culled chains */
+    assert_int_equal(culled_chains(u), 1 + N_MIXED / 9);
     check_against_fold(u, parts, N_MIXED, 1);
-    /* fewer than four children: the plain fold, the same numbers */
+    /* three children: the plain fold, the same numbers */
     fv_sdf *small = compile(&t, op2(&t, FV_SDF_UNION, op2(&t, FV_SDF_UNION, kids[0], kids[1]), kids[2]));
+    assert_int_equal(culled_chains(small), 0);
     check_against_fold(small, parts, 3, 2);
     fv_sdf_destroy(small);
     fv_sdf_destroy(u);
@@ -270,6 +300,7 @@ static void test_merged_parts(void **st)
     for (int n = 3; n <= N_MIXED; n += N_MIXED - 3) {
         fv_sdf *m = NULL;
         if (fv_sdf_union_create((const fv_sdf *const *)parts, n, &m, &err) != FV_OK) fail_msg("%s", err.msg);
+        assert_int_equal(culled_chains(m), (n > 3) + (n - 1) / 9); /* the parts' own chains moved in */
         check_against_fold(m, parts, n, 3 + (uint64_t)n);
         fv_sdf_destroy(m);
     }
@@ -462,6 +493,7 @@ static void test_world_moving(void **st)
     assert_int_equal(fv_sdf_world_build(&w, s, &err), FV_OK);
     assert_int_equal(w.count, 8);
     assert_non_null(w.merged);
+    assert_int_equal(culled_chains(w.merged), 1);
     /* the skip test is live for every moving object, the stretched one too */
     for (int i = 0; i < w.count; i++) assert_true(w.objs[i].cull_c > 0.1f && w.objs[i].cull_c <= 1.0f);
     for (int b = 0; b < 2000; b++) {

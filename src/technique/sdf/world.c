@@ -143,15 +143,14 @@ static inline bool far_from(const fv_sdf_world *w, const fv_sdf_world_object *o,
 
 void fv_sdf_world_eval8(const fv_sdf_world *w, const float *x, const float *y, const float *z, float *d, int *mat)
 {
+    if (w->count == 0) { /* static objects only: one field */
+        fv_sdf_distance8(w->statics, x, y, z, d, mat);
+        return;
+    }
     float best[8], od[8], lx[8], ly[8], lz[8];
     int bm[8], om[8];
     if (w->statics) {
         fv_sdf_distance8(w->statics, x, y, z, best, bm);
-        if (w->count == 0) {
-            memcpy(d, best, sizeof best);
-            if (mat) memcpy(mat, bm, sizeof bm);
-            return;
-        }
     } else {
         for (int k = 0; k < 8; k++) best[k] = INFINITY, bm[k] = 0;
     }
@@ -175,15 +174,10 @@ void fv_sdf_world_eval8(const fv_sdf_world *w, const float *x, const float *y, c
 
 float fv_sdf_world_eval1(const fv_sdf_world *w, float x, float y, float z, int *mat)
 {
+    if (w->count == 0) return fv_sdf_distance1(w->statics, x, y, z, mat);
     float best = INFINITY;
     int bm = 0;
-    if (w->statics) {
-        best = fv_sdf_distance1(w->statics, x, y, z, &bm);
-        if (w->count == 0) {
-            if (mat) *mat = bm;
-            return best;
-        }
-    }
+    if (w->statics) best = fv_sdf_distance1(w->statics, x, y, z, &bm);
     for (int i = 0; i < w->count; i++) {
         const fv_sdf_world_object *o = &w->objs[i];
         if (far_from(w, o, x, y, z, best)) continue;
