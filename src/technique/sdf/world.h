@@ -44,7 +44,7 @@ typedef struct fv_sdf_world {
     const fv_sdf *statics;     /* the static objects' union (NULL: none); owned when merged */
     fv_sdf *merged;            /* statics when several were merged, else NULL */
     fv_sdf_world_object *objs; /* the moving objects, in scene order */
-    int count;
+    int count;                 /* how many moving objects */
     fv_vec3 lo, hi;            /* box around every object, padded by a few hit distances */
     float eps_abs;             /* smallest hit distance: 1e-5 of the box diagonal */
     float cull_margin;         /* the rounding margin of skipping a moving object, without the point's part */
