@@ -21,7 +21,8 @@
  *   PLANE         solid below dot(n, x) = h: v[0] normal n (unit within 1e-4), p[0] offset h
  *   HEIGHTFIELD   solid below y = p[0] + p[1] * fbm(p[2] * (x, z)): p[0] base height, p[1] amplitude >= 0,
  *                 p[2] frequency > 0, p[3] octaves (integer 1..8), p[4] seed (integer 0..2^24)
- *   UNION         a, b children: the nearer
+ *   UNION         a, b children: the nearer (a union of many children only evaluates those near the
+ *                 point, with the same result: docs/sdf.md, "Unions of many shapes")
  *   SUBTRACT      a minus b
  *   INTERSECT     a and b
  *   SMOOTH_UNION  a, b children, p[0] blend width k > 0 (the surface grows by at most k/4)
@@ -83,7 +84,9 @@ typedef struct fv_sdf_node {
 } fv_sdf_node;
 
 /* Largest node count, and deepest nesting of the compiled tree (a node shared by several parents
- * is expanded once per use, so the compiled program may be longer than the node array). */
+ * is expanded once per use, so the compiled program may be longer than the node array). A chain
+ * of UNIONs through child a (the left fold of a flat list, as the scene loader builds it) is one
+ * n-ary union: its children are one level below it however many there are. */
 #define FV_SDF_MAX_NODES 65536
 #define FV_SDF_MAX_DEPTH 48
 

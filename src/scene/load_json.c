@@ -368,7 +368,9 @@ static fv_status sdf_node(sdf_build *b, const cJSON *o, const char *where, int m
                                        "union", "subtract", "intersect", "smooth_union", "transform", "repeat", "material", NULL};
     const json_ctx *c = b->c;
     if (depth > FV_SDF_MAX_DEPTH)
-        return fv_error_set(err, FV_ERR_INVALID, "%s: %s: sdf nested deeper than %d levels", c->file, where, FV_SDF_MAX_DEPTH);
+        /* the reason before the path, which at this depth is long enough to be cut off */
+        return fv_error_set(err, FV_ERR_INVALID, "%s: sdf nested deeper than %d levels (a flat list of children is one level) at %s",
+                            c->file, FV_SDF_MAX_DEPTH, where);
     if (!cJSON_IsObject(o)) return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an sdf node object", c->file, where);
     fv_status st = fv_json_check_keys(o, keys, c->file, where, err);
     if (st) return st;

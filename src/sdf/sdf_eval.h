@@ -19,4 +19,13 @@ void fv_sdf_distance8_base(const fv_sdf *sdf, const float x[8], const float y[8]
 void fv_sdf_distance8_avx2(const fv_sdf *sdf, const float x[8], const float y[8], const float z[8], float d[8], int mat[8]);
 float fv_sdf_distance1(const fv_sdf *sdf, float x, float y, float z, int *mat);
 
+/* One field that is the union of n compiled fields, parts[0] first (compile.c): the program a
+ * "union" of their trees compiles to (a culled chain when eight or more parts can be culled), so
+ * it gives their fold's values and materials bit for bit; the SDF family's world merges its static
+ * objects with it. The parts stay owned by the caller; the result is released with
+ * fv_sdf_destroy. FV_ERR_INVALID, NOMEM. */
+fv_status fv_sdf_union_create(const fv_sdf *const *parts, int n, fv_sdf **out, fv_error *err);
+/* c of the field's bounds: outside fv_sdf_bounds' box, d >= c times the distance to it (c in [0, 1]). */
+float fv_sdf_bound_c(const fv_sdf *sdf);
+
 #endif

@@ -6,6 +6,13 @@
  * two and push one, TRANSFORM and REPEAT push a new evaluation point before their child and pop
  * it (fixing the child's distance) after. Every constant an instruction needs is precomputed
  * (inverse rotation, 1/period, the height field's Lipschitz divisor).
+ *
+ * A union of many children (a chain of UNION nodes, which is how a flat JSON "union" list arrives)
+ * compiles to a culled chain (issue 29): CULL_BEGIN pushes a far accumulator and an upper bound U
+ * of the union's value, each child runs behind a CULL that jumps past it and its UNION when its box
+ * proves it cannot be the nearest, and the children sit in groups behind one CULL each (a two-level
+ * hierarchy over consecutive children). The rules, and why the result is the unculled fold's bit for
+ * bit, are in kernel.h (FV_OP_CULL) and docs/sdf.md.
  */
 #ifndef FV_SDF_IMPL_H
 #define FV_SDF_IMPL_H
@@ -29,8 +36,14 @@ typedef enum fv_sdf_opcode {
     FV_OP_XFORM_PUSH,   /* f0..8 R^T row-major, f9..11 t, f12 1/s */
     FV_OP_XFORM_POP,    /* f0 s */
     FV_OP_REPEAT_PUSH,  /* f0..2 period (0: none), f3..5 1/period, f6..8 cell limit n (0: none) */
-    FV_OP_REPEAT_POP    /* f0 margin m between the child's bounds and its cell, f1..3 / f4..6 the box
+    FV_OP_REPEAT_POP,   /* f0 margin m between the child's bounds and its cell, f1..3 / f4..6 the box
                            holding every copy (+-1e30 where unlimited) */
+    FV_OP_CULL_BEGIN,   /* ia groups, ib data ops that follow (skipped), f0 the chain's magnitude */
+    FV_OP_CULL_DATA,    /* a box: f0..2 lo, f3..5 hi (+-1e30 where unbounded), f6 c (d >= c dist(p, box)
+                           outside it), material 1 when the field never exceeds the distance to the
+                           box's farthest point; a group's also ia its first member's data op, ib count */
+    FV_OP_CULL,         /* ia the op to jump to when culled, ib the index of its CULL_DATA op */
+    FV_OP_CULL_END      /* pops what CULL_BEGIN pushed, leaving the union's value */
 } fv_sdf_opcode;
 
 typedef struct fv_sdf_op {
@@ -44,6 +57,9 @@ struct fv_sdf {
     fv_sdf_op *ops;
     int count;
     fv_vec3 lo, hi;   /* the root's bounds */
+    float c;          /* d >= c dist(p, [lo, hi]) outside the box (compile.c) */
+    int upper;        /* 1: d never exceeds the distance to the box's farthest point */
+    float mag;        /* the magnitude of the coordinates and constants evaluation works with */
     float normal_h;   /* default step of fv_sdf_normal */
 };
 

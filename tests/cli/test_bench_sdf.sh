@@ -37,7 +37,7 @@ for f in sdf-quality.md sdf-quality/reference.png sdf-quality/ipr.png sdf-qualit
     [ -s "$OUT/$f" ] || fail "missing $f"
 done
 # every sdf scenario parses and names methods that exist (a bad one would exit 2 here)
-for s in sdf-speed sdf-speed-columns sdf-speed-primitives sdf-quality-columns sdf-quality-primitives sdf-fov; do
+for s in sdf-speed sdf-speed-columns sdf-speed-primitives sdf-speed-grid sdf-quality-columns sdf-quality-primitives sdf-fov; do
     expect 0 "" -- $FOVEA bench $s --check
 done
 finish

@@ -2,7 +2,8 @@
  * against `pt` on the CPU (Embree): the same estimator drawing the same random numbers, so the two
  * images agree pixel by pixel except where the two traversals' last bits send a path elsewhere.
  * Checked on the built-in cornell (area light) and city (environment, many objects), a scene with
- * a moving object at a later time, a textured mesh and an SDF scene; plus the auxiliary buffers,
+ * a moving object at a later time, a textured mesh, an SDF scene and an SDF union of 81 children
+ * (its culled chain runs in the kernel's evaluator, issue 29); plus the auxiliary buffers,
  * and the refusals of devices a method or build lacks.
  *
  * The two traversals find the same surfaces at the same distances to within a few float ulps
@@ -112,6 +113,12 @@ static void test_sdf_scene(void **st)
     compare_scene("sdf-primitives", 48, 48, 0.0, 1, "max_depth=3");
 }
 
+static void test_sdf_union_81(void **st)
+{
+    (void)st;
+    compare_scene(FOVEA_SOURCE_DIR "/scenes/sdf-grid81.json", 48, 27, 0.0, 1, "max_depth=3");
+}
+
 /* Devices a method or the build lacks are refused in one line, before anything renders. */
 static void test_refusals(void **st)
 {
@@ -172,7 +179,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cornell),       cmocka_unit_test(test_city),      cmocka_unit_test(test_moving_object),
-        cmocka_unit_test(test_textured_mesh), cmocka_unit_test(test_sdf_scene), cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_textured_mesh), cmocka_unit_test(test_sdf_scene), cmocka_unit_test(test_sdf_union_81), cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_emission_texture),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

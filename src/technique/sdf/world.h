@@ -3,12 +3,13 @@
  *
  * Polychronakis, Koulieris and Mania (EG 2023, Sec. 2.1 and 3) march one implicit scene; a fovea
  * scene may hold several SDF objects, some moving. The world evaluates them as one field, the
- * minimum over objects, each taken in its own space (a moving object's points are moved back by
- * its inverse transform, and its distance scaled by that transform's smallest stretch so it stays
- * a lower bound). With several objects, each object's distance is also raised to the distance to
- * its box (both are lower bounds), which lets a whole batch skip an object whose box is farther
- * than what it already found without changing any value: the 8-wide and the scalar evaluation give
- * the same numbers bit for bit.
+ * union (minimum) over objects, each taken in its own space. The static objects are merged into one
+ * compiled union (fv_sdf_union_create), so many objects cost what one "union" of the same shapes
+ * costs and give its values bit for bit: the kernel culls the objects far from the point (issue 29).
+ * A moving object's points are moved back by its inverse transform and its distance scaled by
+ * that transform's smallest stretch so it stays a lower bound; the moving objects come after the
+ * static union, each skipped when its box proves it cannot be nearer than what was found (which
+ * changes no value): the 8-wide and the scalar evaluation give the same numbers bit for bit.
  *
  * Meshes are not sphere-traced (the family's techniques warn once); pt renders mixed scenes.
  */
@@ -19,11 +20,14 @@
 #include "scene/light.h"
 #include "scene/query.h"
 
+/* Relative rounding margin of the moving objects' skip test (as FV_K_CULL_REL, sdf/kernel.h). */
+#define FV_SDF_WORLD_CULL_REL 2.44140625e-4f
+
 typedef struct fv_sdf_world_object {
     const fv_sdf *sdf;
-    bool moved;        /* evaluate at inv * p and scale by lip */
-    fv_xform inv;
+    fv_xform inv;      /* world to the object's space */
     float lip;         /* 1 / the largest stretch of inv: world distance >= lip * local distance */
+    float cull_c;      /* outside the world box, lip * local distance >= cull_c * distance to it */
     fv_vec3 lo, hi;    /* world box */
 } fv_sdf_world_object;
 
@@ -37,10 +41,13 @@ typedef struct fv_sdf_point_light {
 
 typedef struct fv_sdf_world {
     const fv_scene *scene;
-    fv_sdf_world_object *objs;
-    int count;
+    const fv_sdf *statics;     /* the static objects' union (NULL: none); owned when merged */
+    fv_sdf *merged;            /* statics when several were merged, else NULL */
+    fv_sdf_world_object *objs; /* the moving objects, in scene order */
+    int count;                 /* how many moving objects */
     fv_vec3 lo, hi;            /* box around every object, padded by a few hit distances */
     float eps_abs;             /* smallest hit distance: 1e-5 of the box diagonal */
+    float cull_margin;         /* the rounding margin of skipping a moving object, without the point's part */
     fv_sdf_point_light *lights;
     int light_count;
 } fv_sdf_world;
