@@ -13,6 +13,16 @@
 #include <unistd.h>
 #include "core/sandbox.h"
 
+/* AddressSanitizer: GCC says so with __SANITIZE_ADDRESS__, clang (the libFuzzer build,
+ * docs/fuzzing.md) with __has_feature. */
+#if defined(__SANITIZE_ADDRESS__)
+#define FV_SANDBOX_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define FV_SANDBOX_ASAN 1
+#endif
+#endif
+
 struct fv_sandbox {
     pid_t pid;
     int fd;
@@ -66,7 +76,7 @@ fv_status fv_sandbox_start(fv_sandbox_fn fn, void *user, size_t mem_bytes, int c
         /* Under AddressSanitizer the address space is mostly shadow memory reserved up front: an
          * RLIMIT_AS would fail its first allocation, so the sanitized build relies on the
          * sanitizer's own allocation limit instead. */
-#if !defined(__SANITIZE_ADDRESS__)
+#if !defined(FV_SANDBOX_ASAN)
         if (mem_bytes) {
             struct rlimit rl = {(rlim_t)mem_bytes, (rlim_t)mem_bytes};
             setrlimit(RLIMIT_AS, &rl);
