@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include "bench/scenario.h"
 
@@ -237,7 +238,7 @@ void fv_fuzz_clean_work(const fv_fuzz_ctx *c, char (*before)[FV_FUZZ_NAME_MAX], 
     for (int i = 0; i < n; i++) {
         if (listed(now[i], before, nbefore)) continue;
         char p[4400];
-        snprintf(p, sizeof p, "%s/%s", c->work, now[i]);
+        snprintf(p, sizeof p, "%s/%.255s", c->work, now[i]);
         remove(p);
     }
 }
@@ -259,6 +260,14 @@ const char *fv_fuzz_judge(const fv_fuzz_ctx *c, const char *input, fv_status st,
             snprintf(why, n, "the message does not name the file: %s", err->msg);
             return why;
         }
+    }
+    /* A child process the library started (the mesh import's sandbox) and did not wait for stays
+     * a zombie: reaping one here means the library left it behind. */
+    int status;
+    pid_t z = waitpid(-1, &status, WNOHANG);
+    if (z > 0) {
+        snprintf(why, n, "left a child process behind (pid %d, ended unreaped)", (int)z);
+        return why;
     }
     const char *base = strrchr(input, '/');
     base = base ? base + 1 : input;

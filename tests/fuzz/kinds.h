@@ -11,7 +11,7 @@
 
 /* What one fuzzing process keeps between inputs. */
 typedef struct fv_fuzz_ctx {
-    char work[4096];        /* the private work folder: inputs are written there, and nothing else may appear */
+    char work[64];          /* the private work folder (/dev/shm or /tmp): inputs are written there, and nothing else may appear */
     fv_scene *cornell;      /* for gaze and camera traces, built once */
     fv_view *cornell_view;
     bool bad_warning;       /* a warning with a control byte */

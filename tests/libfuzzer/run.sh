@@ -3,7 +3,7 @@
 # for the kind (`fovea-fuzz --kind KIND --seeds-out`), what libFuzzer adds goes to OUT/corpus-KIND
 # (kept between runs), a finding to OUT/KIND-crash-... (libFuzzer's artifact names).
 #   bash tests/libfuzzer/run.sh FOVEA_FUZZ TARGET KIND OUT [libFuzzer flags, e.g. -runs=3000]
-# Exit status: libFuzzer's (0: no finding).
+# Exit status: libFuzzer's (0: no finding), or 1 when no input at all was accepted.
 set -u
 FUZZ=${1:?usage: run.sh FOVEA_FUZZ TARGET KIND OUT [flags]}
 TARGET=${2:?} KIND=${3:?} OUT=${4:?}
@@ -18,9 +18,15 @@ rm -rf "$OUT/seeds-$KIND"
 rc=$?
 # The summary a reader wants: executions, time, speed, and the verdict.
 runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$OUT/$KIND.log" | tail -1)
-secs=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$OUT/$KIND.log" | tail -1)
+speed=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$OUT/$KIND.log" | tail -1)
 cov=$(grep -o 'cov: [0-9]*' "$OUT/$KIND.log" | tail -1)
 verdicts=$(sed -n 's/^fovea libfuzzer: [a-z]*: //p' "$OUT/$KIND.log" | tail -1)
-echo "$KIND: ${runs:-?} executions, ${secs:-?} exec/s, ${cov:-cov: ?}, ${verdicts:-?}, exit $rc (log $OUT/$KIND.log)"
-if [ "$rc" != 0 ]; then tail -40 "$OUT/$KIND.log"; fi
-exit $rc
+echo "$KIND: ${runs:-?} executions, ${speed:-?} exec/s, ${cov:-cov: ?}, ${verdicts:-?}, exit $rc (log $OUT/$KIND.log)"
+# 72: libFuzzer's status when interrupted (SIGINT, -max_total_time is not that): no finding.
+if [ "$rc" = 72 ]; then echo "$KIND: interrupted after ${runs:-?} executions, no finding"; exit 0; fi
+if [ "$rc" != 0 ]; then tail -40 "$OUT/$KIND.log"; exit $rc; fi
+# The seeds hold valid files of every kind: a target that accepts nothing fuzzes only its refusals.
+case "$verdicts" in
+  "0 inputs accepted"*) echo "$KIND: no input was accepted (the seeds' valid files were refused)"; exit 1 ;;
+esac
+exit 0
