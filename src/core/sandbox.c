@@ -136,10 +136,13 @@ fv_status fv_sandbox_finish(fv_sandbox *sb, const char *what, fv_error *err)
     int status = 0;
     pid_t w;
     /* The parent stops reading early only on an error of its own or a silent child: either way
-     * the child's work is of no use any more. */
-    if ((w = waitpid(sb->pid, &status, WNOHANG)) == 0) {
+     * the child's work is of no use any more. A signal handled while waiting (one without
+     * SA_RESTART: libFuzzer's timer, a caller's own) must not end the wait, or the child stays a
+     * zombie and its result is lost (tests/unit/test_sandbox.c). */
+    while ((w = waitpid(sb->pid, &status, WNOHANG)) < 0 && errno == EINTR) {}
+    if (w == 0) {
         kill(sb->pid, SIGKILL);
-        w = waitpid(sb->pid, &status, 0);
+        while ((w = waitpid(sb->pid, &status, 0)) < 0 && errno == EINTR) {}
     }
     fv_sandbox s = *sb;
     free(sb);

@@ -22,7 +22,7 @@ speed=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$OUT/$KIND.log" | tail -1)
 cov=$(grep -o 'cov: [0-9]*' "$OUT/$KIND.log" | tail -1)
 verdicts=$(sed -n 's/^fovea libfuzzer: [a-z]*: //p' "$OUT/$KIND.log" | tail -1)
 echo "$KIND: ${runs:-?} executions, ${speed:-?} exec/s, ${cov:-cov: ?}, ${verdicts:-?}, exit $rc (log $OUT/$KIND.log)"
-# 72: libFuzzer's status when interrupted (SIGINT, -max_total_time is not that): no finding.
+# 72: libFuzzer's status when stopped by SIGINT (a long run cut short by hand): no finding.
 if [ "$rc" = 72 ]; then echo "$KIND: interrupted after ${runs:-?} executions, no finding"; exit 0; fi
 if [ "$rc" != 0 ]; then tail -40 "$OUT/$KIND.log"; exit $rc; fi
 # The seeds hold valid files of every kind: a target that accepts nothing fuzzes only its refusals.
