@@ -177,8 +177,12 @@ const fv_fuzz_kind *fv_fuzz_kind_find(const char *name)
 bool fv_fuzz_ctx_init(fv_fuzz_ctx *c, const char *src)
 {
     memset(c, 0, sizeof *c);
-    /* In memory where there is a tmpfs: an input written per execution costs no disk. */
-    snprintf(c->work, sizeof c->work, "%s/fovea-fuzz-XXXXXX", access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp");
+    /* In memory where there is a tmpfs: an input written per execution costs no disk. Under
+     * FOVEA_FUZZ_TMPDIR when set (tests/libfuzzer/run.sh: a folder it removes however the target
+     * ends, as libFuzzer stopped by SIGINT runs no exit handler). */
+    const char *base = getenv("FOVEA_FUZZ_TMPDIR");
+    if (!base || !*base || strlen(base) > 30) base = access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp";
+    snprintf(c->work, sizeof c->work, "%s/fovea-fuzz-XXXXXX", base);
     if (!mkdtemp(c->work)) {
         perror("fovea fuzz: mkdtemp");
         return false;
@@ -187,8 +191,8 @@ bool fv_fuzz_ctx_init(fv_fuzz_ctx *c, const char *src)
     char cmd[9000];
     snprintf(cmd, sizeof cmd,
              "cp %s/tests/data/*.ply %s/tests/data/*.obj %s/tests/data/*.mtl %s/tests/data/*.gltf %s/tests/data/*.csv %s/ && "
-             "cp -r %s/scenes/meshes %s/ && cp %s/tests/fuzz/seeds/gaze/mono.csv %s/gaze.csv",
-             src, src, src, src, src, c->work, src, c->work, src, c->work);
+             "cp -r %s/scenes/meshes %s/scenes/*.csv %s/ && cp %s/tests/fuzz/seeds/gaze/mono.csv %s/gaze.csv",
+             src, src, src, src, src, c->work, src, src, c->work, src, c->work);
     if (system(cmd) != 0) fprintf(stderr, "fovea fuzz: warning: could not copy the test meshes into %s\n", c->work);
     return true;
 }

@@ -13,9 +13,12 @@ rm -rf "$OUT/seeds-$KIND"
 "$FUZZ" --kind "$KIND" --seeds-out "$OUT/seeds-$KIND" >/dev/null || exit 2
 # -malloc_limit_mb above the 3 GiB at which the target's allocator returns NULL (target.c), so a
 # huge allocation is the library's to refuse; -timeout charges a hang to its input.
-"$TARGET" -artifact_prefix="$OUT/$KIND-" -timeout=60 -rss_limit_mb=4096 -malloc_limit_mb=4096 -print_final_stats=1 \
-  "$@" "$OUT/corpus-$KIND" "$OUT/seeds-$KIND" 2>"$OUT/$KIND.log"
+# The target's work folder goes in a folder of ours, removed however the target ends.
+tmp=$(mktemp -d "$( [ -w /dev/shm ] && echo /dev/shm || echo /tmp )/fovea-lf-XXXXXX")
+FOVEA_FUZZ_TMPDIR=$tmp "$TARGET" -artifact_prefix="$OUT/$KIND-" -timeout=60 -rss_limit_mb=4096 -malloc_limit_mb=4096 \
+  -print_final_stats=1 "$@" "$OUT/corpus-$KIND" "$OUT/seeds-$KIND" 2>"$OUT/$KIND.log"
 rc=$?
+rm -rf "$tmp"
 # The summary a reader wants: executions, time, speed, and the verdict.
 runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$OUT/$KIND.log" | tail -1)
 speed=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$OUT/$KIND.log" | tail -1)

@@ -9,10 +9,14 @@
  * file, nothing left behind. An input that breaks a rule aborts, so libFuzzer saves it as a
  * crash; crashes, hangs, leaks and sanitizer reports libFuzzer finds itself.
  */
+#include <dirent.h>
+#include <errno.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "../fuzz/kinds.h"
 
 #ifndef FV_FUZZ_KIND
@@ -33,12 +37,62 @@ typedef struct target_state {
     char before[64][FV_FUZZ_NAME_MAX];
     int nbefore;
     long accepted, refused; /* printed at exit: how far the inputs got */
+    char omp_tag[32];       /* our libomp registration's address (see sweep_omp_files); "" when none */
 } target_state;
 
 static target_state *state(void)
 {
     static target_state s;
     return &s;
+}
+
+#define OMP_FILE "__KMP_REGISTERED_LIB_"
+
+/* The first field of libomp's registration file for pid ("ADDRESS-VALUE-libomp.so.5") into tag. */
+static bool omp_file_tag(const char *name, char *tag, size_t n)
+{
+    char path[300];
+    snprintf(path, sizeof path, "/dev/shm/%s", name);
+    FILE *f = fopen(path, "rb");
+    if (!f) return false;
+    size_t got = fread(tag, 1, n - 1, f);
+    fclose(f);
+    tag[got] = '\0';
+    char *dash = strchr(tag, '-');
+    if (dash) *dash = '\0';
+    return dash != NULL;
+}
+
+/* clang's OpenMP runtime (libomp; GCC's has no such file) registers each process in
+ * /dev/shm/__KMP_REGISTERED_LIB_<pid>_0 and removes the file at exit; a child of fork that ends
+ * with _exit, as the sandbox's child does (src/core/sandbox.c), leaves it: one file per mesh
+ * import, thousands in a long run. Files of our own children carry our registration's address
+ * (they are forks of this process), so those of ended processes are removed. */
+static void sweep_omp_files(target_state *s)
+{
+    if (!s->omp_tag[0]) { /* libomp registers at its first use: until then, nothing to sweep */
+        char own[64];
+        snprintf(own, sizeof own, OMP_FILE "%d_0", (int)getpid());
+        if (!omp_file_tag(own, s->omp_tag, sizeof s->omp_tag)) {
+            s->omp_tag[0] = '\0';
+            return;
+        }
+    }
+    DIR *d = opendir("/dev/shm");
+    if (!d) return;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        int pid;
+        char tail[8];
+        if (sscanf(e->d_name, OMP_FILE "%d%7s", &pid, tail) != 2 || strcmp(tail, "_0") || pid == (int)getpid()) continue;
+        if (kill(pid, 0) == 0 || errno != ESRCH) continue; /* still running */
+        char tag[64];
+        if (!omp_file_tag(e->d_name, tag, sizeof tag) || strcmp(tag, s->omp_tag)) continue;
+        char path[300];
+        snprintf(path, sizeof path, "/dev/shm/%s", e->d_name);
+        unlink(path);
+    }
+    closedir(d);
 }
 
 static void at_exit(void)
@@ -96,6 +150,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     char why[600];
     const char *bad = fv_fuzz_judge(&s->ctx, s->input, st, &err, s->before, s->nbefore, why, sizeof why);
     fv_fuzz_clean_work(&s->ctx, s->before, s->nbefore);
+    sweep_omp_files(s);
     if (st == FV_OK) s->accepted++;
     else s->refused++;
     if (bad) {
