@@ -3,6 +3,7 @@
  * with gnuplot when it is installed; the CSV is written regardless).
  */
 #include <cjson/cJSON.h>
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -366,7 +367,11 @@ static bool run_gnuplot(const char *script_path)
         _exit(127);
     }
     int status = 0;
-    if (waitpid(pid, &status, 0) < 0) return false;
+    pid_t w;
+    /* A handled signal (one without SA_RESTART) must not end the wait: gnuplot would be left a
+     * zombie and its plot counted as failed (as in core/sandbox.c). */
+    while ((w = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {}
+    if (w < 0) return false;
     return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 

@@ -13,6 +13,16 @@
 #include <unistd.h>
 #include "core/sandbox.h"
 
+/* AddressSanitizer: GCC says so with __SANITIZE_ADDRESS__, clang (the libFuzzer build,
+ * docs/fuzzing.md) with __has_feature. */
+#if defined(__SANITIZE_ADDRESS__)
+#define FV_SANDBOX_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define FV_SANDBOX_ASAN 1
+#endif
+#endif
+
 struct fv_sandbox {
     pid_t pid;
     int fd;
@@ -66,7 +76,7 @@ fv_status fv_sandbox_start(fv_sandbox_fn fn, void *user, size_t mem_bytes, int c
         /* Under AddressSanitizer the address space is mostly shadow memory reserved up front: an
          * RLIMIT_AS would fail its first allocation, so the sanitized build relies on the
          * sanitizer's own allocation limit instead. */
-#if !defined(__SANITIZE_ADDRESS__)
+#if !defined(FV_SANDBOX_ASAN)
         if (mem_bytes) {
             struct rlimit rl = {(rlim_t)mem_bytes, (rlim_t)mem_bytes};
             setrlimit(RLIMIT_AS, &rl);
@@ -126,10 +136,13 @@ fv_status fv_sandbox_finish(fv_sandbox *sb, const char *what, fv_error *err)
     int status = 0;
     pid_t w;
     /* The parent stops reading early only on an error of its own or a silent child: either way
-     * the child's work is of no use any more. */
-    if ((w = waitpid(sb->pid, &status, WNOHANG)) == 0) {
+     * the child's work is of no use any more. A signal handled while waiting (one without
+     * SA_RESTART: libFuzzer's timer, a caller's own) must not end the wait, or the child stays a
+     * zombie and its result is lost (tests/unit/test_sandbox.c). */
+    while ((w = waitpid(sb->pid, &status, WNOHANG)) < 0 && errno == EINTR) {}
+    if (w == 0) {
         kill(sb->pid, SIGKILL);
-        w = waitpid(sb->pid, &status, 0);
+        while ((w = waitpid(sb->pid, &status, 0)) < 0 && errno == EINTR) {}
     }
     fv_sandbox s = *sb;
     free(sb);

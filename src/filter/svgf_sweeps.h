@@ -294,7 +294,15 @@ TAP_INLINE vfw tap_load(const float *b, long q, const int *qi)
 typedef int32_t viw_u __attribute__((vector_size(4 * SVGF_VW), aligned(4), may_alias));
 TAP_INLINE vfw tap_window(const float *b, long q, viw d)
 {
+#if defined(__clang__)
+    /* clang has no two-vector shuffle by variable indices (__builtin_shuffle is GCC's); the same
+     * values lane by lane, for the clang build of the libFuzzer targets (docs/fuzzing.md). */
+    vfw r;
+    for (int j = 0; j < SVGF_VW; j++) r[j] = b[q + d[j]];
+    return r;
+#else
     return __builtin_shuffle(LDW(&b[q]), LDW(&b[q + SVGF_VW]), d);
+#endif
 }
 
 /* For the gathered taps of the fovea's lines: true when the indices qi[0..SVGF_VW) lie in
