@@ -23,7 +23,8 @@ static void usage(FILE *f)
                "  --quick           small sizes, under a minute (the scenario's \"quick\" block)\n"
                "  --full            the papers' sizes (the scenario's \"full\" block)\n"
                "  --repeats N       timing repeats (overrides the scenario)\n"
-               "  --threads N       worker threads, 0 = all [0]\n"
+               "  --threads N       worker threads, 0 = the thread policy's default [0]\n"
+           FV_CLI_THREAD_POLICY_HELP
                "  --device D        run every measured method that has device D there (cpu, portable, cuda,\n"
                "                    auto; docs/gpu.md); methods and references naming a device keep theirs\n"
                "  --check           only validate the scenario\n"
@@ -137,9 +138,9 @@ static void on_status(void *user, const char *line)
 
 int fv_cmd_bench(int argc, char **argv)
 {
-    enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_CHECK, O_LIST, O_QUIET, O_HELP };
+    enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_TPOLICY, O_CHECK, O_LIST, O_QUIET, O_HELP };
     static const struct option longs[] = {{"out", 1, 0, O_OUT},       {"device", 1, 0, O_DEVICE},   {"cache", 1, 0, O_CACHE},     {"quick", 0, 0, O_QUICK},
-                                          {"full", 0, 0, O_FULL},     {"repeats", 1, 0, O_REPEATS}, {"threads", 1, 0, O_THREADS},
+                                          {"full", 0, 0, O_FULL},     {"repeats", 1, 0, O_REPEATS}, {"threads", 1, 0, O_THREADS}, {"thread-policy", 1, 0, O_TPOLICY},
                                           {"check", 0, 0, O_CHECK},   {"list", 0, 0, O_LIST},       {"quiet", 0, 0, O_QUIET},
                                           {"help", 0, 0, O_HELP},     {0, 0, 0, 0}};
     const char *cmd = "bench";
@@ -164,6 +165,9 @@ int fv_cmd_bench(int argc, char **argv)
         case O_REPEATS:
             if (!fv_cli_parse_int(optarg, 1, 1000, &l)) return fv_cli_usage_error(cmd, "--repeats %s: expected an integer in [1, 1000]", optarg);
             opt.repeats = (int)l;
+            break;
+        case O_TPOLICY:
+            if (fv_cli_opt_thread_policy(cmd, optarg)) return FV_EXIT_USAGE;
             break;
         case O_THREADS:
             if (!fv_cli_parse_int(optarg, 0, 256, &l)) return fv_cli_usage_error(cmd, "--threads %s: expected an integer in [0, 256]", optarg);
