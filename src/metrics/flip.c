@@ -18,6 +18,7 @@
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/parallel.h"
 #include "core/alloc.h"
 #include "fovea/film.h"
 #include "fovea/metrics.h"
@@ -63,6 +64,7 @@ static float hyab(const float *a, const float *b)
 /* 1D convolution along x (dir 0) or y (dir 1) with clamp-to-edge, one channel. */
 static void conv1d(const float *in, float *out, int w, int h, const float *k, int r, int dir)
 {
+    fv_region_opened();
     #pragma omp parallel for schedule(static)
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -188,6 +190,7 @@ fv_status fv_metrics_flip_map(const float *ref, const float *test, int w, int h,
     hunt_lab(green, lg);
     hunt_lab(blue, lb);
     const float cmax = powf(hyab(lg, lb), qc);
+    fv_region_opened();
     #pragma omp parallel for schedule(static)
     for (long long ii = 0; ii < (long long)n; ii++) {
         size_t i = (size_t)ii;

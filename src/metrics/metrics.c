@@ -8,6 +8,7 @@
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/parallel.h"
 #include "core/alloc.h"
 #include "fovea/film.h"
 #include "fovea/metrics.h"
@@ -36,6 +37,7 @@ void fv_metrics_prepare(const float *rgb, size_t n, const fv_metric_opts *o, flo
 
 static void blur_sep(const float *in, float *tmp, float *out, int w, int h, const float *k)
 {
+    fv_region_opened();
     #pragma omp parallel for schedule(static)
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -48,6 +50,7 @@ static void blur_sep(const float *in, float *tmp, float *out, int w, int h, cons
             }
             tmp[(size_t)y * w + x] = (float)(s / ws);
         }
+    fv_region_opened();
     #pragma omp parallel for schedule(static)
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -138,6 +141,7 @@ fv_status fv_metrics_compare(const float *ref, const float *test, int w, int h, 
     }
     if (st != FV_OK) goto done;
     /* Per row and region: count, squared error, E, SSIM, FLIP, pixels with a non-finite value. */
+    fv_region_opened();
     #pragma omp parallel for schedule(static)
     for (int y = 0; y < h; y++) {
         double *r = rows + (size_t)y * FV_REGION_COUNT * 6;

@@ -105,6 +105,7 @@ static void grid_extent(fv_photon_map *m, int nt)
 {
     int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
     const int n = m->n;
+    fv_region_opened();
     #pragma omp parallel num_threads(nt)
     {
         int l[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, h[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
@@ -162,6 +163,7 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
     uint32_t *count = fv_calloc_array((size_t)nc * (size_t)nt, sizeof *count);
     if (!count) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
     const int n = m->n;
+    fv_region_opened();
     #pragma omp parallel num_threads(nt)
     {
         const int t = omp_get_thread_num(), T = omp_get_num_threads();
