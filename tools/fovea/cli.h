@@ -133,6 +133,7 @@ int fv_cmd_methods(int argc, char **argv);
 int fv_cmd_scenes(int argc, char **argv);
 int fv_cmd_compare(int argc, char **argv);
 int fv_cmd_bench(int argc, char **argv);
+int fv_cmd_bench_scaling(int argc, char **argv); /* `fovea bench scaling` (cmd_bench_scaling.c) */
 int fv_cmd_view(int argc, char **argv);
 int fv_cmd_gaze(int argc, char **argv);
 

@@ -15,6 +15,7 @@
 static void usage(FILE *f)
 {
     fprintf(f, "usage: fovea bench SCENARIO [options]\n"
+               "       fovea bench scaling [options]  (every method at 1, 2, 4, ... threads; --help there)\n"
                "Renders every method of a scenario side by side, times them (median of repeats) and measures\n"
                "their error per region (fovea, transition, periphery) against a cached reference.\n\n"
                "  SCENARIO          a scenario name (bench/NAME.json) or a path to a .json file\n"
@@ -138,6 +139,8 @@ static void on_status(void *user, const char *line)
 
 int fv_cmd_bench(int argc, char **argv)
 {
+    /* a built-in mode rather than a scenario: it sweeps the thread count, not methods' parameters */
+    if (argc > 1 && !strcmp(argv[1], "scaling")) return fv_cmd_bench_scaling(argc - 1, argv + 1);
     enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_TPOLICY, O_CHECK, O_LIST, O_QUIET, O_HELP };
     static const struct option longs[] = {{"out", 1, 0, O_OUT},       {"device", 1, 0, O_DEVICE},   {"cache", 1, 0, O_CACHE},     {"quick", 0, 0, O_QUICK},
                                           {"full", 0, 0, O_FULL},     {"repeats", 1, 0, O_REPEATS}, {"threads", 1, 0, O_THREADS}, {"thread-policy", 1, 0, O_TPOLICY},
