@@ -65,6 +65,20 @@ check "bench --thread-policy share" OMP_WAIT_POLICY PASSIVE
 grep -q '^  threads: [0-9]* (share: .* OMP_WAIT_POLICY=passive GOMP_SPINCOUNT=0' "$TMP/err" ||
   fail "--stats lacks the thread plan: $(cat "$TMP/err")"
 
+# fovea bench scaling: a row per thread count with the regions a frame opened, the report whole
+"$FOVEA" bench scaling --methods vpolar,pt --size 16x12 --frames 2 --warmup 0 --max-threads 2 --quiet \
+  --report "$TMP/scaling.md" >"$TMP/out" 2>"$TMP/err" || fail "bench scaling exited $?: $(cat "$TMP/err")"
+for m in pt vpolar; do
+  for t in 1 2; do
+    grep -Eq "^\| $m \| cornell \| $t \| [0-9.]+ \| [0-9.]+ \|.* \| [1-9][0-9]* \|$" "$TMP/out" ||
+      fail "bench scaling: no row for $m at $t threads: $(cat "$TMP/out")"
+  done
+done
+cmp -s "$TMP/out" "$TMP/scaling.md" || fail "bench scaling: the report differs from what it printed"
+expect 2 "unknown method 'nope'" -- "$FOVEA" bench scaling --methods vpolar,nope
+expect 2 "--frames 0: expected an integer in [1, 100000]" -- "$FOVEA" bench scaling --frames 0
+expect 2 "unexpected argument 'x'" -- "$FOVEA" bench scaling x
+
 # bad input: one line, exit 2, naming where the name came from
 expect 2 "--thread-policy fast: expected auto, pace, share or openmp" -- "$FOVEA" "${R[@]}" --thread-policy fast
 expect 2 "FOVEA_THREAD_POLICY spin: expected auto" -- env FOVEA_THREAD_POLICY=spin "$FOVEA" "${R[@]}"

@@ -278,7 +278,7 @@ int fv_cmd_bench_scaling(int argc, char **argv)
                 double kf = karp_flatt(a->stage_ms[s], tb, maxt);
                 put(&stages, " %s: %.1f%% (%.0f%%);", a->stage[s], 100.0 * kf, 100.0 * a->stage_ms[s] / a->p50);
             }
-            put(&stages, "\n");
+            put(&stages, " |\n");
         }
         fv_scene_destroy(scene);
         fv_view_destroy(view);
