@@ -33,6 +33,13 @@ typedef struct fv_bench_options {
     /* "cpu", "portable", "cuda", "auto" or NULL: the device of every measured method that has it
      * and whose parameters name none (fovea/device.h); references stay where the scenario puts them. */
     const char *device;
+    /* Called once when the run has written its reports, with the main result table (Markdown,
+     * one row per method: time, speed-up, errors per region) for the caller to show; may be NULL.
+     * Gets status_user. */
+    void (*table)(void *user, const char *text);
+    /* The command that ran this, recorded in the reports as it is (e.g. "fovea bench pt-cornell
+     * --quick"); may be NULL. */
+    const char *command;
 } fv_bench_options;
 
 /* Runs the scenario file at `path`. Bad scenario -> FV_ERR_INVALID naming file and field. Writes
@@ -42,6 +49,12 @@ FV_API fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_
 
 /* Only parses and validates the scenario (for `fovea bench --check`). */
 FV_API fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err);
+
+/* The same for a scenario given as JSON text (`fovea bench --scene ...` builds one): `label`
+ * stands for its file name (messages, and the report's name when the text has no "name"), `dir`
+ * for its folder (relative scene and gaze-trace paths resolve against it). */
+FV_API fv_status fv_bench_run_text(const char *json, const char *label, const char *dir, const fv_bench_options *opt, fv_error *err);
+FV_API fv_status fv_bench_check_text(const char *json, const char *label, const char *dir, fv_bench_mode mode, fv_error *err);
 
 #ifdef __cplusplus
 }

@@ -17,6 +17,7 @@
 #include <stdint.h>
 #include "fovea/math.h"
 #include "fovea/status.h"
+#include "fovea/params.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -90,6 +91,18 @@ FV_API fv_image_format fv_image_format_from_path(const char *path);
  * sRGB-encoded, 8 bits. PFM: exact floats. EXR: half-free 32-bit float R,G,B. */
 FV_API fv_status fv_image_write(const char *path, const float *rgb, int width, int height, float exposure,
                          fv_error *err);
+/* Image metadata: how an image was made, as a bag of key=value text (fovea/params.h; keys
+ * [a-z0-9_-]). Written as PNG text chunks and EXR string attributes named "fovea:KEY"; PFM files
+ * have no metadata (it is dropped). The keys `fovea render` writes are listed in docs/metrics.md.
+ * meta may be NULL (none); the pixels are the same either way. */
+FV_API fv_status fv_image_write_meta(const char *path, const float *rgb, int width, int height, float exposure,
+                                     const fv_params *meta, fv_error *err);
+FV_API fv_status fv_film_write_meta(const fv_film *film, const char *path, float exposure, const fv_params *meta,
+                                    fv_error *err);
+/* Reads the "fovea:" metadata of a PNG or EXR (an empty bag for a PFM or a file without any) into
+ * a new bag *out (release with fv_params_destroy). Other software's entries are left out. */
+FV_API fv_status fv_image_read_meta(const char *path, fv_params **out, fv_error *err);
+
 /* Writes the film: PNG/PFM get the colour; EXR gets colour plus every auxiliary buffer as named
  * channels (depth Z, normal N.x/N.y/N.z, albedo albedo.R/G/B, position P.x/P.y/P.z, id). */
 FV_API fv_status fv_film_write(const fv_film *film, const char *path, float exposure, fv_error *err);

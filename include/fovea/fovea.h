@@ -25,5 +25,6 @@
 #include "fovea/bench.h"
 #include "fovea/sdf.h"
 #include "fovea/limits.h"
+#include "fovea/provenance.h"
 
 #endif

@@ -38,6 +38,9 @@ FV_API int fv_technique_index(const char *name);
 /* The key of method i's samples-per-pixel parameter ("spp" for pt), NULL when the method has no
  * such notion (or i is out of range). */
 FV_API const char *fv_technique_spp_param(int i);
+/* Whether method i spends less effort away from the gaze (its image depends on the gaze); false
+ * for an index out of range. */
+FV_API bool fv_technique_foveated(int i);
 /* Sets method `name`'s samples-per-pixel parameter to spp in params (what the CLI's --spp means
  * for every method). FV_ERR_INVALID, with a one-line message naming the parameter to use instead,
  * when the method has none; the message of fv_technique_create when the name is unknown. */

@@ -14,6 +14,7 @@ typedef struct fv_bench_result {
     double ms_median, ms_min, ms_max;
     double speedup;             /* median over rounds of baseline / this (run.c) */
     fv_stats stages;            /* per stage: median over repeats of the mean per frame */
+    fv_stats stages_min, stages_max; /* the same stages (same order): least and most over repeats */
     fv_stats counters;          /* mean per frame, last repeat */
     fv_metric_report error;     /* mean over frames, per region */
     fv_metric_report error_vs[FV_BENCH_MAX_EXTRA]; /* the same against each extra reference */

@@ -12,7 +12,10 @@
 #include <unistd.h>
 #include "bench/bench_impl.h"
 #include "core/fileio.h"
+#include "core/provenance.h"
+#include "core/rng.h"
 #include "fovea/fovea.h"
+#include "drive/params_json.h"
 
 /* A growable text buffer for the Markdown and CSV files. */
 typedef struct text {
@@ -60,11 +63,32 @@ static fv_status text_write(text *t, const char *path, fv_error *err)
 /* JSON numbers cannot be inf or NaN: those become null. */
 static cJSON *num(double v) { return isfinite(v) ? cJSON_CreateNumber(v) : cJSON_CreateNull(); }
 
-static cJSON *params_json(const fv_params *p)
+/* A method's parameters with their types (numbers as numbers, switches as booleans). */
+static cJSON *params_json(const fv_bench_method *m) { return fv_params_typed_json(m->method, m->params); }
+
+static const char *mode_name(fv_bench_mode m) { return m == FV_BENCH_QUICK ? "quick" : m == FV_BENCH_FULL ? "full" : "default"; }
+
+/* One sentence of the settings this run actually used (after the --quick/--full overrides): a
+ * quick run's report must not claim the default run's sizes, which the scenario's own description
+ * states. */
+static void run_settings(const fv_bench_run_info *info, text *t)
 {
-    cJSON *o = cJSON_CreateObject();
-    for (int i = 0; i < fv_params_count(p); i++) cJSON_AddStringToObject(o, fv_params_key(p, i), fv_params_value(p, i));
-    return o;
+    const fv_scenario *sc = info->sc;
+    int reps = info->opt->repeats > 0 ? info->opt->repeats : sc->repeats;
+    tprintf(t, "This %s run: scene `%s`, %dx%d, %d frame(s) at %g fps from t=%g s, %d repeat(s), seed %llu, %d thread(s); reference `%s`",
+            mode_name(info->opt->mode), sc->scene, sc->width, sc->height, sc->frames, sc->fps, sc->start_time, reps, sc->seed,
+            fv_threads_used(info->threads), sc->reference.method);
+    for (int i = 0; i < fv_params_count(sc->reference.params); i++)
+        tprintf(t, " %s=%s", fv_params_key(sc->reference.params, i), fv_params_value(sc->reference.params, i));
+    tprintf(t, "; methods");
+    for (int i = 0; i < sc->nmethods; i++) {
+        const fv_bench_method *m = &sc->methods[i];
+        tprintf(t, "%s `%s`", i ? "," : "", m->label);
+        for (int k = 0; k < fv_params_count(m->params); k++)
+            tprintf(t, "%s%s=%s", k ? " " : " (", fv_params_key(m->params, k), fv_params_value(m->params, k));
+        if (fv_params_count(m->params)) tprintf(t, ")");
+    }
+    tprintf(t, ".");
 }
 
 static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *r)
@@ -72,7 +96,7 @@ static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *
     cJSON *o = cJSON_CreateObject();
     cJSON_AddStringToObject(o, "method", r->m->label);
     cJSON_AddStringToObject(o, "technique", r->m->method);
-    cJSON_AddItemToObject(o, "params", params_json(r->m->params));
+    cJSON_AddItemToObject(o, "params", params_json(r->m));
     if (r->m->from_sweep) cJSON_AddItemToObject(o, "sweep_value", num(r->m->sweep_value));
     /* With several sweeps a row also says which parameter it varies (one sweep: the old output). */
     if (r->m->from_sweep && info->sc->sweep_array) cJSON_AddStringToObject(o, "sweep_param", info->sc->sweeps[r->m->sweep].param);
@@ -94,6 +118,14 @@ static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *
     for (int i = 0; i < reps; i++) cJSON_AddItemToArray(all, num(r->ms[i]));
     cJSON *st = cJSON_AddObjectToObject(o, "stages_ms");
     for (int i = 0; i < r->stages.n_stages; i++) cJSON_AddItemToObject(st, r->stages.stage[i].name, num(r->stages.stage[i].value));
+    /* Every timing with its spread over the repeats (stages_ms keeps the medians, as before). */
+    cJSON *sr = cJSON_AddObjectToObject(o, "stages_ms_range");
+    for (int i = 0; i < r->stages.n_stages; i++) {
+        cJSON *one = cJSON_AddObjectToObject(sr, r->stages.stage[i].name);
+        cJSON_AddItemToObject(one, "median", num(r->stages.stage[i].value));
+        cJSON_AddItemToObject(one, "min", num(r->stages_min.stage[i].value));
+        cJSON_AddItemToObject(one, "max", num(r->stages_max.stage[i].value));
+    }
     cJSON_AddItemToObject(o, "speedup", num(r->speedup));
     cJSON *er = cJSON_AddObjectToObject(o, "error");
     for (int g = 0; g < FV_REGION_COUNT; g++) {
@@ -145,7 +177,14 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     cJSON *root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "scenario", sc->name);
     if (sc->description) cJSON_AddStringToObject(root, "description", sc->description);
+    text settings = {0};
+    run_settings(info, &settings);
+    cJSON_AddStringToObject(root, "run_description", settings.s ? settings.s : "");
+    free(settings.s);
     cJSON_AddStringToObject(root, "fovea_version", FOVEA_VERSION_STRING);
+    cJSON *prov = fv_provenance_json(info->threads);
+    if (prov && info->opt->command) cJSON_AddStringToObject(prov, "command", info->opt->command);
+    cJSON_AddItemToObject(root, "provenance", prov);
     cJSON_AddStringToObject(root, "scene", sc->scene);
     /* The scene edits, only when asked for (reports of other scenarios stay as they were). */
     if (sc->diffuse) cJSON_AddBoolToObject(root, "diffuse", true);
@@ -166,17 +205,41 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     cJSON_AddNumberToObject(root, "measure_from", sc->measure_from);
     cJSON_AddNumberToObject(root, "fps", sc->fps);
     cJSON_AddNumberToObject(root, "repeats", info->opt->repeats > 0 ? info->opt->repeats : sc->repeats);
-    cJSON_AddNumberToObject(root, "threads", info->threads);
-    cJSON_AddStringToObject(root, "mode", info->opt->mode == FV_BENCH_QUICK ? "quick" : info->opt->mode == FV_BENCH_FULL ? "full" : "default");
+    /* The threads the renders used (0 asked for "all": this says how many that was). */
+    cJSON_AddNumberToObject(root, "threads", fv_threads_used(info->threads));
+    cJSON_AddStringToObject(root, "mode", mode_name(info->opt->mode));
+    cJSON_AddNumberToObject(root, "start_time", sc->start_time);
+    cJSON_AddNumberToObject(root, "exposure", sc->exposure);
+    /* Seeds are 64-bit: as decimal text, which a JSON number (a double) could not hold exactly. */
+    char seed[32];
+    snprintf(seed, sizeof seed, "%llu", sc->seed);
+    cJSON_AddStringToObject(root, "seed", seed);
     cJSON *eye = cJSON_AddObjectToObject(root, "eye");
     cJSON_AddItemToObject(eye, "fovea_radius_px", num(fv_eye_fovea_radius_px(&sc->eye)));
     cJSON_AddItemToObject(eye, "transition_radius_px", num(fv_eye_transition_radius_px(&sc->eye)));
     cJSON *ref = cJSON_AddObjectToObject(root, "reference");
     cJSON_AddStringToObject(ref, "method", sc->reference.method);
-    cJSON_AddItemToObject(ref, "params", params_json(sc->reference.params));
+    cJSON_AddItemToObject(ref, "params", params_json(&sc->reference));
+    /* The reference's own random stream (core/rng.h: fv_seed_reference), never a measured method's. */
+    cJSON_AddStringToObject(ref, "stream", "reference");
+    snprintf(seed, sizeof seed, "%llu", (unsigned long long)fv_seed_reference(sc->seed));
+    cJSON_AddStringToObject(ref, "seed", seed);
     cJSON_AddNumberToObject(ref, "cached_frames", info->ref_cached);
     cJSON_AddItemToObject(ref, "ms_per_frame", info->ref_ms > 0 ? num(info->ref_ms) : cJSON_CreateNull());
     cJSON_AddStringToObject(ref, "image", info->ref_img);
+    if (sc->nextra > 0) {
+        cJSON *ex = cJSON_AddArrayToObject(root, "extra_references");
+        for (int k = 0; k < sc->nextra; k++) {
+            cJSON *e = cJSON_CreateObject();
+            cJSON_AddStringToObject(e, "label", sc->extra[k].label);
+            cJSON_AddStringToObject(e, "method", sc->extra[k].method);
+            cJSON_AddItemToObject(e, "params", params_json(&sc->extra[k]));
+            cJSON_AddStringToObject(e, "stream", "reference");
+            cJSON_AddNumberToObject(e, "cached_frames", info->extra_cached[k]);
+            cJSON_AddItemToObject(e, "ms_per_frame", info->extra_ms[k] > 0 ? num(info->extra_ms[k]) : cJSON_CreateNull());
+            cJSON_AddItemToArray(ex, e);
+        }
+    }
     cJSON_AddStringToObject(root, "baseline", sc->baseline);
     cJSON *rows = cJSON_AddArrayToObject(root, "results");
     for (int i = 0; i < n; i++) cJSON_AddItemToArray(rows, result_json(info, &res[i]));
@@ -205,13 +268,27 @@ static void sweep_stem(const fv_scenario *sc, int k, char *out, size_t n)
     else snprintf(out, n, "%s-sweep", sc->name);
 }
 
-static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
+/* *table: a copy of the main table (NULL when out of memory), for fv_bench_options.table. */
+static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_result *res, int n, char **table, fv_error *err)
 {
     const fv_scenario *sc = info->sc;
     text t = {0};
     char a[32], b[32], c[32], d[32], e[32], f[32], g[32], h[32];
     tprintf(&t, "# Benchmark `%s`\n\n", sc->name);
-    if (sc->description) tprintf(&t, "%s\n\n", sc->description);
+    if (sc->description) tprintf(&t, "%s%s\n\n", info->opt->mode != FV_BENCH_DEFAULT ? "The scenario (its default run): " : "", sc->description);
+    run_settings(info, &t);
+    tprintf(&t, "\n\n");
+    {
+        /* Provenance: which build on which machine, so a figure can be traced (issue 27). */
+        char line[512], date[32];
+        fv_provenance_line(line, sizeof line);
+        fv_host_info host;
+        fv_host_info_get(&host);
+        fv_utc_now(date, sizeof date);
+        tprintf(&t, "Made by %s on %s (%d cores, %s), %d thread(s), %s", line, host.cpu, host.cores, host.os, fv_threads_used(info->threads), date);
+        if (info->opt->command) tprintf(&t, ", with `%s`", info->opt->command);
+        tprintf(&t, ".\n\n");
+    }
     tprintf(&t, "Scene `%s`, %dx%d, %d frame(s) at %g fps (errors from frame %d on), gaze (%.2f, %.2f) at the last frame, fovea radius %.0f px, "
                 "transition %.0f px. Reference: `%s`",
             sc->scene, sc->width, sc->height, sc->frames, sc->fps, sc->measure_from, info->last_gaze.x, info->last_gaze.y, fv_eye_fovea_radius_px(&sc->eye),
@@ -223,20 +300,22 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
                 "Errors are means over frames on display values (exposure %g, sRGB); MSE' is the temporal error "
                 "(Foveated Photon Mapping Eq. 9).\n\n",
             reps, sc->baseline, sc->exposure);
-    tprintf(&t, "| method | params | ms/frame | speed-up | MSE fovea | MSE transition | MSE periphery | SSIM fovea | FLIP fovea | "
-                "FLIP all | MSE' fovea | MSE' periphery |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    size_t table_at = t.len;
+    tprintf(&t, "| method | params | ms/frame | ms min–max | speed-up | MSE fovea | MSE transition | MSE periphery | SSIM fovea | FLIP fovea | "
+                "FLIP all | MSE' fovea | MSE' periphery |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int i = 0; i < n; i++) {
         const fv_bench_result *r = &res[i];
         tprintf(&t, "| %s%s | ", r->m->label, r->m->match > 0 && !r->m->match_reached ? " (target not reached)" : "");
         for (int k = 0; k < fv_params_count(r->m->params); k++)
             tprintf(&t, "%s%s=%s", k ? " " : "", fv_params_key(r->m->params, k), fv_params_value(r->m->params, k));
         const fv_metric_values *v = r->error.region;
-        tprintf(&t, " | %.1f | %.2f | %s | %s | %s | %s | %s | %s | %s | %s |\n", r->ms_median, r->speedup,
+        tprintf(&t, " | %.1f | %.1f–%.1f | %.2f | %s | %s | %s | %s | %s | %s | %s | %s |\n", r->ms_median, r->ms_min, r->ms_max, r->speedup,
                 sci(a, v[FV_REGION_FOVEA].mse), sci(b, v[FV_REGION_TRANSITION].mse), sci(c, v[FV_REGION_PERIPHERY].mse),
                 sci(d, v[FV_REGION_FOVEA].ssim), sci(e, v[FV_REGION_FOVEA].flip), sci(f, v[FV_REGION_ALL].flip),
                 sci(g, r->has_temporal ? r->temporal_mse[FV_REGION_FOVEA] : NAN),
                 sci(h, r->has_temporal ? r->temporal_mse[FV_REGION_PERIPHERY] : NAN));
     }
+    if (!t.oom && t.s) *table = strdup(t.s + table_at);
     /* Ray throughput where a method counts its rays: one camera ray per sample is primary, the
      * rest (bounces and shadow rays) secondary. */
     bool rays = false;
@@ -351,8 +430,12 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
 
 fv_status fv_bench_write_reports(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
 {
+    char *table = NULL;
     fv_status st = write_json(info, res, n, err);
-    if (st == FV_OK) st = write_markdown(info, res, n, err);
+    if (st == FV_OK) st = write_markdown(info, res, n, &table, err);
     for (int k = 0; k < info->sc->nsweeps && st == FV_OK; k++) st = write_sweep(info, res, n, k, err);
+    /* Shown only once every file is written. */
+    if (st == FV_OK && table && info->opt->table) info->opt->table(info->opt->status_user, table);
+    free(table);
     return st;
 }

@@ -19,6 +19,7 @@
 #include "core/params_read.h"
 #include "fovea/device.h"
 #include "core/rng.h"
+#include "drive/frame_meta.h"
 #include "fovea/fovea.h"
 #include "scene/edit.h"
 
@@ -399,8 +400,16 @@ static fv_status method_end(method_run *mr, fv_error *err)
         res->ms_max = fmax(res->ms_max, res->ms[r]);
     }
     fv_stats_clear(&res->stages);
-    for (int q = 0; q < mr->stage_names.n_stages; q++)
-        fv_stats_add_ms(&res->stages, mr->stage_names.stage[q].name, median(mr->stage_per_rep + (size_t)q * reps, reps));
+    fv_stats_clear(&res->stages_min);
+    fv_stats_clear(&res->stages_max);
+    for (int q = 0; q < mr->stage_names.n_stages; q++) {
+        const double *v = mr->stage_per_rep + (size_t)q * reps;
+        double lo = v[0], hi = v[0];
+        for (int r = 1; r < reps; r++) lo = fmin(lo, v[r]), hi = fmax(hi, v[r]);
+        fv_stats_add_ms(&res->stages, mr->stage_names.stage[q].name, median(v, reps));
+        fv_stats_add_ms(&res->stages_min, mr->stage_names.stage[q].name, lo);
+        fv_stats_add_ms(&res->stages_max, mr->stage_names.stage[q].name, hi);
+    }
     fv_stats_clear(&res->counters);
     for (int k = 0; k < c->counter_sum.n_counters; k++)
         fv_stats_add_count(&res->counters, c->counter_sum.counter[k].name, c->counter_sum.counter[k].value / sc->frames);
@@ -428,7 +437,14 @@ static fv_status method_end(method_run *mr, fv_error *err)
     snprintf(res->heat, sizeof res->heat, "%s/%s-flip.png", sc->name, label);
     snprintf(res->crop, sizeof res->crop, "%s/%s-fovea.png", sc->name, label);
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->img);
-    fv_status st = fv_image_write(path, c->last, sc->width, sc->height, sc->exposure, err);
+    /* The frame says how it was made, as `fovea render`'s images do (drive/frame_meta.h). */
+    fv_frame_views v;
+    fv_driver_views(info->driver, sc->frames - 1, &v);
+    fv_frame_meta_run run = {res->m->method, sc->scene, res->m->params, sc->width, sc->height, info->threads, sc->seed, sc->exposure};
+    fv_params *meta = NULL;
+    fv_status st = fv_frame_meta(&run, sc->frames - 1, &v, 0, res->ms_median, &meta, err);
+    if (st == FV_OK) st = fv_image_write_meta(path, c->last, sc->width, sc->height, sc->exposure, meta, err);
+    fv_params_destroy(meta);
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->heat);
     if (st == FV_OK) st = fv_heatmap_write(path, c->flip_map, sc->width, sc->height, 1.0f, &sc->eye, lf->gaze, err);
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->crop);
@@ -645,11 +661,10 @@ static fv_status validate(const fv_scenario *sc, const char *path, const fv_log 
     return st;
 }
 
-fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err)
+/* Validates a loaded scenario (destroyed here); path names it in messages. */
+static fv_status check_loaded(fv_scenario *sc, const char *path, fv_error *err)
 {
-    fv_scenario *sc;
-    fv_status st = fv_scenario_load(path, mode, &sc, err);
-    if (st != FV_OK) return st;
+    fv_status st;
     fv_scene *scene = NULL;
     fv_view *view = NULL;
     st = validate(sc, path, NULL, &scene, &view, err);
@@ -679,9 +694,23 @@ static fv_status apply_device(fv_scenario *sc, const char *device, fv_error *err
     return st;
 }
 
-fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *err)
+fv_status fv_bench_check(const char *path, fv_bench_mode mode, fv_error *err)
 {
-    fv_scenario *sc = NULL;
+    fv_scenario *sc;
+    fv_status st = fv_scenario_load(path, mode, &sc, err);
+    return st == FV_OK ? check_loaded(sc, path, err) : st;
+}
+
+fv_status fv_bench_check_text(const char *json, const char *label, const char *dir, fv_bench_mode mode, fv_error *err)
+{
+    fv_scenario *sc;
+    fv_status st = fv_scenario_load_text(json, label, dir, mode, &sc, err);
+    return st == FV_OK ? check_loaded(sc, label, err) : st;
+}
+
+/* Runs a loaded scenario (destroyed here); path names it in messages. */
+static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_options *opt, fv_error *err)
+{
     fv_scene *scene = NULL;
     fv_view *view = NULL;
     frame_setup *frames = NULL;
@@ -690,8 +719,7 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
     int nrows = 0;
     fv_bench_run_info info;
     memset(&info, 0, sizeof info);
-    fv_status st = fv_scenario_load(path, opt->mode, &sc, err);
-    if (st != FV_OK) return st;
+    fv_status st = FV_OK;
     info.sc = sc;
     info.opt = opt;
     info.threads = opt->threads;
@@ -750,7 +778,15 @@ fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *
     {
         char p[4096 + 160];
         snprintf(p, sizeof p, "%s/%s", info.out_dir, info.ref_img);
-        if ((st = fv_image_write(p, frames[sc->frames - 1].ref[0], sc->width, sc->height, sc->exposure, err)) != FV_OK) goto done;
+        fv_frame_views v;
+        fv_driver_views(info.ref_driver, sc->frames - 1, &v);
+        fv_frame_meta_run run = {sc->reference.method, sc->scene, sc->reference.params, sc->width, sc->height, info.threads,
+                                 fv_seed_reference(sc->seed), sc->exposure};
+        fv_params *meta = NULL;
+        st = fv_frame_meta(&run, sc->frames - 1, &v, 0, info.ref_ms > 0 ? info.ref_ms : -1.0, &meta, err);
+        if (st == FV_OK) st = fv_image_write_meta(p, frames[sc->frames - 1].ref[0], sc->width, sc->height, sc->exposure, meta, err);
+        fv_params_destroy(meta);
+        if (st != FV_OK) goto done;
     }
 
     nrows = sc->nmethods + sc->nmatches;
@@ -787,4 +823,18 @@ done:
     fv_scene_destroy(scene);
     fv_scenario_destroy(sc);
     return st;
+}
+
+fv_status fv_bench_run(const char *path, const fv_bench_options *opt, fv_error *err)
+{
+    fv_scenario *sc;
+    fv_status st = fv_scenario_load(path, opt->mode, &sc, err);
+    return st == FV_OK ? run_loaded(sc, path, opt, err) : st;
+}
+
+fv_status fv_bench_run_text(const char *json, const char *label, const char *dir, const fv_bench_options *opt, fv_error *err)
+{
+    fv_scenario *sc;
+    fv_status st = fv_scenario_load_text(json, label, dir, opt->mode, &sc, err);
+    return st == FV_OK ? run_loaded(sc, label, opt, err) : st;
 }

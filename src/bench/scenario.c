@@ -463,14 +463,14 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
     return FV_OK;
 }
 
-fv_status fv_scenario_load(const char *path, fv_bench_mode mode, fv_scenario **out, fv_error *err)
+/* The scenario in `root` (taken: freed here); `label` names it in messages and gives the default
+ * name (its base name without extension), relative paths resolve against `dir`. */
+static fv_status load_root(cJSON *root, const char *label, const char *dir, fv_bench_mode mode, fv_scenario **out, fv_error *err)
 {
-    cJSON *root = NULL;
-    fv_status st = fv_json_parse_file(path, &root, err);
-    if (st != FV_OK) return st;
+    fv_status st = FV_OK;
     fv_scenario *s = calloc(1, sizeof *s);
-    char *pathcopy = strdup(path), *pathcopy2 = strdup(path);
-    if (!s || !pathcopy || !pathcopy2) {
+    char *labelcopy = strdup(label);
+    if (!s || !labelcopy) {
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
         goto done;
     }
@@ -478,14 +478,14 @@ fv_status fv_scenario_load(const char *path, fv_bench_mode mode, fv_scenario **o
     s->fps = 30.0;
     s->repeats = 3;
     /* Default name: the file name without .json. */
-    const char *base = basename(pathcopy2);
+    const char *base = basename(labelcopy);
     snprintf(s->name, sizeof s->name, "%.*s", (int)(strcspn(base, ".")), base);
     const char *key = mode == FV_BENCH_QUICK ? "quick" : mode == FV_BENCH_FULL ? "full" : NULL;
     const cJSON *over = key ? cJSON_GetObjectItemCaseSensitive(root, key) : NULL;
     for (int k = 0; k < 2; k++) {
         const cJSON *blk = cJSON_GetObjectItemCaseSensitive(root, k ? "full" : "quick");
         if (blk && !cJSON_IsObject(blk)) {
-            st = fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an object of overrides", path, k ? "full" : "quick");
+            st = fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an object of overrides", label, k ? "full" : "quick");
             goto done;
         }
     }
@@ -498,17 +498,39 @@ fv_status fv_scenario_load(const char *path, fv_bench_mode mode, fv_scenario **o
             goto done;
         }
     }
-    st = parse_root(root, path, dirname(pathcopy), s, err);
+    st = parse_root(root, label, dir, s, err);
 done:
     cJSON_Delete(root);
-    free(pathcopy);
-    free(pathcopy2);
+    free(labelcopy);
     if (st != FV_OK) {
         fv_scenario_destroy(s);
         return st;
     }
     *out = s;
     return FV_OK;
+}
+
+fv_status fv_scenario_load(const char *path, fv_bench_mode mode, fv_scenario **out, fv_error *err)
+{
+    cJSON *root = NULL;
+    fv_status st = fv_json_parse_file(path, &root, err);
+    if (st != FV_OK) return st;
+    char *pathcopy = strdup(path);
+    if (!pathcopy) {
+        cJSON_Delete(root);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    }
+    st = load_root(root, path, dirname(pathcopy), mode, out, err);
+    free(pathcopy);
+    return st;
+}
+
+fv_status fv_scenario_load_text(const char *text, const char *label, const char *dir, fv_bench_mode mode, fv_scenario **out, fv_error *err)
+{
+    cJSON *root = NULL;
+    fv_status st = fv_json_parse_text(label, text, &root, err);
+    if (st != FV_OK) return st;
+    return load_root(root, label, dir, mode, out, err);
 }
 
 void fv_scenario_destroy(fv_scenario *s)

@@ -88,6 +88,9 @@ typedef struct fv_scenario {
 } fv_scenario;
 
 fv_status fv_scenario_load(const char *path, fv_bench_mode mode, fv_scenario **out, fv_error *err);
+/* The same from JSON text: `label` stands for the file name (messages, default name), `dir` for
+ * its folder (relative scene and trace paths). */
+fv_status fv_scenario_load_text(const char *text, const char *label, const char *dir, fv_bench_mode mode, fv_scenario **out, fv_error *err);
 void fv_scenario_destroy(fv_scenario *s);
 
 #endif

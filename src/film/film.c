@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "film/film_sums.h"
 #include "fovea/film.h"
 
 struct fv_film {
@@ -14,6 +15,7 @@ struct fv_film {
     unsigned aux;
     float *color, *depth, *normal, *albedo, *position;
     uint32_t *id;
+    double *sums; /* film_sums.h: only when a caller asked for it */
 };
 
 fv_status fv_film_check_size(int width, int height, fv_error *err)
@@ -64,8 +66,18 @@ void fv_film_destroy(fv_film *f)
     free(f->albedo);
     free(f->id);
     free(f->position);
+    free(f->sums);
     free(f);
 }
+
+fv_status fv_film_want_sums(fv_film *f, fv_error *err)
+{
+    if (f->sums) return FV_OK;
+    f->sums = fv_calloc_array((size_t)f->width * (size_t)f->height, 3 * sizeof(double));
+    return f->sums ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d film's sums", f->width, f->height);
+}
+
+double *fv_film_sums(fv_film *f) { return f->sums; }
 
 void fv_film_clear(fv_film *f)
 {

@@ -4,6 +4,9 @@
  *
  * Every write goes through an fv_atomic_file (core/fileio.h): a failed or interrupted write never
  * leaves a truncated image under the requested name.
+ * Metadata (how the image was made: fovea/film.h, fv_image_write_meta) goes into PNG text chunks
+ * before the pixels and EXR string attributes, each named "fovea:KEY" (image_meta.h); PFM has no
+ * place for it. The pixel data is the same with or without it.
  * Limits: PNG read is 8 bits per channel (16-bit files are reduced); EXR read takes the first
  * part, scanline or tiled images decoded by scanline chunks only (tiled files are refused).
  */
@@ -11,6 +14,7 @@
 #include <errno.h>
 #include <math.h>
 #include <png.h>
+#include <setjmp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,6 +24,7 @@
 #include "core/alloc.h"
 #include "core/fileio.h"
 #include "fovea/film.h"
+#include "film/image_meta.h"
 
 fv_image_format fv_image_format_from_path(const char *path)
 {
@@ -32,37 +37,100 @@ fv_image_format fv_image_format_from_path(const char *path)
     return FV_IMG_UNKNOWN;
 }
 
-/* ---- PNG (libpng's simplified API) ---- */
+/* ---- PNG: written with libpng's full API (the simplified one has no text chunks), read with
+ * the simplified one ---- */
 
-static fv_status png_write(const char *path, const float *rgb, int w, int h, float exposure, fv_error *err)
+typedef struct png_wctx {
+    jmp_buf jb;
+    char msg[200];
+} png_wctx;
+
+static void png_on_error(png_structp png, png_const_charp msg)
+{
+    png_wctx *c = png_get_error_ptr(png);
+    snprintf(c->msg, sizeof c->msg, "%s", msg ? msg : "libpng failed");
+    longjmp(c->jb, 1);
+}
+
+static void png_on_warning(png_structp png, png_const_charp msg) { (void)png, (void)msg; }
+
+/* True when the text is printable ASCII, the same in tEXt's Latin-1 and in UTF-8; anything else
+ * goes into an iTXt chunk, whose text is UTF-8 (PNG 1.2, 11.3.4), so other readers see the same
+ * characters. */
+static bool ascii_text(const char *v)
+{
+    for (const unsigned char *c = (const unsigned char *)v; *c; c++)
+        if ((*c < 32 && *c != '\n') || *c >= 127) return false;
+    return true;
+}
+
+/* Writes the 8-bit rows and the text chunks into an open stream; false with c->msg on failure.
+ * Everything the error path frees is allocated by the caller, so the longjmp leaks nothing. */
+static bool png_write_stream(FILE *f, unsigned char *px, png_bytep *rows, png_text *texts, int nt, int w, int h, png_wctx *c)
+{
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, c, png_on_error, png_on_warning);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    if (!png || !info) {
+        snprintf(c->msg, sizeof c->msg, "out of memory");
+        png_destroy_write_struct(&png, NULL);
+        return false;
+    }
+    if (setjmp(c->jb)) {
+        png_destroy_write_struct(&png, &info);
+        return false;
+    }
+    png_init_io(png, f);
+    png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
+    /* The sRGB chunk the simplified writer added: the bytes are sRGB-encoded. */
+    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    if (nt > 0) png_set_text(png, info, texts, nt);
+    for (int y = 0; y < h; y++) rows[y] = px + (size_t)y * (size_t)w * 3;
+    png_write_info(png, info);
+    png_write_image(png, rows);
+    png_write_end(png, NULL);
+    png_destroy_write_struct(&png, &info);
+    return true;
+}
+
+static fv_status png_write(const char *path, const float *rgb, int w, int h, float exposure, const fv_params *meta, fv_error *err)
 {
     size_t n = (size_t)w * (size_t)h * 3;
+    int nm = fv_params_count(meta);
     unsigned char *px = fv_alloc_array(n, 1);
-    if (!px) return fv_error_set(err, FV_ERR_NOMEM, "out of memory writing '%s'", path);
+    png_bytep *rows = fv_alloc_array((size_t)h, sizeof *rows);
+    png_text *texts = fv_calloc_array((size_t)nm + 1, sizeof *texts);
+    char (*keys)[FV_IMAGE_META_KEY_MAX] = fv_calloc_array((size_t)nm + 1, FV_IMAGE_META_KEY_MAX);
+    if (!px || !rows || !texts || !keys) {
+        free(px), free(rows), free(texts), free(keys);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory writing '%s'", path);
+    }
     for (size_t i = 0; i < n; i++) px[i] = (unsigned char)lrintf(255.0f * fv_srgb_encode(rgb[i] * exposure));
+    int nt = 0;
+    for (int i = 0; i < nm; i++) {
+        const char *v = fv_params_value(meta, i);
+        if (!fv_image_meta_name(fv_params_key(meta, i), keys[nt], sizeof keys[nt])) continue;
+        texts[nt].key = keys[nt];
+        texts[nt].text = (png_charp)v;
+        texts[nt].text_length = strlen(v);
+        texts[nt].compression = ascii_text(v) ? PNG_TEXT_COMPRESSION_NONE : PNG_ITXT_COMPRESSION_NONE;
+        nt++;
+    }
     fv_atomic_file af;
     FILE *f = NULL;
     fv_status s = fv_atomic_file_begin(path, &af, err);
     if (s == FV_OK) s = fv_atomic_file_stream(&af, &f, err);
-    if (s != FV_OK) {
-        fv_atomic_file_abort(&af);
-        free(px);
-        return s;
+    if (s == FV_OK) {
+        png_wctx c;
+        c.msg[0] = 0;
+        bool ok = png_write_stream(f, px, rows, texts, nt, w, h, &c);
+        if (ok) s = fv_atomic_file_commit(&af, err);
+        /* libpng says only "Write Error" when the stream fails: the stream's own errno says why. */
+        else if (af.werr) s = fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, strerror(af.werr));
+        else s = fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, c.msg[0] ? c.msg : "libpng failed");
     }
-    png_image img;
-    memset(&img, 0, sizeof img);
-    img.version = PNG_IMAGE_VERSION;
-    img.width = (png_uint_32)w;
-    img.height = (png_uint_32)h;
-    img.format = PNG_FORMAT_RGB;
-    bool ok = png_image_write_to_stdio(&img, f, 0, px, 0, NULL) != 0;
-    if (ok) s = fv_atomic_file_commit(&af, err);
-    /* libpng says only "Write Error" when the stream fails: the stream's own errno says why. */
-    else if (af.werr) s = fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, strerror(af.werr));
-    else s = fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", path, img.message[0] ? img.message : "libpng failed");
     fv_atomic_file_abort(&af);
-    png_image_free(&img);
-    free(px);
+    free(px), free(rows), free(texts), free(keys);
     return s;
 }
 
@@ -236,7 +304,7 @@ typedef struct exr_plane {
     exr_pixel_type_t type;
 } exr_plane;
 
-static fv_status exr_write_planes(const char *path, int w, int h, const exr_plane *planes, int np, fv_error *err)
+static fv_status exr_write_planes(const char *path, int w, int h, const exr_plane *planes, int np, const fv_params *meta, fv_error *err)
 {
     fv_atomic_file af;
     fv_status s = fv_atomic_file_begin(path, &af, err);
@@ -252,6 +320,10 @@ static fv_status exr_write_planes(const char *path, int w, int h, const exr_plan
     if (r == EXR_ERR_SUCCESS) r = exr_initialize_required_attr_simple(ctxt, part, w, h, EXR_COMPRESSION_ZIP);
     for (int i = 0; i < np && r == EXR_ERR_SUCCESS; i++)
         r = exr_add_channel(ctxt, part, planes[i].name, planes[i].type, EXR_PERCEPTUALLY_LINEAR, 1, 1);
+    for (int i = 0; i < fv_params_count(meta) && r == EXR_ERR_SUCCESS; i++) {
+        char name[FV_IMAGE_META_KEY_MAX];
+        if (fv_image_meta_name(fv_params_key(meta, i), name, sizeof name)) r = exr_attr_set_string(ctxt, part, name, fv_params_value(meta, i));
+    }
     if (r == EXR_ERR_SUCCESS) r = exr_write_header(ctxt);
     int32_t lines = 1;
     if (r == EXR_ERR_SUCCESS) r = exr_get_scanlines_per_chunk(ctxt, part, &lines);
@@ -305,7 +377,7 @@ static float *deinterleave(const float *src, size_t n, int c)
     return p;
 }
 
-static fv_status exr_write(const char *path, const float *rgb, int w, int h, const fv_film *film, fv_error *err)
+static fv_status exr_write(const char *path, const float *rgb, int w, int h, const fv_film *film, const fv_params *meta, fv_error *err)
 {
     static const char *const rgbn[3] = {"R", "G", "B"};
     static const char *const nn[3] = {"N.X", "N.Y", "N.Z"};
@@ -337,7 +409,7 @@ static fv_status exr_write(const char *path, const float *rgb, int w, int h, con
     }
     if (film && fv_film_aux_const(film, FV_AUX_DEPTH)) planes[np++] = (exr_plane){"Z", fv_film_aux_const(film, FV_AUX_DEPTH), EXR_PIXEL_FLOAT};
     if (film && fv_film_id_const(film)) planes[np++] = (exr_plane){"id", fv_film_id_const(film), EXR_PIXEL_UINT};
-    fv_status s = ok ? exr_write_planes(path, w, h, planes, np, err) : fv_error_set(err, FV_ERR_NOMEM, "out of memory writing '%s'", path);
+    fv_status s = ok ? exr_write_planes(path, w, h, planes, np, meta, err) : fv_error_set(err, FV_ERR_NOMEM, "out of memory writing '%s'", path);
     for (int i = 0; i < no; i++) free(owned[i]);
     return s;
 }
@@ -469,6 +541,11 @@ static fv_status check_args(const char *path, int w, int h, fv_image_format *fmt
 
 fv_status fv_image_write(const char *path, const float *rgb, int w, int h, float exposure, fv_error *err)
 {
+    return fv_image_write_meta(path, rgb, w, h, exposure, NULL, err);
+}
+
+fv_status fv_image_write_meta(const char *path, const float *rgb, int w, int h, float exposure, const fv_params *meta, fv_error *err)
+{
     fv_image_format fmt;
     fv_status s = check_args(path, w, h, &fmt, err);
     if (s != FV_OK) return s;
@@ -476,21 +553,26 @@ fv_status fv_image_write(const char *path, const float *rgb, int w, int h, float
         return fv_error_set(err, FV_ERR_INVALID, "cannot write '%s': exposure %g must be finite and >= 0", path, exposure);
     if (err) fv_error_clear(err);
     switch (fmt) {
-    case FV_IMG_PNG: return png_write(path, rgb, w, h, exposure, err);
+    case FV_IMG_PNG: return png_write(path, rgb, w, h, exposure, meta, err);
     case FV_IMG_PFM: return pfm_write(path, rgb, w, h, err);
-    default: return exr_write(path, rgb, w, h, NULL, err);
+    default: return exr_write(path, rgb, w, h, NULL, meta, err);
     }
 }
 
 fv_status fv_film_write(const fv_film *film, const char *path, float exposure, fv_error *err)
 {
+    return fv_film_write_meta(film, path, exposure, NULL, err);
+}
+
+fv_status fv_film_write_meta(const fv_film *film, const char *path, float exposure, const fv_params *meta, fv_error *err)
+{
     int w = fv_film_width(film), h = fv_film_height(film);
     fv_image_format fmt;
     fv_status s = check_args(path, w, h, &fmt, err);
     if (s != FV_OK) return s;
-    if (fmt != FV_IMG_EXR) return fv_image_write(path, fv_film_color_const(film), w, h, exposure, err);
+    if (fmt != FV_IMG_EXR) return fv_image_write_meta(path, fv_film_color_const(film), w, h, exposure, meta, err);
     if (err) fv_error_clear(err);
-    return exr_write(path, fv_film_color_const(film), w, h, film, err);
+    return exr_write(path, fv_film_color_const(film), w, h, film, meta, err);
 }
 
 fv_status fv_image_read(const char *path, fv_image *out, fv_error *err) { return fv_image_read_layer(path, "", out, err); }

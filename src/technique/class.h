@@ -49,6 +49,11 @@ typedef struct fv_technique_class {
      * its fovea. The conformance suite checks that such a frame changes its image and makes it
      * independent of the gaze, and that the eye model changes no other method's image. */
     bool foveated;
+    /* The method keeps state between the frames of a sequence (history buffers, photons or VPLs
+     * carried over, a refresh cycle): the frames a block of a sequence starts with, unwritten,
+     * when a sequence is split over MPI ranks (src/dist, docs/distributed.md). 0: no such state;
+     * the conformance suite checks that such a method's frame does not depend on the ones before. */
+    int warmup_frames;
 } fv_technique_class;
 
 /* The class of a registered method by index or name (NULL when unknown). */

@@ -62,6 +62,7 @@ const char *fv_technique_name(int i) { return i >= 0 && i < N_CLASSES ? k_classe
 const char *fv_technique_summary(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->summary : NULL; }
 const char *fv_technique_params_help(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->params_help : NULL; }
 const char *fv_technique_spp_param(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->spp_param : NULL; }
+bool fv_technique_foveated(int i) { return i >= 0 && i < N_CLASSES && k_classes[i]->foveated; }
 
 fv_status fv_technique_set_spp(const char *name, fv_params *params, int spp, fv_error *err)
 {

@@ -608,6 +608,40 @@ static void test_widen(void **st)
     fv_film_destroy(o);
 }
 
+/* A method that states no temporal state (class.h's warmup_frames 0) renders a frame the same
+ * whether it rendered the frames before or starts there: what lets an MPI-split sequence deal its
+ * frames to ranks without warm-up (src/dist, docs/distributed.md). The gaze moves every frame so
+ * that a foveated method's regions change too. Methods with warm-up frames are the ones this
+ * would fail for (tests/cli/test_mpi.sh checks fipr's warm-up gives its exact frames). */
+static void test_history(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    if (c->warmup_frames > 0) return;
+    fv_film *a = film_new(W, H), *b = film_new(W, H);
+    fv_technique *seq = create(c, suite_of(c)->cornell), *fresh = create(c, suite_of(c)->cornell);
+    fv_eye_model eye;
+    fv_eye_model_default(W, H, &eye);
+    fv_error err;
+    for (int i = 0; i < 3; i++) {
+        fv_frame fr = frame_at(&suite_of(c)->cornell_cam, i, 0);
+        fr.eye_model = &eye;
+        fr.gaze = (fv_gaze){0.2f + 0.3f * (float)i, 0.7f - 0.2f * (float)i};
+        fv_stats stats;
+        fv_stats_clear(&stats);
+        if (fv_technique_render(seq, &fr, a, &stats, &err) != FV_OK) fail_msg("%s: frame %d: %s", c->name, i, err.msg);
+        if (i == 2) {
+            fr.prev_camera = NULL;
+            if (fv_technique_render(fresh, &fr, b, &stats, &err) != FV_OK) fail_msg("%s: frame 2 alone: %s", c->name, err.msg);
+        }
+    }
+    if (!same_image(a, b))
+        fail_msg("%s: frame 2 differs after frames 0-1 from frame 2 alone: state it keeps needs warmup_frames (class.h)", c->name);
+    fv_technique_destroy(seq);
+    fv_technique_destroy(fresh);
+    fv_film_destroy(a);
+    fv_film_destroy(b);
+}
+
 /* ---- the table: every check for every registered technique ---- */
 
 typedef struct check {
@@ -618,6 +652,7 @@ typedef struct check {
 static const check k_checks[] = {
     {"furnace", test_furnace}, {"params", test_params},     {"threads", test_threads},   {"stereo", test_stereo},
     {"refusals", test_refusals}, {"overflow", test_overflow}, {"progress", test_progress}, {"widen", test_widen},
+    {"history", test_history},
 };
 #define N_CHECKS (sizeof k_checks / sizeof k_checks[0])
 

@@ -9,12 +9,16 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "bench_cmdline.h"
 #include "cli.h"
+#include "core/json_util.h"
 #include "core/fileio.h"
 
 static void usage(FILE *f)
 {
     fprintf(f, "usage: fovea bench SCENARIO [options]\n"
+               "       fovea bench --scene SCENE --methods M1,M2[:KEY=VALUE...] [--reference pt:spp=1024] [--gaze X,Y |\n"
+               "                   --gaze-trace F] [--frames N] [--size WxH] [--save-scenario F] [options]\n"
                "       fovea bench scaling [options]  (every method at 1, 2, 4, ... threads; --help there)\n"
                "Renders every method of a scenario side by side, times them (median of repeats) and measures\n"
                "their error per region (fovea, transition, periphery) against a cached reference.\n\n"
@@ -29,7 +33,15 @@ static void usage(FILE *f)
                "  --device D        run every measured method that has device D there (cpu, portable, cuda,\n"
                "                    auto; docs/gpu.md); methods and references naming a device keep theirs\n"
                "  --check           only validate the scenario\n"
-               "  --list            list the scenarios found\n"
+               "  --list            list the scenarios found, each with its description's first sentence\n"
+               "Without a scenario file (the same harness, cache and reports; docs/bench.md):\n"
+               "  --scene SCENE     built-in name or scene file to compare the methods on\n"
+               "  --methods LIST    methods, comma-separated, each METHOD[:KEY=VALUE...] (e.g. fpm,pm:photons=20000);\n"
+               "                    speed-ups are relative to the first\n"
+               "  --reference SPEC  the reference, METHOD[:KEY=VALUE...] [pt:spp=1024]\n"
+               "  --gaze X,Y        a fixed gaze [the scene's gaze, else the centre];  --gaze-trace F: a CSV trace\n"
+               "  --frames N        frames [1];  --size WxH: image size [256x256]\n"
+               "  --save-scenario F write the scenario built as a JSON file (to rerun or edit)\n"
                "  --quiet           no progress lines\n");
 }
 
@@ -102,6 +114,27 @@ static int is_json(const struct dirent *e)
     return n > 5 && strcmp(e->d_name + n - 5, ".json") == 0;
 }
 
+/* The first sentence of a scenario's "description" (at most 100 characters), or "" when it has
+ * none or cannot be read: --list shows it beside the name. */
+static void one_line(const char *dir, const char *file, char *out, size_t n)
+{
+    out[0] = 0;
+    char path[PATH_MAX + 256];
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    cJSON *root = NULL;
+    fv_error err;
+    if (fv_json_parse_file(path, &root, &err) != FV_OK) return;
+    const cJSON *d = cJSON_GetObjectItemCaseSensitive(root, "description");
+    if (cJSON_IsString(d) && d->valuestring) {
+        /* A sentence ends at ". " after 40 characters at least: "Figs. 5" or "Eq. 8" end none. */
+        const char *t = d->valuestring, *stop = strlen(t) > 40 ? strstr(t + 40, ". ") : NULL;
+        size_t len = stop ? (size_t)(stop - t) + 1 : strlen(t);
+        if (len > 100) snprintf(out, n, "%.97s...", t);
+        else snprintf(out, n, "%.*s", (int)len, t);
+    }
+    cJSON_Delete(root);
+}
+
 static void list_scenarios(void)
 {
     const char *dirs[4];
@@ -124,11 +157,21 @@ static void list_scenarios(void)
         if (nn < 0) continue;
         printf("%s:\n", dirs[i]);
         for (int k = 0; k < nn; k++) {
-            printf("  %.*s\n", (int)(strlen(names[k]->d_name) - 5), names[k]->d_name);
+            char line[128];
+            one_line(dirs[i], names[k]->d_name, line, sizeof line);
+            printf("  %-22.*s %s\n", (int)(strlen(names[k]->d_name) - 5), names[k]->d_name, line);
             free(names[k]);
         }
         free(names);
     }
+}
+
+/* The result table on stdout, whatever --quiet says: it is the command's output. */
+static void on_table(void *user, const char *text)
+{
+    (void)user;
+    fputs(text, stdout);
+    fflush(stdout);
 }
 
 static void on_status(void *user, const char *line)
@@ -137,20 +180,92 @@ static void on_status(void *user, const char *line)
     fprintf(stderr, "fovea bench: %s\n", line);
 }
 
+/* --scene: the scenario built from the command line is checked first, then saved (--save-scenario:
+ * nothing is written for bad input), then run as a scenario file would be. */
+/* argv as one line for the reports: "fovea bench ARG..." (arguments with spaces quoted). */
+static void command_line(int argc, char **argv, char *out, size_t n)
+{
+    size_t len = (size_t)snprintf(out, n, "fovea bench");
+    for (int i = 1; i < argc && len < n; i++) {
+        bool quote = strpbrk(argv[i], " \t'\"") != NULL;
+        len += (size_t)snprintf(out + len, n - len, quote ? " '%s'" : " %s", argv[i]);
+    }
+}
+
+static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check, bool quiet, fv_bench_options *opt)
+{
+    const char *cmd = "bench";
+    char *json = NULL, label[128];
+    int rc = fv_bench_cmdline_json(cmd, cl, &json, label, sizeof label);
+    if (rc) return rc;
+    fv_log log = fv_cli_log(&quiet);
+    opt->log = &log;
+    if (!quiet) opt->status = on_status;
+    opt->table = on_table;
+    fv_error err;
+    fv_error_clear(&err);
+    /* Relative paths in the JSON are already absolute (bench_cmdline.c): "." is only a fallback. */
+    fv_status s = fv_bench_check_text(json, label, ".", opt->mode, &err);
+    if (s == FV_OK && save) s = fv_file_write_atomic(save, json, strlen(json), &err);
+    if (s == FV_OK && !check) s = fv_bench_run_text(json, label, ".", opt, &err);
+    free(json);
+    if (s != FV_OK) return fv_cli_fail(cmd, s, err.msg);
+    if (check) printf("%s: ok\n", save ? save : label);
+    else if (!quiet) fprintf(stderr, "fovea bench: wrote %s/\n", opt->out_dir);
+    return FV_EXIT_OK;
+}
+
+#ifdef FOVEA_HAVE_MPI
+#include "dist/dist.h"
+/* Under an MPI launcher with several ranks the bench is not split yet (docs/distributed.md, "Not
+ * done yet"): rather than N copies of the same scenario writing the same report, every rank stops
+ * and one says why. Returns the exit status, or -1 to run the bench as usual. */
+static int refuse_ranks(void)
+{
+    if (!fv_dist_launched()) return -1;
+    fv_dist *d = NULL;
+    fv_error err;
+    fv_error_clear(&err);
+    if (fv_dist_start(NULL, NULL, &d, &err) != FV_OK) return fv_cli_fail("bench", FV_ERR_IO, err.msg);
+    int size = fv_dist_size(d), rank = fv_dist_rank(d);
+    fv_dist_end(d);
+    if (size == 1) return -1;
+    if (rank == 0)
+        fv_cli_usage_error("bench", "not split over MPI ranks yet (%d ranks): run `fovea bench` in one process (docs/distributed.md)", size);
+    return FV_EXIT_USAGE;
+}
+#endif
+
 int fv_cmd_bench(int argc, char **argv)
 {
     /* a built-in mode rather than a scenario: it sweeps the thread count, not methods' parameters */
     if (argc > 1 && !strcmp(argv[1], "scaling")) return fv_cmd_bench_scaling(argc - 1, argv + 1);
-    enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_TPOLICY, O_CHECK, O_LIST, O_QUIET, O_HELP };
+#ifdef FOVEA_HAVE_MPI
+    int refused = refuse_ranks();
+    if (refused >= 0) return refused;
+#endif
+    enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_TPOLICY, O_CHECK, O_LIST, O_QUIET, O_HELP, O_SCENE,
+           O_METHODS, O_REFERENCE, O_GAZE, O_GAZE_TRACE, O_FRAMES, O_SIZE, O_SAVE };
     static const struct option longs[] = {{"out", 1, 0, O_OUT},       {"device", 1, 0, O_DEVICE},   {"cache", 1, 0, O_CACHE},     {"quick", 0, 0, O_QUICK},
                                           {"full", 0, 0, O_FULL},     {"repeats", 1, 0, O_REPEATS}, {"threads", 1, 0, O_THREADS}, {"thread-policy", 1, 0, O_TPOLICY},
                                           {"check", 0, 0, O_CHECK},   {"list", 0, 0, O_LIST},       {"quiet", 0, 0, O_QUIET},
-                                          {"help", 0, 0, O_HELP},     {0, 0, 0, 0}};
+                                          {"help", 0, 0, O_HELP},     {"scene", 1, 0, O_SCENE},     {"methods", 1, 0, O_METHODS},
+                                          {"reference", 1, 0, O_REFERENCE}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_GAZE_TRACE},
+                                          {"frames", 1, 0, O_FRAMES}, {"size", 1, 0, O_SIZE},       {"save-scenario", 1, 0, O_SAVE},
+                                          {0, 0, 0, 0}};
     const char *cmd = "bench";
     fv_bench_options opt;
     memset(&opt, 0, sizeof opt);
     opt.out_dir = "bench-out";
-    bool check = false, quiet = false, list = false;
+    /* Before getopt_long, which reorders argv. */
+    char command[2048];
+    command_line(argc, argv, command, sizeof command);
+    opt.command = command;
+    bool check = false, quiet = false, list = false, cmdline = false;
+    fv_bench_cmdline cl;
+    memset(&cl, 0, sizeof cl);
+    const char *save = NULL;
+    int rc;
     long l;
     opterr = 0;
     optind = 1;
@@ -176,6 +291,23 @@ int fv_cmd_bench(int argc, char **argv)
             if (!fv_cli_parse_int(optarg, 0, 256, &l)) return fv_cli_usage_error(cmd, "--threads %s: expected an integer in [0, 256]", optarg);
             opt.threads = (int)l;
             break;
+        case O_SCENE: cl.scene = optarg; break;
+        case O_METHODS: cl.methods = optarg, cmdline = true; break;
+        case O_REFERENCE: cl.reference = optarg, cmdline = true; break;
+        case O_GAZE:
+            if ((rc = fv_cli_opt_gaze(cmd, optarg, cl.gaze))) return rc;
+            cl.has_gaze = cmdline = true;
+            break;
+        case O_GAZE_TRACE: cl.gaze_trace = optarg, cmdline = true; break;
+        case O_FRAMES:
+            if (!fv_cli_parse_int(optarg, 1, 100000, &l)) return fv_cli_usage_error(cmd, "--frames %s: expected an integer in [1, 100000]", optarg);
+            cl.frames = (int)l, cmdline = true;
+            break;
+        case O_SIZE:
+            if ((rc = fv_cli_opt_size(cmd, optarg, &cl.width, &cl.height))) return rc;
+            cmdline = true;
+            break;
+        case O_SAVE: save = optarg, cmdline = true; break;
         case O_CHECK: check = true; break;
         case O_LIST: list = true; break;
         case O_QUIET: quiet = true; break;
@@ -188,6 +320,11 @@ int fv_cmd_bench(int argc, char **argv)
         list_scenarios();
         return FV_EXIT_OK;
     }
+    if (cl.scene) {
+        if (optind != argc) return fv_cli_usage_error(cmd, "--scene builds the scenario: give no SCENARIO file ('%s')", argv[optind]);
+        return run_cmdline(&cl, save, check, quiet, &opt);
+    }
+    if (cmdline) return fv_cli_usage_error(cmd, "--methods, --reference, --gaze, --gaze-trace, --frames, --size and --save-scenario need --scene");
     if (optind != argc - 1) return fv_cli_usage_error(cmd, optind >= argc ? "missing SCENARIO (try fovea bench --list)" : "too many arguments");
     char path[4096];
     if (!resolve(argv[optind], path, sizeof path))
@@ -195,6 +332,7 @@ int fv_cmd_bench(int argc, char **argv)
     fv_log log = fv_cli_log(&quiet);
     opt.log = &log;
     if (!quiet) opt.status = on_status;
+    opt.table = on_table;
     fv_error err;
     fv_error_clear(&err);
     /* A regular file only: the JSON reader opens it by name, and a FIFO would block it. */

@@ -11,7 +11,10 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: fovea compare REF TEST [options]\n"
                "Compares TEST against REF (PNG, PFM or EXR) over the whole image and per region around the gaze.\n\n"
-               "  --gaze X,Y              gaze point in [0,1] screen coordinates [0.5,0.5]\n"
+               "  --gaze X,Y              gaze point in [0,1] screen coordinates [the gaze TEST's metadata records\n"
+               "                          (fovea render writes it), else REF's, else 0.5,0.5]\n"
+               "  --allow-gaze-mismatch   compare even when REF and TEST were both rendered by foveated methods for\n"
+               "                          different gazes (refused otherwise)\n"
                "  --json                  print JSON instead of a table\n"
                "  --heatmap FILE          write a PNG heat map of the per-pixel error\n"
                "  --heatmap-metric M      flip | mse | e [flip]\n"
@@ -34,6 +37,25 @@ static fv_status load(const char *path, fv_image *img, fv_error *err)
     fv_status s = fv_file_check_read(path, "image", err);
     if (s == FV_OK) s = fv_image_read(path, img, err);
     return s;
+}
+
+/* The gaze an image's metadata records (fv_image_read_meta, key "gaze"), and whether the image
+ * depends on it (key "foveated"; a file that does not say is taken to depend on it). false when
+ * the file records no gaze, or one that is not X,Y in [0,1]. */
+static bool recorded_gaze(const char *path, float xy[2], bool *foveated)
+{
+    fv_params *meta = NULL;
+    fv_error err;
+    if (fv_image_read_meta(path, &meta, &err) != FV_OK) return false;
+    const char *gz = NULL, *fov = NULL;
+    for (int i = 0; i < fv_params_count(meta); i++) {
+        if (strcmp(fv_params_key(meta, i), "gaze") == 0) gz = fv_params_value(meta, i);
+        if (strcmp(fv_params_key(meta, i), "foveated") == 0) fov = fv_params_value(meta, i);
+    }
+    bool ok = gz && fv_cli_parse_floats(gz, 2, xy) && xy[0] >= 0 && xy[0] <= 1 && xy[1] >= 0 && xy[1] <= 1;
+    *foveated = !fov || strcmp(fov, "false") != 0;
+    fv_params_destroy(meta);
+    return ok;
 }
 
 /* An empty region has NaN values: the table shows "-" rather than "nan". */
@@ -65,15 +87,16 @@ static void json_string(const char *s)
 
 int fv_cmd_compare(int argc, char **argv)
 {
-    enum { O_GAZE = 256, O_JSON, O_HEAT, O_HEATM, O_EXPOSURE, O_LINEAR, O_PPD, O_FDEG, O_TDEG, O_FFRAC, O_TFRAC, O_PPI, O_EYED, O_FOVX, O_HELP };
+    enum { O_GAZE = 256, O_JSON, O_HEAT, O_HEATM, O_EXPOSURE, O_LINEAR, O_PPD, O_FDEG, O_TDEG, O_FFRAC, O_TFRAC, O_PPI, O_EYED, O_FOVX, O_HELP, O_ALLOW_GAZE };
     static const struct option longs[] = {
         {"gaze", 1, 0, O_GAZE}, {"json", 0, 0, O_JSON}, {"heatmap", 1, 0, O_HEAT}, {"heatmap-metric", 1, 0, O_HEATM},
         {"exposure", 1, 0, O_EXPOSURE}, {"linear", 0, 0, O_LINEAR}, {"ppd", 1, 0, O_PPD}, {"fovea-deg", 1, 0, O_FDEG},
         {"transition-deg", 1, 0, O_TDEG}, {"fovea-frac", 1, 0, O_FFRAC}, {"transition-frac", 1, 0, O_TFRAC},
-        {"ppi", 1, 0, O_PPI}, {"eye-dist", 1, 0, O_EYED}, {"fov-x", 1, 0, O_FOVX}, {"help", 0, 0, O_HELP}, {0, 0, 0, 0}};
+        {"ppi", 1, 0, O_PPI}, {"eye-dist", 1, 0, O_EYED}, {"fov-x", 1, 0, O_FOVX}, {"help", 0, 0, O_HELP},
+        {"allow-gaze-mismatch", 0, 0, O_ALLOW_GAZE}, {0, 0, 0, 0}};
     const char *cmd = "compare";
     float gaze[2] = {0.5f, 0.5f};
-    bool json = false;
+    bool json = false, has_gaze = false, allow_mismatch = false;
     const char *heat = NULL, *heat_metric = "flip";
     fv_metric_opts mo;
     fv_metric_opts_default(&mo);
@@ -88,7 +111,9 @@ int fv_cmd_compare(int argc, char **argv)
         case O_GAZE:
             if (!fv_cli_parse_floats(optarg, 2, gaze) || !(gaze[0] >= 0 && gaze[0] <= 1 && gaze[1] >= 0 && gaze[1] <= 1))
                 return fv_cli_usage_error(cmd, "--gaze %s: expected X,Y with both in [0,1]", optarg);
+            has_gaze = true;
             break;
+        case O_ALLOW_GAZE: allow_mismatch = true; break;
         case O_JSON: json = true; break;
         case O_HEAT: heat = optarg; break;
         case O_HEATM:
@@ -139,6 +164,26 @@ int fv_cmd_compare(int argc, char **argv)
         goto done;
     }
     int w = ref.width, h = ref.height;
+    /* The gaze the images were rendered for, from their metadata: two foveated renders for
+     * different gazes have their detail in different places, and no one region fits both. A
+     * non-foveated image (pt as the reference) looks the same for any gaze: the other's counts. */
+    {
+        float gr[2], gt[2];
+        bool fr = false, ft = false;
+        bool hr = recorded_gaze(ref_path, gr, &fr), ht = recorded_gaze(test_path, gt, &ft);
+        if (hr && ht && fr && ft && !allow_mismatch && (fabsf(gr[0] - gt[0]) > 1e-4f || fabsf(gr[1] - gt[1]) > 1e-4f)) {
+            rc = fv_cli_usage_error(cmd, "%s was rendered for gaze %g,%g and %s for gaze %g,%g: pass --allow-gaze-mismatch to compare them anyway",
+                                    ref_path, gr[0], gr[1], test_path, gt[0], gt[1]);
+            goto done;
+        }
+        /* TEST's gaze, unless only REF depends on its gaze. */
+        bool from_test = ht && (ft || !(hr && fr));
+        if (!has_gaze && (ht || hr)) {
+            gaze[0] = from_test ? gt[0] : gr[0];
+            gaze[1] = from_test ? gt[1] : gr[1];
+            fprintf(stderr, "fovea compare: gaze %g,%g from the metadata of %s (--gaze overrides)\n", gaze[0], gaze[1], from_test ? test_path : ref_path);
+        }
+    }
     fv_eye_model eye;
     fv_eye_model_default(w, h, &eye);
     if (ffrac > 0 || tfrac > 0) {

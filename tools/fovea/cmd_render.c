@@ -11,6 +11,10 @@
 #include <unistd.h>
 #include "cli.h"
 #include "core/parallel.h"
+#include "render_record.h"
+#ifdef FOVEA_HAVE_MPI
+#include "dist/split.h"
+#endif
 
 #define MAX_LIGHTS 64
 
@@ -44,7 +48,13 @@ static void help(void)
            "  --camera-trace FILE   camera over time from a CSV trace (docs/gaze.md)\n"
            "  --stereo SEP          render a stereo pair with eye separation SEP: OUT_left.ext, OUT_right.ext\n"
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
+           "  --warmup N            under MPI (docs/distributed.md): frames each rank's block of a sequence starts\n"
+           "                        with, unwritten, to rebuild a temporal method's history [the method's own]\n"
            "  --stats               print every counter of each frame (rays, steps, ...) after its timings\n"
+           "  --no-metadata         write images without the metadata that says how they were made (method,\n"
+           "                        parameters, camera, gaze, build, date: docs/metrics.md), byte-reproducible\n"
+           "  --stats-json FILE     write every frame's stage timings and counters, with the method, its\n"
+           "                        parameters and the build, as JSON (written whole at the end)\n"
            "  --quiet               no progress bar, warnings or per-frame lines\n"
            "Exit status: 0 ok, 1 internal error, 2 bad input (the message names it), 130/143 interrupted by\n"
            "SIGINT/SIGTERM (frames already written stay; no partial or temporary file).\n");
@@ -67,13 +77,29 @@ static bool dir_writable(const char *path)
     return access(dir, W_OK | X_OK) == 0;
 }
 
+static void print_frame(int f, double ms, const fv_stats *stats, bool show_stats)
+{
+    double rays = fv_stats_get_count(stats, "rays"), bad = fv_stats_get_count(stats, "nan_samples");
+    fprintf(stderr, "frame %d: %.1f ms", f, ms);
+    for (int i = 0; i < stats->n_stages; i++) fprintf(stderr, "  %s %.1f ms", stats->stage[i].name, stats->stage[i].value);
+    if (rays > 0) fprintf(stderr, "  %.2f Mrays/s", rays / (ms * 1e3));
+    if (bad > 0) fprintf(stderr, "  (%.0f NaN/Inf samples discarded)", bad);
+    fputc('\n', stderr);
+    if (show_stats) {
+        fprintf(stderr, "  counters:");
+        for (int i = 0; i < stats->n_counters; i++) fprintf(stderr, " %s=%.10g", stats->counter[i].name, stats->counter[i].value);
+        fputc('\n', stderr);
+    }
+}
+
 typedef struct render_opts {
     const char *scene, *method, *out, *device;
     int width, height, frames, threads, spp;
+    int warmup; /* -1: the method's own */
     double fps, time0, exposure, stereo;
     unsigned long long seed;
-    bool quiet, show_stats, has_pos, has_look, has_up, has_fov, has_gaze;
-    const char *gaze_trace, *camera_trace;
+    bool quiet, show_stats, no_meta, has_pos, has_look, has_up, has_fov, has_gaze;
+    const char *gaze_trace, *camera_trace, *stats_json;
     fv_gaze_missing missing;
     float pos[3], look[3], up[3], fov, gaze[2];
     int nlights;
@@ -81,17 +107,48 @@ typedef struct render_opts {
     fv_cli_scene_opts scene_opts;  /* --env, --no-default-light, --frame-view */
 } render_opts;
 
+/* The files of frame f: OUT.ext, OUT_left/_right.ext for stereo, _NNNN before the extension for a
+ * sequence; each written whole or not at all, and each saying how it was made (method,
+ * parameters, camera, gaze of its eye, ...; docs/metrics.md) unless --no-metadata. */
+static fv_status write_frame(const render_opts *o, const fv_frame_meta_run *rec, fv_driver *driver, fv_film *const *film, int neyes,
+                             int f, double ms, fv_error *err)
+{
+    fv_frame_views views;
+    fv_driver_views(driver, f, &views);
+    fv_status s = FV_OK;
+    for (int e = 0; e < neyes && s == FV_OK; e++) {
+        char path[4096], tmp[4096];
+        snprintf(path, sizeof path, "%s", o->out);
+        if (neyes == 2) {
+            tagged_path(o->out, e ? "_right" : "_left", tmp, sizeof tmp);
+            snprintf(path, sizeof path, "%s", tmp);
+        }
+        if (o->frames > 1) {
+            char tag[32];
+            snprintf(tag, sizeof tag, "_%04d", f);
+            tagged_path(path, tag, tmp, sizeof tmp);
+            snprintf(path, sizeof path, "%s", tmp);
+        }
+        fv_params *meta = NULL;
+        if (!o->no_meta) s = fv_frame_meta(rec, f, &views, e, ms, &meta, err);
+        if (s == FV_OK) s = fv_film_write_meta(film[e], path, (float)o->exposure, meta, err);
+        fv_params_destroy(meta);
+    }
+    return s;
+}
+
+
 static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
     enum { O_METHOD = 256, O_SPP, O_DEVICE, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_TPOLICY, O_OUT, O_EXPOSURE, O_POS,
            O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP,
-           O_MISSING };
+           O_MISSING, O_STATS_JSON, O_NO_META, O_WARMUP };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"device", 1, 0, O_DEVICE}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
         {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS}, {"thread-policy", 1, 0, O_TPOLICY},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
         {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE}, {"gaze-missing", 1, 0, O_MISSING},
-        {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"help", 0, 0, O_HELP},
+        {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"stats-json", 1, 0, O_STATS_JSON}, {"no-metadata", 0, 0, O_NO_META}, {"help", 0, 0, O_HELP}, {"warmup", 1, 0, O_WARMUP},
         FV_CLI_SCENE_LONGOPTS, {0, 0, 0, 0}};
     const char *cmd = "render";
     long l;
@@ -184,8 +241,14 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
         case O_PARAM:
             if ((rc = fv_cli_opt_param(cmd, optarg, params))) return rc;
             break;
+        case O_WARMUP:
+            if (!fv_cli_parse_int(optarg, 0, 1000000, &l)) return fv_cli_usage_error(cmd, "--warmup %s: expected an integer in [0, 1000000]", optarg);
+            o->warmup = (int)l;
+            break;
         case O_QUIET: o->quiet = true; break;
         case O_STATS: o->show_stats = true; break;
+        case O_STATS_JSON: o->stats_json = optarg; break;
+        case O_NO_META: o->no_meta = true; break;
         case O_HELP:
         case 'h': help(); return -1;
         default:
@@ -197,7 +260,119 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
     return 0;
 }
 
-int fv_cmd_render(int argc, char **argv)
+#ifdef FOVEA_HAVE_MPI
+/* ---- over MPI ranks (docs/distributed.md; the split itself is src/dist's) ---- */
+
+typedef struct dist_progress {
+    fv_dist *d;
+    fv_cli_progress *bar;
+} dist_progress;
+
+/* Rank 0's bar; every rank stops here once another failed. */
+static bool on_dist_progress(void *user, double f)
+{
+    dist_progress *p = user;
+    if (fv_dist_poll(p->d)) return false;
+    return fv_cli_progress_frame(p->bar, f);
+}
+
+/* The one line of a failed job, on the rank the agreement chose: "rank R: fovea render: ..." when
+ * not every rank failed (as the held messages of the set-up are replayed), else as one process. */
+static int dist_fail(fv_dist *d, fv_status s, bool print_it, bool name_rank, const char *msg)
+{
+    if (print_it) {
+        if (name_rank) fprintf(stderr, "rank %d: ", fv_dist_rank(d));
+        return fv_cli_fail("render", s, msg);
+    }
+    return fv_cli_exit_code(s);
+}
+
+static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run *rec, const fv_params *params, const fv_scene *scene,
+                       const fv_log *log, fv_driver *driver, fv_technique *tech, fv_film **film, int neyes)
+{
+    const int rank = fv_dist_rank(d), size = fv_dist_size(d);
+    if (rank == 0 && o->stats_json) fv_log_warn(log, "--stats-json: not written by a run split over MPI ranks (yet)");
+    fv_error err;
+    fv_error_clear(&err);
+    fv_status s = FV_OK;
+    bool print_it = false, name_rank = false;
+    fv_cli_progress bar;
+    fv_cli_progress_init(&bar, o->quiet || rank != 0, 1);
+    /* Launchers give a rank a terminal for stdout, not for stderr: rank 0 draws the bar when
+     * the job's output is a terminal. */
+    if (rank == 0 && !o->quiet) bar.enabled = isatty(STDOUT_FILENO);
+    dist_progress dp = {d, &bar};
+    double t0 = fv_time_ms();
+    fv_stats stats;
+    fv_stats_clear(&stats);
+    fv_cli_interrupt_defer(true);
+    if (o->frames == 1) {
+        fv_dist_still_job job = {o->method, params, scene, log, driver, 0, false, on_dist_progress, &dp};
+        const char *spp_key = fv_technique_spp_param(fv_technique_index(o->method));
+        for (int i = 0; spp_key && i < fv_params_count(params); i++)
+            if (!strcmp(fv_params_key(params, i), spp_key)) job.spp = atoi(fv_params_value(params, i));
+        for (int i = 0; i < fv_params_count(params); i++)
+            if (!strcmp(fv_params_key(params, i), "device") && strcmp(fv_params_value(params, i), "cpu")) job.other_device = true;
+        if (fv_dist_still_splits(&job, size)) {
+            s = fv_dist_still(d, &job, film, neyes, &stats, &print_it, &name_rank, &err);
+        } else {
+            /* Not split (docs/distributed.md says which stills are): rank 0 renders it alone. */
+            if (rank == 0) s = fv_driver_render(driver, tech, 0, false, film, &stats, on_dist_progress, &dp, &err);
+            s = fv_dist_agree(d, s, &print_it, &name_rank, &err);
+        }
+        double ms = fv_time_ms() - t0;
+        fv_cli_interrupt_defer(false);
+        fv_cli_progress_done(&bar);
+        if (s != FV_OK) return dist_fail(d, s, print_it, name_rank, err.msg);
+        if (rank != 0) return FV_EXIT_OK;
+        if ((s = write_frame(o, rec, driver, film, neyes, 0, ms, &err)) != FV_OK) return fv_cli_fail("render", s, err.msg);
+        if (!o->quiet) {
+            print_frame(0, ms, &stats, o->show_stats);
+            fprintf(stderr, "mpi: %d ranks; rank 0 moved data for %.3f s, waited for the others %.3f s\n", size,
+                    fv_dist_comm_seconds(d), fv_dist_wait_seconds(d));
+        }
+        return FV_EXIT_OK;
+    }
+    /* A sequence: this rank's block of frames, after its warm-up frames. */
+    int warmup = o->warmup >= 0 ? o->warmup : fv_dist_warmup(o->method), start, first, end;
+    fv_dist_frames(o->frames, rank, size, warmup, &start, &first, &end);
+    bar.frames = end - start > 0 ? end - start : 1;
+    for (int f = start; f < end && s == FV_OK && !fv_cli_interrupted(); f++) {
+        fv_stats_clear(&stats);
+        bar.frame = f - start;
+        double f0 = fv_time_ms();
+        s = fv_driver_render(driver, tech, f, f > start, film, &stats, on_dist_progress, &dp, &err);
+        if (s == FV_OK && f >= first) s = write_frame(o, rec, driver, film, neyes, f, fv_time_ms() - f0, &err);
+        if (s != FV_OK) {
+            /* the others stop at their next progress step (unless this rank only stopped for another) */
+            if (!fv_dist_poll(d)) fv_dist_tell_failure(d);
+        } else if (!o->quiet && rank == 0) {
+            fv_cli_progress_done(&bar);
+            if (f < first) fprintf(stderr, "(warm-up) ");
+            print_frame(f, fv_time_ms() - f0, &stats, o->show_stats);
+        }
+    }
+    if (s == FV_OK && fv_cli_interrupted()) s = fv_error_set(&err, FV_ERR_CANCELLED, "interrupted");
+    fv_cli_interrupt_defer(false);
+    fv_cli_progress_done(&bar);
+    if ((s = fv_dist_agree(d, s, &print_it, &name_rank, &err)) != FV_OK) return dist_fail(d, s, print_it, name_rank, err.msg);
+    if (rank != 0) return FV_EXIT_OK;
+    /* What was split how, beside the frames: OUT_ranks.json. */
+    char path[4096];
+    char noext[4096 - 16];
+    snprintf(noext, sizeof noext, "%s", o->out);
+    char *dot = strrchr(noext, '.'), *slash = strrchr(noext, '/');
+    if (dot && (!slash || dot > slash)) *dot = '\0';
+    snprintf(path, sizeof path, "%s_ranks.json", noext);
+    if ((s = fv_dist_frames_manifest(path, o->method, o->frames, size, warmup, &err)) != FV_OK) return fv_cli_fail("render", s, err.msg);
+    if (!o->quiet)
+        fprintf(stderr, "mpi: %d ranks wrote %d frames (%d warm-up frames per block; %s)\n", size, o->frames, warmup, path);
+    return FV_EXIT_OK;
+}
+#endif
+
+/* dist: the MPI job (fv_dist *) when launched over several ranks, else NULL. */
+static int render(int argc, char **argv, void *dist)
 {
     const char *cmd = "render";
     render_opts o;
@@ -207,6 +382,7 @@ int fv_cmd_render(int argc, char **argv)
     o.out = "fovea.png";
     o.width = o.height = 512;
     o.frames = 1;
+    o.warmup = -1;
     o.fps = 30.0;
     o.exposure = 1.0;
     o.seed = 1;
@@ -221,14 +397,20 @@ int fv_cmd_render(int argc, char **argv)
     fv_film *film[2] = {NULL, NULL};
     fv_gaze_path *trace = NULL;
     fv_camera_path ctrace = {NULL, 0};
+    fv_stats_log *slog = NULL;
     int rc = FV_EXIT_OK;
     fv_status s;
+    bool setup_agreed = false;
 
-    if ((s = fv_params_create(&params, &err)) != FV_OK) return fv_cli_fail(cmd, s, err.msg);
+    if ((s = fv_params_create(&params, &err)) != FV_OK) {
+        rc = fv_cli_fail(cmd, s, err.msg);
+        goto done;
+    }
     int pr = parse(argc, argv, &o, params);
     if (pr != 0) {
-        fv_params_destroy(params);
-        return pr < 0 ? FV_EXIT_OK : pr;
+        rc = pr < 0 ? FV_EXIT_OK : pr;
+        if (pr < 0) setup_agreed = true; /* --help: every rank printed it, nothing to agree */
+        goto done;
     }
     /* Cheap checks first: nothing is loaded or rendered for a typo. */
     if ((s = fv_film_check_size(o.width, o.height, &err)) != FV_OK) {
@@ -242,6 +424,10 @@ int fv_cmd_render(int argc, char **argv)
     }
     if (!dir_writable(o.out)) {
         rc = fv_cli_usage_error(cmd, "--out %s: cannot write there (%s)", o.out, strerror(errno));
+        goto done;
+    }
+    if (o.stats_json && (!o.stats_json[0] || !dir_writable(o.stats_json))) {
+        rc = fv_cli_usage_error(cmd, "--stats-json %s: cannot write there (%s)", o.stats_json, o.stats_json[0] ? strerror(errno) : "empty path");
         goto done;
     }
     if ((rc = fv_cli_check_method(cmd, o.method)) != 0) goto done;
@@ -306,6 +492,11 @@ int fv_cmd_render(int argc, char **argv)
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
     }
+    fv_frame_meta_run rec = {o.method, o.scene, params, o.width, o.height, o.threads, o.seed, (float)o.exposure};
+    if (o.stats_json && !dist && (s = fv_stats_log_create(&rec, &slog, &err)) != FV_OK) {
+        rc = fv_cli_fail(cmd, s, err.msg);
+        goto done;
+    }
     unsigned aux = fmt == FV_IMG_EXR ? FV_AUX_ALL : 0;
     int neyes = fv_driver_eye_count(driver);
     for (int e = 0; e < neyes; e++)
@@ -314,6 +505,19 @@ int fv_cmd_render(int argc, char **argv)
             goto done;
         }
 
+#ifdef FOVEA_HAVE_MPI
+    if (dist) {
+        /* Every rank set up alike: agree, so a problem is said once, then split the work. */
+        bool print_it, name_rank;
+        setup_agreed = true;
+        if ((s = fv_dist_agree(dist, FV_OK, &print_it, &name_rank, &err)) != FV_OK) {
+            rc = fv_cli_exit_code(s);
+            goto done;
+        }
+        rc = render_dist(dist, &o, &rec, params, scene, &log, driver, tech, film, neyes);
+        goto done;
+    }
+#endif
     /* From here a signal stops the render at its next cancellation point (the progress callback
      * cancels) or after the frame's files are written, not at once (cli.h). */
     fv_cli_progress prog;
@@ -326,43 +530,41 @@ int fv_cmd_render(int argc, char **argv)
         double t0 = fv_time_ms();
         if ((s = fv_driver_render(driver, tech, f, f > 0, film, &stats, fv_cli_progress_frame, &prog, &err)) != FV_OK) break;
         double ms = fv_time_ms() - t0;
-        for (int e = 0; e < neyes && s == FV_OK; e++) {
-            char path[4096], tmp[4096];
-            snprintf(path, sizeof path, "%s", o.out);
-            if (neyes == 2) {
-                tagged_path(o.out, e ? "_right" : "_left", tmp, sizeof tmp);
-                snprintf(path, sizeof path, "%s", tmp);
-            }
-            if (o.frames > 1) {
-                char tag[32];
-                snprintf(tag, sizeof tag, "_%04d", f);
-                tagged_path(path, tag, tmp, sizeof tmp);
-                snprintf(path, sizeof path, "%s", tmp);
-            }
-            s = fv_film_write(film[e], path, (float)o.exposure, &err);
-        }
+        fv_frame_views views;
+        fv_driver_views(driver, f, &views);
+        if (slog) s = fv_stats_log_add(slog, f, &views, ms, &stats, &err);
+        if (s == FV_OK) s = write_frame(&o, &rec, driver, film, neyes, f, ms, &err);
         if (s != FV_OK) break;
         if (!o.quiet) {
             fv_cli_progress_done(&prog);
-            double rays = fv_stats_get_count(&stats, "rays"), bad = fv_stats_get_count(&stats, "nan_samples");
-            fprintf(stderr, "frame %d: %.1f ms", f, ms);
-            for (int i = 0; i < stats.n_stages; i++) fprintf(stderr, "  %s %.1f ms", stats.stage[i].name, stats.stage[i].value);
-            if (rays > 0) fprintf(stderr, "  %.2f Mrays/s", rays / (ms * 1e3));
-            if (bad > 0) fprintf(stderr, "  (%.0f NaN/Inf samples discarded)", bad);
-            fputc('\n', stderr);
-            if (o.show_stats) {
-                if (f == 0) fprintf(stderr, "  threads: %d (%s)\n", fv_thread_count(o.threads), fv_cli_thread_plan());
-                fprintf(stderr, "  counters:");
-                for (int i = 0; i < stats.n_counters; i++) fprintf(stderr, " %s=%.10g", stats.counter[i].name, stats.counter[i].value);
-                fputc('\n', stderr);
-            }
+            if (o.show_stats && f == 0) fprintf(stderr, "  threads: %d (%s)\n", fv_thread_count(o.threads), fv_cli_thread_plan());
+            print_frame(f, ms, &stats, o.show_stats);
         }
     }
     fv_cli_interrupt_defer(false);
     fv_cli_progress_done(&prog);
+    /* The log of the frames that were rendered, also after an interruption ("complete": false). */
+    if (slog) {
+        fv_error werr;
+        fv_status ws = fv_stats_log_write(slog, o.stats_json, s == FV_OK && !fv_cli_interrupted(), &werr);
+        if (ws != FV_OK && s == FV_OK) s = ws, err = werr;
+    }
     if (fv_cli_interrupted()) rc = fv_cli_interrupt_exit();
     else if (s != FV_OK) rc = fv_cli_fail(cmd, s, err.msg);
 done:
+#ifdef FOVEA_HAVE_MPI
+    if (dist && !setup_agreed) {
+        /* This rank failed before the split: its message (held) is replayed if the agreement
+         * picks it, and every rank ends with the job's exit status. */
+        bool print_it, name_rank;
+        fv_status js = fv_dist_agree(dist, rc == FV_EXIT_INTERNAL ? FV_ERR_INTERNAL : FV_ERR_INVALID, &print_it, &name_rank, &err);
+        rc = fv_cli_exit_code(js);
+    }
+#else
+    (void)dist;
+    (void)setup_agreed;
+#endif
+    fv_stats_log_destroy(slog);
     fv_driver_destroy(driver);
     fv_gaze_path_destroy(trace);
     fv_camera_keys_free(ctrace.keys);
@@ -373,4 +575,26 @@ done:
     fv_view_destroy(view);
     fv_params_destroy(params);
     return rc;
+}
+
+int fv_cmd_render(int argc, char **argv)
+{
+#ifdef FOVEA_HAVE_MPI
+    /* Launched as one rank of several (mpirun, srun): the job is split (docs/distributed.md). */
+    if (fv_dist_launched()) {
+        fv_dist *d = NULL;
+        fv_error err;
+        fv_error_clear(&err);
+        fv_status s = fv_dist_start(NULL, NULL, &d, &err);
+        if (s != FV_OK) return fv_cli_fail("render", s, err.msg);
+        if (fv_dist_size(d) > 1 && (s = fv_dist_hold(d, &err)) != FV_OK) {
+            fv_dist_end(d);
+            return fv_cli_fail("render", s, err.msg);
+        }
+        int rc = render(argc, argv, fv_dist_size(d) > 1 ? d : NULL);
+        fv_dist_end(d);
+        return rc;
+    }
+#endif
+    return render(argc, argv, NULL);
 }

@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "cli.h"
+#include "core/provenance.h"
 
 typedef struct fv_command {
     const char *name;
@@ -41,7 +42,10 @@ int main(int argc, char **argv)
         return FV_EXIT_OK;
     }
     if (!strcmp(argv[1], "--version")) {
-        printf("fovea %s\n", FOVEA_VERSION_STRING);
+        /* The version and the build it is (commit, dirty flag, type, compiler, Embree). */
+        char line[512];
+        fv_provenance_line(line, sizeof line);
+        printf("%s\n", line);
         return FV_EXIT_OK;
     }
     for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)

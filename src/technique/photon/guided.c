@@ -596,6 +596,8 @@ const fv_technique_class fv_technique_fpm_guided = {
     .render = gd_render,
     .destroy = gd_destroy,
     .foveated = true,
+    /* fpm's temporal photon management (pm.c), the same warm-up */
+    .warmup_frames = 8,
     .test_params = "photons=40000",
     .furnace_params = "radius=0.25",
     .furnace_radiance = 0.998046875, /* pm's: 1 - 0.5^9 (pm.c, FURNACE_TEST) */

@@ -635,4 +635,8 @@ const fv_technique_class fv_technique_fpm = {
     .destroy = pm_destroy,
     FURNACE_TEST,
     .foveated = true,
+    /* Temporal photon management keeps foveated paths while they stay valid, with no bound on
+     * their age: a block of an MPI-split sequence rebuilds most of that pool in 8 frames (the
+     * difference that remains is measured in docs/distributed.md). */
+    .warmup_frames = 8,
 };

@@ -13,12 +13,19 @@
  * Everything is pm's: photon_trace.c traces, photon_map.c grids (a cell of the pass's radius),
  * gather.c follows eye paths and gathers; no filter, which would be a bias of its own. Each eye is
  * rendered on its own, each frame from scratch.
+ *
+ * Passes are summed in double in blocks of FV_SAMPLE_BLOCK, the blocks along core/blocks.h's fixed
+ * tree (up to 64 passes: the plain sum, as always); block_first/block_count render a range of
+ * blocks and leave its double sums in the film (film/film_sums.h), which is how an MPI job deals
+ * passes to ranks and still adds up to the one-process image bit for bit (docs/distributed.md).
  */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "core/blocks.h"
 #include "core/parallel.h"
+#include "film/film_sums.h"
 #include "technique/class.h"
 #include "technique/kit.h"
 #include "technique/photon/gather.h"
@@ -34,6 +41,7 @@ typedef struct ppm_opts {
     double alpha;     /* Eq. 15 */
     double radius;    /* r_1; 0: Eq. 8 */
     int max_depth, eye_depth;
+    int block_first, block_count; /* the blocks of passes rendered */
 } ppm_opts;
 
 typedef struct ppm_state {
@@ -51,6 +59,10 @@ static fv_status read_opts(fv_params *p, ppm_opts *o, fv_error *err)
         (s = fv_params_float(p, "alpha", 2.0 / 3.0, 0.0, 1.0, &o->alpha, err)) ||
         (s = fv_photon_read_radius(p, "initial gather radius", &o->radius, err)) ||
         (s = fv_params_int(p, "max_depth", 8, 1, 64, &o->max_depth, err)) || (s = fv_params_int(p, "eye_depth", 8, 1, 64, &o->eye_depth, err)))
+        return s;
+    const int nb = fv_blocks_count(o->passes);
+    if ((s = fv_params_int(p, "block_first", 0, 0, nb - 1, &o->block_first, err)) ||
+        (s = fv_params_int(p, "block_count", nb - o->block_first, 1, nb - o->block_first, &o->block_count, err)))
         return s;
     /* The readers' bounds are inclusive; Eq. 15 needs both ends open: alpha = 0 would shrink the
      * radius as fast as the photons accumulate (no variance reduction), 1 would never shrink it. */
@@ -123,6 +135,8 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
 {
     ppm_state *st = state;
     const int w = fv_film_width(film), h = fv_film_height(film), passes = st->o.passes;
+    const int nb = fv_blocks_count(passes), b0 = st->o.block_first, b1 = b0 + st->o.block_count;
+    const int p0 = b0 * FV_SAMPLE_BLOCK, p1 = b1 == nb ? passes : b1 * FV_SAMPLE_BLOCK, range = p1 - p0;
     pass_ctx c;
     memset(&c, 0, sizeof c);
     fv_status rc = fv_frame_camera(frame->camera, film, &c.cam, err);
@@ -133,6 +147,9 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
     c.out = fv_film_views_of(film);
     c.sum = fv_calloc_array(n * 3, sizeof *c.sum);
     c.counters = fv_kit_counters_create();
+    /* Finished blocks as a binary counter of node images (core/blocks.h): at most one per bit. */
+    double *node[FV_BLOCKS_MAX_DEPTH] = {0};
+    int node_size[FV_BLOCKS_MAX_DEPTH], nodes = 0;
     if (!c.sum || !c.counters) {
         free(c.sum);
         fv_kit_counters_destroy(c.counters);
@@ -142,12 +159,13 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
     fv_scene_bounds(st->scene, &lo, &hi);
     const double r1 = st->o.radius > 0.0 ? st->o.radius : fv_photon_radius_eq8(lo, hi, w, h);
     double r2 = r1 * r1;
+    for (int pass = 0; pass < p0; pass++) r2 = fv_ppm_next_r2(r2, st->o.alpha, pass + 1); /* Eq. 15 up to the range */
     fv_kit_progress prog = {0};
     uint64_t rays = 0;
     double photons = 0.0, t_light = 0.0, t_render = 0.0;
-    for (int pass = 0; pass < passes && rc == FV_OK; pass++) {
+    for (int pass = p0; pass < p1 && rc == FV_OK; pass++) {
         /* Progress: each pass an equal share; in it, tracing light the first 40%, pixels the rest. */
-        const double base = (double)pass / passes, span = 1.0 / passes;
+        const double base = (double)(pass - p0) / range, span = 1.0 / range;
         c.pass = pass;
         c.r = (float)sqrt(r2);
         c.norm = 1.0f / (FV_PI * c.r * c.r);
@@ -168,13 +186,39 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
             rc = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
         t_render += fv_time_ms() - t0;
         r2 = fv_ppm_next_r2(r2, st->o.alpha, pass + 1);
+        if (nb > 1 && ((pass + 1) % FV_SAMPLE_BLOCK == 0 || pass + 1 == p1)) {
+            /* a block done: onto the counter, merged with equal neighbours (left += right) */
+            node[nodes] = c.sum;
+            node_size[nodes++] = 1;
+            while (nodes >= 2 && node_size[nodes - 1] == node_size[nodes - 2]) {
+                double *l = node[nodes - 2], *r = node[nodes - 1];
+                for (size_t i = 0; i < 3 * n; i++) l[i] += r[i];
+                free(r);
+                node_size[nodes - 2] *= 2;
+                nodes--;
+            }
+            c.sum = pass + 1 < p1 ? fv_calloc_array(n * 3, sizeof *c.sum) : NULL;
+            if (pass + 1 < p1 && !c.sum) rc = fv_error_set(err, FV_ERR_NOMEM, "out of memory for %dx%d progressive photon mapping", w, h);
+        }
     }
+    if (rc == FV_OK && nb > 1) {
+        /* the counter's nodes folded right to left: the tree's order */
+        for (int k = nodes - 2; k >= 0; k--) {
+            for (size_t i = 0; i < 3 * n; i++) node[k][i] = node[k][i] + node[k + 1][i];
+            free(node[k + 1]);
+        }
+        free(c.sum);
+        c.sum = node[0];
+        nodes = 0;
+    }
+    double *sums = fv_film_sums(film);
+    if (rc == FV_OK && sums) memcpy(sums, c.sum, n * 3 * sizeof *sums);
     if (rc == FV_OK) {
         /* The mean of the passes' estimates (Knaus & Zwicker Eq. 5); finite sums can still
          * overflow float when divided back. */
         uint64_t bad = 0;
         for (size_t i = 0; i < n; i++) {
-            fv_vec3 v = fv_kit_guard(fv_v3((float)(c.sum[3 * i] / passes), (float)(c.sum[3 * i + 1] / passes), (float)(c.sum[3 * i + 2] / passes)), &bad);
+            fv_vec3 v = fv_kit_guard(fv_v3((float)(c.sum[3 * i] / range), (float)(c.sum[3 * i + 1] / range), (float)(c.sum[3 * i + 2] / range)), &bad);
             c.out.color[3 * i] = v.x, c.out.color[3 * i + 1] = v.y, c.out.color[3 * i + 2] = v.z;
         }
         fv_kit_count(c.counters, 0, FV_KIT_NAN, bad);
@@ -187,6 +231,7 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
     fv_stats_add_count(stats, "radius_first", r1);
     fv_stats_add_count(stats, "radius_last", c.r);
     fv_kit_counters_destroy(c.counters);
+    for (int k = 0; k < nodes; k++) free(node[k]);
     free(c.sum);
     return rc;
 }
@@ -201,7 +246,9 @@ const fv_technique_class fv_technique_ppm = {
                    "radius=float (Eq. 8): gather radius of the first pass, in scene units\n"
                    "alpha=float (0.667): radius shrinking, r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1), in (0, 1)\n"
                    "max_depth=int (8): photon bounces\n"
-                   "eye_depth=int (8): mirror/glass bounces of eye rays\n",
+                   "eye_depth=int (8): mirror/glass bounces of eye rays\n"
+                   "block_first=int (0): first block of 64 passes rendered (a reference split over MPI ranks)\n"
+                   "block_count=int (all from block_first): blocks of passes rendered; the image is their mean\n",
     .create = ppm_create,
     .render = ppm_render,
     .destroy = ppm_destroy,

@@ -6,10 +6,16 @@
  *    (scene/export.h), which is how CI tests the GPU's code;
  *  - cuda: the same kernel on an NVIDIA GPU (device/cuda_backend.h).
  * All three draw the same random numbers per pixel and sample.
+ * On the cpu, more than FV_SAMPLE_BLOCK samples are summed as blocks along core/blocks.h's fixed
+ * tree in double, and the parameters block_first/block_count render one range of those blocks,
+ * leaving its double sums in the film (film/film_sums.h): how a still is split over processes
+ * (src/dist, docs/distributed.md) and still adds up to the one-process image bit for bit.
  */
 #include <stdlib.h>
 #include <string.h>
+#include "core/blocks.h"
 #include "device/cuda_backend.h"
+#include "film/film_sums.h"
 #include "kernel/pt.h"
 #include "scene/export.h"
 #include "technique/class.h"
@@ -20,6 +26,7 @@ typedef struct pt_state {
     const fv_scene *scene;
     fv_path_opts opt;
     fv_device device;
+    int block_first, block_count; /* the blocks rendered: [first, first + count) of the spp's */
     fv_scene_export *flat; /* portable and cuda: the flat scene at the frame's time */
     fv_cuda_pt *cuda;      /* cuda: the GPU's copy of it */
 } pt_state;
@@ -40,6 +47,11 @@ static fv_status pt_create(const fv_scene *scene, fv_params *params, fv_device d
     st->scene = scene;
     st->device = device;
     fv_status s = fv_path_read_opts(params, &st->opt, err);
+    int nb = s == FV_OK ? fv_blocks_count(st->opt.spp) : 1;
+    if (s == FV_OK) s = fv_params_int(params, "block_first", 0, 0, nb - 1, &st->block_first, err);
+    if (s == FV_OK) s = fv_params_int(params, "block_count", nb - st->block_first, 1, nb - st->block_first, &st->block_count, err);
+    if (s == FV_OK && device != FV_DEVICE_CPU && st->block_count != nb)
+        s = fv_error_set(err, FV_ERR_INVALID, "parameters block_first/block_count: only the cpu device renders a range of sample blocks");
     if (s == FV_OK && device != FV_DEVICE_CPU) s = fv_scene_export_create(scene, &st->flat, err);
     if (s == FV_OK && device == FV_DEVICE_CUDA) s = fv_cuda_pt_create(fv_scene_export_view(st->flat), &st->cuda, err);
     if (s != FV_OK) {
@@ -55,6 +67,7 @@ typedef struct pt_job {
     const fv_frame *frame;
     fv_camera_basis cam;
     fv_film_views out;
+    double *sums; /* the range's double sums, when the film has them */
     fv_kit_counters *counters;
 } pt_job;
 
@@ -66,6 +79,9 @@ static void pt_tile(void *ctx, const fv_tile *tile)
     pt_job *j = ctx;
     const fv_path_opts *opt = &j->st->opt;
     const int w = j->cam.width;
+    const int nb = fv_blocks_count(opt->spp), b0 = j->st->block_first, b1 = b0 + j->st->block_count;
+    int range_spp = 0;
+    for (int b = b0; b < b1; b++) range_spp += fv_blocks_samples(opt->spp, b);
     uint64_t rays = 0, bad = 0;
     for (int y = tile->y0; y < tile->y1; y++) {
         for (int x0 = tile->x0; x0 < tile->x1; x0 += 8) {
@@ -75,31 +91,48 @@ static void pt_tile(void *ctx, const fv_tile *tile)
             fv_rng rng[8];
             fv_hit hits[8];
             bool ok[8];
+            fv_blocks_acc acc[8];
             memset(first, 0, sizeof first);
-            for (int k = 0; k < n; k++) sum[k] = fv_v3s(0.0f);
-            for (int sidx = 0; sidx < opt->spp; sidx++) {
-                for (int k = 0; k < n; k++) {
-                    size_t pix = (size_t)y * (size_t)w + (size_t)(x0 + k);
-                    rng[k] = fv_kit_rng(j->frame, pix, (uint64_t)sidx);
-                    float jx = fv_rng_next(&rng[k]), jy = fv_rng_next(&rng[k]);
-                    dir[k] = fv_camera_dir(&j->cam, (float)(x0 + k) + jx, (float)y + jy);
+            for (int k = 0; k < n; k++) acc[k].n = 0;
+            for (int b = b0; b < b1; b++) {
+                const int s0 = b * FV_SAMPLE_BLOCK, s1 = s0 + fv_blocks_samples(opt->spp, b);
+                for (int k = 0; k < n; k++) sum[k] = fv_v3s(0.0f);
+                for (int sidx = s0; sidx < s1; sidx++) {
+                    for (int k = 0; k < n; k++) {
+                        size_t pix = (size_t)y * (size_t)w + (size_t)(x0 + k);
+                        rng[k] = fv_kit_rng(j->frame, pix, (uint64_t)sidx);
+                        float jx = fv_rng_next(&rng[k]), jy = fv_rng_next(&rng[k]);
+                        dir[k] = fv_camera_dir(&j->cam, (float)(x0 + k) + jx, (float)y + jy);
+                    }
+                    fv_scene_intersect8(j->st->scene, j->cam.pos, dir, n, hits, ok);
+                    for (int k = 0; k < n; k++) {
+                        fv_vec3 L = fv_path_trace_from(j->st->scene, opt, j->cam.pos, dir[k], &hits[k], ok[k], &rng[k],
+                                                       sidx == 0 ? &first[k] : NULL, &rays);
+                        sum[k] = fv_add(sum[k], fv_kit_guard(L, &bad));
+                    }
                 }
-                fv_scene_intersect8(j->st->scene, j->cam.pos, dir, n, hits, ok);
-                for (int k = 0; k < n; k++) {
-                    fv_vec3 L = fv_path_trace_from(j->st->scene, opt, j->cam.pos, dir[k], &hits[k], ok[k], &rng[k],
-                                                   sidx == 0 ? &first[k] : NULL, &rays);
-                    sum[k] = fv_add(sum[k], fv_kit_guard(L, &bad));
-                }
+                if (nb > 1)
+                    for (int k = 0; k < n; k++) fv_blocks_acc_push(&acc[k], sum[k].x, sum[k].y, sum[k].z);
             }
             for (int k = 0; k < n; k++) {
                 size_t pix = (size_t)y * (size_t)w + (size_t)(x0 + k);
-                /* finite samples can still sum past the float range */
-                fv_vec3 v = fv_kit_guard(fv_scale(sum[k], 1.0f / (float)opt->spp), &bad);
-                const fv_path_first_hit *f = &first[k];
+                double tot[3] = {sum[k].x, sum[k].y, sum[k].z};
+                fv_vec3 v;
+                if (nb == 1) {
+                    /* finite samples can still sum past the float range */
+                    v = fv_kit_guard(fv_scale(sum[k], 1.0f / (float)opt->spp), &bad);
+                } else {
+                    float c[3];
+                    fv_blocks_acc_total(&acc[k], tot);
+                    bad += (uint64_t)fv_blocks_pixel(tot, range_spp, c);
+                    v = fv_v3(c[0], c[1], c[2]);
+                }
                 j->out.color[3 * pix] = v.x;
                 j->out.color[3 * pix + 1] = v.y;
                 j->out.color[3 * pix + 2] = v.z;
-                fv_film_store_first_hit(&j->out, pix, f->hit, f->t, f->p, f->n, f->albedo, f->obj);
+                if (j->sums) j->sums[3 * pix] = tot[0], j->sums[3 * pix + 1] = tot[1], j->sums[3 * pix + 2] = tot[2];
+                const fv_path_first_hit *f = &first[k];
+                if (b0 == 0) fv_film_store_first_hit(&j->out, pix, f->hit, f->t, f->p, f->n, f->albedo, f->obj);
             }
         }
     }
@@ -178,13 +211,16 @@ static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv
     j.st = st;
     j.frame = frame;
     j.out = fv_film_views_of(film);
+    j.sums = fv_film_sums(film);
     fv_kit_progress prog = {0};
     fv_kit_phase(&prog, frame, 0.0, 1.0);
     double t0 = fv_time_ms();
     bool done = fv_parallel_tiles(cam->width, cam->height, frame->threads, pt_tile, &j, fv_kit_progress_fn, &prog);
     fv_stats_add_ms(stats, "trace", fv_time_ms() - t0);
     fv_kit_report(j.counters, stats);
-    fv_stats_add_count(stats, "samples", (double)cam->width * cam->height * st->opt.spp);
+    int range_spp = 0;
+    for (int b = st->block_first; b < st->block_first + st->block_count; b++) range_spp += fv_blocks_samples(st->opt.spp, b);
+    fv_stats_add_count(stats, "samples", (double)cam->width * cam->height * range_spp);
     fv_kit_counters_destroy(j.counters);
     return done ? FV_OK : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
 }
@@ -194,7 +230,9 @@ const fv_technique_class fv_technique_pt = {
     .summary = "reference path tracer: NEE + MIS, Russian roulette (ground truth)",
     .params_help = "spp=int (16): samples per pixel\n"
                    "max_depth=int (8): path vertices that gather light, 1 = direct light only\n"
-                   "rr_depth=int (3): depth from which Russian roulette may end paths\n",
+                   "rr_depth=int (3): depth from which Russian roulette may end paths\n"
+                   "block_first=int (0): first block of 64 samples rendered (cpu; a still split over MPI ranks)\n"
+                   "block_count=int (all from block_first): blocks rendered; the image is their mean\n",
     .create_on = pt_create,
     .devices = (1u << FV_DEVICE_PORTABLE) | (1u << FV_DEVICE_CUDA),
     .render = pt_render,

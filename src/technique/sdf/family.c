@@ -131,24 +131,30 @@ static fv_status create_fipr(const fv_scene *s, fv_params *p, const fv_log *l, v
  * sdf-furnace the camera and a point light of intensity 2 pi sit at the centre of a hollow sphere
  * of radius 1 and albedo 0.5, so every pixel sees albedo / pi x I / r^2 = 1 (the hit stops a hit
  * distance short of the wall: well under the tolerance). */
-#define SDF_CLASS(id, nm, sum, help, fn, fov)                                                                         \
+/* fipr keeps the colour of pixels outside the mask for up to refresh - 1 frames (at most 3): a
+ * block of an MPI-split sequence that starts 3 frames early has every such pixel shaded as one
+ * process shades it (the refresh pattern follows the frame index), so its frames are the
+ * one-process frames bit for bit (tests/cli/test_mpi.sh). */
+#define FIPR_WARMUP 3
+
+#define SDF_CLASS(id, nm, sum, help, fn, fov, warmup)                                                                 \
     const fv_technique_class id = {.name = nm, .summary = sum, .params_help = COMMON_HELP help, .create = fn, .render = render, \
                                    .destroy = destroy, .sdf_only = true, .test_params = "spp=1", .furnace_radiance = 1.0,      \
-                                   .furnace_tolerance = 0.01, .spp_param = "spp", .foveated = fov}
+                                   .furnace_tolerance = 0.01, .spp_param = "spp", .foveated = fov, .warmup_frames = warmup}
 
 SDF_CLASS(fv_technique_sdf_gt, "sdf-gt", "sphere tracing of every target sample from the camera (ground truth of ipr/fipr)",
-          "show=image|steps (image): the image, or steps per ray from blue (1) to red (256)\n", create_gt, false);
+          "show=image|steps (image): the image, or steps per ray from blue (1) to red (256)\n", create_gt, false, 0);
 SDF_CLASS(fv_technique_sdf_relaxed, "sdf-relaxed", "over-relaxed sphere tracing (Keinert et al. 2014) of every target sample",
           "relax=float (1.6): step factor in [1, 2)\n"
           "show=image|steps (image): the image, or steps per ray from blue (1) to red (256)\n",
-          create_relaxed, false);
+          create_relaxed, false, 0);
 SDF_CLASS(fv_technique_ipr, "ipr", "inverted-pyramid sphere tracing: each level starts at the min-filtered depth of the one below",
           "levels=int (3): pyramid levels, 1 = sdf-gt (the tip has 1/4^(levels-1) of the rays)\n"
           "min_filter=bool (true): start at the 3x3 minimum of the depths below (false: the parent's depth)\n"
           "relax=float (1): over-relaxation of every level's march, in [1, 2)\n"
           "shadow_reuse=bool (false): ours, for a CPU: take shadows from the level below where its 3x3 agree\n"
           "show=image|steps|level (image): the image, steps per ray, or the level each pixel came from\n",
-          create_ipr, false);
+          create_ipr, false, 0);
 SDF_CLASS(fv_technique_fipr, "fipr", "foveated inverted-pyramid sphere tracing: the five passes of Polychronakis et al. 2023",
           "levels=int (3): pyramid levels, 3 to 6\n"
           "min_filter=bool (true): start at the 3x3 minimum of the depths below\n"
@@ -161,4 +167,4 @@ SDF_CLASS(fv_technique_fipr, "fipr", "foveated inverted-pyramid sphere tracing: 
           "blur=bool (false): pass 5, a Gaussian blur of the mask's transitions\n"
           "blur_sigma=float (2): its standard deviation in pixels\n"
           "show=image|steps|level|mask|edges (image): the image or a pass's output\n",
-          create_fipr, true);
+          create_fipr, true, FIPR_WARMUP);

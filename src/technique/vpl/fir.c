@@ -826,6 +826,10 @@ const fv_technique_class fv_technique_fir = {
     .render = fir_render,
     .destroy = fir_destroy,
     .foveated = true,
+    /* VPLs survive from frame to frame while they stay important (the management of manage.c), so
+     * a block of an MPI-split sequence starts 8 frames early (docs/distributed.md measures what
+     * remains) */
+    .warmup_frames = 8,
     /* furnace: emitted 0.5 + direct 0.25 + the VPLs' two bounces 0.1875 = 0.9375; a first frame
      * measures 0.892: its few hundred VPLs' cells and their neighbours cover less of the sphere
      * than a full set's (0.546 of 0.5625 for the VPL term after three frames) */
