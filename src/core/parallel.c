@@ -2,6 +2,16 @@
 #include <omp.h>
 #include "core/parallel.h"
 
+/* The one piece of mutable state in the library, and why it is per thread: regions are opened by
+ * the thread that renders (nested regions are off), so its own count is exactly the regions of
+ * its frames, whatever other renders other threads run; passing a counter to every stage and
+ * filter that opens a region would thread one more argument through forty call sites for a
+ * number that never changes a pixel. */
+static _Thread_local uint64_t t_regions;
+
+uint64_t fv_region_count(void) { return t_regions; }
+void fv_region_opened(void) { t_regions++; }
+
 int fv_thread_count(int requested)
 {
     int n = requested > 0 ? requested : omp_get_max_threads();
@@ -18,6 +28,7 @@ bool fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *
     const int ntiles = tx * ty;
     const int nthreads = fv_thread_count(threads);
     int done = 0, stop = 0;
+    fv_region_opened();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
     for (int i = 0; i < ntiles; i++) {
         int halt;
@@ -52,6 +63,7 @@ bool fv_parallel_for_progress(int64_t n, int64_t chunk, int threads, fv_range_fn
     const int nthreads = fv_thread_count(threads);
     int64_t done = 0;
     int stop = 0;
+    fv_region_opened();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
     for (int64_t c = 0; c < nchunks; c++) {
         int halt;

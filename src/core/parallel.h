@@ -37,4 +37,12 @@ void fv_parallel_for(int64_t n, int64_t chunk, int threads, fv_range_fn fn, void
 bool fv_parallel_for_progress(int64_t n, int64_t chunk, int threads, fv_range_fn fn, void *ctx, fv_progress_fn progress,
                               void *progress_user);
 
+/* The parallel regions the calling thread has opened so far. Every `#pragma omp parallel` in
+ * fovea is preceded by fv_region_opened() (fv_parallel_* call it themselves), so that
+ * fv_technique_render can report "parallel_regions" per frame: each region wakes the team, and
+ * the wake-ups are what pacing depends on (docs/threads.md). tests/cli/test_regions.sh checks the
+ * count against the runtime's own. */
+uint64_t fv_region_count(void);
+void fv_region_opened(void);
+
 #endif

@@ -16,8 +16,10 @@
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/parallel.h"
 #include "core/alloc.h"
 #include "filter/atrous.h"
+#include "filter/demod.h"
 #include "fovea/math.h"
 
 void fv_atrous_opts_default(fv_atrous_opts *o)
@@ -26,6 +28,8 @@ void fv_atrous_opts_default(fv_atrous_opts *o)
     o->sigma_color = 0.8f;
     o->sigma_normal = 0.3f;
     o->sigma_position = 0.0f;
+    o->demod = NULL;
+    o->threads = 0;
 }
 
 static const float k_b3[5] = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
@@ -55,71 +59,114 @@ fv_status fv_atrous_filter(float *rgb, const float *normal, const float *positio
                             (double)o->sigma_position);
     size_t n = (size_t)w * h;
     float *tmp = fv_alloc_array(n, 3 * sizeof(float));
-    if (!tmp) return fv_error_set(err, FV_ERR_NOMEM, "out of memory filtering a %dx%d image", w, h);
-    /* The colour scale: the mean luminance of the surface pixels. */
-    double lum = 0.0;
-    long count = 0;
-    for (size_t i = 0; i < n; i++)
-        if (has_surface(normal, i)) {
-            float l = 0.2126f * rgb[3 * i] + 0.7152f * rgb[3 * i + 1] + 0.0722f * rgb[3 * i + 2];
-            if (isfinite(l)) lum += l, count++;
-        }
-    float scale = count > 0 && lum > 0.0 ? (float)(lum / count) : 1.0f;
-    float *src = rgb, *dst = tmp;
+    /* per-row luminance sums: added up in row order after, the same whatever the thread count */
+    double *row_lum = fv_alloc_array((size_t)h, sizeof(double));
+    long *row_count = fv_alloc_array((size_t)h, sizeof(long));
+    if (!tmp || !row_lum || !row_count) {
+        free(tmp), free(row_lum), free(row_count);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory filtering a %dx%d image", w, h);
+    }
     const float inv_n2 = 1.0f / (o->sigma_normal * o->sigma_normal);
     const float inv_x2 = o->sigma_position > 0.0f ? 1.0f / (o->sigma_position * o->sigma_position) : 0.0f;
-    for (int it = 0; it < o->iterations; it++) {
-        int step = 1 << it;
-        float sc = o->sigma_color * scale / (float)(1 << it); /* halves every iteration */
-        float inv_c2 = 1.0f / (sc * sc);
-        #pragma omp parallel for schedule(static)
-        for (int y = 0; y < h; y++)
+    const float *demod = o->demod;
+    float scale = 1.0f;
+    /* One region for the whole filter (docs/threads.md): every pass is an `omp for` whose implicit
+     * barrier orders it before the next, instead of a region per pass that wakes the team again. */
+    fv_region_opened();
+    #pragma omp parallel num_threads(fv_thread_count(o->threads))
+    {
+        #pragma omp for schedule(static)
+        for (int y = 0; y < h; y++) {
+            double lum = 0.0;
+            long count = 0;
             for (int x = 0; x < w; x++) {
-                size_t p = (size_t)y * w + x;
-                const float *cp = &src[3 * p];
-                if (!has_surface(normal, p)) {
-                    memcpy(&dst[3 * p], cp, 3 * sizeof(float));
-                    continue;
+                size_t i = (size_t)y * w + x;
+                if (demod) {
+                    float d[3];
+                    fv_demod_factors(&demod[3 * i], d);
+                    for (int k = 0; k < 3; k++) rgb[3 * i + k] /= d[k];
                 }
-                float sum[3] = {0, 0, 0}, wsum = 0.0f;
-                for (int j = -2; j <= 2; j++) {
-                    int yy = y + j * step;
-                    if (yy < 0 || yy >= h) continue;
-                    for (int i = -2; i <= 2; i++) {
-                        int xx = x + i * step;
-                        if (xx < 0 || xx >= w) continue;
-                        size_t q = (size_t)yy * w + xx;
-                        if (!has_surface(normal, q)) continue;
-                        const float *cq = &src[3 * q];
-                        float dc = (cp[0] - cq[0]) * (cp[0] - cq[0]) + (cp[1] - cq[1]) * (cp[1] - cq[1]) + (cp[2] - cq[2]) * (cp[2] - cq[2]);
-                        /* dc > 0 test: a tiny image scale can make inv_c2 infinite, and 0 * inf
-                         * would turn identical neighbours into NaN weights. */
-                        float e = dc > 0.0f ? dc * inv_c2 : 0.0f;
-                        if (normal) {
-                            const float *np = &normal[3 * p], *nq = &normal[3 * q];
-                            float dn = (np[0] - nq[0]) * (np[0] - nq[0]) + (np[1] - nq[1]) * (np[1] - nq[1]) + (np[2] - nq[2]) * (np[2] - nq[2]);
-                            if (dn > 0.0f) e += dn * inv_n2;
-                        }
-                        if (position && inv_x2 > 0.0f) {
-                            const float *xp = &position[3 * p], *xq = &position[3 * q];
-                            float dx = (xp[0] - xq[0]) * (xp[0] - xq[0]) + (xp[1] - xq[1]) * (xp[1] - xq[1]) + (xp[2] - xq[2]) * (xp[2] - xq[2]);
-                            if (dx > 0.0f) e += dx * inv_x2;
-                        }
-                        float wt = k_b3[i + 2] * k_b3[j + 2] * expf(-e);
-                        if (!(wt > 0.0f) || !fv_is_finite3(fv_v3(cq[0], cq[1], cq[2]))) continue;
-                        sum[0] += wt * cq[0];
-                        sum[1] += wt * cq[1];
-                        sum[2] += wt * cq[2];
-                        wsum += wt;
-                    }
+                if (has_surface(normal, i)) {
+                    float l = 0.2126f * rgb[3 * i] + 0.7152f * rgb[3 * i + 1] + 0.0722f * rgb[3 * i + 2];
+                    if (isfinite(l)) lum += l, count++;
                 }
-                for (int c = 0; c < 3; c++) dst[3 * p + c] = wsum > 0.0f ? sum[c] / wsum : cp[c];
             }
-        float *t = src;
-        src = dst;
-        dst = t;
+            row_lum[y] = lum;
+            row_count[y] = count;
+        }
+        /* The colour scale: the mean luminance of the surface pixels (one thread adds the rows up;
+         * the barrier after `single` publishes it). */
+        #pragma omp single
+        {
+            double lum = 0.0;
+            long count = 0;
+            for (int y = 0; y < h; y++) lum += row_lum[y], count += row_count[y];
+            scale = count > 0 && lum > 0.0 ? (float)(lum / count) : 1.0f;
+        }
+        for (int it = 0; it < o->iterations; it++) {
+            /* ping-pong: even passes read rgb and write tmp, odd ones the other way */
+            const float *src = it % 2 == 0 ? rgb : tmp;
+            float *dst = it % 2 == 0 ? tmp : rgb;
+            int step = 1 << it;
+            float sc = o->sigma_color * scale / (float)(1 << it); /* halves every iteration */
+            float inv_c2 = 1.0f / (sc * sc);
+            #pragma omp for schedule(static)
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < w; x++) {
+                    size_t p = (size_t)y * w + x;
+                    const float *cp = &src[3 * p];
+                    if (!has_surface(normal, p)) {
+                        memcpy(&dst[3 * p], cp, 3 * sizeof(float));
+                        continue;
+                    }
+                    float sum[3] = {0, 0, 0}, wsum = 0.0f;
+                    for (int j = -2; j <= 2; j++) {
+                        int yy = y + j * step;
+                        if (yy < 0 || yy >= h) continue;
+                        for (int i = -2; i <= 2; i++) {
+                            int xx = x + i * step;
+                            if (xx < 0 || xx >= w) continue;
+                            size_t q = (size_t)yy * w + xx;
+                            if (!has_surface(normal, q)) continue;
+                            const float *cq = &src[3 * q];
+                            float dc = (cp[0] - cq[0]) * (cp[0] - cq[0]) + (cp[1] - cq[1]) * (cp[1] - cq[1]) + (cp[2] - cq[2]) * (cp[2] - cq[2]);
+                            /* dc > 0 test: a tiny image scale can make inv_c2 infinite, and 0 * inf
+                             * would turn identical neighbours into NaN weights. */
+                            float e = dc > 0.0f ? dc * inv_c2 : 0.0f;
+                            if (normal) {
+                                const float *np = &normal[3 * p], *nq = &normal[3 * q];
+                                float dn = (np[0] - nq[0]) * (np[0] - nq[0]) + (np[1] - nq[1]) * (np[1] - nq[1]) + (np[2] - nq[2]) * (np[2] - nq[2]);
+                                if (dn > 0.0f) e += dn * inv_n2;
+                            }
+                            if (position && inv_x2 > 0.0f) {
+                                const float *xp = &position[3 * p], *xq = &position[3 * q];
+                                float dx = (xp[0] - xq[0]) * (xp[0] - xq[0]) + (xp[1] - xq[1]) * (xp[1] - xq[1]) + (xp[2] - xq[2]) * (xp[2] - xq[2]);
+                                if (dx > 0.0f) e += dx * inv_x2;
+                            }
+                            float wt = k_b3[i + 2] * k_b3[j + 2] * expf(-e);
+                            if (!(wt > 0.0f) || !fv_is_finite3(fv_v3(cq[0], cq[1], cq[2]))) continue;
+                            sum[0] += wt * cq[0];
+                            sum[1] += wt * cq[1];
+                            sum[2] += wt * cq[2];
+                            wsum += wt;
+                        }
+                    }
+                    for (int c = 0; c < 3; c++) dst[3 * p + c] = wsum > 0.0f ? sum[c] / wsum : cp[c];
+                }
+        }
+        /* the result back into rgb (after an odd number of passes it is in tmp), remodulated */
+        const float *res = o->iterations % 2 == 1 ? tmp : rgb;
+        if (res != rgb || demod) {
+            #pragma omp for schedule(static)
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < w; x++) {
+                    size_t i = (size_t)y * w + x;
+                    float d[3] = {1.0f, 1.0f, 1.0f};
+                    if (demod) fv_demod_factors(&demod[3 * i], d);
+                    for (int k = 0; k < 3; k++) rgb[3 * i + k] = res[3 * i + k] * d[k];
+                }
+        }
     }
-    if (src != rgb) memcpy(rgb, src, n * 3 * sizeof(float));
-    free(tmp);
+    free(tmp), free(row_lum), free(row_count);
     return FV_OK;
 }

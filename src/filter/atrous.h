@@ -21,11 +21,16 @@ typedef struct fv_atrous_opts {
     float sigma_color;     /* relative to the image's mean luminance, so exposure does not matter */
     float sigma_normal;    /* on |n_p - n_q|^2 of unit normals */
     float sigma_position;  /* in scene units; 0 turns the position term off */
+    /* Light, not colour (filter/demod.h): what each pixel's first surface reflects (3 floats per
+     * pixel); the colour is divided by its demodulation factors before filtering and multiplied
+     * back after, inside the filter's one parallel region. NULL (default): colour as it is. */
+    const float *demod;
+    int threads;           /* OpenMP threads, 0 (default): all (core/parallel.h) */
 } fv_atrous_opts;
 
 void fv_atrous_opts_default(fv_atrous_opts *o);
 
-/* Filters rgb (w*h*3 linear floats) in place, guided by normal and position (3 floats per pixel
+/* Filters rgb (w*h*3 linear floats) in place, in one parallel region (a barrier between passes), guided by normal and position (3 floats per pixel
  * each, either may be NULL: its weight is then 1). o NULL means the defaults; an infinite sigma
  * turns its term off. Deterministic and independent of the thread count. Bad sizes or sigmas ->
  * FV_ERR_INVALID, no scratch memory -> FV_ERR_NOMEM (rgb is then unchanged). */

@@ -480,6 +480,7 @@ fv_status fv_blur_variable(float *rgb, int w, int h, const float *sigma, int thr
     if (!cost) return fv_error_set(err, FV_ERR_NOMEM, "out of memory blurring a %dx%d image", w, h);
     float smax = 0.0f;
     int bad = 0;
+fv_region_opened();
 #pragma omp parallel for schedule(static) num_threads(nt) reduction(max : smax) reduction(| : bad)
     for (int y = 0; y < h; y++) {
         const float *row = sigma + (size_t)y * w;
@@ -544,6 +545,7 @@ fv_status fv_blur_variable(float *rgb, int w, int h, const float *sigma, int thr
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory blurring a %dx%d image", w, h);
     }
 
+fv_region_opened();
 #pragma omp parallel num_threads(nt)
     {
 #pragma omp for schedule(static, 1)

@@ -2,6 +2,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/parallel.h"
 #include "core/alloc.h"
 #include "filter/atrous.h"
 #include "filter/lattice.h"
@@ -14,6 +15,7 @@ long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, cons
     const int S0 = o->step > 1 ? o->step : 1;
     const float inv_s2 = o->sigma_position > 0.0f ? 1.0f / (o->sigma_position * o->sigma_position) : 0.0f;
     long missing = 0;
+    fv_region_opened();
     #pragma omp parallel for schedule(static) reduction(+ : missing)
     for (int y = 0; y < h; y++) {
         for (int x = 0; x < w; x++) {

@@ -142,6 +142,7 @@ void fv_phi_mips_build(fv_phi_mips *m, const float *rgb, int threads)
     if (!m || !rgb) return;
     const size_t stride = 3 * (size_t)m->w;
     const int h0 = m->grid[0].h;
+fv_region_opened();
 #pragma omp parallel num_threads(fv_thread_count(threads))
     {
 #pragma omp for schedule(static)

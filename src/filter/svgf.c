@@ -1,7 +1,8 @@
 /* fovea — spatiotemporal variance-guided filtering (Schied et al., HPG 2017, Sec. 4; see svgf.h for
  * the algorithm and the contract). This file is the CPU implementation on an fv_grid.
  *
- * One frame is a few sweeps over the grid, each an OpenMP loop over rows; every pixel is computed
+ * One frame is a few sweeps over the grid, each an OpenMP loop over rows inside the frame's one
+ * parallel region (the hole fill, when needed, opens a second); every pixel is computed
  * from its inputs alone, in a fixed order, so the result does not depend on the thread count:
  *  A. classify each pixel, demodulate, fetch and blend its history (Sec. 4.1), keep its features;
  *  B. depth gradient and variance: temporal, or the 7x7 spatial estimate (Sec. 4.2);
@@ -299,13 +300,13 @@ static bool fetch_history(const fv_svgf *f, const float *pc, const float *np, co
     return true;
 }
 
-static void sweep_accumulate(fv_svgf *f, const fv_svgf_frame *fr, bool history, int nt)
+static void sweep_accumulate(fv_svgf *f, const fv_svgf_frame *fr, bool history)
 {
     const fv_grid *g = &f->g;
     const int w = g->w, h = g->h;
     const float ac = f->o.alpha_color, am = f->o.alpha_moments;
     float *const *v = f->val[0];
-    #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
+    #pragma omp for schedule(static, ROWS_PER_BLOCK)
     for (int y = 0; y < h; y++) {
         long n_surface = 0, n_hist = 0, n_holes = 0;
         double len_sum = 0.0;
@@ -366,11 +367,11 @@ static void sweep_accumulate(fv_svgf *f, const fv_svgf_frame *fr, bool history, 
 
 /* ---- D. remodulation and the history of the next frame */
 
-static void sweep_finish(fv_svgf *f, const fv_svgf_frame *fr, int cur, bool copy_hist, int nt)
+static void sweep_finish(fv_svgf *f, const fv_svgf_frame *fr, int cur, bool copy_hist)
 {
     const int w = f->g.w, h = f->g.h;
     float *const *v = f->val[cur];
-    #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
+    #pragma omp for schedule(static, ROWS_PER_BLOCK)
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             size_t p = (size_t)y * w + x;
@@ -394,6 +395,7 @@ static void sweep_holes(fv_svgf *f, float *color, int nt)
     const int w = g->w, h = g->h;
     const uint8_t *kind = f->kind;
     const int max_step = f->o.iterations > 1 ? 1 << (f->o.iterations - 1) : 1;
+    fv_region_opened();
     #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
     for (int y = 0; y < h; y++) {
         if (!f->row_holes[y]) continue;
@@ -439,26 +441,36 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
         if (!need[i].p) return fv_error_set(err, FV_ERR_INVALID, "SVGF: no %s buffer", need[i].name);
     const int nt = fv_thread_count(threads);
     const bool history = f->have_history && fr->prev_coord;
-
-    sweep_accumulate(f, fr, history, nt);
     f->ln_features = false;
-    if (f->avx2)
-        fv_svgf_variance_avx2(f, nt);
-    else
-        fv_svgf_variance_base(f, nt);
-    int cur = 0;
-    for (int it = 0; it < f->o.iterations; it++) {
-        f->pass_cut = it < f->periph_passes ? f->g.w : f->periph_x;
-        if (f->avx2) {
-            fv_svgf_prefilter_avx2(f, f->val[cur][V_VAR], nt);
-            fv_svgf_atrous_avx2(f, 1 << it, cur, it == 0, nt);
-        } else {
-            fv_svgf_prefilter_base(f, f->val[cur][V_VAR], nt);
-            fv_svgf_atrous_base(f, 1 << it, cur, it == 0, nt);
+
+    /* The whole filter but the rare hole fill is one parallel region (docs/threads.md): each sweep
+     * is an orphaned `omp for` whose implicit barrier orders it before the next, instead of a
+     * region per sweep that wakes the team again (about twenty a frame before). Everything a thread
+     * keeps between sweeps (cur) is private and the same on every thread; the state shared between
+     * sweeps (pass_cut) is written by one thread inside `single`, whose barrier publishes it. */
+    fv_region_opened();
+    #pragma omp parallel num_threads(nt)
+    {
+        sweep_accumulate(f, fr, history);
+        if (f->avx2)
+            fv_svgf_variance_avx2(f);
+        else
+            fv_svgf_variance_base(f);
+        int cur = 0;
+        for (int it = 0; it < f->o.iterations; it++) {
+            #pragma omp single
+            f->pass_cut = it < f->periph_passes ? f->g.w : f->periph_x;
+            if (f->avx2) {
+                fv_svgf_prefilter_avx2(f, f->val[cur][V_VAR]);
+                fv_svgf_atrous_avx2(f, 1 << it, cur, it == 0);
+            } else {
+                fv_svgf_prefilter_base(f, f->val[cur][V_VAR]);
+                fv_svgf_atrous_base(f, 1 << it, cur, it == 0);
+            }
+            cur = 1 - cur;
         }
-        cur = 1 - cur;
+        sweep_finish(f, fr, cur, f->o.iterations == 0);
     }
-    sweep_finish(f, fr, cur, f->o.iterations == 0, nt);
 
     long n_surface = 0, n_hist = 0, n_holes = 0;
     double len_sum = 0.0;

@@ -20,7 +20,7 @@
 /* Not x86-64: svgf.c never calls these (fv_svgf_set_isa refuses AVX2); they only keep the
  * symbols defined. */
 #include "filter/svgf_impl.h"
-void fv_svgf_variance_avx2(fv_svgf *f, int nt) { fv_svgf_variance_base(f, nt); }
-void fv_svgf_prefilter_avx2(fv_svgf *f, const float *var, int nt) { fv_svgf_prefilter_base(f, var, nt); }
-void fv_svgf_atrous_avx2(fv_svgf *f, int step, int src, bool write_hist, int nt) { fv_svgf_atrous_base(f, step, src, write_hist, nt); }
+void fv_svgf_variance_avx2(fv_svgf *f) { fv_svgf_variance_base(f); }
+void fv_svgf_prefilter_avx2(fv_svgf *f, const float *var) { fv_svgf_prefilter_base(f, var); }
+void fv_svgf_atrous_avx2(fv_svgf *f, int step, int src, bool write_hist) { fv_svgf_atrous_base(f, step, src, write_hist); }
 #endif

@@ -229,12 +229,14 @@ static inline float axis_gradient(const fv_svgf *f, long qm, long qp, float zc)
 }
 
 /* The two builds of svgf_sweeps.h: B. depth gradient and variance; C. the variance prefilter and
- * one À-Trous pass. The _avx2 ones need an AVX2 CPU. */
-void fv_svgf_variance_base(fv_svgf *f, int nt);
-void fv_svgf_prefilter_base(fv_svgf *f, const float *var, int nt);
-void fv_svgf_atrous_base(fv_svgf *f, int step, int src, bool write_hist, int nt);
-void fv_svgf_variance_avx2(fv_svgf *f, int nt);
-void fv_svgf_prefilter_avx2(fv_svgf *f, const float *var, int nt);
-void fv_svgf_atrous_avx2(fv_svgf *f, int step, int src, bool write_hist, int nt);
+ * one À-Trous pass. The _avx2 ones need an AVX2 CPU. Each is an orphaned `omp for`: called by every
+ * thread of fv_svgf_filter's one parallel region, it shares its rows among them (called outside a
+ * region, by one thread, it does them all). */
+void fv_svgf_variance_base(fv_svgf *f);
+void fv_svgf_prefilter_base(fv_svgf *f, const float *var);
+void fv_svgf_atrous_base(fv_svgf *f, int step, int src, bool write_hist);
+void fv_svgf_variance_avx2(fv_svgf *f);
+void fv_svgf_prefilter_avx2(fv_svgf *f, const float *var);
+void fv_svgf_atrous_avx2(fv_svgf *f, int step, int src, bool write_hist);
 
 #endif

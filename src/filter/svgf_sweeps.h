@@ -16,7 +16,7 @@ TAP_INLINE void moments_tap(const fv_svgf *f, size_t p, int q, int k, float rz, 
     aw[k] += wt;
 }
 
-void SVGF_ISA(variance)(fv_svgf *f, int nt)
+void SVGF_ISA(variance)(fv_svgf *f)
 {
     const fv_grid *g = &f->g;
     const int w = g->w, h = g->h;
@@ -40,7 +40,7 @@ void SVGF_ISA(variance)(fv_svgf *f, int nt)
                 if (d2s[c] == d2) cls[t] = c;
             t++;
         }
-    #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
+    #pragma omp for schedule(static, ROWS_PER_BLOCK)
     for (int y = 0; y < h; y++) {
         float a1[CHUNK], a2[CHUNK], aw[CHUNK], rz[9][CHUNK];
         int fq[CHUNK];
@@ -132,14 +132,14 @@ void SVGF_ISA(variance)(fv_svgf *f, int nt)
 
 /* The variance that guides the luminance weight, prefiltered with a 3x3 Gaussian over the surface
  * neighbours (Sec. 4.3: one pixel's variance estimate is itself noisy). */
-void SVGF_ISA(prefilter)(fv_svgf *f, const float *var, int nt)
+void SVGF_ISA(prefilter)(fv_svgf *f, const float *var)
 {
     const fv_grid *g = &f->g;
     const int w = g->w, h = g->h;
     const uint8_t *kind = f->kind;
     const float *surf = f->surf;
     float *gvar = f->gvar;
-    #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
+    #pragma omp for schedule(static, ROWS_PER_BLOCK)
     for (int y = 0; y < h; y++) {
         float av[CHUNK], aw[CHUNK];
         int fq[CHUNK];
@@ -379,11 +379,11 @@ static int block_rows(const fv_grid *g, int xb, int xe)
 /* Copies the columns [0, xr) of the n grid-ordered buffers src into the lines dst, ghosts included
  * (a column shorter than the ghosts wraps more than once). Blocks of 8 columns, rows outer: the
  * reads are runs of a row. */
-static void lines_load(const fv_svgf *f, float *const *dst, float *const *src, int n, int xr, int nt)
+static void lines_load(const fv_svgf *f, float *const *dst, float *const *src, int n, int xr)
 {
     const fv_grid *g = &f->g;
     const int w = g->w, stride = f->line_stride;
-    #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
+    #pragma omp for schedule(dynamic, 1)
     for (int xb = 0; xb < xr; xb += 8) {
         const int xe = imin(xb + 8, xr), lmax = block_rows(g, xb, xe);
         for (int b = 0; b < n; b++)
@@ -399,11 +399,11 @@ static void lines_load(const fv_svgf *f, float *const *dst, float *const *src, i
 
 /* The lines' output values of the columns [0, xt) back in the grid's order (dst), and into the
  * history where write_hist; blocks of 8 columns, rows outer, like lines_load. */
-static void lines_store(fv_svgf *f, float *const *dst, bool write_hist, int xt, int nt)
+static void lines_store(fv_svgf *f, float *const *dst, bool write_hist, int xt)
 {
     const fv_grid *g = &f->g;
     const int w = g->w, stride = f->line_stride;
-    #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
+    #pragma omp for schedule(dynamic, 1)
     for (int xb = 0; xb < xt; xb += 8) {
         const int xe = imin(xb + 8, xt), lmax = block_rows(g, xb, xe);
         for (int c = 0; c < NVAL; c++) {
@@ -424,7 +424,7 @@ static void lines_store(fv_svgf *f, float *const *dst, bool write_hist, int xt, 
 
 /* One pass over the columns [0, xt) along their lines (taps `step` apart; di, dj, kw, cls as in the
  * row loop), from the lines' values to their output values. */
-static void lines_pass(fv_svgf *f, int step, int xt, const int *di, const int *dj, const float *kw, const int *cls, int nt)
+static void lines_pass(fv_svgf *f, int step, int xt, const int *di, const int *dj, const float *kw, const int *cls)
 {
     const fv_grid *g = &f->g;
     const int w = g->w, stride = f->line_stride;
@@ -432,7 +432,7 @@ static void lines_pass(fv_svgf *f, int step, int xt, const int *di, const int *d
     const float *grad = f->ln[LN_GRAD], *gvar = f->ln[LN_GVAR], *surf = f->ln[LN_SURF];
     const pass_src s = {f->ln[LN_NX], f->ln[LN_NY], f->ln[LN_NZ], f->ln[LN_Z], f->ln[LN_VAL + V_R],
                         f->ln[LN_VAL + V_G], f->ln[LN_VAL + V_B], f->ln[LN_VAL + V_VAR], f->ln[LN_VAL + V_LUM]};
-    #pragma omp parallel for schedule(dynamic, 2) num_threads(nt)
+    #pragma omp for schedule(dynamic, 2)
     for (int x = 0; x < xt; x++) {
         pass_acc acc;
         int qt[NTAP][CHUNK], rows[5][CHUNK];
@@ -492,7 +492,7 @@ static void lines_pass(fv_svgf *f, int step, int xt, const int *di, const int *d
 }
 
 /* One pass with taps `step` apart from val[src] to val[1 - src]; the first also writes the history. */
-void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
+void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist)
 {
     const fv_grid *g = &f->g;
     const int w = g->w, h = g->h;
@@ -523,16 +523,19 @@ void SVGF_ISA(atrous)(fv_svgf *f, int step, int src, bool write_hist, int nt)
         xt = imin(imin(f->full_from + 2 * step, f->pass_cut), w);
         if (!f->ln_features) {
             float *feat[LN_FEATURES] = {f->nx[0], f->ny[0], f->nz[0], f->z[0], f->grad, f->surf};
-            lines_load(f, &f->ln[LN_NX], feat, LN_FEATURES, f->lines_w, nt);
+            lines_load(f, &f->ln[LN_NX], feat, LN_FEATURES, f->lines_w);
+            /* every thread read the flag before the load's barrier; one sets it after, and the
+             * barrier of `single` keeps the next pass's readers behind the write */
+            #pragma omp single
             f->ln_features = true;
         }
         float *in[1 + NVAL] = {f->gvar};
         for (int c = 0; c < NVAL; c++) in[1 + c] = f->val[src][c];
-        lines_load(f, &f->ln[LN_GVAR], in, 1 + NVAL, imin(f->full_from + 4 * step, w), nt);
-        lines_pass(f, step, xt, di, dj, kw, cls, nt);
-        lines_store(f, dst, write_hist, xt, nt);
+        lines_load(f, &f->ln[LN_GVAR], in, 1 + NVAL, imin(f->full_from + 4 * step, w));
+        lines_pass(f, step, xt, di, dj, kw, cls);
+        lines_store(f, dst, write_hist, xt);
     }
-    #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
+    #pragma omp for schedule(static, ROWS_PER_BLOCK)
     for (int y = 0; y < h; y++) {
         pass_acc acc;
         int fq[CHUNK], qt[NTAP][CHUNK];

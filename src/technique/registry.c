@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/parallel.h"
 #include "scene/query.h"
 #include "technique/class.h"
 
@@ -191,13 +192,21 @@ fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_film *f
     if (frame->camera->width != fv_film_width(film) || frame->camera->height != fv_film_height(film))
         return fv_error_set(err, FV_ERR_INVALID, "render: camera size %dx%d differs from the film's %dx%d", frame->camera->width,
                             frame->camera->height, fv_film_width(film), fv_film_height(film));
-    if (!frame->progress) return t->cls->render(t->state, frame, film, stats, err);
+    /* Every eye reports the parallel regions it opened (core/parallel.h; docs/threads.md): each
+     * region wakes the team, so fewer is better paced. */
+    const uint64_t regions = fv_region_count();
+    fv_status s;
     relay r = {frame->progress, frame->progress_user, false};
-    fv_frame f = *frame;
-    f.progress = relay_progress;
-    f.progress_user = &r;
-    fv_status s = t->cls->render(t->state, &f, film, stats, err);
-    if (s == FV_OK && r.cancelled) s = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    if (!frame->progress) {
+        s = t->cls->render(t->state, frame, film, stats, err);
+    } else {
+        fv_frame f = *frame;
+        f.progress = relay_progress;
+        f.progress_user = &r;
+        s = t->cls->render(t->state, &f, film, stats, err);
+        if (s == FV_OK && r.cancelled) s = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    }
+    fv_stats_add_count(stats, "parallel_regions", (double)(fv_region_count() - regions));
     return s;
 }
 

@@ -66,6 +66,21 @@ int fv_cli_interrupted(void);
 /* Prints the interruption line (once) and returns the exit status, 128 + the signal. */
 int fv_cli_interrupt_exit(void);
 
+/* ---- the thread policy (cli_threads.c, docs/threads.md) ----
+ *
+ * Puts the policy chosen by --thread-policy, else FOVEA_THREAD_POLICY, else auto, into OpenMP's
+ * variables and executes the program again so that the runtime reads them; call it first thing in
+ * main for a command that renders, with main's own argc and argv. Returns -1 to go on (the plan is in place, or cannot be), or an
+ * exit status (a bad policy name: 2). */
+int fv_cli_thread_policy(int argc, char **argv, const char *cmd);
+/* --thread-policy NAME as a command's option: only checked here (main applied it already). */
+int fv_cli_opt_thread_policy(const char *cmd, const char *arg);
+#define FV_CLI_THREAD_POLICY_HELP \
+    "  --thread-policy P     auto, pace, share or openmp: how many threads by default and how they\n" \
+    "                        wait between parallel regions (docs/threads.md) [auto]\n"
+/* One line saying which plan is in effect, for --stats. */
+const char *fv_cli_thread_plan(void);
+
 /* A progress bar with ETA on stderr, drawn only when stderr is a terminal and not quiet. */
 typedef struct fv_cli_progress {
     bool enabled;
@@ -118,6 +133,7 @@ int fv_cmd_methods(int argc, char **argv);
 int fv_cmd_scenes(int argc, char **argv);
 int fv_cmd_compare(int argc, char **argv);
 int fv_cmd_bench(int argc, char **argv);
+int fv_cmd_bench_scaling(int argc, char **argv); /* `fovea bench scaling` (cmd_bench_scaling.c) */
 int fv_cmd_view(int argc, char **argv);
 int fv_cmd_gaze(int argc, char **argv);
 

@@ -19,6 +19,7 @@ static void usage(FILE *f)
     fprintf(f, "usage: fovea bench SCENARIO [options]\n"
                "       fovea bench --scene SCENE --methods M1,M2[:KEY=VALUE...] [--reference pt:spp=1024] [--gaze X,Y |\n"
                "                   --gaze-trace F] [--frames N] [--size WxH] [--save-scenario F] [options]\n"
+               "       fovea bench scaling [options]  (every method at 1, 2, 4, ... threads; --help there)\n"
                "Renders every method of a scenario side by side, times them (median of repeats) and measures\n"
                "their error per region (fovea, transition, periphery) against a cached reference.\n\n"
                "  SCENARIO          a scenario name (bench/NAME.json) or a path to a .json file\n"
@@ -27,7 +28,8 @@ static void usage(FILE *f)
                "  --quick           small sizes, under a minute (the scenario's \"quick\" block)\n"
                "  --full            the papers' sizes (the scenario's \"full\" block)\n"
                "  --repeats N       timing repeats (overrides the scenario)\n"
-               "  --threads N       worker threads, 0 = all [0]\n"
+               "  --threads N       worker threads, 0 = the thread policy's default [0]\n"
+           FV_CLI_THREAD_POLICY_HELP
                "  --device D        run every measured method that has device D there (cpu, portable, cuda,\n"
                "                    auto; docs/gpu.md); methods and references naming a device keep theirs\n"
                "  --check           only validate the scenario\n"
@@ -236,14 +238,16 @@ static int refuse_ranks(void)
 
 int fv_cmd_bench(int argc, char **argv)
 {
+    /* a built-in mode rather than a scenario: it sweeps the thread count, not methods' parameters */
+    if (argc > 1 && !strcmp(argv[1], "scaling")) return fv_cmd_bench_scaling(argc - 1, argv + 1);
 #ifdef FOVEA_HAVE_MPI
     int refused = refuse_ranks();
     if (refused >= 0) return refused;
 #endif
-    enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_CHECK, O_LIST, O_QUIET, O_HELP, O_SCENE, O_METHODS,
-           O_REFERENCE, O_GAZE, O_GAZE_TRACE, O_FRAMES, O_SIZE, O_SAVE };
+    enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_TPOLICY, O_CHECK, O_LIST, O_QUIET, O_HELP, O_SCENE,
+           O_METHODS, O_REFERENCE, O_GAZE, O_GAZE_TRACE, O_FRAMES, O_SIZE, O_SAVE };
     static const struct option longs[] = {{"out", 1, 0, O_OUT},       {"device", 1, 0, O_DEVICE},   {"cache", 1, 0, O_CACHE},     {"quick", 0, 0, O_QUICK},
-                                          {"full", 0, 0, O_FULL},     {"repeats", 1, 0, O_REPEATS}, {"threads", 1, 0, O_THREADS},
+                                          {"full", 0, 0, O_FULL},     {"repeats", 1, 0, O_REPEATS}, {"threads", 1, 0, O_THREADS}, {"thread-policy", 1, 0, O_TPOLICY},
                                           {"check", 0, 0, O_CHECK},   {"list", 0, 0, O_LIST},       {"quiet", 0, 0, O_QUIET},
                                           {"help", 0, 0, O_HELP},     {"scene", 1, 0, O_SCENE},     {"methods", 1, 0, O_METHODS},
                                           {"reference", 1, 0, O_REFERENCE}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_GAZE_TRACE},
@@ -279,6 +283,9 @@ int fv_cmd_bench(int argc, char **argv)
         case O_REPEATS:
             if (!fv_cli_parse_int(optarg, 1, 1000, &l)) return fv_cli_usage_error(cmd, "--repeats %s: expected an integer in [1, 1000]", optarg);
             opt.repeats = (int)l;
+            break;
+        case O_TPOLICY:
+            if (fv_cli_opt_thread_policy(cmd, optarg)) return FV_EXIT_USAGE;
             break;
         case O_THREADS:
             if (!fv_cli_parse_int(optarg, 0, 256, &l)) return fv_cli_usage_error(cmd, "--threads %s: expected an integer in [0, 256]", optarg);

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "cli.h"
+#include "core/parallel.h"
 #include "render_record.h"
 #ifdef FOVEA_HAVE_MPI
 #include "dist/split.h"
@@ -31,7 +32,8 @@ static void help(void)
            "  --fps F               frames per second of scene time [30]\n"
            "  --time T              scene time of the first frame in seconds [0]\n"
            "  --seed S              random seed [1]\n"
-           "  --threads T           worker threads, 0 = all cores [0]\n"
+           "  --threads T           worker threads, 0 = the thread policy's default [0]\n"
+           FV_CLI_THREAD_POLICY_HELP
            "  --out FILE            output .png (tone-mapped sRGB), .pfm or .exr (linear, + aux channels) [fovea.png]\n"
            "  --exposure E          scale applied before PNG tone mapping [1]\n"
            "  --camera-pos x,y,z    camera position      --camera-look x,y,z  point looked at\n"
@@ -138,12 +140,12 @@ static fv_status write_frame(const render_opts *o, const fv_frame_meta_run *rec,
 
 static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
-    enum { O_METHOD = 256, O_SPP, O_DEVICE, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_OUT, O_EXPOSURE, O_POS,
+    enum { O_METHOD = 256, O_SPP, O_DEVICE, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_TPOLICY, O_OUT, O_EXPOSURE, O_POS,
            O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP,
            O_MISSING, O_STATS_JSON, O_NO_META, O_WARMUP };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"device", 1, 0, O_DEVICE}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
-        {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS},
+        {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS}, {"thread-policy", 1, 0, O_TPOLICY},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
         {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE}, {"gaze-missing", 1, 0, O_MISSING},
         {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"stats-json", 1, 0, O_STATS_JSON}, {"no-metadata", 0, 0, O_NO_META}, {"help", 0, 0, O_HELP}, {"warmup", 1, 0, O_WARMUP},
@@ -189,6 +191,9 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             if (errno || end == optarg || *end || optarg[0] == '-') return fv_cli_usage_error(cmd, "--seed %s: expected a non-negative integer", optarg);
             break;
         }
+        case O_TPOLICY:
+            if (fv_cli_opt_thread_policy(cmd, optarg)) return FV_EXIT_USAGE;
+            break;
         case O_THREADS:
             if (!fv_cli_parse_int(optarg, 0, 256, &l)) return fv_cli_usage_error(cmd, "--threads %s: expected an integer in [0, 256]", optarg);
             o->threads = (int)l;
@@ -532,6 +537,7 @@ static int render(int argc, char **argv, void *dist)
         if (s != FV_OK) break;
         if (!o.quiet) {
             fv_cli_progress_done(&prog);
+            if (o.show_stats && f == 0) fprintf(stderr, "  threads: %d (%s)\n", fv_thread_count(o.threads), fv_cli_thread_plan());
             print_frame(f, ms, &stats, o.show_stats);
         }
     }

@@ -53,6 +53,12 @@ int main(int argc, char **argv)
             /* SIGINT/SIGTERM end any command in one line with 130/143 and leave no temporary
              * file or child behind (cli.h); the line names the command as its errors do. */
             bool import = !strcmp(argv[1], "gaze") && argc > 2 && !strcmp(argv[2], "import");
+            /* Commands that render run under the thread policy: before anything else, since it
+             * may execute the program again (cli_threads.c). */
+            if (!strcmp(argv[1], "render") || !strcmp(argv[1], "bench") || !strcmp(argv[1], "view")) {
+                int rc = fv_cli_thread_policy(argc, argv, argv[1]);
+                if (rc >= 0) return rc;
+            }
             fv_cli_interrupt_install(import ? "gaze import" : argv[1]);
             return k_commands[i].run(argc - 1, argv + 1);
         }

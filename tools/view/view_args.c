@@ -17,7 +17,8 @@ static void help(void)
            "  --gaze X,Y            fixed gaze (normalised) instead of the mouse\n"
            "  --gaze-trace FILE     replay a gaze trace (docs/gaze.md) instead of the mouse\n"
            "  --stereo SEP          left and right eye side by side, eye separation SEP\n"
-           "  --threads N           worker threads, 0 = all cores [0]\n"
+           "  --threads N           worker threads, 0 = the thread policy's default [0]\n"
+           FV_CLI_THREAD_POLICY_HELP
            FV_CLI_SCENE_HELP
            "  --script FILE         timed commands by frame number (docs/viewer.md)\n"
            "  --fps-log FILE        one CSV line per frame: render and frame milliseconds\n"
@@ -28,10 +29,10 @@ static void help(void)
 
 int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
 {
-    enum { O_METHOD = 256, O_PARAM, O_DEVICE, O_SIZE, O_SCALE, O_GAZE, O_TRACE, O_STEREO, O_THREADS, O_SCRIPT, O_FPSLOG, O_HELP };
+    enum { O_METHOD = 256, O_PARAM, O_DEVICE, O_SIZE, O_SCALE, O_GAZE, O_TRACE, O_STEREO, O_THREADS, O_TPOLICY, O_SCRIPT, O_FPSLOG, O_HELP };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"param", 1, 0, O_PARAM}, {"device", 1, 0, O_DEVICE},   {"size", 1, 0, O_SIZE},       {"scale", 1, 0, O_SCALE},
-        {"gaze", 1, 0, O_GAZE},     {"gaze-trace", 1, 0, O_TRACE}, {"stereo", 1, 0, O_STEREO}, {"threads", 1, 0, O_THREADS},
+        {"gaze", 1, 0, O_GAZE},     {"gaze-trace", 1, 0, O_TRACE}, {"stereo", 1, 0, O_STEREO}, {"threads", 1, 0, O_THREADS}, {"thread-policy", 1, 0, O_TPOLICY},
         {"script", 1, 0, O_SCRIPT}, {"fps-log", 1, 0, O_FPSLOG}, {"help", 0, 0, O_HELP},
         FV_CLI_SCENE_LONGOPTS, {0, 0, 0, 0}};
     const char *cmd = "view";
@@ -67,6 +68,9 @@ int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)
         case O_STEREO:
             if ((rc = fv_cli_opt_stereo(cmd, optarg, &d))) return rc;
             a->stereo = d;
+            break;
+        case O_TPOLICY:
+            if (fv_cli_opt_thread_policy(cmd, optarg)) return FV_EXIT_USAGE;
             break;
         case O_THREADS:
             if (!fv_cli_parse_int(optarg, 0, 256, &l)) return fv_cli_usage_error(cmd, "--threads %s: expected an integer in [0, 256]", optarg);

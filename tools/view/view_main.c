@@ -189,6 +189,9 @@ static int run(fv_vw_app *app, sdl_out *o, fv_vw_script *script)
 
 int main(int argc, char **argv)
 {
+    /* The thread policy first: it may execute the viewer again (tools/fovea/cli_threads.c). */
+    int prc = fv_cli_thread_policy(argc, argv, k_cmd);
+    if (prc >= 0) return prc;
     fv_vw_app app;
     memset(&app, 0, sizeof app);
     app.main.method = app.base.method = -1;

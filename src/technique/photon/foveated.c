@@ -143,6 +143,7 @@ fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera 
     int *src = fv_alloc_array(np, sizeof(int));
     if (!src) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     int nthreads = fv_thread_count(threads);
+    fv_region_opened();
     #pragma omp parallel for schedule(dynamic, 4) num_threads(nthreads)
     for (int y = 0; y < f->h; y++)
         for (int x = 0; x < f->w; x++) {
@@ -351,6 +352,7 @@ fv_status fv_foveated_trace(fv_foveated *f, const fv_scene *s, const fv_camera *
         for (int k = 0; k < f->fbm[i]; k++) task_px[t++] = (int)i;
     trace_ctx c = {s, &cb, m_ls, m_ld, radius, f->max_depth, seed, frame};
     int nthreads = fv_thread_count(threads);
+    fv_region_opened();
     #pragma omp parallel for schedule(dynamic, 64) num_threads(nthreads)
     for (long j = 0; j < ntasks; j++) {
         int px = task_px[j] % f->w, py = task_px[j] / f->w;

@@ -302,6 +302,7 @@ static void gather_needed(gd_ctx *c, uint64_t *gathers)
     const int w = c->cam.width;
     long n = (long)st->bufn;
     uint64_t g = 0;
+    fv_region_opened();
     #pragma omp parallel for schedule(dynamic, 64) reduction(+ : g) num_threads(fv_thread_count(c->frame->threads))
     for (long i = 0; i < n; i++) {
         const float *nq = &st->nbuf[3 * i];

@@ -21,6 +21,7 @@ void fv_photon_map_free(fv_photon_map *m)
     free(m->scratch);
     free(m->px);
     free(m->key);
+    free(m->count);
     memset(m, 0, sizeof *m);
 }
 
@@ -105,6 +106,7 @@ static void grid_extent(fv_photon_map *m, int nt)
 {
     int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
     const int n = m->n;
+    fv_region_opened();
     #pragma omp parallel num_threads(nt)
     {
         int l[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, h[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
@@ -159,29 +161,56 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
      * contiguous share of the photons, every (cell, thread) pair gets its offset in cell-major,
      * thread-minor order, and each thread scatters its share in order. So the photons of a cell
      * stay in the order they were stored, whatever the thread count. */
-    uint32_t *count = fv_calloc_array((size_t)nc * (size_t)nt, sizeof *count);
-    if (!count) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+    /* The counts live in the map, grown, never shrunk: after the first frames a build allocates
+     * nothing (a fresh calloc of cells x threads was tens of MB a frame at 16 threads), and the
+     * threads zero their own rows. */
+    const size_t need = (size_t)nc * (size_t)nt;
+    if (need > m->count_cap) {
+        uint32_t *c = fv_alloc_array(need, sizeof *c);
+        if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+        free(m->count);
+        m->count = c;
+        m->count_cap = need;
+    }
+    uint32_t *count = m->count;
     const int n = m->n;
+    /* per thread: the running offset where its block of cells starts (the scan's second level) */
+    uint32_t block_sum[FV_MAX_THREADS + 1];
+    fv_region_opened();
     #pragma omp parallel num_threads(nt)
     {
         const int t = omp_get_thread_num(), T = omp_get_num_threads();
         const int i0 = (int)((int64_t)n * t / T), i1 = (int)((int64_t)n * (t + 1) / T);
         uint32_t *cnt = count + (size_t)t * nc;
+        memset(cnt, 0, (size_t)nc * sizeof *cnt);
         for (int i = i0; i < i1; i++) cnt[m->key[i] = photon_cell(m, m->p[i].pos)]++;
+        #pragma omp barrier
+        /* The exclusive scan over (cell, thread) in cell-major, thread-minor order, in parallel:
+         * each thread sums its own block of cells, one thread scans the T block sums, and each
+         * thread then writes its block's offsets from its block's start. Integer sums: the same
+         * offsets as one serial scan (which was O(cells x threads) on one thread). */
+        const uint32_t b0 = (uint32_t)((uint64_t)nc * t / T), b1 = (uint32_t)((uint64_t)nc * (t + 1) / T);
+        uint32_t local = 0;
+        for (uint32_t b = b0; b < b1; b++)
+            for (int k = 0; k < T; k++) local += count[(size_t)k * nc + b];
+        block_sum[t + 1] = local;
         #pragma omp barrier
         #pragma omp single
         {
-            uint32_t sum = 0;
-            for (uint32_t b = 0; b < nc; b++) {
-                start[b] = sum;
-                for (int k = 0; k < T; k++) {
-                    uint32_t c = count[(size_t)k * nc + b];
-                    count[(size_t)k * nc + b] = sum;
-                    sum += c;
-                }
-            }
-            start[nc] = sum;
+            block_sum[0] = 0;
+            for (int k = 1; k <= T; k++) block_sum[k] += block_sum[k - 1];
+            start[nc] = block_sum[T];
         }
+        uint32_t sum = block_sum[t];
+        for (uint32_t b = b0; b < b1; b++) {
+            start[b] = sum;
+            for (int k = 0; k < T; k++) {
+                uint32_t c = count[(size_t)k * nc + b];
+                count[(size_t)k * nc + b] = sum;
+                sum += c;
+            }
+        }
+        #pragma omp barrier
         for (int i = i0; i < i1; i++) m->scratch[cnt[m->key[i]]++] = m->p[i];
         #pragma omp barrier
         /* The SoA copies from the sorted records: sequential reads and writes (scattering seven
@@ -197,7 +226,6 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
             m->nz[d] = ph->n.z;
         }
     }
-    free(count);
     /* Padding far away: a block reading past the last photon never accepts it. */
     for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
         m->px[n + k] = m->py[n + k] = m->pz[n + k] = INFINITY;

@@ -52,6 +52,8 @@ typedef struct fv_photon_map {
     int scratch_cap;
     uint32_t *key;         /* build scratch: each photon's cell */
     int key_cap;
+    uint32_t *count;       /* build scratch: photons per (thread, cell), kept between builds */
+    size_t count_cap;
 } fv_photon_map;
 
 /* Photons a query tests at once (one pass of the tests over the SoA arrays). */

@@ -402,6 +402,7 @@ static fv_status finish_fpm(render_ctx *c, fv_film *film, fv_stats *stats, fv_er
     free(l), free(f), free(mask);
     float *col = fv_film_color(film);
     uint64_t bad = 0;
+    fv_region_opened();
     #pragma omp parallel for schedule(static) reduction(+ : bad) num_threads(fv_thread_count(c->frame->threads))
     for (long long i = 0; i < (long long)n; i++) {
         fv_vec3 L = fv_kit_guard(estimate_sums(c, &c->sums[i]), &bad);
@@ -421,21 +422,9 @@ static fv_status filter_film(pm_state *st, fv_film *film, float gamma, int threa
     /* Light is filtered, not colour: each pixel divided by what its first surface reflects and
      * multiplied back after (filter/demod.h, as SVGF does), so that a texture's cells keep their
      * colour instead of taking their neighbours' (issue 25). */
-    float *col = fv_film_color(film);
-    const long long n = (long long)fv_film_width(film) * fv_film_height(film);
-    #pragma omp parallel for schedule(static) num_threads(fv_thread_count(threads))
-    for (long long i = 0; i < n; i++) {
-        float d[3];
-        fv_demod_factors(&st->rbuf[3 * i], d);
-        for (int k = 0; k < 3; k++) col[3 * i + k] /= d[k];
-    }
-    fv_status rc = fv_atrous_filter(col, st->nbuf, st->pbuf, fv_film_width(film), fv_film_height(film), &ao, err);
-    #pragma omp parallel for schedule(static) num_threads(fv_thread_count(threads))
-    for (long long i = 0; i < n; i++) {
-        float d[3];
-        fv_demod_factors(&st->rbuf[3 * i], d);
-        for (int k = 0; k < 3; k++) col[3 * i + k] *= d[k];
-    }
+    ao.demod = st->rbuf;
+    ao.threads = threads;
+    fv_status rc = fv_atrous_filter(fv_film_color(film), st->nbuf, st->pbuf, fv_film_width(film), fv_film_height(film), &ao, err);
     fv_stats_add_ms(stats, "filter", fv_time_ms() - t0);
     return rc;
 }

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "core/parallel.h"
 #include "core/rng.h"
 #include "filter/blur.h"
 #include "technique/kit.h"
@@ -444,6 +445,12 @@ done:
 
 /* ---- fipr's passes 2 and 3, and what pass 4 must trace of the middle level ---- */
 
+static int imin(int a, int b) { return a < b ? a : b; }
+static int imax(int a, int b) { return a > b ? a : b; }
+/* Floor and ceiling of a / b for b > 0 and any sign of a (C's division truncates towards 0). */
+static int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+static int ceil_div(int a, int b) { return -floor_div(-a, b); }
+
 /* Returns the number of mask pixels; fills edge, mask and need. */
 static uint64_t build_mask(job *j, uint64_t *edge_pixels, uint64_t *refreshed)
 {
@@ -457,45 +464,58 @@ static uint64_t build_mask(job *j, uint64_t *edge_pixels, uint64_t *refreshed)
     /* a fovea widened to the whole screen (a missing gaze under `widen`): every pixel is traced
      * at the target level, as ipr traces it, whatever fovea_deg says */
     const bool whole = fv_frame_fovea_covers(f, eye, w, h);
-    uint64_t masked = 0, edges = 0;
-    memset(p->need, 0, (size_t)mid->w * mid->h);
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            size_t pix = (size_t)y * w + x;
-            /* the tip's ray whose block holds the pixel's centre (pass 2's upscaling) */
-            int li = (x * S + S / 2) / low->f, lj = (y * S + S / 2) / low->f;
-            bool e = p->edge[(size_t)lj * low->w + li] != 0;
-            double ecc = fv_eye_eccentricity_deg(eye, f->gaze, x, y);
-            double prob = whole ? 1.0 : fv_pyramid_probability(ecc, p->o.fovea_deg, p->o.outer_deg, e);
-            fv_rng rng = fv_rng_stream(f->seed, FV_STREAM_MASK, pix * 2 + (uint64_t)f->eye, 0, (uint64_t)f->index);
-            bool m = prob >= 1.0 || (prob > 0.0 && fv_rng_next(&rng) < prob);
-            p->mask[pix] = m;
-            edges += e;
-            if (!m) continue;
-            masked++;
-            /* the middle-level rays the min filter reads for this pixel's samples */
-            for (int b = 0; b < S; b++)
-                for (int a = 0; a < S; a++) {
-                    int mi = (x * S + a) >> 1, mj = (y * S + b) >> 1;
-                    for (int dy = -1; dy <= 1; dy++)
-                        for (int dx = -1; dx <= 1; dx++) {
-                            int u = mi + dx, v = mj + dy;
-                            if (u >= 0 && u < mid->w && v >= 0 && v < mid->h) p->need[(size_t)v * mid->w + u] |= 1;
-                        }
-                }
-        }
-    /* Refresh: ray (i, j) of the middle level is shaded when its phase comes round (a 2x2
-     * interleave for 1/4, a checkerboard for 1/2), so each frame refreshes an even share, and
-     * whenever it has never been shaded. */
+    uint64_t masked = 0, edges = 0, fresh = 0;
     const int R = p->o.refresh, now = f->index;
-    uint64_t fresh = 0;
-    for (int v = 0; v < mid->h; v++)
-        for (int u = 0; u < mid->w; u++) {
-            size_t i = (size_t)v * mid->w + u;
-            int phase = R == 4 ? (u & 1) + 2 * (v & 1) : R == 2 ? (u + v) & 1 : 0;
-            bool due = j->hist->stamp[i] == INT_MIN || ((now % R) + R) % R == phase;
-            if (due) p->need[i] = 2, fresh++;
+    /* Both loops run in one parallel region (the mask was a serial 56 ms of a frame at 720x800,
+     * issue 29). The middle-level rays a mask pixel needs are gathered, not scattered, so that no
+     * two threads write one cell: pixel x's samples (x*S + a) >> 1, a in [0, S), span the rays
+     * [(x*S) >> 1, (x*S + S - 1) >> 1], and the min filter reads those +-1; so ray u is needed by
+     * the pixels x with x*S <= 2u + 3 and x*S + S - 1 >= 2u - 2 (the same in y), and is needed
+     * when any of them is in the mask: the same set the scatter marked. */
+    fv_region_opened();
+    #pragma omp parallel num_threads(fv_thread_count(f->threads))
+    {
+        #pragma omp for schedule(static) reduction(+ : masked, edges)
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                size_t pix = (size_t)y * w + x;
+                /* the tip's ray whose block holds the pixel's centre (pass 2's upscaling) */
+                int li = (x * S + S / 2) / low->f, lj = (y * S + S / 2) / low->f;
+                bool e = p->edge[(size_t)lj * low->w + li] != 0;
+                double ecc = fv_eye_eccentricity_deg(eye, f->gaze, x, y);
+                double prob = whole ? 1.0 : fv_pyramid_probability(ecc, p->o.fovea_deg, p->o.outer_deg, e);
+                fv_rng rng = fv_rng_stream(f->seed, FV_STREAM_MASK, pix * 2 + (uint64_t)f->eye, 0, (uint64_t)f->index);
+                bool m = prob >= 1.0 || (prob > 0.0 && fv_rng_next(&rng) < prob);
+                p->mask[pix] = m;
+                edges += e;
+                masked += m;
+            }
+        /* Refresh: ray (i, j) of the middle level is shaded when its phase comes round (a 2x2
+         * interleave for 1/4, a checkerboard for 1/2), so each frame refreshes an even share, and
+         * whenever it has never been shaded. */
+        #pragma omp for schedule(static) reduction(+ : fresh)
+        for (int v = 0; v < mid->h; v++) {
+            const int y0 = imax(0, ceil_div(2 * v - 1 - S, S)), y1 = imin(h - 1, floor_div(2 * v + 3, S));
+            for (int u = 0; u < mid->w; u++) {
+                size_t i = (size_t)v * mid->w + u;
+                int phase = R == 4 ? (u & 1) + 2 * (v & 1) : R == 2 ? (u + v) & 1 : 0;
+                bool due = j->hist->stamp[i] == INT_MIN || ((now % R) + R) % R == phase;
+                if (due) {
+                    p->need[i] = 2, fresh++;
+                    continue;
+                }
+                const int x0 = imax(0, ceil_div(2 * u - 1 - S, S)), x1 = imin(w - 1, floor_div(2 * u + 3, S));
+                uint8_t need = 0;
+                for (int y = y0; y <= y1 && !need; y++)
+                    for (int x = x0; x <= x1; x++)
+                        if (p->mask[(size_t)y * w + x]) {
+                            need = 1;
+                            break;
+                        }
+                p->need[i] = need;
+            }
         }
+    }
     *edge_pixels = edges;
     *refreshed = fresh;
     return masked;
