@@ -93,6 +93,11 @@ int fv_cli_interrupted(void)
     return g_signal;
 }
 
+void fv_cli_interrupt_mute(void)
+{
+    g_said = 1;
+}
+
 int fv_cli_interrupt_exit(void)
 {
     int sig = g_signal ? g_signal : SIGINT;

@@ -65,6 +65,10 @@ void fv_cli_interrupt_defer(bool on);
 int fv_cli_interrupted(void);
 /* Prints the interruption line (once) and returns the exit status, 128 + the signal. */
 int fv_cli_interrupt_exit(void);
+/* The command's outcome is decided and its one line said (or about to be, by another process of
+ * the job): a signal from now on ends it without a line of its own. For an MPI job, whose
+ * launcher signals the other ranks once a failed rank exits (docs/distributed.md). */
+void fv_cli_interrupt_mute(void);
 
 /* ---- the thread policy (cli_threads.c, docs/threads.md) ----
  *

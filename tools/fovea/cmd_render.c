@@ -280,6 +280,7 @@ static bool on_dist_progress(void *user, double f)
  * not every rank failed (as the held messages of the set-up are replayed), else as one process. */
 static int dist_fail(fv_dist *d, fv_status s, bool print_it, bool name_rank, const char *msg)
 {
+    fv_cli_interrupt_mute(); /* the launcher may now signal this rank: the job's line is said once */
     if (print_it) {
         if (name_rank) fprintf(stderr, "rank %d: ", fv_dist_rank(d));
         return fv_cli_fail("render", s, msg);
@@ -321,9 +322,9 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
             s = fv_dist_agree(d, s, &print_it, &name_rank, &err);
         }
         double ms = fv_time_ms() - t0;
-        fv_cli_interrupt_defer(false);
         fv_cli_progress_done(&bar);
         if (s != FV_OK) return dist_fail(d, s, print_it, name_rank, err.msg);
+        fv_cli_interrupt_defer(false);
         if (rank != 0) return FV_EXIT_OK;
         if ((s = write_frame(o, rec, driver, film, neyes, 0, ms, &err)) != FV_OK) return fv_cli_fail("render", s, err.msg);
         if (!o->quiet) {
@@ -353,9 +354,11 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
         }
     }
     if (s == FV_OK && fv_cli_interrupted()) s = fv_error_set(&err, FV_ERR_CANCELLED, "interrupted");
-    fv_cli_interrupt_defer(false);
     fv_cli_progress_done(&bar);
+    /* Signals stay deferred through the agreement: once a rank fails and exits, the launcher
+     * signals the others, which must end with the job's one line, not one each. */
     if ((s = fv_dist_agree(d, s, &print_it, &name_rank, &err)) != FV_OK) return dist_fail(d, s, print_it, name_rank, err.msg);
+    fv_cli_interrupt_defer(false);
     if (rank != 0) return FV_EXIT_OK;
     /* What was split how, beside the frames: OUT_ranks.json. */
     char path[4096];
