@@ -228,10 +228,16 @@ static int refuse_ranks(void)
     fv_error_clear(&err);
     if (fv_dist_start(NULL, NULL, &d, &err) != FV_OK) return fv_cli_fail("bench", FV_ERR_IO, err.msg);
     int size = fv_dist_size(d), rank = fv_dist_rank(d);
-    fv_dist_end(d);
-    if (size == 1) return -1;
+    if (size == 1) {
+        fv_dist_end(d);
+        return -1;
+    }
+    /* Said before the job ends (MPI_Finalize waits for every rank), so that no rank exits, and
+     * has the launcher signal the others, before the line is out; a signal after it is silent. */
     if (rank == 0)
         fv_cli_usage_error("bench", "not split over MPI ranks yet (%d ranks): run `fovea bench` in one process (docs/distributed.md)", size);
+    fv_cli_interrupt_mute();
+    fv_dist_end(d);
     return FV_EXIT_USAGE;
 }
 #endif

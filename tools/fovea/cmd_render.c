@@ -514,6 +514,7 @@ static int render(int argc, char **argv, void *dist)
         bool print_it, name_rank;
         setup_agreed = true;
         if ((s = fv_dist_agree(dist, FV_OK, &print_it, &name_rank, &err)) != FV_OK) {
+            fv_cli_interrupt_mute(); /* another rank says the job's line; the launcher may signal this one */
             rc = fv_cli_exit_code(s);
             goto done;
         }
@@ -560,6 +561,7 @@ done:
         /* This rank failed before the split: its message (held) is replayed if the agreement
          * picks it, and every rank ends with the job's exit status. */
         bool print_it, name_rank;
+        fv_cli_interrupt_mute(); /* the job has failed: its one line is this rank's or another's */
         fv_status js = fv_dist_agree(dist, rc == FV_EXIT_INTERNAL ? FV_ERR_INTERNAL : FV_ERR_INVALID, &print_it, &name_rank, &err);
         rc = fv_cli_exit_code(js);
     }
