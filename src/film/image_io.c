@@ -25,6 +25,7 @@
 #include "core/fileio.h"
 #include "fovea/film.h"
 #include "film/image_meta.h"
+#include "film/png_errors.h"
 
 fv_image_format fv_image_format_from_path(const char *path)
 {
@@ -40,20 +41,6 @@ fv_image_format fv_image_format_from_path(const char *path)
 /* ---- PNG: written with libpng's full API (the simplified one has no text chunks), read with
  * the simplified one ---- */
 
-typedef struct png_wctx {
-    jmp_buf jb;
-    char msg[200];
-} png_wctx;
-
-static void png_on_error(png_structp png, png_const_charp msg)
-{
-    png_wctx *c = png_get_error_ptr(png);
-    snprintf(c->msg, sizeof c->msg, "%s", msg ? msg : "libpng failed");
-    longjmp(c->jb, 1);
-}
-
-static void png_on_warning(png_structp png, png_const_charp msg) { (void)png, (void)msg; }
-
 /* True when the text is printable ASCII, the same in tEXt's Latin-1 and in UTF-8; anything else
  * goes into an iTXt chunk, whose text is UTF-8 (PNG 1.2, 11.3.4), so other readers see the same
  * characters. */
@@ -66,9 +53,9 @@ static bool ascii_text(const char *v)
 
 /* Writes the 8-bit rows and the text chunks into an open stream; false with c->msg on failure.
  * Everything the error path frees is allocated by the caller, so the longjmp leaks nothing. */
-static bool png_write_stream(FILE *f, unsigned char *px, png_bytep *rows, png_text *texts, int nt, int w, int h, png_wctx *c)
+static bool png_write_stream(FILE *f, unsigned char *px, png_bytep *rows, png_text *texts, int nt, int w, int h, fv_png_ctx *c)
 {
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, c, png_on_error, png_on_warning);
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, c, fv_png_on_error, fv_png_on_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (!png || !info) {
         snprintf(c->msg, sizeof c->msg, "out of memory");
@@ -121,7 +108,7 @@ static fv_status png_write(const char *path, const float *rgb, int w, int h, flo
     fv_status s = fv_atomic_file_begin(path, &af, err);
     if (s == FV_OK) s = fv_atomic_file_stream(&af, &f, err);
     if (s == FV_OK) {
-        png_wctx c;
+        fv_png_ctx c;
         c.msg[0] = 0;
         bool ok = png_write_stream(f, px, rows, texts, nt, w, h, &c);
         if (ok) s = fv_atomic_file_commit(&af, err);

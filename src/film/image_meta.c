@@ -13,6 +13,7 @@
 #include <OpenEXR/openexr.h>
 #include "film/image_meta.h"
 #include "fovea/film.h"
+#include "film/png_errors.h"
 
 bool fv_image_meta_name(const char *key, char *out, size_t n)
 {
@@ -32,25 +33,11 @@ static fv_status keep(fv_params *out, const char *name, const char *value, fv_er
     return FV_OK;
 }
 
-typedef struct png_rctx {
-    jmp_buf jb;
-    char msg[200];
-} png_rctx;
-
-static void png_on_error(png_structp png, png_const_charp msg)
-{
-    png_rctx *c = png_get_error_ptr(png);
-    snprintf(c->msg, sizeof c->msg, "%s", msg ? msg : "libpng failed");
-    longjmp(c->jb, 1);
-}
-
-static void png_on_warning(png_structp png, png_const_charp msg) { (void)png, (void)msg; }
-
 static fv_status png_meta(const char *path, FILE *f, fv_params *out, fv_error *err)
 {
-    png_rctx c;
+    fv_png_ctx c;
     c.msg[0] = 0;
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &c, png_on_error, png_on_warning);
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &c, fv_png_on_error, fv_png_on_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (!png || !info) {
         png_destroy_read_struct(&png, NULL, NULL);
