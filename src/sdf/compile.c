@@ -654,6 +654,28 @@ static fv_status compile_node(compiler *cc, int i, int depth, box3 *out)
     return FV_OK;
 }
 
+/* The end of a compile: on success the program and its bounds go into s, *out = s; on failure
+ * both are freed and st returned. */
+static fv_status finish(compiler *cc, fv_sdf *s, const box3 *b, fv_status st, fv_sdf **out)
+{
+    if (st != FV_OK) {
+        free(cc->ops);
+        free(s);
+        return st;
+    }
+    s->ops = cc->ops;
+    s->count = cc->n_ops;
+    s->lo = fv_v3(b->lo[0], b->lo[1], b->lo[2]);
+    s->hi = fv_v3(b->hi[0], b->hi[1], b->hi[2]);
+    s->c = b->c;
+    s->upper = b->upper ? 1 : 0;
+    s->mag = b->mag;
+    s->normal_h = 1e-4f * fv_length(fv_sub(s->hi, s->lo));
+    if (!(s->normal_h > 0.0f)) s->normal_h = 1e-6f;
+    *out = s;
+    return FV_OK;
+}
+
 fv_status fv_sdf_create(const fv_sdf_node *nodes, int count, int root, fv_sdf **out, fv_error *err)
 {
     fv_error_clear(err);
@@ -681,22 +703,7 @@ fv_status fv_sdf_create(const fv_sdf_node *nodes, int count, int root, fv_sdf **
         st = fv_error_set(err, FV_ERR_INVALID,
                           "sdf: root %d (%s) is unbounded; intersect planes, height fields and repetitions with a box",
                           root, kind_names[nodes[root].kind]);
-    if (st != FV_OK) {
-        free(cc.ops);
-        free(s);
-        return st;
-    }
-    s->ops = cc.ops;
-    s->count = cc.n_ops;
-    s->lo = fv_v3(b.lo[0], b.lo[1], b.lo[2]);
-    s->hi = fv_v3(b.hi[0], b.hi[1], b.hi[2]);
-    s->c = b.c;
-    s->upper = b.upper ? 1 : 0;
-    s->mag = b.mag;
-    s->normal_h = 1e-4f * fv_length(fv_sub(s->hi, s->lo));
-    if (!(s->normal_h > 0.0f)) s->normal_h = 1e-6f;
-    *out = s;
-    return FV_OK;
+    return finish(&cc, s, &b, st, out);
 }
 
 void fv_sdf_destroy(fv_sdf *sdf)
@@ -743,21 +750,7 @@ fv_status fv_sdf_union_create(const fv_sdf *const *parts, int n, fv_sdf **out, f
     box3 b;
     fv_status st = emit_parts(&cc, 0, cp, n, &b);
     free(cp);
-    if (st != FV_OK) {
-        free(cc.ops);
-        free(s);
-        return st;
-    }
-    s->ops = cc.ops;
-    s->count = cc.n_ops;
-    s->lo = fv_v3(b.lo[0], b.lo[1], b.lo[2]);
-    s->hi = fv_v3(b.hi[0], b.hi[1], b.hi[2]);
-    s->c = b.c;
-    s->upper = b.upper ? 1 : 0;
-    s->mag = b.mag;
-    s->normal_h = 1e-4f * fv_length(fv_sub(s->hi, s->lo));
-    if (!(s->normal_h > 0.0f)) s->normal_h = 1e-6f;
-    return *out = s, FV_OK;
+    return finish(&cc, s, &b, st, out);
 }
 
 float fv_sdf_bound_c(const fv_sdf *sdf) { return sdf->c; }
