@@ -16,7 +16,9 @@
  *   eye     the options' eye model when given (a scenario's), else the view's display with its
  *           density rescaled to the image width (the regions cover the same part of the view),
  *           else the default model for the image size;
- *   seed    every frame of a driver uses the options' seed (frame index and eye decorrelate).
+ *   seed    every frame of a driver uses the options' seed (frame index and eye decorrelate);
+ *   warm-up the options' warm-up frames come before frame 0, at frame 0's views, and shift the
+ *           index every frame's technique sees (fv_driver_warm_up).
  *
  * Lifetime: the scene, the view and whatever the options point to must outlive the driver. A
  * driver is not thread-safe; it renders one frame at a time.
@@ -42,6 +44,9 @@ extern "C" {
 
 enum { FV_DRIVE_POS = 1, FV_DRIVE_LOOK = 2, FV_DRIVE_UP = 4, FV_DRIVE_FOV = 8 };
 
+/* The most warm-up frames a driver renders before frame 0. */
+#define FV_DRIVE_MAX_WARMUP 1000
+
 typedef struct fv_drive_opts {
     int width, height;                 /* image size per eye */
     double time0, fps;                 /* frame i at time0 + i / fps */
@@ -57,6 +62,11 @@ typedef struct fv_drive_opts {
     const fv_gaze_path *gaze_path;     /* optional: replaces the view's gaze path */
     fv_gaze_missing gaze_missing;      /* while the path's gaze is unknown; PATH (0): the path's policy */
     const fv_eye_model *eye_model;     /* optional: replaces the view's display */
+    /* Frames a technique renders before frame 0, unwritten, at frame 0's views
+     * (fv_driver_warm_up): a method with temporal state (SVGF's history) then shows frame 0
+     * converged. Every frame's index as the technique sees it (fv_frame.index, its random
+     * streams) is shifted by this count, so that warm-up frames are 0 .. warmup - 1. */
+    int warmup;
 } fv_drive_opts;
 
 /* Defaults: 512x512, time 0, 30 fps, seed 1, all threads, mono, nothing overridden. */
@@ -102,6 +112,12 @@ FV_API void fv_driver_set_camera(fv_driver *d, const fv_camera *c);
  * may cancel it (FV_ERR_CANCELLED). */
 FV_API fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool continues, fv_film *const *films, fv_stats *stats,
                                   fv_progress_fn progress, void *progress_user, fv_error *err);
+/* Renders the options' warm-up frames with technique t, each at frame 0's views, into films
+ * (their pixels are then the last warm-up frame's); a later fv_driver_render(index 0, continues
+ * true) goes on from them. Nothing happens when the count is 0. progress (optional) receives the
+ * fraction of all warm-up frames and may cancel them. */
+FV_API fv_status fv_driver_warm_up(fv_driver *d, fv_technique *t, fv_film *const *films, fv_stats *stats, fv_progress_fn progress,
+                                   void *progress_user, fv_error *err);
 
 #ifdef __cplusplus
 }

@@ -41,6 +41,14 @@ FV_API const char *fv_technique_spp_param(int i);
 /* Whether method i spends less effort away from the gaze (its image depends on the gaze); false
  * for an index out of range. */
 FV_API bool fv_technique_foveated(int i);
+/* Frames method i renders before a still (or a sequence's first frame) is converged: `fovea
+ * render` runs them unwritten at frame 0's views (fv_drive_opts.warmup). 0 for a method whose
+ * first frame is already its steady state, and for an index out of range. */
+FV_API int fv_technique_still_warmup(int i);
+/* Frames of a sequence a method with state between frames needs before a frame matches the one
+ * an uninterrupted sequence renders (a block of a sequence split over MPI ranks starts that many
+ * frames early, docs/distributed.md). 0 for a method without such state or an index out of range. */
+FV_API int fv_technique_sequence_warmup(int i);
 /* Sets method `name`'s samples-per-pixel parameter to spp in params (what the CLI's --spp means
  * for every method). FV_ERR_INVALID, with a one-line message naming the parameter to use instead,
  * when the method has none; the message of fv_technique_create when the name is unknown. */

@@ -440,7 +440,7 @@ static fv_status method_end(method_run *mr, fv_error *err)
     /* The frame says how it was made, as `fovea render`'s images do (drive/frame_meta.h). */
     fv_frame_views v;
     fv_driver_views(info->driver, sc->frames - 1, &v);
-    fv_frame_meta_run run = {res->m->method, sc->scene, res->m->params, sc->width, sc->height, info->threads, sc->seed, sc->exposure};
+    fv_frame_meta_run run = {res->m->method, sc->scene, res->m->params, sc->width, sc->height, info->threads, sc->seed, sc->exposure, 0};
     fv_params *meta = NULL;
     fv_status st = fv_frame_meta(&run, sc->frames - 1, &v, 0, res->ms_median, &meta, err);
     if (st == FV_OK) st = fv_image_write_meta(path, c->last, sc->width, sc->height, sc->exposure, meta, err);
@@ -781,7 +781,7 @@ static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_op
         fv_frame_views v;
         fv_driver_views(info.ref_driver, sc->frames - 1, &v);
         fv_frame_meta_run run = {sc->reference.method, sc->scene, sc->reference.params, sc->width, sc->height, info.threads,
-                                 fv_seed_reference(sc->seed), sc->exposure};
+                                 fv_seed_reference(sc->seed), sc->exposure, 0};
         fv_params *meta = NULL;
         st = fv_frame_meta(&run, sc->frames - 1, &v, 0, info.ref_ms > 0 ? info.ref_ms : -1.0, &meta, err);
         if (st == FV_OK) st = fv_image_write_meta(p, frames[sc->frames - 1].ref[0], sc->width, sc->height, sc->exposure, meta, err);

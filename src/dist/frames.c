@@ -1,6 +1,6 @@
 /* fovea — a sequence over MPI ranks (docs/distributed.md, "A sequence"): contiguous blocks of
  * frames, one per rank, each frame written by the rank that rendered it (fv_film_write is atomic).
- * A method that keeps state between frames (its class's warmup_frames, technique/class.h) starts
+ * A method that keeps state between frames (fv_technique_sequence_warmup, fovea/technique.h) starts
  * each block that many frames early and discards them: its first written frame then has the
  * history a one-process run would have built over those frames. Methods whose history decays
  * (exponential averages) converge to, but do not equal bit for bit, the one-process frames; the
@@ -11,19 +11,12 @@
 #include <string.h>
 #include "core/fileio.h"
 #include "dist/split.h"
-#include "technique/class.h"
 
 void fv_dist_frames(int frames, int rank, int size, int warmup, int *start, int *first, int *end)
 {
     *first = (int)((long long)frames * rank / size);
     *end = (int)((long long)frames * (rank + 1) / size);
     *start = *first - warmup < 0 ? 0 : *first - warmup;
-}
-
-int fv_dist_warmup(const char *method)
-{
-    const fv_technique_class *c = fv_technique_class_find(method);
-    return c ? c->warmup_frames : 0;
 }
 
 fv_status fv_dist_frames_manifest(const char *path, const char *method, int frames, int size, int warmup, fv_error *err)

@@ -39,9 +39,6 @@ fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *const
  * a method with temporal state renders from *start = first - warmup (not before 0) without writing
  * the warm-up frames, so each block's history is rebuilt as the method needs. */
 void fv_dist_frames(int frames, int rank, int size, int warmup, int *start, int *first, int *end);
-/* The warm-up frames a method needs before its first written frame: 0 for a method without
- * temporal state (its frames do not depend on the ones before), else the class's own count. */
-int fv_dist_warmup(const char *method);
 /* Rank 0 writes how the sequence was split (ranks, each block, the warm-up) as JSON next to the
  * frames, whole or not at all. */
 fv_status fv_dist_frames_manifest(const char *path, const char *method, int frames, int size, int warmup, fv_error *err);

@@ -1,4 +1,5 @@
 /* fovea — the sequence driver (see include/fovea/drive.h). */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,7 +16,7 @@ struct fv_driver {
      * (fv_driver_set_camera), so frame i-1's camera can only be known by remembering it, not by
      * deriving it again from today's overrides. */
     fv_frame_views last;
-    int last_index; /* -1: none yet */
+    int last_seen; /* the index the technique saw last (frame index + warm-up count); -1: none yet */
 };
 
 void fv_drive_opts_init(fv_drive_opts *o)
@@ -44,6 +45,8 @@ fv_status fv_driver_create(fv_scene *scene, const fv_view *view, const fv_drive_
         ((opts->camera_set & FV_DRIVE_UP) && (s = fv_limit_vec3("driver: camera up vector", opts->up, err)) != FV_OK))
         return s;
     if (opts->threads < 0) return fv_error_set(err, FV_ERR_INVALID, "driver: thread count %d must be >= 0", opts->threads);
+    if (opts->warmup < 0 || opts->warmup > FV_DRIVE_MAX_WARMUP)
+        return fv_error_set(err, FV_ERR_INVALID, "driver: %d warm-up frames (expected 0 to %d)", opts->warmup, FV_DRIVE_MAX_WARMUP);
     fv_driver *d = calloc(1, sizeof *d);
     if (!d) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     d->scene = scene;
@@ -64,7 +67,7 @@ fv_status fv_driver_create(fv_scene *scene, const fv_view *view, const fv_drive_
     }
     d->o.eye_model = &d->eye;
     fv_eye_model_whole_screen(&d->eye, &d->eye_whole);
-    d->last_index = -1;
+    d->last_seen = -1;
     *out = d;
     return FV_OK;
 }
@@ -122,7 +125,8 @@ void fv_driver_views(const fv_driver *d, int index, fv_frame_views *out)
 
 void fv_driver_prev_views(const fv_driver *d, int index, fv_frame_views *out)
 {
-    if (index > 0 && d->last_index == index - 1) *out = d->last;
+    /* frame 0 goes on from the last warm-up frame, which had frame 0's views */
+    if (index >= 0 && d->last_seen >= 0 && d->last_seen == index + d->o.warmup - 1) *out = d->last;
     else fv_driver_views(d, index - 1 > 0 ? index - 1 : 0, out);
 }
 
@@ -131,48 +135,72 @@ typedef struct eye_progress {
     fv_progress_fn fn;
     void *user;
     int eye, eyes;
+    int frame, frames; /* of a run of frames reported as one (the warm-up) */
 } eye_progress;
 
 static bool on_eye_progress(void *user, double f)
 {
     eye_progress *p = user;
-    return p->fn(p->user, (p->eye + f) / p->eyes);
+    return p->fn(p->user, (p->frame + (p->eye + f) / p->eyes) / p->frames);
+}
+
+/* Renders views v as the technique's frame `seen` (its index: warm-up frames first). */
+static fv_status render_views(fv_driver *d, fv_technique *t, const fv_frame_views *v, int seen, const fv_frame_views *pv,
+                              fv_film *const *films, fv_stats *stats, eye_progress *ep, fv_error *err)
+{
+    fv_status s = fv_scene_set_time(d->scene, v->time, err);
+    for (int e = 0; e < v->eye_count && s == FV_OK; e++) {
+        if (!films[e]) return fv_error_set(err, FV_ERR_INVALID, "driver: no film for eye %d", e);
+        fv_frame fr;
+        fv_frame_init(&fr, &v->camera[e]);
+        fr.time = v->time;
+        fr.index = seen;
+        fr.seed = d->o.seed;
+        fr.threads = d->o.threads;
+        fr.eye = e;
+        fr.eye_count = v->eye_count;
+        fr.prev_camera = pv ? &pv->camera[e] : NULL;
+        fr.left_camera = e == 1 ? &v->camera[0] : NULL;
+        fr.gaze = v->gaze[e];
+        fr.eye_model = v->eye_model;
+        if (ep->fn) {
+            ep->eye = e;
+            fr.progress = on_eye_progress;
+            fr.progress_user = ep;
+        }
+        s = fv_technique_render(t, &fr, films[e], stats, err);
+    }
+    if (s == FV_OK) {
+        d->last = *v;
+        d->last_seen = seen;
+    }
+    return s;
 }
 
 fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool continues, fv_film *const *films, fv_stats *stats,
                            fv_progress_fn progress, void *progress_user, fv_error *err)
 {
     if (index < 0) return fv_error_set(err, FV_ERR_INVALID, "driver: frame index %d must be >= 0", index);
+    if (index > INT_MAX - d->o.warmup) return fv_error_set(err, FV_ERR_INVALID, "driver: frame index %d is too large", index);
+    const int seen = index + d->o.warmup;
     fv_frame_views v, pv;
     fv_driver_views(d, index, &v);
-    bool has_prev = continues && index > 0;
+    bool has_prev = continues && seen > 0;
     if (has_prev) fv_driver_prev_views(d, index, &pv);
-    fv_status s = fv_scene_set_time(d->scene, v.time, err);
-    eye_progress ep = {progress, progress_user, 0, v.eye_count};
-    for (int e = 0; e < v.eye_count && s == FV_OK; e++) {
-        if (!films[e]) return fv_error_set(err, FV_ERR_INVALID, "driver: no film for eye %d", e);
-        fv_frame fr;
-        fv_frame_init(&fr, &v.camera[e]);
-        fr.time = v.time;
-        fr.index = index;
-        fr.seed = d->o.seed;
-        fr.threads = d->o.threads;
-        fr.eye = e;
-        fr.eye_count = v.eye_count;
-        fr.prev_camera = has_prev ? &pv.camera[e] : NULL;
-        fr.left_camera = e == 1 ? &v.camera[0] : NULL;
-        fr.gaze = v.gaze[e];
-        fr.eye_model = v.eye_model;
-        if (progress) {
-            ep.eye = e;
-            fr.progress = on_eye_progress;
-            fr.progress_user = &ep;
-        }
-        s = fv_technique_render(t, &fr, films[e], stats, err);
-    }
-    if (s == FV_OK) {
-        d->last = v;
-        d->last_index = index;
+    eye_progress ep = {progress, progress_user, 0, v.eye_count, 0, 1};
+    return render_views(d, t, &v, seen, has_prev ? &pv : NULL, films, stats, &ep, err);
+}
+
+fv_status fv_driver_warm_up(fv_driver *d, fv_technique *t, fv_film *const *films, fv_stats *stats, fv_progress_fn progress,
+                            void *progress_user, fv_error *err)
+{
+    fv_frame_views v;
+    fv_driver_views(d, 0, &v);
+    fv_status s = FV_OK;
+    for (int k = 0; k < d->o.warmup && s == FV_OK; k++) {
+        eye_progress ep = {progress, progress_user, 0, v.eye_count, k, d->o.warmup};
+        /* a still: each warm-up frame's previous frame had the same views */
+        s = render_views(d, t, &v, k, k > 0 ? &v : NULL, films, stats, &ep, err);
     }
     return s;
 }

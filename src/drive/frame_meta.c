@@ -65,6 +65,7 @@ fv_status fv_frame_meta(const fv_frame_meta_run *run, int frame, const fv_frame_
     SET("frame", "%d", frame);
     SET("frame_time", "%.9g", v->time);
     SET("seed", "%llu", run->seed);
+    SET("warmup_frames", "%d", run->warmup);
     SET("size", "%dx%d", run->width, run->height);
     SET("exposure", "%.9g", run->exposure);
     SET("threads", "%d", fv_threads_used(run->threads));

@@ -14,6 +14,7 @@ typedef struct fv_frame_meta_run {
     int width, height, threads;
     unsigned long long seed;
     float exposure;
+    int warmup; /* frames rendered at frame 0's views before frame 0 (fv_drive_opts.warmup) */
 } fv_frame_meta_run;
 
 /* The metadata of eye `eye` of frame `frame` (its views from fv_driver_views) into a new bag *out;

@@ -54,6 +54,12 @@ typedef struct fv_technique_class {
      * when a sequence is split over MPI ranks (src/dist, docs/distributed.md). 0: no such state;
      * the conformance suite checks that such a method's frame does not depend on the ones before. */
     int warmup_frames;
+    /* Frames a still needs before its image is converged: `fovea render` renders them at frame
+     * 0's views before the first frame it writes (fv_drive_opts.warmup). Only methods whose first
+     * frame is worse than their steady state need any: a temporal filter's history (SVGF) or a
+     * light set that is refined over frames (fir's VPL management); photons and fipr's refresh
+     * are as good in their first frame (measured in tests/cli/test_still_warmup.sh). */
+    int still_warmup_frames;
 } fv_technique_class;
 
 /* The class of a registered method by index or name (NULL when unknown). */

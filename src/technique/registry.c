@@ -63,6 +63,8 @@ const char *fv_technique_summary(int i) { return i >= 0 && i < N_CLASSES ? k_cla
 const char *fv_technique_params_help(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->params_help : NULL; }
 const char *fv_technique_spp_param(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->spp_param : NULL; }
 bool fv_technique_foveated(int i) { return i >= 0 && i < N_CLASSES && k_classes[i]->foveated; }
+int fv_technique_still_warmup(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->still_warmup_frames : 0; }
+int fv_technique_sequence_warmup(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->warmup_frames : 0; }
 
 fv_status fv_technique_set_spp(const char *name, fv_params *params, int spp, fv_error *err)
 {

@@ -395,6 +395,57 @@ static void test_set_camera_keeps_the_past(void **st)
     fv_params_destroy(p);
 }
 
+/* Warm-up frames come first, at frame 0's views, and shift the index the technique sees: with 3 of
+ * them frame 0 is what frame 3 of a driver without warm-up is (pt keeps no state, cornell does not
+ * move), and the warm-up's progress rises to 1. */
+static void test_warm_up(void **st)
+{
+    (void)st;
+    fv_error err;
+    fv_params *p;
+    assert_int_equal(fv_params_create(&p, &err), FV_OK);
+    assert_int_equal(fv_params_set(p, "spp", "1", &err), FV_OK);
+    fv_technique *t;
+    assert_int_equal(fv_technique_create("pt", g_scene, p, NULL, &t, &err), FV_OK);
+    fv_drive_opts o;
+    fv_drive_opts_init(&o);
+    o.width = 32, o.height = 32, o.threads = 1;
+    fv_film *a, *b;
+    assert_int_equal(fv_film_create(32, 32, 0, &a, &err), FV_OK);
+    assert_int_equal(fv_film_create(32, 32, 0, &b, &err), FV_OK);
+    fv_stats stats;
+    fv_stats_clear(&stats);
+    fv_driver *plain = make(g_view, &o);
+    assert_int_equal(fv_driver_render(plain, t, 3, false, &b, &stats, NULL, NULL, &err), FV_OK);
+    o.warmup = 3;
+    fv_driver *warm = make(g_view, &o);
+    progress_log log = {{0}, 0, -1};
+    assert_int_equal(fv_driver_warm_up(warm, t, &a, &stats, on_progress, &log, &err), FV_OK);
+    assert_true(log.n >= 3);
+    for (int i = 1; i < log.n; i++) assert_true(log.f[i] >= log.f[i - 1]);
+    assert_float_equal(log.f[log.n - 1], 1.0, 1e-9);
+    /* frame 0 goes on from the last warm-up frame, which had its views */
+    fv_frame_views v0, pv;
+    fv_driver_views(warm, 0, &v0);
+    fv_driver_prev_views(warm, 0, &pv);
+    assert_memory_equal(&pv.camera[0], &v0.camera[0], sizeof v0.camera[0]);
+    assert_int_equal(fv_driver_render(warm, t, 0, true, &a, &stats, NULL, NULL, &err), FV_OK);
+    assert_memory_equal(fv_film_color(a), fv_film_color(b), 32 * 32 * 3 * sizeof(float));
+    fv_driver_destroy(warm);
+    fv_driver_destroy(plain);
+    /* a count out of range is refused */
+    fv_driver *bad = NULL;
+    o.warmup = -1;
+    assert_int_equal(fv_driver_create(g_scene, g_view, &o, &bad, &err), FV_ERR_INVALID);
+    o.warmup = FV_DRIVE_MAX_WARMUP + 1;
+    assert_int_equal(fv_driver_create(g_scene, g_view, &o, &bad, &err), FV_ERR_INVALID);
+    assert_null(bad);
+    fv_film_destroy(a);
+    fv_film_destroy(b);
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -402,7 +453,7 @@ int main(void)
         cmocka_unit_test(test_gaze_precedence), cmocka_unit_test(test_eye_model),
         cmocka_unit_test(test_bad_options),     cmocka_unit_test(test_render_progress_and_cancel),
         cmocka_unit_test(test_set_camera_keeps_the_past),
-        cmocka_unit_test(test_missing_gaze),
+        cmocka_unit_test(test_missing_gaze),     cmocka_unit_test(test_warm_up),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -48,8 +48,10 @@ static void help(void)
            "  --camera-trace FILE   camera over time from a CSV trace (docs/gaze.md)\n"
            "  --stereo SEP          render a stereo pair with eye separation SEP: OUT_left.ext, OUT_right.ext\n"
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
-           "  --warmup N            under MPI (docs/distributed.md): frames each rank's block of a sequence starts\n"
-           "                        with, unwritten, to rebuild a temporal method's history [the method's own]\n"
+           "  --warmup N            frames rendered before the first written one, unwritten: at frame 0's view, so\n"
+           "                        that a temporal method's still is converged; under MPI (docs/distributed.md)\n"
+           "                        also the frames each rank's block of a sequence starts with [the method's\n"
+           "                        own: fovea methods NAME]\n"
            "  --stats               print every counter of each frame (rays, steps, ...) after its timings\n"
            "  --no-metadata         write images without the metadata that says how they were made (method,\n"
            "                        parameters, camera, gaze, build, date: docs/metrics.md), byte-reproducible\n"
@@ -110,6 +112,22 @@ typedef struct render_opts {
 /* The files of frame f: OUT.ext, OUT_left/_right.ext for stereo, _NNNN before the extension for a
  * sequence; each written whole or not at all, and each saying how it was made (method,
  * parameters, camera, gaze of its eye, ...; docs/metrics.md) unless --no-metadata. */
+/* The method's warm-up frames before frame 0 (fv_driver_warm_up), said in one line unless quiet;
+ * bar (may be NULL) is drawn meanwhile. */
+static fv_status warm_up(const render_opts *o, const fv_frame_meta_run *rec, fv_driver *driver, fv_technique *tech, fv_film *const *film,
+                         fv_progress_fn progress, void *user, fv_cli_progress *bar, fv_error *err)
+{
+    if (rec->warmup == 0) return FV_OK;
+    fv_stats stats;
+    fv_stats_clear(&stats);
+    double t0 = fv_time_ms();
+    fv_status s = fv_driver_warm_up(driver, tech, film, &stats, progress, user, err);
+    if (bar) fv_cli_progress_done(bar);
+    if (s == FV_OK && bar && !o->quiet)
+        fprintf(stderr, "warm-up: %d frames at frame 0's view in %.1f ms (--warmup N changes it)\n", rec->warmup, fv_time_ms() - t0);
+    return s;
+}
+
 static fv_status write_frame(const render_opts *o, const fv_frame_meta_run *rec, fv_driver *driver, fv_film *const *film, int neyes,
                              int f, double ms, fv_error *err)
 {
@@ -242,7 +260,8 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
             if ((rc = fv_cli_opt_param(cmd, optarg, params))) return rc;
             break;
         case O_WARMUP:
-            if (!fv_cli_parse_int(optarg, 0, 1000000, &l)) return fv_cli_usage_error(cmd, "--warmup %s: expected an integer in [0, 1000000]", optarg);
+            if (!fv_cli_parse_int(optarg, 0, FV_DRIVE_MAX_WARMUP, &l))
+                return fv_cli_usage_error(cmd, "--warmup %s: expected an integer in [0, %d]", optarg, FV_DRIVE_MAX_WARMUP);
             o->warmup = (int)l;
             break;
         case O_QUIET: o->quiet = true; break;
@@ -318,7 +337,8 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
             s = fv_dist_still(d, &job, film, neyes, &stats, &print_it, &name_rank, &err);
         } else {
             /* Not split (docs/distributed.md says which stills are): rank 0 renders it alone. */
-            if (rank == 0) s = fv_driver_render(driver, tech, 0, false, film, &stats, on_dist_progress, &dp, &err);
+            if (rank == 0) s = warm_up(o, rec, driver, tech, film, on_dist_progress, &dp, &bar, &err);
+            if (rank == 0 && s == FV_OK) s = fv_driver_render(driver, tech, 0, rec->warmup > 0, film, &stats, on_dist_progress, &dp, &err);
             s = fv_dist_agree(d, s, &print_it, &name_rank, &err);
         }
         double ms = fv_time_ms() - t0;
@@ -335,14 +355,17 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
         return FV_EXIT_OK;
     }
     /* A sequence: this rank's block of frames, after its warm-up frames. */
-    int warmup = o->warmup >= 0 ? o->warmup : fv_dist_warmup(o->method), start, first, end;
+    const int mi = fv_technique_index(o->method), seq = fv_technique_sequence_warmup(mi), still = fv_technique_still_warmup(mi);
+    int warmup = o->warmup >= 0 ? o->warmup : seq > still ? seq : still, start, first, end;
     fv_dist_frames(o->frames, rank, size, warmup, &start, &first, &end);
+    /* the block that starts the sequence warms up as one process does, at frame 0's views */
+    if (start == 0) s = warm_up(o, rec, driver, tech, film, on_dist_progress, &dp, rank == 0 ? &bar : NULL, &err);
     bar.frames = end - start > 0 ? end - start : 1;
     for (int f = start; f < end && s == FV_OK && !fv_cli_interrupted(); f++) {
         fv_stats_clear(&stats);
         bar.frame = f - start;
         double f0 = fv_time_ms();
-        s = fv_driver_render(driver, tech, f, f > start, film, &stats, on_dist_progress, &dp, &err);
+        s = fv_driver_render(driver, tech, f, f > start || (start == 0 && rec->warmup > 0), film, &stats, on_dist_progress, &dp, &err);
         if (s == FV_OK && f >= first) s = write_frame(o, rec, driver, film, neyes, f, fv_time_ms() - f0, &err);
         if (s != FV_OK) {
             /* the others stop at their next progress step (unless this rank only stopped for another) */
@@ -491,11 +514,13 @@ static int render(int argc, char **argv, void *dist)
     dopt.gaze = (fv_gaze){o.gaze[0], o.gaze[1]};
     dopt.gaze_path = trace;
     dopt.gaze_missing = o.missing;
+    /* A temporal method's still is converged: its warm-up frames first (fovea methods NAME). */
+    dopt.warmup = o.warmup >= 0 ? o.warmup : fv_technique_still_warmup(fv_technique_index(o.method));
     if ((s = fv_driver_create(scene, view, &dopt, &driver, &err)) != FV_OK) {
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
     }
-    fv_frame_meta_run rec = {o.method, o.scene, params, o.width, o.height, o.threads, o.seed, (float)o.exposure};
+    fv_frame_meta_run rec = {o.method, o.scene, params, o.width, o.height, o.threads, o.seed, (float)o.exposure, dopt.warmup};
     if (o.stats_json && !dist && (s = fv_stats_log_create(&rec, &slog, &err)) != FV_OK) {
         rc = fv_cli_fail(cmd, s, err.msg);
         goto done;
@@ -527,12 +552,13 @@ static int render(int argc, char **argv, void *dist)
     fv_cli_progress prog;
     fv_cli_progress_init(&prog, o.quiet, o.frames);
     fv_cli_interrupt_defer(true);
-    for (int f = 0; f < o.frames && !fv_cli_interrupted(); f++) {
+    s = warm_up(&o, &rec, driver, tech, film, fv_cli_progress_frame, &prog, &prog, &err);
+    for (int f = 0; f < o.frames && s == FV_OK && !fv_cli_interrupted(); f++) {
         fv_stats stats;
         fv_stats_clear(&stats);
         prog.frame = f;
         double t0 = fv_time_ms();
-        if ((s = fv_driver_render(driver, tech, f, f > 0, film, &stats, fv_cli_progress_frame, &prog, &err)) != FV_OK) break;
+        if ((s = fv_driver_render(driver, tech, f, f > 0 || rec.warmup > 0, film, &stats, fv_cli_progress_frame, &prog, &err)) != FV_OK) break;
         double ms = fv_time_ms() - t0;
         fv_frame_views views;
         fv_driver_views(driver, f, &views);

@@ -830,6 +830,9 @@ const fv_technique_class fv_technique_fir = {
      * a block of an MPI-split sequence starts 8 frames early (docs/distributed.md measures what
      * remains) */
     .warmup_frames = 8,
+    /* a still's first frame picks its VPLs without the management's history: its error is 1.15x
+     * that of the frames after it (cornell-fir at 128x128), one frame later they have converged */
+    .still_warmup_frames = 1,
     /* furnace: emitted 0.5 + direct 0.25 + the VPLs' two bounces 0.1875 = 0.9375; a first frame
      * measures 0.892: its few hundred VPLs' cells and their neighbours cover less of the sphere
      * than a full set's (0.546 of 0.5625 for the VPL term after three frames) */

@@ -324,7 +324,10 @@ static fv_status create_logpolar(const fv_scene *s, fv_params *p, const fv_log *
 
 /* Warm-up of a block of a sequence split over MPI ranks (class.h): SVGF's history blends each
  * frame in with weight 0.2 (Schied et al. 2017, Sec. 4.1), so after 16 frames a missing past
- * weighs 0.8^16 = 3% of the colour; the image converges to the one-process frame, not bit for bit. */
+ * weighs 0.8^16 = 3% of the colour; the image converges to the one-process frame, not bit for bit.
+ * A still needs as many (class.h's still_warmup_frames): its first frame has no history, so SVGF's
+ * variance comes from the spatial estimate alone and the periphery's error is 1.6x the steady
+ * state's (vpolar, cornell at 128x128, tests/cli/test_still_warmup.sh). */
 #define SVGF_WARMUP 16
 
 const fv_technique_class fv_technique_vpolar = {
@@ -337,7 +340,7 @@ const fv_technique_class fv_technique_vpolar = {
                 "periphery_passes=int (3): SVGF passes for the columns beyond periphery_deg (svgf_iterations or more: all)\n"
                 "periphery_deg=float (20, at most blur_ramp_deg): eccentricity where periphery_passes starts, on the blur's profile\n",
     create_vpolar, vp_render, vp_destroy,
-    FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
+    FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
 
 const fv_technique_class fv_technique_cartesian = {
@@ -346,7 +349,7 @@ const fv_technique_class fv_technique_cartesian = {
     COMMON_HELP "reduction=float (0.61): share of screen pixels not sampled, in (0,1)\n"
                 "blur=bool (false)\n",
     create_cartesian, vp_render, vp_destroy,
-    FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .spp_param = "spp",
+    FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp",
 };
 
 const fv_technique_class fv_technique_cartesian_full = {
@@ -354,7 +357,7 @@ const fv_technique_class fv_technique_cartesian_full = {
     "1 spp at full resolution with SVGF: the cost reference of Visual-Polar Fig. 12",
     COMMON_HELP "blur=bool (false)\n",
     create_cartesian_full, vp_render, vp_destroy,
-    FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .spp_param = "spp",
+    FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp",
 };
 
 const fv_technique_class fv_technique_linear_falloff = {
@@ -364,7 +367,7 @@ const fv_technique_class fv_technique_linear_falloff = {
                 "falloff_probability=float (0.2)\n"
                 "blur=bool (true): foveated blur (blur_fovea_deg default 10)\n",
     create_linear_falloff, vp_render, vp_destroy,
-    FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
+    FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
 
 const fv_technique_class fv_technique_logpolar = {
@@ -374,5 +377,5 @@ const fv_technique_class fv_technique_logpolar = {
                 "alpha=float (4): kernel exponent\n"
                 "blur=bool (false)\n",
     create_logpolar, vp_render, vp_destroy,
-    FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
+    FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
