@@ -24,6 +24,20 @@ typedef struct fv_bench_result {
     char img[4096], heat[4096], crop[4096]; /* paths relative to the output folder */
 } fv_bench_result;
 
+/* The reference's own error, estimated from a probe render (ref_noise.c). */
+typedef struct fv_bench_ref_noise {
+    bool estimated;
+    char why_not[160];           /* when not estimated */
+    const char *spp_key;         /* the reference method's samples-per-pixel parameter */
+    int spp, probe_spp;
+    double mse[FV_REGION_COUNT]; /* the reference's estimated MSE per region, at the last frame */
+    bool warn;                   /* more than a tenth of the smallest error measured against it */
+    int warn_region;             /* where the reference's share of an error is largest */
+    double warn_mse;             /* that error */
+    char warn_label[64];         /* the row that measured it */
+    int spp_needed;              /* samples that bring the reference's share below a tenth */
+} fv_bench_ref_noise;
+
 typedef struct fv_bench_run_info {
     const fv_scenario *sc;
     const fv_bench_options *opt;
@@ -37,7 +51,16 @@ typedef struct fv_bench_run_info {
     int extra_cached[FV_BENCH_MAX_EXTRA];
     char ref_img[4096];
     fv_gaze last_gaze;          /* gaze at the last frame (the images show it) */
+    fv_bench_ref_noise ref_noise;
 } fv_bench_run_info;
+
+/* ref_noise.c. Whether the scenario's reference can be probed, and with how many samples (else
+ * why_not says why); the estimate from the probe's errors against the reference; whether the
+ * rows' errors are too small for it (warn, spp_needed); the one-line warning (empty when none). */
+bool fv_bench_ref_noise_plan(const fv_scenario *sc, fv_bench_ref_noise *rn);
+void fv_bench_ref_noise_estimate(fv_bench_ref_noise *rn, const fv_metric_report *probe_vs_ref);
+void fv_bench_ref_noise_check(fv_bench_ref_noise *rn, const fv_bench_result *res, int n);
+void fv_bench_ref_noise_message(const fv_bench_ref_noise *rn, const fv_scenario *sc, char *buf, size_t n);
 
 /* report.c */
 fv_status fv_bench_write_reports(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err);

@@ -228,6 +228,20 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     cJSON_AddNumberToObject(ref, "cached_frames", info->ref_cached);
     cJSON_AddItemToObject(ref, "ms_per_frame", info->ref_ms > 0 ? num(info->ref_ms) : cJSON_CreateNull());
     cJSON_AddStringToObject(ref, "image", info->ref_img);
+    /* its own error, estimated from a probe (ref_noise.c), and whether it is too noisy */
+    const fv_bench_ref_noise *rn = &info->ref_noise;
+    cJSON *noise = cJSON_AddObjectToObject(ref, "noise");
+    cJSON_AddBoolToObject(noise, "estimated", rn->estimated);
+    if (!rn->estimated) {
+        cJSON_AddStringToObject(noise, "why_not", rn->why_not);
+    } else {
+        cJSON_AddNumberToObject(noise, "probe_spp", rn->probe_spp);
+        cJSON *mse = cJSON_AddObjectToObject(noise, "mse");
+        for (int r = 0; r < FV_REGION_COUNT; r++) cJSON_AddItemToObject(mse, fv_region_name(r), num(rn->mse[r]));
+        char w[1024];
+        fv_bench_ref_noise_message(rn, sc, w, sizeof w);
+        cJSON_AddItemToObject(noise, "warning", rn->warn ? cJSON_CreateString(w) : cJSON_CreateNull());
+    }
     if (sc->nextra > 0) {
         cJSON *ex = cJSON_AddArrayToObject(root, "extra_references");
         for (int k = 0; k < sc->nextra; k++) {
@@ -296,6 +310,14 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
             fv_eye_transition_radius_px(&sc->eye), sc->reference.method);
     for (int i = 0; i < fv_params_count(sc->reference.params); i++)
         tprintf(&t, " %s=%s", fv_params_key(sc->reference.params, i), fv_params_value(sc->reference.params, i));
+    if (info->ref_noise.estimated)
+        tprintf(&t, " (its own MSE, estimated from a %d-sample probe: %.3g in the fovea, %.3g overall)", info->ref_noise.probe_spp,
+                info->ref_noise.mse[FV_REGION_FOVEA], info->ref_noise.mse[FV_REGION_ALL]);
+    if (info->ref_noise.warn) {
+        char w[1024];
+        fv_bench_ref_noise_message(&info->ref_noise, sc, w, sizeof w);
+        tprintf(&t, ". **Warning:** %s", w);
+    }
     int reps = info->opt->repeats > 0 ? info->opt->repeats : sc->repeats;
     tprintf(&t, ". Times are medians of %d repeat(s) (ms per frame, render call only); speed-up is relative to `%s`. "
                 "Errors are means over frames on display values (exposure %g, sRGB); MSE' is the temporal error "

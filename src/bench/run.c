@@ -224,6 +224,75 @@ static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene,
     return st;
 }
 
+/* The reference's own noise (ref_noise.c): a probe of its method with fewer samples on another
+ * stream renders the last frame (cached like a reference), and its errors against the reference
+ * give the estimate. */
+typedef struct probe_ctx {
+    float *rgb;
+    const char *path;
+} probe_ctx;
+
+static fv_status on_probe_frame(void *user, int i, fv_film *film, double ms, const fv_stats *stats, fv_error *err)
+{
+    (void)i, (void)ms, (void)stats;
+    probe_ctx *c = user;
+    const int w = fv_film_width(film), h = fv_film_height(film);
+    memcpy(c->rgb, fv_film_color(film), (size_t)w * h * 3 * sizeof(float));
+    return fv_image_write(c->path, c->rgb, w, h, 1.0f, err);
+}
+
+static fv_status probe_reference(fv_bench_run_info *info, fv_scene *scene, const fv_view *view, const fv_drive_opts *dopt, frame_setup *frames,
+                                 const char *cache_dir, fv_error *err)
+{
+    const fv_scenario *sc = info->sc;
+    fv_bench_ref_noise *rn = &info->ref_noise;
+    if (!fv_bench_ref_noise_plan(sc, rn)) return FV_OK;
+    const int last = sc->frames - 1;
+    const size_t npix = (size_t)sc->width * sc->height;
+    fv_bench_method probe = sc->reference;
+    probe.params = NULL;
+    fv_driver *driver = NULL;
+    float *rgb = fv_alloc_array(npix, 3 * sizeof(float));
+    char v[32], key[2048 + 32], path[4096 + 64];
+    snprintf(v, sizeof v, "%d", rn->probe_spp);
+    fv_status st = rgb ? fv_params_clone(sc->reference.params, &probe.params, err) : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (st == FV_OK) st = fv_params_set(probe.params, rn->spp_key, v, err);
+    if (st != FV_OK) goto done;
+    reference_key(sc, &probe, &frames[last], last, key, sizeof key - 32);
+    strcat(key, "|stream=probe");
+    snprintf(path, sizeof path, "%s/probe-%016llx.pfm", cache_dir, (unsigned long long)fnv1a(FNV_BASIS, key));
+    fv_image img;
+    fv_error e2;
+    if (fv_file_exists(path) && fv_image_read(path, &img, &e2) == FV_OK) {
+        bool fits = img.width == sc->width && img.height == sc->height;
+        if (fits) memcpy(rgb, img.rgb, npix * 3 * sizeof(float));
+        fv_image_free(&img);
+        if (fits) goto compare;
+    }
+    say(info->opt, "reference noise: probing with %s=%d on its own stream", rn->spp_key, rn->probe_spp);
+    fv_drive_opts o = *dopt;
+    o.seed = fv_seed_reference_probe(sc->seed);
+    if ((st = fv_driver_create(scene, view, &o, &driver, err)) != FV_OK) goto done;
+    render_job j = {sc, scene, driver, &probe, info->opt->log};
+    probe_ctx c = {rgb, path};
+    if ((st = render_sequence(&j, last, last + 1, on_probe_frame, &c, err)) != FV_OK) {
+        fv_error_prefix(err, "the reference's noise probe: ");
+        goto done;
+    }
+compare:;
+    fv_metric_opts mo;
+    fv_metric_opts_default(&mo);
+    mo.exposure = sc->exposure;
+    fv_metric_report rep;
+    if ((st = fv_metrics_compare(frames[last].ref[0], rgb, sc->width, sc->height, frames[last].labels, &mo, &rep, NULL, err)) == FV_OK)
+        fv_bench_ref_noise_estimate(rn, &rep);
+done:
+    fv_driver_destroy(driver);
+    fv_params_destroy(probe.params);
+    free(rgb);
+    return st;
+}
+
 /* ---- the methods ---- */
 
 typedef struct method_ctx {
@@ -770,6 +839,8 @@ static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_op
         fv_eye_region_labels(&sc->eye, f->gaze, f->labels);
     }
     if ((st = load_references(&info, scene, frames, cache_dir, 0, &info.ref_cached, &info.ref_ms, err)) != FV_OK) goto done;
+    dopt.seed = sc->seed;
+    if ((st = probe_reference(&info, scene, view, &dopt, frames, cache_dir, err)) != FV_OK) goto done;
     for (int k = 0; k < sc->nextra && st == FV_OK; k++)
         st = load_references(&info, scene, frames, cache_dir, 1 + k, &info.extra_cached[k], &info.extra_ms[k], err);
     if (st != FV_OK) goto done;
@@ -803,6 +874,12 @@ static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_op
     for (int i = 0; i < sc->nmethods; i++)
         if (strcmp(sc->methods[i].label, sc->baseline) == 0) base = res[i].ms_median;
     for (int i = sc->nmethods; i < nrows; i++) res[i].speedup = res[i].ms_median > 0.0 ? base / res[i].ms_median : 0.0;
+    fv_bench_ref_noise_check(&info.ref_noise, res, nrows);
+    if (info.ref_noise.warn) {
+        char line[1024];
+        fv_bench_ref_noise_message(&info.ref_noise, sc, line, sizeof line);
+        fv_log_warn(opt->log, "bench %s: %s", sc->name, line);
+    }
     st = fv_bench_write_reports(&info, res, nrows, err);
 done:
     if (frames)

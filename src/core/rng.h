@@ -69,6 +69,9 @@ FV_HD static inline fv_rng fv_rng_stream(uint64_t seed, uint64_t stream, uint64_
  * draws from it, so a 1-sample method's first sample is not the reference's first sample (which
  * would understate its error). */
 FV_HD static inline uint64_t fv_seed_reference(uint64_t seed) { return fv_hash_combine(fv_hash64(seed), 0x7265666572656e63ULL); }
+/* The seed of the probe that estimates a reference's own noise (src/bench/ref_noise.c): a stream
+ * independent of the reference's and of every measured method's. */
+FV_HD static inline uint64_t fv_seed_reference_probe(uint64_t seed) { return fv_hash_combine(fv_hash64(seed), 0x70726f6265ULL); }
 
 /* Uniform float in [0, 1): 24 random mantissa bits. */
 FV_HD static inline float fv_rng_next(fv_rng *r)
