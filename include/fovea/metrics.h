@@ -70,11 +70,29 @@ FV_API void fv_temporal_destroy(fv_temporal *t);
 
 /* ---- heat maps ---- */
 
-/* Writes map (w*h values, 0..vmax) as a PNG through a perceptual colour ramp (dark purple for 0,
- * through red and orange, to pale yellow for vmax). With eye non-NULL, the fovea and transition
- * circles around gaze are drawn as thin grey rings. */
-FV_API fv_status fv_heatmap_write(const char *path, const float *map, int w, int h, float vmax, const fv_eye_model *eye,
-                           fv_gaze gaze, fv_error *err);
+/* How a heat map is drawn. Zero-initialised: scaled to the map's largest value, no rings, no
+ * colour bar. */
+typedef struct fv_heatmap_opts {
+    float vmax;              /* the value drawn as the ramp's top colour (larger ones too); <= 0 or not
+                                finite: fv_heatmap_scale of the map. Give several heat maps the same
+                                vmax to compare them by eye */
+    const fv_eye_model *eye; /* non-NULL: the fovea and transition rings of this model (of the map's
+                                size) around gaze, and a cross at the gaze point */
+    fv_gaze gaze;
+    const char *label;       /* non-NULL: a colour bar strip below the map with this name (the metric)
+                                and the scale: 0, vmax / 2, vmax */
+} fv_heatmap_opts;
+
+/* The scale a heat map of this map gets without a vmax: its largest finite value, 1 when none
+ * is positive. */
+FV_API float fv_heatmap_scale(const float *map, int w, int h);
+/* Writes map (w*h values, 0..vmax) as a PNG through a perceptual colour ramp (near black for 0,
+ * through purple, red and orange, to pale yellow for vmax), with the rings and the colour bar
+ * o asks for (o NULL: none, the map's own scale). The colour bar adds rows below the map (and
+ * columns to the right of a map too narrow for it); the map keeps its pixels at the top left.
+ * The file's metadata (fovea/film.h) says what it is: `heatmap` (the label, or "error"),
+ * `heatmap_max` (vmax), and `overlay` when rings are drawn, so it is never taken for an image. */
+FV_API fv_status fv_heatmap_write(const char *path, const float *map, int w, int h, const fv_heatmap_opts *o, fv_error *err);
 
 #ifdef __cplusplus
 }

@@ -7,6 +7,12 @@
 #include "fovea/drive.h"
 #include "fovea/metrics.h"
 
+/* The heat maps of a report: each method's FLIP error of the last frame. FLIP lies in [0,1], so
+ * its fixed top is one scale shared by every method of a comparison (and by every report): the
+ * same colour is the same error in every heat map, and the colour bar says so. */
+#define FV_BENCH_HEAT_LABEL "FLIP"
+#define FV_BENCH_HEAT_MAX 1.0f
+
 /* What one method measured over all frames and repeats. */
 typedef struct fv_bench_result {
     const fv_bench_method *m;

@@ -218,6 +218,11 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     cJSON *eye = cJSON_AddObjectToObject(root, "eye");
     cJSON_AddItemToObject(eye, "fovea_radius_px", num(fv_eye_fovea_radius_px(&sc->eye)));
     cJSON_AddItemToObject(eye, "transition_radius_px", num(fv_eye_transition_radius_px(&sc->eye)));
+    /* The one scale of every method's heat map (images.flip): its colour bar goes from 0 to max. */
+    cJSON *hm = cJSON_AddObjectToObject(root, "heatmaps");
+    cJSON_AddStringToObject(hm, "metric", "flip");
+    cJSON_AddItemToObject(hm, "max", num(FV_BENCH_HEAT_MAX));
+    cJSON_AddBoolToObject(hm, "shared", true);
     cJSON *ref = cJSON_AddObjectToObject(root, "reference");
     cJSON_AddStringToObject(ref, "method", sc->reference.method);
     cJSON_AddItemToObject(ref, "params", params_json(&sc->reference));
@@ -364,7 +369,10 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
                     sci(c, v[FV_REGION_PERIPHERY].mse), sci(d, v[FV_REGION_FOVEA].flip), sci(e, v[FV_REGION_ALL].flip));
         }
     }
-    tprintf(&t, "\n| method | last frame | FLIP error (rings: fovea, transition) | around the gaze |\n|---|---|---|---|\n");
+    tprintf(&t, "\nThe heat maps show each method's %s error on one scale, shared by every method: 0 (no error) to %g, "
+                "the bar below each; rings: fovea (cyan), transition (green).\n",
+            FV_BENCH_HEAT_LABEL, FV_BENCH_HEAT_MAX);
+    tprintf(&t, "\n| method | last frame | %s error, 0 to %g | around the gaze |\n|---|---|---|---|\n", FV_BENCH_HEAT_LABEL, FV_BENCH_HEAT_MAX);
     tprintf(&t, "| reference | ![](%s) | | |\n", info->ref_img);
     for (int i = 0; i < n; i++)
         tprintf(&t, "| %s | ![](%s) | ![](%s) | ![](%s) |\n", res[i].m->label, res[i].img, res[i].heat, res[i].crop);

@@ -498,7 +498,8 @@ static fv_status method_end(method_run *mr, fv_error *err)
         for (size_t q = 0; q < npix; q++) sum += c->last[3 * q + k];
         res->image_mean[k] = sum / (double)npix;
     }
-    /* Images of the last frame: the frame, its FLIP heat map with the region rings, the fovea. */
+    /* Images of the last frame: the frame, its FLIP heat map with the region rings and the colour
+     * bar of the scale every method shares, the fovea. */
     char path[4096 + 128];
     const frame_setup *lf = &c->frames[sc->frames - 1];
     const char *label = res->m->label;
@@ -515,7 +516,8 @@ static fv_status method_end(method_run *mr, fv_error *err)
     if (st == FV_OK) st = fv_image_write_meta(path, c->last, sc->width, sc->height, sc->exposure, meta, err);
     fv_params_destroy(meta);
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->heat);
-    if (st == FV_OK) st = fv_heatmap_write(path, c->flip_map, sc->width, sc->height, 1.0f, &sc->eye, lf->gaze, err);
+    const fv_heatmap_opts ho = {FV_BENCH_HEAT_MAX, &sc->eye, lf->gaze, FV_BENCH_HEAT_LABEL};
+    if (st == FV_OK) st = fv_heatmap_write(path, c->flip_map, sc->width, sc->height, &ho, err);
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->crop);
     if (st == FV_OK) st = write_crop(sc, c->last, lf->gaze, path, err);
     return st;

@@ -81,3 +81,5 @@ fv_status fv_frame_meta(const fv_frame_meta_run *run, int frame, const fv_frame_
     *out = p;
     return FV_OK;
 }
+
+fv_status fv_frame_meta_overlay(fv_params *meta, fv_error *err) { return fv_params_set(meta, "overlay", "rings,gaze", err); }

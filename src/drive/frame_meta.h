@@ -22,4 +22,9 @@ typedef struct fv_frame_meta_run {
 fv_status fv_frame_meta(const fv_frame_meta_run *run, int frame, const fv_frame_views *v, int eye, double render_ms,
                         fv_params **out, fv_error *err);
 
+/* Marks a frame's metadata as drawn over (key `overlay`: `fovea render --overlay` drew the eye
+ * model's rings and the gaze cross on its pixels): `fovea compare` refuses such an image, whose
+ * pixels are no longer what was rendered. Written even under --no-metadata, as the one key. */
+fv_status fv_frame_meta_overlay(fv_params *meta, fv_error *err);
+
 #endif

@@ -28,6 +28,30 @@ PY
 for f in pt-cornell.md pt-cornell-sweep.csv pt-cornell/reference.png pt-cornell/pt-spp=4.png pt-cornell/pt-spp=4-flip.png pt-cornell/pt-spp=4-fovea.png; do
   [ -s "$OUT/$f" ] || fail "missing $f"
 done
+# Every method's heat map on one scale (FLIP's 0..1), said in the report and in each file, with the
+# colour bar's strip below the frame.
+python3 - "$OUT" <<'PY' || fail "the heat maps do not share one stated scale"
+import json, struct, sys, zlib
+out = sys.argv[1]
+d = json.load(open(f"{out}/pt-cornell.json"))
+assert d["heatmaps"] == {"metric": "flip", "max": 1, "shared": True}, d["heatmaps"]
+def png(path):
+    data, pos, text = open(path, "rb").read(), 8, {}
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + n]
+        if kind == b"IHDR": w, h = struct.unpack(">II", body[:8])
+        if kind == b"tEXt":
+            k, v = body.split(b"\0", 1)
+            text[k.decode()] = v.decode()
+        pos += 12 + n
+    return w, h, text
+for r in d["results"]:
+    w, h, text = png(f"{out}/{r['images']['flip']}")
+    assert text.get("fovea:heatmap") == "FLIP" and text.get("fovea:heatmap_max") == "1", (r["images"]["flip"], text)
+    assert w >= d["size"][0] and h > d["size"][1], (w, h, d["size"])
+PY
+grep -q "on one scale, shared by every method: 0 (no error) to 1" "$OUT/pt-cornell.md" || fail "pt-cornell.md does not state the heat maps' scale"
 ls "$OUT"/cache/ref-*.pfm >/dev/null 2>&1 || fail "no cached reference"
 expect 0 "" -- $B pt-cornell --quick --out "$OUT" --repeats 1
 grep -q "from the cache" "$TMP/err" || fail "second run did not use the cached reference"

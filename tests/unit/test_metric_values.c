@@ -228,7 +228,8 @@ static void test_heatmap(void **st)
     fv_eye_model eye;
     fv_eye_model_default(12, 8, &eye);
     fv_error err;
-    assert_int_equal(fv_heatmap_write(path, map, 12, 8, 1.0f, &eye, (fv_gaze){0.5f, 0.5f}, &err), FV_OK);
+    const fv_heatmap_opts ho = {1.0f, &eye, {0.5f, 0.5f}, NULL};
+    assert_int_equal(fv_heatmap_write(path, map, 12, 8, &ho, &err), FV_OK);
     fv_image img;
     assert_int_equal(fv_image_read(path, &img, &err), FV_OK);
     assert_int_equal(img.width, 12);

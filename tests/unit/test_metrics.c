@@ -198,7 +198,7 @@ static void test_heatmap_ramp_and_rings(void **st)
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) map[y * w + x] = 4.0f * (float)x / (float)(w - 1); /* 0..4 */
     fv_error err;
-    assert_int_equal(fv_heatmap_write(path, map, w, h, 0.0f, NULL, (fv_gaze){0.5f, 0.5f}, &err), FV_OK);
+    assert_int_equal(fv_heatmap_write(path, map, w, h, NULL, &err), FV_OK);
     fv_image img;
     assert_int_equal(fv_image_read(path, &img, &err), FV_OK);
     assert_int_equal(img.width, w);
@@ -210,25 +210,27 @@ static void test_heatmap_ramp_and_rings(void **st)
     assert_true(luma(img.rgb) < 0.01f);
     fv_image_free(&img);
 
-    /* Rings: a pixel whose centre is at the foveal radius from the gaze is grey (0.75 encoded),
-     * the gaze pixel itself is not. */
+    /* Rings: a pixel whose centre is at the foveal radius from the gaze has the heat-map palette's
+     * fovea colour (cyan, gaze/overlay.h), the gaze pixel itself keeps its error colour. */
     fv_eye_model eye;
     fv_eye_model_default(w, h, &eye);
     double rf = fv_eye_fovea_radius_px(&eye);
     assert_true(rf > 1.5 && rf < w / 2 - 1); /* the centre pixel (0.71 px away) is off the ring */
     int xr = (int)floor(w / 2 + rf); /* its centre is within 0.5 px (plus a little for the half-pixel row offset) of rf */
     for (int i = 0; i < w * h; i++) map[i] = 0.0f;
-    assert_int_equal(fv_heatmap_write(path, map, w, h, 1.0f, &eye, (fv_gaze){0.5f, 0.5f}, &err), FV_OK);
+    const fv_heatmap_opts ho = {1.0f, &eye, {0.5f, 0.5f}, NULL};
+    assert_int_equal(fv_heatmap_write(path, map, w, h, &ho, &err), FV_OK);
     assert_int_equal(fv_image_read(path, &img, &err), FV_OK);
     const float *ring = img.rgb + 3 * ((h / 2) * w + xr), *centre = img.rgb + 3 * ((h / 2) * w + w / 2);
-    float grey = fv_srgb_decode(0.75f);
-    for (int c = 0; c < 3; c++) assert_float_equal(ring[c], grey, 0.01);
+    assert_float_equal(ring[0], 0.0, 0.01);
+    assert_float_equal(ring[1], 1.0, 0.01);
+    assert_float_equal(ring[2], 1.0, 0.01);
     assert_true(luma(centre) < 0.01f);
     fv_image_free(&img);
     unlink(path);
 
     /* An unwritable place is a file problem. */
-    assert_int_equal(fv_heatmap_write("/nonexistent-dir/heat.png", map, w, h, 1.0f, NULL, (fv_gaze){0.5f, 0.5f}, &err), FV_ERR_IO);
+    assert_int_equal(fv_heatmap_write("/nonexistent-dir/heat.png", map, w, h, NULL, &err), FV_ERR_IO);
     free(map);
 }
 

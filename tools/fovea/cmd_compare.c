@@ -16,8 +16,12 @@ static void usage(FILE *f)
                "  --allow-gaze-mismatch   compare even when REF and TEST were both rendered by foveated methods for\n"
                "                          different gazes (refused otherwise)\n"
                "  --json                  print JSON instead of a table\n"
-               "  --heatmap FILE          write a PNG heat map of the per-pixel error\n"
+               "  --heatmap FILE          write a PNG heat map of the per-pixel error, with the eye model's rings\n"
+               "                          around the gaze and a colour bar below that gives its scale\n"
                "  --heatmap-metric M      flip | mse | e [flip]\n"
+               "  --heatmap-max V         the error drawn as the ramp's top colour (larger errors too): give the heat\n"
+               "                          maps of one comparison the same V to compare them by eye [1 for flip, the\n"
+               "                          largest error of the map for mse and e]\n"
                "  --exposure E            scale linear values before display encoding [1]\n"
                "  --linear                compare linear values (FLIP still uses display values)\n"
                "  --ppd N                 pixels per degree for FLIP [67]\n"
@@ -26,7 +30,28 @@ static void usage(FILE *f)
                "  --transition-frac F     transition radius as a fraction of the width [1.5 x fovea]\n"
                "  --ppi N --eye-dist MM   display density and pupil-to-lens distance [615, 18]\n"
                "  --fov-x DEG             horizontal field of view (instead of ppi and eye distance)\n"
+               "An image drawn over (fovea render --overlay, or a heat map) is refused: its pixels are not data.\n"
                "Regions and their defaults: docs/gaze.md. Metrics: docs/metrics.md.\n");
+}
+
+/* An image whose metadata says something was drawn over its pixels (`overlay`: the eye model's
+ * rings, fovea render --overlay; `heatmap`: a heat map) is a picture, not data: the rings would
+ * count as error. Refused rather than warned about, since the numbers would be wrong. */
+static fv_status drawn_over(const char *path, fv_error *err)
+{
+    fv_params *meta = NULL;
+    fv_error merr;
+    if (fv_image_read_meta(path, &meta, &merr) != FV_OK) return FV_OK; /* the reader says what is wrong */
+    fv_status s = FV_OK;
+    for (int i = 0; i < fv_params_count(meta) && s == FV_OK; i++) {
+        const char *k = fv_params_key(meta, i);
+        if (strcmp(k, "overlay") == 0)
+            s = fv_error_set(err, FV_ERR_INVALID, "%s has the eye model's rings drawn over it (fovea render --overlay): not an image to compare", path);
+        else if (strcmp(k, "heatmap") == 0)
+            s = fv_error_set(err, FV_ERR_INVALID, "%s is a heat map (fovea compare --heatmap), not an image to compare", path);
+    }
+    fv_params_destroy(meta);
+    return s;
 }
 
 static fv_status load(const char *path, fv_image *img, fv_error *err)
@@ -35,6 +60,7 @@ static fv_status load(const char *path, fv_image *img, fv_error *err)
      * FIFO would hang them. Reading an image that is not there is the user's input problem, as a
      * malformed one is. */
     fv_status s = fv_file_check_read(path, "image", err);
+    if (s == FV_OK) s = drawn_over(path, err);
     if (s == FV_OK) s = fv_image_read(path, img, err);
     return s;
 }
@@ -87,10 +113,10 @@ static void json_string(const char *s)
 
 int fv_cmd_compare(int argc, char **argv)
 {
-    enum { O_GAZE = 256, O_JSON, O_HEAT, O_HEATM, O_EXPOSURE, O_LINEAR, O_PPD, O_FDEG, O_TDEG, O_FFRAC, O_TFRAC, O_PPI, O_EYED, O_FOVX, O_HELP, O_ALLOW_GAZE };
+    enum { O_GAZE = 256, O_JSON, O_HEAT, O_HEATM, O_HEATMAX, O_EXPOSURE, O_LINEAR, O_PPD, O_FDEG, O_TDEG, O_FFRAC, O_TFRAC, O_PPI, O_EYED, O_FOVX, O_HELP, O_ALLOW_GAZE };
     static const struct option longs[] = {
         {"gaze", 1, 0, O_GAZE}, {"json", 0, 0, O_JSON}, {"heatmap", 1, 0, O_HEAT}, {"heatmap-metric", 1, 0, O_HEATM},
-        {"exposure", 1, 0, O_EXPOSURE}, {"linear", 0, 0, O_LINEAR}, {"ppd", 1, 0, O_PPD}, {"fovea-deg", 1, 0, O_FDEG},
+        {"heatmap-max", 1, 0, O_HEATMAX}, {"exposure", 1, 0, O_EXPOSURE}, {"linear", 0, 0, O_LINEAR}, {"ppd", 1, 0, O_PPD}, {"fovea-deg", 1, 0, O_FDEG},
         {"transition-deg", 1, 0, O_TDEG}, {"fovea-frac", 1, 0, O_FFRAC}, {"transition-frac", 1, 0, O_TFRAC},
         {"ppi", 1, 0, O_PPI}, {"eye-dist", 1, 0, O_EYED}, {"fov-x", 1, 0, O_FOVX}, {"help", 0, 0, O_HELP},
         {"allow-gaze-mismatch", 0, 0, O_ALLOW_GAZE}, {0, 0, 0, 0}};
@@ -98,6 +124,7 @@ int fv_cmd_compare(int argc, char **argv)
     float gaze[2] = {0.5f, 0.5f};
     bool json = false, has_gaze = false, allow_mismatch = false;
     const char *heat = NULL, *heat_metric = "flip";
+    double heat_max = 0.0; /* 0: the metric's default scale */
     fv_metric_opts mo;
     fv_metric_opts_default(&mo);
     double fdeg = 0, tdeg = 0, ffrac = 0, tfrac = 0, ppi = 0, eyed = 0, fovx = 0, d;
@@ -120,6 +147,11 @@ int fv_cmd_compare(int argc, char **argv)
             if (strcmp(optarg, "flip") && strcmp(optarg, "mse") && strcmp(optarg, "e"))
                 return fv_cli_usage_error(cmd, "--heatmap-metric %s: expected flip, mse or e", optarg);
             heat_metric = optarg;
+            break;
+        case O_HEATMAX:
+            if (!fv_cli_parse_float(optarg, &d) || !(d > 0) || !isfinite(d) || d > 3e38)
+                return fv_cli_usage_error(cmd, "--heatmap-max %s: expected a positive number", optarg);
+            heat_max = d;
             break;
         case O_EXPOSURE:
             if (!fv_cli_parse_float(optarg, &d) || !(d > 0)) return fv_cli_usage_error(cmd, "--exposure %s: expected a positive number", optarg);
@@ -147,6 +179,7 @@ int fv_cmd_compare(int argc, char **argv)
     if (argc - optind != 2) return fv_cli_usage_error(cmd, "expected two images: REF TEST (try fovea compare --help)");
     const char *ref_path = argv[optind], *test_path = argv[optind + 1];
     if (heat && fv_image_format_from_path(heat) != FV_IMG_PNG) return fv_cli_usage_error(cmd, "--heatmap %s: the heat map is a .png file", heat);
+    if (heat_max > 0 && !heat) return fv_cli_usage_error(cmd, "--heatmap-max: only with --heatmap FILE");
     fv_error err;
     fv_image ref, test;
     fv_status s = load(ref_path, &ref, &err);
@@ -223,9 +256,10 @@ int fv_cmd_compare(int argc, char **argv)
     if (bad[0] || bad[1])
         fprintf(stderr, "fovea compare: warning: pixels with NaN or Inf values, counted as black in every metric: %lld of %zu in %s, %lld in %s\n",
                 bad[0], n, ref_path, bad[1], test_path);
+    float vmax = 0.0f;
     if (heat) {
-        float vmax = 1.0f;
-        if (strcmp(heat_metric, "flip") != 0) {
+        bool flip = strcmp(heat_metric, "flip") == 0;
+        if (!flip) {
             /* Per-pixel squared or absolute error of the compared values. */
             float *a = malloc(n * 3 * sizeof *a), *b = malloc(n * 3 * sizeof *b);
             if (!a || !b) {
@@ -247,9 +281,12 @@ int fv_cmd_compare(int argc, char **argv)
             }
             free(a);
             free(b);
-            vmax = 0.0f; /* scale to the largest error */
         }
-        if ((s = fv_heatmap_write(heat, map, w, h, vmax, &eye, g, &err)) != FV_OK) {
+        /* FLIP lies in [0,1]: its fixed scale is comparable across heat maps as it is; MSE and E
+         * have no top, so their default scale is this map's largest error (--heatmap-max shares one). */
+        vmax = heat_max > 0 ? (float)heat_max : flip ? 1.0f : fv_heatmap_scale(map, w, h);
+        const fv_heatmap_opts ho = {vmax, &eye, g, flip ? "FLIP" : strcmp(heat_metric, "mse") == 0 ? "MSE" : "E"};
+        if ((s = fv_heatmap_write(heat, map, w, h, &ho, &err)) != FV_OK) {
             rc = fv_cli_fail(cmd, s, err.msg);
             goto done;
         }
@@ -276,7 +313,14 @@ int fv_cmd_compare(int argc, char **argv)
             json_number(v->flip);
             printf(", \"nonfinite\": %lld}%s\n", v->nonfinite, r + 1 < FV_REGION_COUNT ? "," : "");
         }
-        printf("  },\n  \"nonfinite_pixels\": {\"ref\": %lld, \"test\": %lld}\n}\n", bad[0], bad[1]);
+        printf("  },\n  \"nonfinite_pixels\": {\"ref\": %lld, \"test\": %lld}", bad[0], bad[1]);
+        if (heat) {
+            /* the scale the heat map was drawn with, to give the next one the same (--heatmap-max) */
+            printf(",\n  \"heatmap\": {\"file\": ");
+            json_string(heat);
+            printf(", \"metric\": \"%s\", \"max\": %.9g}", heat_metric, vmax);
+        }
+        printf("\n}\n");
     } else {
         printf("%-11s %10s %10s %10s %10s %10s %10s %10s\n", "region", "pixels", "MSE", "PSNR", "E", "SSIM", "FLIP", "NaN/Inf");
         for (int r = 0; r < FV_REGION_COUNT; r++) {

@@ -10,7 +10,9 @@
 #include <string.h>
 #include <unistd.h>
 #include "cli.h"
+#include "core/alloc.h"
 #include "core/parallel.h"
+#include "gaze/overlay.h"
 #include "render_record.h"
 #ifdef FOVEA_HAVE_MPI
 #include "dist/split.h"
@@ -36,6 +38,10 @@ static void help(void)
            FV_CLI_THREAD_POLICY_HELP
            "  --out FILE            output .png (tone-mapped sRGB), .pfm or .exr (linear, + aux channels) [fovea.png]\n"
            "  --exposure E          scale applied before PNG tone mapping [1]\n"
+           "  --overlay             draw the eye model over the PNG: a ring at the foveal radius (magenta), one at\n"
+           "                        the transition radius (cyan), a cross at the gaze (yellow), each eye its own\n"
+           "                        gaze; a .png --out only (PFM and EXR hold data: refused), and the file says so\n"
+           "                        in its metadata (overlay, kept with --no-metadata); fovea compare refuses it\n"
            "  --camera-pos x,y,z    camera position      --camera-look x,y,z  point looked at\n"
            "  --camera-up x,y,z     camera up vector     --fov DEG            vertical field of view\n"
            "  --point-light x,y,z,r,g,b  add a point light (intensity W/sr), repeatable\n"
@@ -100,7 +106,7 @@ typedef struct render_opts {
     int warmup; /* -1: the method's own */
     double fps, time0, exposure, stereo;
     unsigned long long seed;
-    bool quiet, show_stats, no_meta, has_pos, has_look, has_up, has_fov, has_gaze;
+    bool quiet, show_stats, no_meta, overlay, has_pos, has_look, has_up, has_fov, has_gaze;
     const char *gaze_trace, *camera_trace, *stats_json;
     fv_gaze_missing missing;
     float pos[3], look[3], up[3], fov, gaze[2];
@@ -109,9 +115,21 @@ typedef struct render_opts {
     fv_cli_scene_opts scene_opts;  /* --env, --no-default-light, --frame-view */
 } render_opts;
 
-/* The files of frame f: OUT.ext, OUT_left/_right.ext for stereo, _NNNN before the extension for a
- * sequence; each written whole or not at all, and each saying how it was made (method,
- * parameters, camera, gaze of its eye, ...; docs/metrics.md) unless --no-metadata. */
+/* --overlay: the PNG of a film with the eye model's rings and the gaze cross drawn over a copy of
+ * its pixels (gaze/overlay.h), for this eye's gaze; the film itself stays data. */
+static fv_status write_overlaid(const fv_film *film, const char *path, float exposure, const fv_eye_model *m, fv_gaze g, const fv_params *meta,
+                                fv_error *err)
+{
+    const int w = fv_film_width(film), h = fv_film_height(film);
+    float *rgb = fv_alloc_array((size_t)w * h, 3 * sizeof(float));
+    if (!rgb) return fv_error_set(err, FV_ERR_NOMEM, "out of memory writing '%s'", path);
+    memcpy(rgb, fv_film_color_const(film), (size_t)w * h * 3 * sizeof(float));
+    fv_overlay_draw_rgb(rgb, w, m, g, FV_OVERLAY_ON_IMAGE, exposure);
+    fv_status s = fv_image_write_meta(path, rgb, w, h, exposure, meta, err);
+    free(rgb);
+    return s;
+}
+
 /* The method's warm-up frames before frame 0 (fv_driver_warm_up), said in one line unless quiet;
  * bar (may be NULL) is drawn meanwhile. */
 static fv_status warm_up(const render_opts *o, const fv_frame_meta_run *rec, fv_driver *driver, fv_technique *tech, fv_film *const *film,
@@ -128,6 +146,10 @@ static fv_status warm_up(const render_opts *o, const fv_frame_meta_run *rec, fv_
     return s;
 }
 
+/* The files of frame f: OUT.ext, OUT_left/_right.ext for stereo, _NNNN before the extension for a
+ * sequence; each written whole or not at all, and each saying how it was made (method,
+ * parameters, camera, gaze of its eye, ...; docs/metrics.md) unless --no-metadata; with
+ * --overlay, the eye model drawn over it for its eye's gaze and the `overlay` key in any case. */
 static fv_status write_frame(const render_opts *o, const fv_frame_meta_run *rec, fv_driver *driver, fv_film *const *film, int neyes,
                              int f, double ms, fv_error *err)
 {
@@ -149,7 +171,10 @@ static fv_status write_frame(const render_opts *o, const fv_frame_meta_run *rec,
         }
         fv_params *meta = NULL;
         if (!o->no_meta) s = fv_frame_meta(rec, f, &views, e, ms, &meta, err);
-        if (s == FV_OK) s = fv_film_write_meta(film[e], path, (float)o->exposure, meta, err);
+        else if (o->overlay) s = fv_params_create(&meta, err); /* the overlay mark alone (frame_meta.h) */
+        if (s == FV_OK && o->overlay) s = fv_frame_meta_overlay(meta, err);
+        if (s == FV_OK && o->overlay) s = write_overlaid(film[e], path, (float)o->exposure, views.eye_model, views.gaze[e], meta, err);
+        else if (s == FV_OK) s = fv_film_write_meta(film[e], path, (float)o->exposure, meta, err);
         fv_params_destroy(meta);
     }
     return s;
@@ -160,14 +185,14 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 {
     enum { O_METHOD = 256, O_SPP, O_DEVICE, O_SIZE, O_FRAMES, O_FPS, O_TIME, O_SEED, O_THREADS, O_TPOLICY, O_OUT, O_EXPOSURE, O_POS,
            O_LOOK, O_UP, O_FOV, O_LIGHT, O_GAZE, O_TRACE, O_CTRACE, O_STEREO, O_PARAM, O_QUIET, O_STATS, O_HELP,
-           O_MISSING, O_STATS_JSON, O_NO_META, O_WARMUP };
+           O_MISSING, O_STATS_JSON, O_NO_META, O_WARMUP, O_OVERLAY };
     static const struct option longs[] = {
         {"method", 1, 0, O_METHOD}, {"spp", 1, 0, O_SPP}, {"device", 1, 0, O_DEVICE}, {"size", 1, 0, O_SIZE}, {"frames", 1, 0, O_FRAMES},
         {"fps", 1, 0, O_FPS}, {"time", 1, 0, O_TIME}, {"seed", 1, 0, O_SEED}, {"threads", 1, 0, O_THREADS}, {"thread-policy", 1, 0, O_TPOLICY},
         {"out", 1, 0, O_OUT}, {"exposure", 1, 0, O_EXPOSURE}, {"camera-pos", 1, 0, O_POS}, {"camera-look", 1, 0, O_LOOK},
         {"camera-up", 1, 0, O_UP}, {"fov", 1, 0, O_FOV}, {"point-light", 1, 0, O_LIGHT}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_TRACE}, {"camera-trace", 1, 0, O_CTRACE}, {"gaze-missing", 1, 0, O_MISSING},
         {"stereo", 1, 0, O_STEREO}, {"param", 1, 0, O_PARAM}, {"quiet", 0, 0, O_QUIET}, {"stats", 0, 0, O_STATS}, {"stats-json", 1, 0, O_STATS_JSON}, {"no-metadata", 0, 0, O_NO_META}, {"help", 0, 0, O_HELP}, {"warmup", 1, 0, O_WARMUP},
-        FV_CLI_SCENE_LONGOPTS, {0, 0, 0, 0}};
+        {"overlay", 0, 0, O_OVERLAY}, FV_CLI_SCENE_LONGOPTS, {0, 0, 0, 0}};
     const char *cmd = "render";
     long l;
     double d;
@@ -268,6 +293,7 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
         case O_STATS: o->show_stats = true; break;
         case O_STATS_JSON: o->stats_json = optarg; break;
         case O_NO_META: o->no_meta = true; break;
+        case O_OVERLAY: o->overlay = true; break;
         case O_HELP:
         case 'h': help(); return -1;
         default:
@@ -446,6 +472,12 @@ static int render(int argc, char **argv, void *dist)
     fv_image_format fmt = fv_image_format_from_path(o.out);
     if (fmt == FV_IMG_UNKNOWN) {
         rc = fv_cli_usage_error(cmd, "--out %s: unknown image format (use .png, .pfm or .exr)", o.out);
+        goto done;
+    }
+    /* The rings are drawn over the pixels: only where the pixels are a picture, never over the
+     * linear data of PFM and EXR (what compare, the bench and other tools read as radiance). */
+    if (o.overlay && fmt != FV_IMG_PNG) {
+        rc = fv_cli_usage_error(cmd, "--overlay: draws over a .png only; %s would hold linear data (write a .png, or leave --overlay out)", o.out);
         goto done;
     }
     if (!dir_writable(o.out)) {

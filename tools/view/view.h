@@ -2,7 +2,7 @@
  * fv_vw_app struct that view_main.c owns and passes around (no mutable globals); each file is one
  * concern: arguments (view_args.c), techniques and their main parameter (view_tech.c), rendering
  * a frame through the sequence driver (view_render.c), the flying camera (view_camera.c), keys and
- * mouse (view_input.c), timed scripts (view_script.c), the bitmap font (view_font.c), the gaze
+ * mouse (view_input.c), timed scripts (view_script.c), text in the library's font (view_font.c), the gaze
  * overlay and the on-screen text (view_overlay.c), gaze/camera recording (view_record.c). */
 #ifndef FV_VIEW_H
 #define FV_VIEW_H
@@ -48,10 +48,7 @@ enum { FV_VW_CELL_W = 6, FV_VW_CELL_H = 9 };
  * width drawn. Characters outside 32..126 draw as '?'. */
 int fv_vw_text(fv_vw_canvas *c, int x, int y, uint32_t color, const char *s);
 
-/* ---- overlay colours (the test looks for the fovea circle's exact colour) ---- */
-#define FV_VW_FOVEA_COLOR 0xFFFF00FFu      /* magenta: r_f */
-#define FV_VW_TRANSITION_COLOR 0xFF00FFFFu /* cyan: r_t */
-#define FV_VW_CURSOR_COLOR 0xFFFFFF00u     /* yellow: the gaze point */
+/* ---- overlay (gaze/overlay.h's shapes and colours: magenta r_f, cyan r_t, yellow gaze) ---- */
 /* Fovea and transition circles of eye model m around gaze g, and a cursor, inside panel; the
  * model is in film pixels, film_w wide, drawn scaled to the panel. */
 void fv_vw_overlay_gaze(fv_vw_canvas *c, fv_vw_rect panel, const fv_eye_model *m, int film_w, fv_gaze g);

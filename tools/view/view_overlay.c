@@ -1,44 +1,42 @@
 /* fovea-view — what is drawn over the render: the eye model's fovea and transition circles and
  * a gaze cursor (key O), and the text lines (method, ms per frame and per stage, counters,
  * gaze). The circles come from the driver's eye model, so they are the regions the technique
- * was given, scaled from film pixels to the panel. */
-#include <math.h>
+ * was given, scaled from film pixels to the panel; their shapes and colours are the library's
+ * (gaze/overlay.h), the ones `fovea render --overlay` draws. */
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include "view.h"
+#include "gaze/overlay.h"
 
-static void put_clipped(fv_vw_canvas *c, fv_vw_rect r, int x, int y, uint32_t color)
-{
-    if (x < r.x || y < r.y || x >= r.x + r.w || y >= r.y + r.h) return;
-    if (x < 0 || y < 0 || x >= c->w || y >= c->h) return;
-    c->px[(size_t)y * c->w + x] = color;
-}
-
-/* Two pixels thick, stepped finely enough that the outline has no gaps at any radius. */
-static void circle(fv_vw_canvas *c, fv_vw_rect r, float cx, float cy, float radius, uint32_t color)
-{
-    int steps = (int)(2.0f * 3.14159265f * (radius + 2.0f) * 2.0f) + 16;
-    for (int i = 0; i < steps; i++) {
-        float a = 2.0f * 3.14159265f * (float)i / (float)steps;
-        for (int k = 0; k < 2; k++) {
-            float rr = radius + (float)k - 0.5f;
-            put_clipped(c, r, (int)floorf(cx + rr * cosf(a)), (int)floorf(cy + rr * sinf(a)), color);
-        }
-    }
-}
-
+/* The library's shapes (gaze/overlay.h: the rings and cross `fovea render --overlay` draws), on
+ * the panel's pixel grid: the film scaled to the panel, pixels judged one by one inside the box
+ * the shapes can reach, clipped to the panel. */
 void fv_vw_overlay_gaze(fv_vw_canvas *c, fv_vw_rect panel, const fv_eye_model *m, int film_w, fv_gaze g)
 {
-    float s = (float)panel.w / (float)film_w;
-    float cx = (float)panel.x + g.x * (float)panel.w, cy = (float)panel.y + g.y * (float)panel.h;
-    circle(c, panel, cx, cy, (float)fv_eye_transition_radius_px(m) * s, FV_VW_TRANSITION_COLOR);
-    circle(c, panel, cx, cy, (float)fv_eye_fovea_radius_px(m) * s, FV_VW_FOVEA_COLOR);
-    for (int d = -6; d <= 6; d++) {
-        if (d > -2 && d < 2) continue; /* leave the gaze pixel itself visible */
-        put_clipped(c, panel, (int)cx + d, (int)cy, FV_VW_CURSOR_COLOR);
-        put_clipped(c, panel, (int)cx, (int)cy + d, FV_VW_CURSOR_COLOR);
+    fv_overlay_shape sh;
+    fv_overlay_shape_of(m, g, panel.x, panel.y, (double)panel.w / (double)film_w, 1, &sh);
+    uint32_t color[FV_MARK_COUNT];
+    for (int k = 0; k < FV_MARK_COUNT; k++) {
+        uint8_t b[3];
+        fv_overlay_color(FV_OVERLAY_ON_IMAGE, (fv_overlay_mark)k, b);
+        color[k] = fv_vw_rgb(b[0], b[1], b[2]);
     }
+    int x0, y0, x1, y1;
+    fv_overlay_bounds(&sh, &x0, &y0, &x1, &y1);
+    if (x0 < panel.x) x0 = panel.x;
+    if (y0 < panel.y) y0 = panel.y;
+    if (x1 > panel.x + panel.w - 1) x1 = panel.x + panel.w - 1;
+    if (y1 > panel.y + panel.h - 1) y1 = panel.y + panel.h - 1;
+    if (x0 < 0) x0 = 0;
+    if (y0 < 0) y0 = 0;
+    if (x1 > c->w - 1) x1 = c->w - 1;
+    if (y1 > c->h - 1) y1 = c->h - 1;
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            fv_overlay_mark k = fv_overlay_mark_at(&sh, x, y);
+            if (k != FV_MARK_NONE) c->px[(size_t)y * c->w + x] = color[k];
+        }
 }
 
 /* Appends "fmt" to a line, wrapping to the next one when the panel would be too narrow. */
