@@ -15,6 +15,8 @@
 #ifndef FOVEA_TECHNIQUE_H
 #define FOVEA_TECHNIQUE_H
 
+#include <stdbool.h>
+#include <stddef.h>
 #include "fovea/export.h"
 #include "fovea/film.h"
 #include "fovea/frame.h"
@@ -27,12 +29,11 @@
 extern "C" {
 #endif
 
-/* The registry, in a fixed order: name ("pt", "fpm", ...), one-line summary, and the parameter
- * help (lines "key=type (default): meaning"). NULL for i out of range. Static strings. */
+/* The registry, in a fixed order: name ("pt", "fpm", ...) and one-line summary. NULL for i out of
+ * range. Static strings. */
 FV_API int fv_technique_count(void);
 FV_API const char *fv_technique_name(int i);
 FV_API const char *fv_technique_summary(int i);
-FV_API const char *fv_technique_params_help(int i);
 /* Index of a method by name, -1 when unknown. */
 FV_API int fv_technique_index(const char *name);
 /* The key of method i's samples-per-pixel parameter ("spp" for pt), NULL when the method has no
@@ -41,14 +42,95 @@ FV_API const char *fv_technique_spp_param(int i);
 /* Whether method i spends less effort away from the gaze (its image depends on the gaze); false
  * for an index out of range. */
 FV_API bool fv_technique_foveated(int i);
+/* The family method i belongs to, the kind of light transport its paper is about: "path tracing",
+ * "photon mapping", "instant radiosity", "sphere tracing", "visual-polar path tracing". NULL for i
+ * out of range. Families follow the registry's order of their first method. */
+FV_API const char *fv_technique_family(int i);
+/* The method method i is measured against in its paper or its family's benchmarks (fpm: "pm",
+ * vpolar: "cartesian-full", ...): a registered method, never i itself, and following baselines
+ * always ends at the reference path tracer, the one method without a baseline (NULL). */
+FV_API const char *fv_technique_baseline(int i);
+/* Frames a method with temporal state (history buffers, photons or VPLs carried over) renders
+ * before its image stands for the method's steady state: 0 for a method whose frames do not
+ * depend on the ones before; what a block of an MPI-split sequence starts with (docs/distributed.md). */
+FV_API int fv_technique_warmup_frames(int i);
 /* Frames method i renders before a still (or a sequence's first frame) is converged: `fovea
  * render` runs them unwritten at frame 0's views (fv_drive_opts.warmup). 0 for a method whose
- * first frame is already its steady state, and for an index out of range. */
+ * first frame is already its steady state (photons, fipr's refresh), and for an index out of range. */
 FV_API int fv_technique_still_warmup(int i);
-/* Frames of a sequence a method with state between frames needs before a frame matches the one
- * an uninterrupted sequence renders (a block of a sequence split over MPI ranks starts that many
- * frames early, docs/distributed.md). 0 for a method without such state or an index out of range. */
-FV_API int fv_technique_sequence_warmup(int i);
+
+/* ---- parameters: every key a method reads from its fv_params bag, described once ----
+ *
+ * Every method also takes `device` (fv_technique_device_param), which the registry reads for it. */
+typedef enum fv_param_type {
+    FV_PARAM_INT,    /* a decimal integer */
+    FV_PARAM_FLOAT,  /* a finite number */
+    FV_PARAM_BOOL,   /* on/off, true/false, yes/no, 1/0 */
+    FV_PARAM_CHOICE, /* one of `choices` */
+    FV_PARAM_STRING  /* any text */
+} fv_param_type;
+
+typedef struct fv_param_info {
+    const char *key;
+    fv_param_type type;
+    /* The default, as a --param value would write it ("16", "0.61", "true", "grid"): setting the key
+     * to it changes nothing. NULL when the method derives it from the scene or from other
+     * parameters; def_note then says how ("Eq. 8", "all from block_first"). */
+    const char *def;
+    /* A qualifier shown with the default: its derivation, or what bounds it besides (NULL: none). */
+    const char *def_note;
+    /* int and float: the values accepted lie within [min, max], an end excluded when its _open flag
+     * is set. A value outside is refused with FV_ERR_INVALID; other parameters may narrow the range
+     * further (the help says so). */
+    double min, max;
+    bool min_open, max_open;
+    /* choice: the values accepted, NULL-terminated. int: when not NULL, the only values accepted. */
+    const char *const *choices;
+    const char *help; /* what it means, one line */
+} fv_param_info;
+
+/* Method i's parameters in the order its help lists them; NULL for an index out of range. */
+FV_API int fv_technique_param_count(int i);
+FV_API const fv_param_info *fv_technique_param_at(int i, int j);
+/* Method i's parameter `key`, NULL when it has none of that name. */
+FV_API const fv_param_info *fv_technique_param_find(int i, const char *key);
+/* The parameter every method takes: device=cpu|portable|cuda|auto (cpu), read by the registry. */
+FV_API const fv_param_info *fv_technique_device_param(void);
+/* "int", "float", "bool", "choice", "string". */
+FV_API const char *fv_param_type_name(fv_param_type type);
+/* One line "key=TYPE (DEFAULT) in RANGE: help" into buf (TYPE is the choices a|b|c of a choice or
+ * of an int with choices; RANGE [min, max] of an int or float, an open end written with a
+ * parenthesis), no newline; returns what snprintf returns. The text `fovea methods NAME` prints. */
+FV_API int fv_param_info_format(const fv_param_info *p, char *buf, size_t n);
+
+/* ---- the main parameter: what sets method i's cost, as an interactive viewer steps it ---- */
+/* Its key, NULL when the method has none. */
+FV_API const char *fv_technique_main_param(int i);
+/* The values offered, in increasing order (+ steps up, - down): the papers' settings around the
+ * default, as text. */
+FV_API int fv_technique_main_step_count(int i);
+FV_API const char *fv_technique_main_step(int i, int k);
+/* The step equal to the parameter's default, -1 when none is (or no main parameter). */
+FV_API int fv_technique_main_default_step(int i);
+/* Whether method i's frames are independent estimates of one image, so that frames rendered while
+ * nothing moves may be averaged (a viewer then starts it at its first step). */
+FV_API bool fv_technique_progressive(int i);
+/* The method an interactive viewer starts with when none is named (a static string). */
+FV_API const char *fv_technique_default_interactive(void);
+
+/* ---- the registry as JSON (`fovea methods --json`) ----
+ *
+ * A document {"families": [{"name", "methods": [names]}], "common_parameters": [device],
+ * "methods": [{"name", "summary", "family", "foveated", "baseline", "devices", "warmup_frames", "still_warmup_frames",
+ * "spp_param", "spp_instead", "sdf_only", "main_parameter": {"key", "steps", "default_step",
+ * "progressive"} or null, "parameters": [{"key", "type", "default", "default_note", "min", "max",
+ * "min_open", "max_open", "choices", "help"}]}]}; values of numeric parameters (defaults, bounds,
+ * numeric choices and steps) are JSON numbers, a bool's default true or false, a derived default
+ * null. name NULL: every method; else that method alone (FV_ERR_INVALID naming the known methods
+ * when there is none of that name). Returns a string to release with fv_methods_json_free, NULL on
+ * failure (err says why). */
+FV_API char *fv_methods_json(const char *name, fv_error *err);
+FV_API void fv_methods_json_free(char *json);
 /* Sets method `name`'s samples-per-pixel parameter to spp in params (what the CLI's --spp means
  * for every method). FV_ERR_INVALID, with a one-line message naming the parameter to use instead,
  * when the method has none; the message of fv_technique_create when the name is unknown. */

@@ -36,7 +36,7 @@ bool fv_bench_ref_noise_plan(const fv_scenario *sc, fv_bench_ref_noise *rn)
         snprintf(rn->why_not, sizeof rn->why_not, "%s has no samples-per-pixel parameter", m->method);
         return false;
     }
-    if (fv_technique_sequence_warmup(mi) > 0 || fv_technique_still_warmup(mi) > 0) {
+    if (fv_technique_warmup_frames(mi) > 0 || fv_technique_still_warmup(mi) > 0) {
         snprintf(rn->why_not, sizeof rn->why_not, "%s keeps state between frames", m->method);
         return false;
     }

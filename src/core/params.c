@@ -22,6 +22,8 @@ typedef struct fv_param_entry {
 struct fv_params {
     fv_param_entry *e;
     int n, cap;
+    fv_params_watch_fn watch; /* told every key a reader asks for (fv_params_watch) */
+    void *watch_user;
 };
 
 fv_status fv_params_create(fv_params **out, fv_error *err)
@@ -46,6 +48,20 @@ static fv_param_entry *find(const fv_params *p, const char *key)
     for (int i = 0; i < p->n; i++)
         if (strcmp(p->e[i].key, key) == 0) return &p->e[i];
     return NULL;
+}
+
+void fv_params_watch(fv_params *p, fv_params_watch_fn fn, void *user)
+{
+    p->watch = fn;
+    p->watch_user = user;
+}
+
+/* The entry of key, after telling the watcher that a reader asked for it. */
+static fv_param_entry *ask(const fv_params *p, const char *key)
+{
+    if (!p) return NULL;
+    if (p->watch) p->watch(p->watch_user, key);
+    return find(p, key);
 }
 
 static bool valid_key(const char *k)
@@ -108,7 +124,7 @@ fv_status fv_params_clone(const fv_params *p, fv_params **out, fv_error *err)
 
 fv_status fv_params_int(fv_params *p, const char *key, int def, int lo, int hi, int *out, fv_error *err)
 {
-    fv_param_entry *e = p ? find(p, key) : NULL;
+    fv_param_entry *e = ask(p, key);
     if (!e) {
         *out = def;
         return FV_OK;
@@ -128,7 +144,7 @@ fv_status fv_params_int(fv_params *p, const char *key, int def, int lo, int hi, 
 fv_status fv_params_float(fv_params *p, const char *key, double def, double lo, double hi, double *out,
                           fv_error *err)
 {
-    fv_param_entry *e = p ? find(p, key) : NULL;
+    fv_param_entry *e = ask(p, key);
     if (!e) {
         *out = def;
         return FV_OK;
@@ -147,7 +163,7 @@ fv_status fv_params_float(fv_params *p, const char *key, double def, double lo, 
 
 fv_status fv_params_bool(fv_params *p, const char *key, bool def, bool *out, fv_error *err)
 {
-    fv_param_entry *e = p ? find(p, key) : NULL;
+    fv_param_entry *e = ask(p, key);
     if (!e) {
         *out = def;
         return FV_OK;
@@ -164,7 +180,7 @@ fv_status fv_params_bool(fv_params *p, const char *key, bool def, bool *out, fv_
 fv_status fv_params_choice(fv_params *p, const char *key, int def, const char *const *choices, int *out,
                            fv_error *err)
 {
-    fv_param_entry *e = p ? find(p, key) : NULL;
+    fv_param_entry *e = ask(p, key);
     if (!e) {
         *out = def;
         return FV_OK;
@@ -182,7 +198,7 @@ fv_status fv_params_choice(fv_params *p, const char *key, int def, const char *c
     return fv_error_set(err, FV_ERR_INVALID, "parameter %s=%s: expected one of %s", key, e->value, list);
 }
 
-bool fv_params_has(const fv_params *p, const char *key) { return p && find(p, key) != NULL; }
+bool fv_params_has(const fv_params *p, const char *key) { return ask(p, key) != NULL; }
 
 fv_status fv_params_check_used(const fv_params *p, const char *technique, fv_error *err)
 {

@@ -19,5 +19,10 @@ fv_status fv_params_choice(fv_params *p, const char *key, int def, const char *c
 bool fv_params_has(const fv_params *p, const char *key);
 /* Any key never read is an error "unknown parameter 'k' for method 'm'". */
 fv_status fv_params_check_used(const fv_params *p, const char *technique, fv_error *err);
+/* From now on every reader above (and fv_params_has) tells fn the key it asks for, present in the
+ * bag or not: how the conformance suite learns every key a method reads, to hold it to the
+ * method's parameter table. fn NULL stops it. Not copied by fv_params_clone. */
+typedef void (*fv_params_watch_fn)(void *user, const char *key);
+void fv_params_watch(fv_params *p, fv_params_watch_fn fn, void *user);
 
 #endif

@@ -1,6 +1,6 @@
 /* fovea — a sequence over MPI ranks (docs/distributed.md, "A sequence"): contiguous blocks of
  * frames, one per rank, each frame written by the rank that rendered it (fv_film_write is atomic).
- * A method that keeps state between frames (fv_technique_sequence_warmup, fovea/technique.h) starts
+ * A method that keeps state between frames (fv_technique_warmup_frames, fovea/technique.h) starts
  * each block that many frames early and discards them: its first written frame then has the
  * history a one-process run would have built over those frames. Methods whose history decays
  * (exponential averages) converge to, but do not equal bit for bit, the one-process frames; the

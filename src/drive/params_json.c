@@ -1,7 +1,7 @@
 /* fovea — typed JSON of a method's parameters. The bag holds text (fovea/params.h); the type of
- * each key is the one the method's registry entry declares in its help ("key=int (16): ..."), so
- * "16" for spp is written as the number 16 and "on" for a bool as true. A key the help does not
- * declare (device, or a method without help) is a number when the whole value reads as a finite
+ * each key is the one the method's parameter table declares (fovea/technique.h, fv_param_info), so
+ * "16" for spp is written as the number 16 and "on" for a bool as true. A key the table does not
+ * declare (device, or an unknown method) is a number when the whole value reads as a finite
  * number, else text. A value its declared type cannot read stays text: the report shows what was
  * given, and fv_technique_create would have refused it anyway.
  */
@@ -14,22 +14,19 @@
 
 typedef enum ptype { P_UNKNOWN, P_NUMBER, P_BOOL, P_TEXT } ptype;
 
-/* The declared type of `key` in a help text of lines "key=type (default): meaning". */
-static ptype declared_type(const char *help, const char *key)
+/* The declared type of `key` for method i. */
+static ptype declared_type(int i, const char *key)
 {
-    size_t klen = strlen(key);
-    for (const char *line = help; line && *line;) {
-        if (strncmp(line, key, klen) == 0 && line[klen] == '=') {
-            const char *t = line + klen + 1;
-            size_t tlen = strcspn(t, " \n");
-            if ((tlen == 3 && strncmp(t, "int", 3) == 0) || (tlen == 5 && strncmp(t, "float", 5) == 0)) return P_NUMBER;
-            if (tlen == 4 && strncmp(t, "bool", 4) == 0) return P_BOOL;
-            return P_TEXT;
-        }
-        const char *nl = strchr(line, '\n');
-        line = nl ? nl + 1 : NULL;
+    const fv_param_info *p = fv_technique_param_find(i, key);
+    if (!p) return P_UNKNOWN;
+    switch (p->type) {
+    case FV_PARAM_INT:
+    case FV_PARAM_FLOAT: return P_NUMBER;
+    case FV_PARAM_BOOL: return P_BOOL;
+    case FV_PARAM_CHOICE:
+    case FV_PARAM_STRING: break;
     }
-    return P_UNKNOWN;
+    return P_TEXT;
 }
 
 static bool read_number(const char *s, double *out)
@@ -57,10 +54,9 @@ cJSON *fv_params_typed_json(const char *method, const fv_params *params)
     cJSON *o = cJSON_CreateObject();
     if (!o) return NULL;
     int ti = method ? fv_technique_index(method) : -1;
-    const char *help = ti >= 0 ? fv_technique_params_help(ti) : NULL;
     for (int i = 0; i < fv_params_count(params); i++) {
         const char *k = fv_params_key(params, i), *v = fv_params_value(params, i);
-        ptype t = declared_type(help, k);
+        ptype t = declared_type(ti, k);
         double d;
         bool b;
         cJSON *item;

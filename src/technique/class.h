@@ -12,10 +12,47 @@
 #include "fovea/device.h"
 #include "fovea/technique.h"
 
+#define FV_MAIN_STEPS_MAX 8 /* the most values a main parameter steps through */
+
+/* A class's parameter table and its length, for the class's initializer. */
+#define FV_CLASS_PARAMS(table) .params = (table), .param_count = (int)(sizeof(table) / sizeof((table)[0]))
+
+/* Entries of a parameter table (fovea/technique.h, fv_param_info): an int or float in [lo, hi], a
+ * bool, one of a NULL-terminated list of choices. An entry with an open end, an int of a few values
+ * or a derived default spells out the fields it needs. */
+#define FV_PARAM_INT(k, d, lo, hi, h) {.key = (k), .type = FV_PARAM_INT, .def = (d), .min = (lo), .max = (hi), .help = (h)}
+#define FV_PARAM_FLOAT(k, d, lo, hi, h) {.key = (k), .type = FV_PARAM_FLOAT, .def = (d), .min = (lo), .max = (hi), .help = (h)}
+#define FV_PARAM_BOOL(k, d, h) {.key = (k), .type = FV_PARAM_BOOL, .def = (d), .help = (h)}
+#define FV_PARAM_CHOICE(k, d, list, h) {.key = (k), .type = FV_PARAM_CHOICE, .def = (d), .choices = (list), .help = (h)}
+
+/* The families (fovea/technique.h, fv_technique_family), named once. */
+#define FV_FAMILY_PT "path tracing"
+#define FV_FAMILY_PHOTON "photon mapping"
+#define FV_FAMILY_VPL "instant radiosity"
+#define FV_FAMILY_SDF "sphere tracing"
+#define FV_FAMILY_VPOLAR "visual-polar path tracing"
+
 typedef struct fv_technique_class {
-    const char *name;        /* "pt", "fpm", ... */
-    const char *summary;     /* one line */
-    const char *params_help; /* lines "key=type (default): meaning" */
+    const char *name;    /* "pt", "fpm", ... */
+    const char *summary; /* one line */
+    /* fovea/technique.h's fv_technique_family and fv_technique_baseline: the family (one of the
+     * FV_FAMILY_* above) and the method this one is measured against (NULL: pt only); the class
+     * says where in its paper or benchmarks the pairing comes from. */
+    const char *family, *baseline;
+    /* Every key create reads, with its type, default, range and meaning: what `fovea methods`, its
+     * JSON and the CLI's help print, and what the conformance suite holds the readers to (every key
+     * read is declared, the declared defaults change nothing, a value outside the declared range is
+     * refused). FV_CLASS_PARAMS(table) sets both. */
+    const fv_param_info *params;
+    int param_count;
+    /* The parameter that sets the method's cost and the values an interactive viewer steps it
+     * through, in increasing order (fovea/technique.h, fv_technique_main_param); key NULL: none.
+     * progressive: frames are independent estimates of one image, so a still view may average them. */
+    struct {
+        const char *key;
+        const char *steps[FV_MAIN_STEPS_MAX + 1]; /* NULL-terminated */
+        bool progressive;
+    } main;
     /* Reads its parameters with the fv_params_* readers (keys it never reads are refused after
      * create returns) and prepares its state. The scene is committed and outlives the state. */
     fv_status (*create)(const fv_scene *scene, fv_params *params, const fv_log *log, void **state, fv_error *err);
@@ -65,5 +102,8 @@ typedef struct fv_technique_class {
 /* The class of a registered method by index or name (NULL when unknown). */
 const fv_technique_class *fv_technique_class_at(int i);
 const fv_technique_class *fv_technique_class_find(const char *name);
+/* FV_ERR_INVALID "unknown method 'x' (known: pt, pm, ...)": the one message for a name the
+ * registry does not know. */
+fv_status fv_technique_unknown(const char *name, fv_error *err);
 
 #endif

@@ -1,8 +1,13 @@
 /* fovea — the registry of rendering techniques, and the instance wrapper every driver uses.
  *
  * Adding a technique: define its fv_technique_class (class.h) in its family's folder and list it
- * here. Nothing else in the project switches on a technique's name; the conformance suite
- * (tests/conformance) runs every class listed here.
+ * here. The class describes the method once, for everything that drives or shows it: its family
+ * and the method it is measured against (baseline), a table of every parameter create reads
+ * (type, default, range or choices, help: `fovea methods`, its JSON and the CLI's help are made
+ * from it, and the conformance suite holds the readers to it), the main parameter an interactive
+ * viewer steps, its devices, warm-up frames and samples-per-pixel key. Nothing else in the project
+ * switches on a technique's name; the conformance suite (tests/conformance) runs every class
+ * listed here.
  *
  * What every method shares is done here once: parameters are validated on a private copy of the
  * caller's bag (the caller's bag is never marked or changed) and keys the method never read are
@@ -58,21 +63,67 @@ int fv_technique_index(const char *name)
 
 const fv_technique_class *fv_technique_class_find(const char *name) { return fv_technique_class_at(fv_technique_index(name)); }
 
+fv_status fv_technique_unknown(const char *name, fv_error *err)
+{
+    char list[512] = "";
+    for (int i = 0; i < N_CLASSES; i++) {
+        size_t l = strlen(list);
+        snprintf(list + l, sizeof list - l, "%s%s", i ? ", " : "", k_classes[i]->name);
+    }
+    return fv_error_set(err, FV_ERR_INVALID, "unknown method '%s' (known: %s)", name ? name : "(null)", list);
+}
+
 const char *fv_technique_name(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->name : NULL; }
 const char *fv_technique_summary(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->summary : NULL; }
-const char *fv_technique_params_help(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->params_help : NULL; }
 const char *fv_technique_spp_param(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->spp_param : NULL; }
 bool fv_technique_foveated(int i) { return i >= 0 && i < N_CLASSES && k_classes[i]->foveated; }
+const char *fv_technique_family(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->family : NULL; }
+const char *fv_technique_baseline(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->baseline : NULL; }
+int fv_technique_warmup_frames(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->warmup_frames : 0; }
 int fv_technique_still_warmup(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->still_warmup_frames : 0; }
-int fv_technique_sequence_warmup(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->warmup_frames : 0; }
+int fv_technique_param_count(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->param_count : 0; }
+
+const fv_param_info *fv_technique_param_at(int i, int j)
+{
+    return j >= 0 && j < fv_technique_param_count(i) ? &k_classes[i]->params[j] : NULL;
+}
+
+const fv_param_info *fv_technique_param_find(int i, const char *key)
+{
+    for (int j = 0; key && j < fv_technique_param_count(i); j++)
+        if (strcmp(k_classes[i]->params[j].key, key) == 0) return &k_classes[i]->params[j];
+    return NULL;
+}
+
+const char *fv_technique_main_param(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->main.key : NULL; }
+
+int fv_technique_main_step_count(int i)
+{
+    int n = 0;
+    while (fv_technique_main_param(i) && n < FV_MAIN_STEPS_MAX && k_classes[i]->main.steps[n]) n++;
+    return n;
+}
+
+const char *fv_technique_main_step(int i, int k) { return k >= 0 && k < fv_technique_main_step_count(i) ? k_classes[i]->main.steps[k] : NULL; }
+
+int fv_technique_main_default_step(int i)
+{
+    const fv_param_info *p = fv_technique_param_find(i, fv_technique_main_param(i));
+    for (int k = 0; p && p->def && k < fv_technique_main_step_count(i); k++)
+        if (strcmp(k_classes[i]->main.steps[k], p->def) == 0) return k;
+    return -1;
+}
+
+bool fv_technique_progressive(int i) { return i >= 0 && i < N_CLASSES && k_classes[i]->main.progressive; }
+
+/* Visual-Polar is the one paper here written for real-time frame rates (its Sec. 1), and vpolar
+ * keeps them on a CPU at a viewer's sizes (docs/results.md): what a viewer shows first. */
+const char *fv_technique_default_interactive(void) { return fv_technique_vpolar.name; }
 
 fv_status fv_technique_set_spp(const char *name, fv_params *params, int spp, fv_error *err)
 {
     const fv_technique_class *cls = fv_technique_class_find(name);
-    if (!cls) {
-        fv_technique *t = NULL;
-        return fv_technique_create(name, NULL, NULL, NULL, &t, err); /* the message listing the methods */
-    }
+    if (!cls) return fv_technique_unknown(name, err);
     if (!cls->spp_param)
         return fv_error_set(err, FV_ERR_INVALID, "--spp: method '%s' has no samples-per-pixel parameter (%s)", cls->name,
                             cls->spp_instead ? cls->spp_instead : "see fovea methods");
@@ -116,12 +167,17 @@ fv_status fv_device_check(const char *method, const char *name, fv_device *out, 
 }
 
 /* The parameter `device` (what --device sets), checked by fv_device_check. */
+static const char *const k_device_names[] = {"cpu", "portable", "cuda", "auto", NULL};
+static const fv_param_info k_device_param =
+    FV_PARAM_CHOICE("device", "cpu", k_device_names, "where the method runs, among the devices it has (docs/gpu.md; --device)");
+
+const fv_param_info *fv_technique_device_param(void) { return &k_device_param; }
+
 static fv_status read_device(const fv_technique_class *cls, fv_params *p, fv_device *out, fv_error *err)
 {
-    static const char *const names[] = {"cpu", "portable", "cuda", "auto", NULL};
     int k = 0;
-    fv_status s = fv_params_choice(p, "device", 0, names, &k, err);
-    return s != FV_OK ? s : fv_device_check(cls->name, names[k], out, err);
+    fv_status s = fv_params_choice(p, "device", 0, k_device_names, &k, err);
+    return s != FV_OK ? s : fv_device_check(cls->name, k_device_names[k], out, err);
 }
 
 struct fv_technique {
@@ -134,14 +190,7 @@ fv_status fv_technique_create(const char *name, const fv_scene *scene, const fv_
 {
     *out = NULL;
     const fv_technique_class *cls = fv_technique_class_find(name);
-    if (!cls) {
-        char list[512] = "";
-        for (int i = 0; i < N_CLASSES; i++) {
-            size_t l = strlen(list);
-            snprintf(list + l, sizeof list - l, "%s%s", i ? ", " : "", k_classes[i]->name);
-        }
-        return fv_error_set(err, FV_ERR_INVALID, "unknown method '%s' (known: %s)", name ? name : "(null)", list);
-    }
+    if (!cls) return fv_technique_unknown(name, err);
     if (!scene) return fv_error_set(err, FV_ERR_INVALID, "method '%s': no scene", name);
     if (cls->sdf_only && fv_scene_sdf_object_count(scene) == 0)
         return fv_error_set(err, FV_ERR_INVALID,

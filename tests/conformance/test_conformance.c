@@ -20,6 +20,18 @@
  *   widen       a whole-screen fovea (fv_eye_model_whole_screen, `--gaze-missing widen`) changes
  *               a foveated method's image (class.h, foveated) and leaves it independent of the
  *               gaze; any other method's image is unchanged by the eye model and the gaze.
+ *   history     a method without warm-up frames renders a frame alone as it does in sequence.
+ *   table       the class's description (class.h) holds: every key create reads is in its
+ *               parameter table and every key of the table is read; each entry's default lies in
+ *               its declared range or choices; the main parameter is declared, its steps are
+ *               valid values and its default one of them; a family; a baseline that is another
+ *               registered method, whose chain of baselines ends at the reference (no cycle),
+ *               and one for every foveated method;
+ *   defaults    every declared default set explicitly gives bit-identical frames to leaving it
+ *               out, and every declared choice and main-parameter step is accepted;
+ *   ranges      a value just outside a declared numeric range (the bound itself at an open end),
+ *               an int off its declared values, a choice not declared and a malformed bool are
+ *               refused with FV_ERR_INVALID naming the key.
  * Once, for all: films of no size cannot be created, and the overflow scene overflows.
  * Renders are 40x32 and a few frames: about 3 s in all, small enough under sanitizers too.
  */
@@ -30,6 +42,7 @@
 #include <string.h>
 #include "testkit.h"
 #include "scene/light.h"
+#include "core/params_read.h"
 #include "scene/scene_impl.h"
 #include "technique/class.h"
 
@@ -642,6 +655,220 @@ static void test_history(void **st)
     fv_film_destroy(b);
 }
 
+/* ---- 10. the class's description: parameter table, main parameter, baseline ---- */
+
+static const fv_param_info *declared(const fv_technique_class *c, const char *key)
+{
+    for (int j = 0; j < c->param_count; j++)
+        if (strcmp(c->params[j].key, key) == 0) return &c->params[j];
+    return NULL;
+}
+
+/* Whether `text` is a value parameter p declares valid on its own (its type, range, choices). */
+static bool valid_value(const fv_param_info *p, const char *text)
+{
+    if (p->choices) {
+        for (int i = 0; p->choices[i]; i++)
+            if (strcmp(p->choices[i], text) == 0) return p->type != FV_PARAM_INT || valid_value(&(fv_param_info){.type = FV_PARAM_INT, .min = p->min, .max = p->max}, text);
+        return false;
+    }
+    char *end;
+    double v = strtod(text, &end);
+    switch (p->type) {
+    case FV_PARAM_INT:
+        if (*end || end == text || v != floor(v)) return false;
+        /* fall through */
+    case FV_PARAM_FLOAT:
+        if (*end || end == text || !isfinite(v)) return false;
+        return (p->min_open ? v > p->min : v >= p->min) && (p->max_open ? v < p->max : v <= p->max);
+    case FV_PARAM_BOOL: return strcmp(text, "true") == 0 || strcmp(text, "false") == 0;
+    case FV_PARAM_CHOICE: return false; /* without choices */
+    case FV_PARAM_STRING: return true;
+    }
+    return false;
+}
+
+/* The keys a reader asked for, by fv_params_watch. */
+typedef struct read_keys {
+    int n;
+    char key[64][32];
+} read_keys;
+
+static void on_read(void *user, const char *key)
+{
+    read_keys *r = user;
+    for (int i = 0; i < r->n; i++)
+        if (strcmp(r->key[i], key) == 0) return;
+    if (r->n == 64) fail_msg("more than 64 keys read");
+    snprintf(r->key[r->n++], sizeof r->key[0], "%s", key);
+}
+
+static void test_table(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    const int me = fv_technique_index(c->name);
+    /* (a) The keys create reads, with the class's test parameters, called directly (the registry
+     * reads `device` for every method: not the class's). */
+    read_keys r = {0};
+    fv_params *p = params_of(c, NULL);
+    fv_params_watch(p, on_read, &r);
+    void *state = NULL;
+    fv_error err;
+    fv_status rc = c->create_on ? c->create_on(suite_of(c)->cornell, p, FV_DEVICE_CPU, NULL, &state, &err)
+                                : c->create(suite_of(c)->cornell, p, NULL, &state, &err);
+    if (rc != FV_OK) fail_msg("%s: %s", c->name, err.msg);
+    c->destroy(state);
+    fv_params_destroy(p);
+    for (int i = 0; i < r.n; i++)
+        if (!declared(c, r.key[i])) fail_msg("%s: create reads '%s', which its parameter table does not declare", c->name, r.key[i]);
+    for (int j = 0; j < c->param_count; j++) {
+        bool read = false;
+        for (int i = 0; i < r.n && !read; i++) read = strcmp(r.key[i], c->params[j].key) == 0;
+        if (!read) fail_msg("%s: its table declares '%s', which create never reads", c->name, c->params[j].key);
+    }
+    /* Each entry is whole and its default valid; no key twice. */
+    for (int j = 0; j < c->param_count; j++) {
+        const fv_param_info *e = &c->params[j];
+        if (!e->key || !e->help || !e->help[0]) fail_msg("%s: entry %d has no key or help", c->name, j);
+        if (declared(c, e->key) != e) fail_msg("%s: '%s' declared twice", c->name, e->key);
+        if (!e->def && !e->def_note) fail_msg("%s: '%s' has neither a default nor a note saying how it is derived", c->name, e->key);
+        if (e->def && !valid_value(e, e->def)) fail_msg("%s: the default %s=%s is not a valid value of its declaration", c->name, e->key, e->def);
+        if (e->type == FV_PARAM_CHOICE && !e->choices) fail_msg("%s: choice '%s' without choices", c->name, e->key);
+        if ((e->type == FV_PARAM_INT || e->type == FV_PARAM_FLOAT) && !(e->min <= e->max))
+            fail_msg("%s: '%s' has the empty range [%g, %g]", c->name, e->key, e->min, e->max);
+        for (int k = 0; e->choices && e->choices[k]; k++)
+            if (!valid_value(e, e->choices[k])) fail_msg("%s: the choice %s=%s lies outside its range", c->name, e->key, e->choices[k]);
+    }
+    /* The main parameter: declared; steps valid and in increasing order of value for numbers; its
+     * default one of them (where a viewer steps from). */
+    if (c->main.key) {
+        const fv_param_info *m = declared(c, c->main.key);
+        if (!m) fail_msg("%s: main parameter '%s' is not declared", c->name, c->main.key);
+        int n = fv_technique_main_step_count(me);
+        if (n < 2) fail_msg("%s: main parameter '%s' with %d steps", c->name, c->main.key, n);
+        for (int k = 0; k < n; k++) {
+            const char *v = fv_technique_main_step(me, k);
+            if (!valid_value(m, v)) fail_msg("%s: step %s=%s is not a valid value", c->name, m->key, v);
+            if (k > 0 && !(strtod(v, NULL) > strtod(fv_technique_main_step(me, k - 1), NULL)))
+                fail_msg("%s: steps of %s not increasing at %s", c->name, m->key, v);
+        }
+        int d = fv_technique_main_default_step(me);
+        if (d < 0 || strcmp(fv_technique_main_step(me, d), m->def) != 0)
+            fail_msg("%s: the default %s=%s is not among its steps", c->name, m->key, m->def ? m->def : "(derived)");
+    }
+    /* Family and baseline: another registered method, and following baselines ends at the
+     * reference without coming back. */
+    if (!c->family || !c->family[0]) fail_msg("%s: no family", c->name);
+    if (c->foveated && !c->baseline) fail_msg("%s: foveated, yet measured against nothing (no baseline)", c->name);
+    int at = me;
+    for (int hops = 0; fv_technique_baseline(at); hops++) {
+        int next = fv_technique_index(fv_technique_baseline(at));
+        if (next < 0) fail_msg("%s: baseline '%s' of %s is not a registered method", c->name, fv_technique_baseline(at), fv_technique_name(at));
+        if (next == at) fail_msg("%s: its own baseline", fv_technique_name(at));
+        if (hops >= fv_technique_count()) fail_msg("%s: its chain of baselines has a cycle", c->name);
+        at = next;
+    }
+}
+
+/* Two frames of cornell (or its SDF twin) by a new instance made with the class's test
+ * parameters plus `extra` (may be NULL). */
+static void render_two(const fv_technique_class *c, const fv_params *extra, fv_film *f)
+{
+    fv_params *p = fv_test_params(NULL);
+    fv_error err;
+    for (int i = 0; extra && i < fv_params_count(extra); i++)
+        if (fv_params_set(p, fv_params_key(extra, i), fv_params_value(extra, i), &err) != FV_OK) fail_msg("%s", err.msg);
+    fv_params *tp = params_of(c, NULL); /* the test parameters win: they keep the render cheap */
+    for (int i = 0; i < fv_params_count(tp); i++)
+        if (fv_params_set(p, fv_params_key(tp, i), fv_params_value(tp, i), &err) != FV_OK) fail_msg("%s", err.msg);
+    fv_params_destroy(tp);
+    fv_technique *t = NULL;
+    if (fv_technique_create(c->name, suite_of(c)->cornell, p, NULL, &t, &err) != FV_OK) fail_msg("%s: %s", c->name, err.msg);
+    fv_params_destroy(p);
+    fv_frame fr = frame_at(&suite_of(c)->cornell_cam, 0, 0);
+    fv_test_render_frames(t, &fr, 2, f, NULL);
+    fv_technique_destroy(t);
+}
+
+/* Creates the class with its test parameters and key=value: the status, err filled. */
+static fv_status create_one(const fv_technique_class *c, const char *key, const char *value, fv_error *err)
+{
+    fv_params *p = params_of(c, NULL);
+    fv_status rc = fv_params_set(p, key, value, err);
+    fv_technique *t = NULL;
+    if (rc == FV_OK) rc = fv_technique_create(c->name, suite_of(c)->cornell, p, NULL, &t, err);
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+    return rc;
+}
+
+static void test_defaults(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    fv_params *defaults = fv_test_params(NULL);
+    fv_error err;
+    for (int j = 0; j < c->param_count; j++)
+        if (c->params[j].def && fv_params_set(defaults, c->params[j].key, c->params[j].def, &err) != FV_OK) fail_msg("%s", err.msg);
+    fv_film *a = film_new(W, H), *b = film_new(W, H);
+    render_two(c, NULL, a);
+    render_two(c, defaults, b);
+    if (!same_image(a, b)) fail_msg("%s: setting every declared default explicitly changes its frames", c->name);
+    fv_params_destroy(defaults);
+    fv_film_destroy(a);
+    fv_film_destroy(b);
+    for (int j = 0; j < c->param_count; j++) {
+        const fv_param_info *e = &c->params[j];
+        for (int k = 0; e->type == FV_PARAM_CHOICE && e->choices[k]; k++)
+            if (create_one(c, e->key, e->choices[k], &err) != FV_OK) fail_msg("%s: declared %s=%s refused: %s", c->name, e->key, e->choices[k], err.msg);
+    }
+    const int me = fv_technique_index(c->name);
+    for (int k = 0; k < fv_technique_main_step_count(me); k++)
+        if (create_one(c, c->main.key, fv_technique_main_step(me, k), &err) != FV_OK)
+            fail_msg("%s: main step %s=%s refused: %s", c->name, c->main.key, fv_technique_main_step(me, k), err.msg);
+}
+
+static void expect_refused_value(const fv_technique_class *c, const char *key, const char *value)
+{
+    fv_error err;
+    char what[160];
+    snprintf(what, sizeof what, "%s %s=%s", c->name, key, value);
+    fv_test_expect_fail(create_one(c, key, value, &err), &err, FV_ERR_INVALID, key, what);
+}
+
+static void test_ranges(void **st)
+{
+    const fv_technique_class *c = cls_of(st);
+    char v[64];
+    for (int j = 0; j < c->param_count; j++) {
+        const fv_param_info *e = &c->params[j];
+        switch (e->type) {
+        case FV_PARAM_INT:
+            snprintf(v, sizeof v, "%.0f", e->min - 1.0);
+            expect_refused_value(c, e->key, v);
+            snprintf(v, sizeof v, "%.0f", e->max + 1.0);
+            expect_refused_value(c, e->key, v);
+            /* the first integer of the range that is not one of the declared values */
+            for (double x = e->min; e->choices && x <= e->max; x++) {
+                snprintf(v, sizeof v, "%.0f", x);
+                if (!valid_value(e, v)) {
+                    expect_refused_value(c, e->key, v);
+                    break;
+                }
+            }
+            break;
+        case FV_PARAM_FLOAT:
+            snprintf(v, sizeof v, "%.17g", e->min_open ? e->min : nextafter(e->min, -INFINITY));
+            expect_refused_value(c, e->key, v);
+            snprintf(v, sizeof v, "%.17g", e->max_open ? e->max : nextafter(e->max, INFINITY));
+            expect_refused_value(c, e->key, v);
+            break;
+        case FV_PARAM_BOOL: expect_refused_value(c, e->key, "maybe"); break;
+        case FV_PARAM_CHOICE: expect_refused_value(c, e->key, "no-such-choice"); break;
+        case FV_PARAM_STRING: break;
+        }
+    }
+}
+
 /* ---- the table: every check for every registered technique ---- */
 
 typedef struct check {
@@ -652,7 +879,7 @@ typedef struct check {
 static const check k_checks[] = {
     {"furnace", test_furnace}, {"params", test_params},     {"threads", test_threads},   {"stereo", test_stereo},
     {"refusals", test_refusals}, {"overflow", test_overflow}, {"progress", test_progress}, {"widen", test_widen},
-    {"history", test_history},
+    {"history", test_history}, {"table", test_table},       {"defaults", test_defaults}, {"ranges", test_ranges},
 };
 #define N_CHECKS (sizeof k_checks / sizeof k_checks[0])
 

@@ -1,7 +1,10 @@
-/* Tests of the parameter bag, the stats record and the counter-based random numbers. */
+/* Tests of the parameter bag (with the watch the conformance suite reads keys through), a
+ * parameter's line of help, the registry's description accessors, the stats record and the
+ * counter-based random numbers. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 #include <cmocka.h>
 #include "core/rng.h"
@@ -66,6 +69,116 @@ static void test_params_errors(void **st)
     fv_params_destroy(p);
 }
 
+typedef struct seen {
+    int n;
+    char keys[8][16];
+} seen;
+
+static void note_key(void *user, const char *key)
+{
+    seen *s = user;
+    if (s->n < 8) snprintf(s->keys[s->n++], sizeof s->keys[0], "%s", key);
+}
+
+/* Every reader tells the watcher the key it asks for, in the bag or not; a clone has no watcher. */
+static void test_params_watch(void **st)
+{
+    (void)st;
+    fv_params *p, *q;
+    fv_error err;
+    assert_int_equal(fv_params_create(&p, &err), FV_OK);
+    assert_int_equal(fv_params_parse(p, "spp=4", &err), FV_OK);
+    seen s = {0};
+    fv_params_watch(p, note_key, &s);
+    int i;
+    double d;
+    bool b;
+    static const char *const modes[] = {"a", "b", NULL};
+    assert_int_equal(fv_params_int(p, "spp", 1, 1, 16, &i, &err), FV_OK);
+    assert_int_equal(fv_params_float(p, "absent", 0.5, 0.0, 1.0, &d, &err), FV_OK);
+    assert_int_equal(fv_params_bool(p, "flag", true, &b, &err), FV_OK);
+    assert_int_equal(fv_params_choice(p, "mode", 1, modes, &i, &err), FV_OK);
+    assert_false(fv_params_has(p, "radius"));
+    assert_int_equal(s.n, 5);
+    const char *want[5] = {"spp", "absent", "flag", "mode", "radius"};
+    for (int k = 0; k < 5; k++) assert_string_equal(s.keys[k], want[k]);
+    assert_int_equal(fv_params_clone(p, &q, &err), FV_OK);
+    assert_int_equal(fv_params_int(q, "spp", 1, 1, 16, &i, &err), FV_OK);
+    assert_int_equal(s.n, 5);
+    fv_params_watch(p, NULL, NULL);
+    assert_int_equal(fv_params_int(p, "spp", 1, 1, 16, &i, &err), FV_OK);
+    assert_int_equal(s.n, 5);
+    fv_params_destroy(q);
+    fv_params_destroy(p);
+}
+
+/* The line `fovea methods NAME` prints for each kind of entry, written out by hand. */
+static void test_param_format(void **st)
+{
+    (void)st;
+    static const char *const orders[] = {"grid", "random", NULL}, *const spps[] = {"1", "4", "16", NULL};
+    const struct {
+        fv_param_info p;
+        const char *line;
+    } cases[] = {
+        {{.key = "photons", .type = FV_PARAM_INT, .def = "300000", .min = 1, .max = 500000000, .help = "photons per frame"},
+         "photons=int (300000) in [1, 500000000]: photons per frame"},
+        {{.key = "alpha", .type = FV_PARAM_FLOAT, .def = "0.66666666666666663", .min = 0, .max = 1, .min_open = true, .max_open = true,
+          .help = "shrinking"},
+         "alpha=float (0.666667) in (0, 1): shrinking"},
+        {{.key = "radius", .type = FV_PARAM_FLOAT, .def_note = "Eq. 8", .min = 0, .max = 1e9, .min_open = true, .help = "r"},
+         "radius=float (Eq. 8) in (0, 1000000000]: r"},
+        {{.key = "periphery_deg", .type = FV_PARAM_FLOAT, .def = "20", .def_note = "at most blur_ramp_deg", .min = 0, .max = 180, .help = "e"},
+         "periphery_deg=float (20, at most blur_ramp_deg) in [0, 180]: e"},
+        {{.key = "order", .type = FV_PARAM_CHOICE, .def = "grid", .choices = orders, .help = "launch order"}, "order=grid|random (grid): launch order"},
+        {{.key = "spp", .type = FV_PARAM_INT, .def = "1", .min = 1, .max = 16, .choices = spps, .help = "grid"}, "spp=1|4|16 (1): grid"},
+        {{.key = "blur", .type = FV_PARAM_BOOL, .def = "true", .help = "blur"}, "blur=bool (true): blur"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char buf[160];
+        int n = fv_param_info_format(&cases[k].p, buf, sizeof buf);
+        assert_string_equal(buf, cases[k].line);
+        assert_int_equal(n, (int)strlen(cases[k].line));
+        /* a short buffer: truncated, terminated, the full length returned */
+        char small[8];
+        assert_int_equal(fv_param_info_format(&cases[k].p, small, sizeof small), n);
+        assert_int_equal(strlen(small), sizeof small - 1);
+        assert_int_equal(strncmp(small, cases[k].line, sizeof small - 1), 0);
+        assert_int_equal(fv_param_info_format(&cases[k].p, NULL, 0), n);
+    }
+    assert_string_equal(fv_param_type_name(FV_PARAM_STRING), "string");
+}
+
+/* Out of range, the description accessors answer nothing rather than read past the registry. */
+static void test_registry_bounds(void **st)
+{
+    (void)st;
+    const int n = fv_technique_count();
+    const int bad[2] = {-1, n};
+    for (int k = 0; k < 2; k++) {
+        int i = bad[k];
+        assert_null(fv_technique_family(i));
+        assert_null(fv_technique_baseline(i));
+        assert_int_equal(fv_technique_warmup_frames(i), 0);
+        assert_int_equal(fv_technique_param_count(i), 0);
+        assert_null(fv_technique_param_at(i, 0));
+        assert_null(fv_technique_param_find(i, "spp"));
+        assert_null(fv_technique_main_param(i));
+        assert_int_equal(fv_technique_main_step_count(i), 0);
+        assert_null(fv_technique_main_step(i, 0));
+        assert_int_equal(fv_technique_main_default_step(i), -1);
+        assert_false(fv_technique_progressive(i));
+    }
+    const int pt = fv_technique_index("pt");
+    assert_null(fv_technique_param_at(pt, fv_technique_param_count(pt)));
+    assert_null(fv_technique_param_find(pt, "no_such_key"));
+    assert_null(fv_technique_main_step(pt, fv_technique_main_step_count(pt)));
+    assert_true(fv_technique_index(fv_technique_default_interactive()) >= 0);
+    fv_error err;
+    assert_null(fv_methods_json("no-such-method", &err));
+    assert_non_null(strstr(err.msg, "unknown method 'no-such-method' (known: pt,"));
+}
+
 static void test_stats(void **st)
 {
     (void)st;
@@ -109,6 +222,9 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_params_read_and_validate),
         cmocka_unit_test(test_params_errors),
+        cmocka_unit_test(test_params_watch),
+        cmocka_unit_test(test_param_format),
+        cmocka_unit_test(test_registry_bounds),
         cmocka_unit_test(test_stats),
         cmocka_unit_test(test_rng),
     };

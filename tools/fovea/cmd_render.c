@@ -381,7 +381,7 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
         return FV_EXIT_OK;
     }
     /* A sequence: this rank's block of frames, after its warm-up frames. */
-    const int mi = fv_technique_index(o->method), seq = fv_technique_sequence_warmup(mi), still = fv_technique_still_warmup(mi);
+    const int mi = fv_technique_index(o->method), seq = fv_technique_warmup_frames(mi), still = fv_technique_still_warmup(mi);
     int warmup = o->warmup >= 0 ? o->warmup : seq > still ? seq : still, start, first, end;
     fv_dist_frames(o->frames, rank, size, warmup, &start, &first, &end);
     /* the block that starts the sequence warms up as one process does, at frame 0's views */

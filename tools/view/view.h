@@ -59,7 +59,7 @@ void fv_vw_overlay_gaze(fv_vw_canvas *c, fv_vw_rect panel, const fv_eye_model *m
 typedef struct fv_vw_slot {
     int method;          /* registry index, -1 when empty */
     fv_technique *tech;
-    int value;           /* position in the main parameter's list, -1: --param's or the default */
+    int value;           /* step of the registry's main parameter (fv_technique_main_step), -1: --param's or the default */
     char label[48];      /* "key=value" of the main parameter as created */
     fv_film *film[2];
     int fw, fh, eyes;
@@ -73,18 +73,7 @@ typedef struct fv_vw_slot {
     fv_gaze gaze[2];     /* the gaze each eye was rendered with */
 } fv_vw_slot;
 
-/* The main parameter +/- steps through: name and the values offered (static strings). */
-typedef struct fv_vw_main_param {
-    const char *key;
-    const char *values[8];
-    int count;
-    int dflt;         /* position of the method's own default in values */
-    bool progressive; /* frames may be averaged while nothing moves */
-} fv_vw_main_param;
-const fv_vw_main_param *fv_vw_main_param_of(const char *method);
-/* The baseline shown beside method in the split view. */
-const char *fv_vw_baseline_of(const char *method);
-/* (Re)creates slot s with registry method m and main-parameter position value (-1: default);
+/* (Re)creates slot s with registry method m and main-parameter step value (-1: default);
  * user_params (may be NULL) is the bag for that method; device (may be NULL) is --device, given to
  * the method when it has that device (the others run on the CPU); the slot keeps its old technique
  * when creation fails (err says why). */
@@ -171,7 +160,8 @@ void fv_vw_say(fv_vw_app *app, const char *fmt, ...) __attribute__((format(print
 void fv_vw_cycle(fv_vw_app *app, int dir);
 /* Steps the main parameter of the main slot (dir +1 / -1). */
 void fv_vw_step_param(fv_vw_app *app, int dir);
-/* Creates (or drops) the baseline slot for the split view. */
+/* Creates (or drops) the baseline slot for the split view: the registry's baseline of the main
+ * method (fv_technique_baseline); the reference, which has none, leaves the split view. */
 void fv_vw_update_baseline(fv_vw_app *app);
 
 /* The panels the window is split into this frame: rect, slot and eye each; returns the count. */

@@ -9,7 +9,7 @@ static void help(void)
 {
     printf("usage: fovea view [SCENE] [options]\n"
            "  SCENE                 built-in name (fovea scenes) or a scene file [cornell]\n"
-           "  --method NAME         rendering method (fovea methods) [vpolar]\n"
+           "  --method NAME         rendering method (fovea methods) [%s]\n"
            "  --param KEY=VALUE     method parameter, repeatable (fovea methods NAME lists them)\n"
            "  --device D            cpu, portable, cuda or auto, for the methods that have it (docs/gpu.md) [cpu]\n"
            "  --size WxH            window size [640x360]\n"
@@ -24,7 +24,8 @@ static void help(void)
            "  --fps-log FILE        one CSV line per frame: render and frame milliseconds\n"
            "Keys: Tab/Shift-Tab method, +/- main parameter, V split with the baseline, O overlay, H text,\n"
            "WASD/QE move, right-drag look, P pause, R record gaze+camera, F12 screenshot, Esc quit.\n"
-           "Exit status: 0 ok, 1 internal error, 2 bad input or no display.\n");
+           "Exit status: 0 ok, 1 internal error, 2 bad input or no display.\n",
+           fv_technique_default_interactive());
 }
 
 int fv_vw_args_parse(int argc, char **argv, fv_vw_args *a)

@@ -199,7 +199,7 @@ int main(int argc, char **argv)
     app.base_seed = 1;
     fv_vw_args *a = &app.args;
     a->scene = "cornell";
-    a->method = "vpolar";
+    a->method = fv_technique_default_interactive();
     a->width = 640;
     a->height = 360;
     a->scale = 1.0;

@@ -75,8 +75,7 @@ static fv_status render_slot(fv_vw_app *app, fv_vw_slot *s, int w, int h, fv_err
     key = mix(key, &app->gaze, sizeof app->gaze);
     key = mix(key, &s->method, sizeof s->method);
     key = mix(key, &s->value, sizeof s->value);
-    const fv_vw_main_param *mp = fv_vw_main_param_of(fv_technique_name(s->method));
-    bool accumulate = mp && mp->progressive && s->accum[0] && s->accum_key == key;
+    bool accumulate = fv_technique_progressive(s->method) && s->accum[0] && s->accum_key == key;
 
     fv_drive_opts o;
     fv_drive_opts_init(&o);
@@ -115,7 +114,7 @@ static fv_status render_slot(fv_vw_app *app, fv_vw_slot *s, int w, int h, fv_err
         }
         fv_vw_record_sample(&app->rec, v.time, v.gaze[0], &c);
     }
-    if (!mp || !mp->progressive) return FV_OK;
+    if (!fv_technique_progressive(s->method)) return FV_OK;
     size_t n = (size_t)w * h * 3;
     for (int e = 0; e < eyes; e++) {
         if (!s->accum[e] && !(s->accum[e] = malloc(n * sizeof(float)))) return fv_error_set(err, FV_ERR_NOMEM, "viewer: out of memory");

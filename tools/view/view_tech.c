@@ -1,51 +1,14 @@
-/* fovea-view — the techniques on screen: which parameter +/- steps for each method, which
- * baseline the split view puts beside it, and (re)creating a slot's technique through
- * fv_technique_create exactly as `fovea render` does. */
+/* fovea-view — the techniques on screen: (re)creating a slot's technique through
+ * fv_technique_create exactly as `fovea render` does, stepping its main parameter and choosing the
+ * baseline the split view puts beside it. Which parameter, its steps and the baseline are the
+ * registry's (fovea/technique.h): no method is named here. */
 #include <stdlib.h>
 #include <string.h>
 #include "view.h"
 
-/* The parameter that sets each method's cost, and the values +/- offer (the papers' settings
- * around each default). The vpolar sample spaces have no spp: their cost is the share of pixels
- * not sampled (vpolar, cartesian) or the bounce count (the full-resolution launches). */
-static const struct {
-    const char *method;
-    fv_vw_main_param p;
-} k_main[] = {
-    {"pt", {"spp", {"1", "2", "4", "8", "16", "32", "64"}, 7, 4, true}},
-    {"pm", {"photons", {"10000", "30000", "100000", "300000", "1000000"}, 5, 3, false}},
-    {"pm-t", {"photons", {"10000", "30000", "100000", "300000", "1000000"}, 5, 3, false}},
-    {"fpm", {"photons", {"10000", "30000", "100000", "300000", "1000000"}, 5, 3, false}},
-    {"ir", {"vpls", {"250", "500", "1000", "2000", "4000", "8000"}, 6, 3, false}},
-    {"ir-low", {"vpls", {"250", "500", "1000", "2000", "4000", "8000"}, 6, 3, false}},
-    {"fir", {"vpls", {"250", "500", "1000", "2000", "4000"}, 5, 2, false}},
-    {"sdf-gt", {"spp", {"1", "4", "16"}, 3, 0, false}},
-    {"sdf-relaxed", {"spp", {"1", "4", "16"}, 3, 0, false}},
-    {"ipr", {"spp", {"1", "4", "16"}, 3, 0, false}},
-    {"fipr", {"spp", {"1", "4", "16"}, 3, 0, false}},
-    {"vpolar", {"reduction", {"0.61", "0.71", "0.88"}, 3, 0, false}},
-    {"cartesian", {"reduction", {"0.61", "0.71", "0.88"}, 3, 0, false}},
-    {"cartesian-full", {"bounces", {"1", "2", "3"}, 3, 0, false}},
-    {"linear-falloff", {"bounces", {"1", "2", "3"}, 3, 0, false}},
-    {"log-polar", {"bounces", {"1", "2", "3"}, 3, 0, false}},
-};
-
-const fv_vw_main_param *fv_vw_main_param_of(const char *method)
-{
-    for (size_t i = 0; i < sizeof k_main / sizeof k_main[0]; i++)
-        if (!strcmp(k_main[i].method, method)) return &k_main[i].p;
-    return NULL;
-}
-
-const char *fv_vw_baseline_of(const char *method)
-{
-    static const char *const pairs[][2] = {
-        {"fpm", "pm"}, {"fir", "ir"}, {"fipr", "sdf-gt"}, {"ipr", "sdf-gt"}, {"vpolar", "cartesian-full"},
-    };
-    for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; i++)
-        if (!strcmp(pairs[i][0], method)) return pairs[i][1];
-    return "pt";
-}
+/* The step a slot of method m starts at: a progressive method at its first step (frames are
+ * averaged while nothing moves, so it converges on screen), any other at its default (-1). */
+static int first_step(int m) { return fv_technique_main_param(m) && fv_technique_progressive(m) ? 0 : -1; }
 
 static void drop_accum(fv_vw_slot *s)
 {
@@ -59,10 +22,10 @@ fv_status fv_vw_slot_create(fv_vw_slot *s, const fv_scene *scene, int m, int val
                             const fv_log *log, fv_error *err)
 {
     const char *name = fv_technique_name(m);
-    const fv_vw_main_param *mp = fv_vw_main_param_of(name);
+    const char *key = fv_technique_main_param(m);
     fv_params *p = NULL;
     fv_status st = user_params ? fv_params_clone(user_params, &p, err) : fv_params_create(&p, err);
-    if (st == FV_OK && mp && value >= 0) st = fv_params_set(p, mp->key, mp->values[value], err);
+    if (st == FV_OK && key && value >= 0) st = fv_params_set(p, key, fv_technique_main_step(m, value), err);
     fv_device d;
     fv_error ignored;
     if (st == FV_OK && device && fv_device_parse(device, name, &d, &ignored) == FV_OK && d != FV_DEVICE_CPU && fv_technique_has_device(m, d))
@@ -74,11 +37,11 @@ fv_status fv_vw_slot_create(fv_vw_slot *s, const fv_scene *scene, int m, int val
     fv_technique_destroy(s->tech);
     s->tech = t;
     s->label[0] = '\0';
-    if (mp) {
-        const char *v = value >= 0 ? mp->values[value] : "default";
+    if (key) {
+        const char *v = value >= 0 ? fv_technique_main_step(m, value) : "default";
         for (int i = 0; value < 0 && user_params && i < fv_params_count(user_params); i++)
-            if (!strcmp(fv_params_key(user_params, i), mp->key)) v = fv_params_value(user_params, i);
-        snprintf(s->label, sizeof s->label, "%s=%s", mp->key, v);
+            if (!strcmp(fv_params_key(user_params, i), key)) v = fv_params_value(user_params, i);
+        snprintf(s->label, sizeof s->label, "%s=%s", key, v);
     }
     s->method = m;
     s->value = value;
@@ -125,11 +88,9 @@ void fv_vw_cycle(fv_vw_app *app, int dir)
     fv_error err;
     for (int k = 1; k < n; k++) {
         int m = ((app->main.method + dir * k) % n + n) % n;
-        const fv_vw_main_param *mp = fv_vw_main_param_of(fv_technique_name(m));
-        /* pt starts at 1 spp here: the viewer averages its frames while nothing moves */
-        int value = mp && !strcmp(fv_technique_name(m), "pt") ? 0 : -1;
+        /* the method named on the command line keeps its --param values */
+        int value = m == app->user_method ? -1 : first_step(m);
         const fv_params *user = m == app->user_method ? app->args.params : NULL;
-        if (m == app->user_method) value = -1;
         fv_error_clear(&err);
         /* a method that refuses the scene (the sdf family without fields) is skipped silently */
         if (fv_vw_slot_create(&app->main, app->scene, m, value, user, app->args.device, &app->log, &err) == FV_OK) {
@@ -144,29 +105,30 @@ void fv_vw_step_param(fv_vw_app *app, int dir)
 {
     fv_vw_slot *s = &app->main;
     if (s->method < 0) return;
-    const char *name = fv_technique_name(s->method);
-    const fv_vw_main_param *mp = fv_vw_main_param_of(name);
-    if (!mp) {
+    const int m = s->method;
+    const char *name = fv_technique_name(m), *key = fv_technique_main_param(m);
+    if (!key) {
         fv_vw_say(app, "%s has no main parameter to step", name);
         return;
     }
+    const int count = fv_technique_main_step_count(m);
     int v = s->value;
     if (v < 0) {
-        /* from --param's value when it is one of the list, else from the method's default */
-        v = mp->dflt;
-        for (int i = 0; i < mp->count; i++)
-            if (!strcmp(s->label + strlen(mp->key) + 1, mp->values[i])) v = i;
+        /* from --param's value when it is one of the steps, else from the method's default */
+        v = fv_technique_main_default_step(m);
+        for (int i = 0; i < count; i++)
+            if (!strcmp(s->label + strlen(key) + 1, fv_technique_main_step(m, i))) v = i;
     }
     v += dir;
-    if (v < 0 || v >= mp->count) {
-        fv_vw_say(app, "%s: %s is at the end of its range", name, mp->key);
+    if (v < 0 || v >= count) {
+        fv_vw_say(app, "%s: %s is at the end of its range", name, key);
         return;
     }
     fv_error err;
     fv_error_clear(&err);
     const fv_params *user = s->method == app->user_method ? app->args.params : NULL;
     if (fv_vw_slot_create(s, app->scene, s->method, v, user, app->args.device, &app->log, &err) != FV_OK) fv_vw_say(app, "%s", err.msg);
-    else fv_vw_say(app, "%s %s=%s", name, mp->key, mp->values[v]);
+    else fv_vw_say(app, "%s %s=%s", name, key, fv_technique_main_step(m, v));
 }
 
 void fv_vw_update_baseline(fv_vw_app *app)
@@ -177,12 +139,19 @@ void fv_vw_update_baseline(fv_vw_app *app)
         app->base.method = -1;
         return;
     }
-    int m = fv_technique_index(fv_vw_baseline_of(fv_technique_name(app->main.method)));
-    if (m < 0 || (app->base.tech && app->base.method == m)) return;
+    const char *baseline = fv_technique_baseline(app->main.method);
+    int m = fv_technique_index(baseline);
+    if (m < 0) {
+        /* the reference has nothing to be measured against: the split view is left */
+        fv_vw_say(app, "%s is the reference: it has no baseline", fv_technique_name(app->main.method));
+        fv_vw_slot_destroy(&app->base);
+        app->split = false;
+        return;
+    }
+    if (app->base.tech && app->base.method == m) return;
     fv_error err;
     fv_error_clear(&err);
-    int value = !strcmp(fv_technique_name(m), "pt") ? 0 : -1;
-    if (fv_vw_slot_create(&app->base, app->scene, m, value, NULL, app->args.device, &app->log, &err) != FV_OK) {
+    if (fv_vw_slot_create(&app->base, app->scene, m, first_step(m), NULL, app->args.device, &app->log, &err) != FV_OK) {
         fv_vw_say(app, "baseline %s: %s", fv_technique_name(m), err.msg);
         app->split = false;
     }

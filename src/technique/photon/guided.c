@@ -575,23 +575,31 @@ static fv_status gd_render(void *state, const fv_frame *frame, fv_film *film, fv
 /* The furnace (a unit sphere, radius 0.25, as pm's check): every pixel in the focus region or on
  * the lattice gathers like pm, the others are filled from lattice pixels on the same sphere, so
  * the expected radiance is pm's: 0.998047 (pm.c explains the number). */
+static const fv_param_info k_params[] = {
+    FV_PARAM_INT("photons", "300000", 1, 500000000, "photons per frame (light + guided)"),
+    FV_PHOTON_RADIUS_PARAM("gather radius gamma in scene units"),
+    FV_PARAM_INT("max_depth", "8", 1, 64, "photon bounces"),
+    FV_PARAM_INT("eye_depth", "8", 1, 64, "mirror/glass bounces of eye rays"),
+    FV_PARAM_BOOL("filter", "true", "lattice filter in the periphery, A-Trous over the focus region"),
+    FV_PARAM_BOOL("split", "true", "follow both reflection and refraction at an eye path's first dielectric"),
+    FV_PARAM_FLOAT("guided_fraction", "0.4", 0.0, 0.95, "share of the photons guided towards the focus region"),
+    FV_PARAM_FLOAT("alpha", "0.8", 0.0, 0.99, "share of guided photons the learnt cells get (the rest uniform)"),
+    FV_PARAM_FLOAT("pilot_fraction", "0.125", 0.01, 0.9, "share of the guided budget spent learning where to guide"),
+    FV_PARAM_FLOAT("retrace_overlap", "0.75", 0.0, 1.0, "keep the guided map while this share of the focus cells is unchanged"),
+    FV_PARAM_INT("fovea_spp", "4", 1, 256, "eye paths per fovea pixel, ramping to 1 across the transition"),
+    FV_PARAM_INT("periphery_step", "2", 1, 16, "the periphery gathers every step-th pixel of every step-th row"),
+    FV_PARAM_INT("focus_passes", "1", 0, 8, "A-Trous passes over the focus region (0: none)"),
+    FV_PARAM_INT("acuity_levels", "1", 0, 3, "the step doubles up to this many times where acuity falls to 1/2, 1/4, ..."),
+};
+
 const fv_technique_class fv_technique_fpm_guided = {
     .name = "fpm-guided",
     .summary = "foveated photon mapping for a CPU: more eye paths in the fovea, a sparse periphery, photons guided to the focus",
-    .params_help = "photons=int (300000): photons per frame (light + guided)\n"
-                   "radius=float (Eq. 8): gather radius gamma in scene units\n"
-                   "max_depth=int (8): photon bounces\n"
-                   "eye_depth=int (8): mirror/glass bounces of eye rays\n"
-                   "filter=bool (true): lattice filter in the periphery, A-Trous over the focus region\n"
-                   "split=bool (true): follow both reflection and refraction at an eye path's first dielectric\n"
-                   "guided_fraction=float (0.4): share of the photons guided towards the focus region\n"
-                   "alpha=float (0.8): share of guided photons the learnt cells get (the rest uniform)\n"
-                   "pilot_fraction=float (0.125): share of the guided budget spent learning where to guide\n"
-                   "retrace_overlap=float (0.75): keep the guided map while this share of the focus cells is unchanged\n"
-                   "fovea_spp=int (4): eye paths per fovea pixel, ramping to 1 across the transition\n"
-                   "periphery_step=int (2): the periphery gathers every step-th pixel of every step-th row\n"
-                   "focus_passes=int (1): A-Trous passes over the focus region (0: none)\n"
-                   "acuity_levels=int (1): the step doubles up to this many times where acuity falls to 1/2, 1/4, ...\n",
+    .family = FV_FAMILY_PHOTON,
+    /* measured, as fpm, against photon mapping with the same photon count (the fpm-* benchmarks) */
+    .baseline = "pm",
+    FV_CLASS_PARAMS(k_params),
+    .main = {"photons", {"10000", "30000", "100000", "300000", "1000000"}, false},
     .create = gd_create,
     .render = gd_render,
     .destroy = gd_destroy,

@@ -14,6 +14,7 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include "fovea/limits.h"
 #include "fovea/math.h"
 #include "fovea/status.h"
 
@@ -118,5 +119,9 @@ float fv_photon_radius_eq8(fv_vec3 lo, fv_vec3 hi, int width, int height);
  * it must be > 0, else FV_ERR_INVALID naming the value and `what` ("gather radius", ...). */
 struct fv_params;
 fv_status fv_photon_read_radius(struct fv_params *p, const char *what, double *radius, fv_error *err);
+/* Its entry in a class's parameter table (technique/class.h), with the method's own help. */
+#define FV_PHOTON_RADIUS_PARAM(h)                                                                                    \
+    {.key = "radius", .type = FV_PARAM_FLOAT, .def_note = "Eq. 8", .min = 0.0, .min_open = true, .max = FV_COORD_MAX, \
+     .help = (h)}
 
 #endif

@@ -83,6 +83,10 @@ typedef struct pm_state {
     double left_eta;
 } pm_state;
 
+/* fpm's choices, in the order of its options' values: the reader and the parameter table share them. */
+static const char *const k_regions[] = {"fovea", "focus", NULL};
+static const char *const k_terms[] = {"all", "light", "foveated", NULL};
+
 static fv_status read_opts(pm_mode mode, fv_params *p, pm_opts *o, fv_error *err)
 {
     fv_status s;
@@ -102,10 +106,8 @@ static fv_status read_opts(pm_mode mode, fv_params *p, pm_opts *o, fv_error *err
             (s = fv_params_float(p, "fov_fraction", 0.4, 0.0, 1.0, &o->fov_fraction, err)) ||
             (s = fv_params_int(p, "paths_per_pixel", 0, 0, 64, &o->paths, err)) || (s = fv_params_bool(p, "tpm", true, &o->tpm, err)))
             return s;
-        static const char *const regions[] = {"fovea", "focus", NULL};
-        if ((s = fv_params_choice(p, "eta_region", 0, regions, &o->eta_region, err))) return s;
-        static const char *const terms[] = {"all", "light", "foveated", NULL};
-        if ((s = fv_params_choice(p, "terms", 0, terms, &o->terms, err))) return s;
+        if ((s = fv_params_choice(p, "eta_region", 0, k_regions, &o->eta_region, err))) return s;
+        if ((s = fv_params_choice(p, "terms", 0, k_terms, &o->terms, err))) return s;
         if (o->fov_fraction >= 1.0)
             return fv_error_set(err, FV_ERR_INVALID, "parameter fov_fraction=%g: some light photons are needed (use < 1)", o->fov_fraction);
         /* Absolute counts (the paper's Fig. 6 b, c vary one at a fixed other) replace the split. */
@@ -579,12 +581,39 @@ static fv_status fpm_create(const fv_scene *s, fv_params *p, const fv_log *log, 
     return pm_create_mode(MODE_FPM, s, p, log, state, err);
 }
 
-#define COMMON_HELP                                                                                 \
-    "photons=int (300000): photons per frame\n"                                                     \
-    "radius=float (Eq. 8): gather radius gamma in scene units\n"                                    \
-    "max_depth=int (8): photon bounces\n"                                                           \
-    "eye_depth=int (8): mirror/glass bounces of eye rays\n"                                         \
-    "filter=bool (true): edge-avoiding A-Trous filter afterwards\n"
+/* The parameters all three read (read_opts), then each one's own. */
+#define COMMON_PARAMS                                                                                                    \
+    FV_PARAM_INT("photons", "300000", 1, 500000000, "photons per frame"), FV_PHOTON_RADIUS_PARAM("gather radius gamma in scene units"), \
+        FV_PARAM_INT("max_depth", "8", 1, FV_FOV_MAX_DEPTH, "photon bounces"),                                            \
+        FV_PARAM_INT("eye_depth", "8", 1, 64, "mirror/glass bounces of eye rays"),                                        \
+        FV_PARAM_BOOL("filter", "true", "edge-avoiding A-Trous filter afterwards")
+
+static const fv_param_info k_pm_params[] = {
+    COMMON_PARAMS,
+    FV_PARAM_INT("passes", "1", 1, 100000, "independent passes averaged (for references)"),
+};
+
+static const fv_param_info k_pmt_params[] = {
+    COMMON_PARAMS,
+    FV_PARAM_FLOAT("dyn_fraction", "0.2", 0.0, 0.95, "share of photons sent towards dynamic objects each frame"),
+};
+
+static const fv_param_info k_fpm_params[] = {
+    COMMON_PARAMS,
+    FV_PARAM_FLOAT("dyn_fraction", "0.2", 0.0, 0.95, "share of light photons sent towards dynamic objects each frame"),
+    {.key = "fov_fraction", .type = FV_PARAM_FLOAT, .def = "0.4", .min = 0.0, .max = 1.0, .max_open = true,
+     .help = "share of foveated photons in the total (some light photons are needed)"},
+    FV_PARAM_INT("light_photons", "0", 0, 500000000, "absolute count of light photons instead of photons and fov_fraction (0: not used)"),
+    FV_PARAM_INT("fov_photons", "0", 0, 500000000, "absolute count of foveated photons, with light_photons"),
+    {.key = "paths_per_pixel", .type = FV_PARAM_INT, .def = "0", .def_note = "from the budget", .min = 0, .max = 64,
+     .help = "N foveated paths per focus pixel"},
+    FV_PARAM_BOOL("tpm", "true", "temporal photon management (false: retrace all foveated paths)"),
+    FV_PARAM_CHOICE("eta_region", "fovea", k_regions, "the pixels whose gathered flux Eq. 1 sums (r_i)"),
+    FV_PARAM_CHOICE("terms", "all", k_terms, "the focus region's estimate, or only one map pair's share of it (analysis)"),
+};
+
+/* The viewer's steps: the paper's 3M photons scaled to a CPU, a decade around the default. */
+#define PHOTON_STEPS {"photons", {"10000", "30000", "100000", "300000", "1000000"}, false}
 
 /* The furnace, with a gather radius fixed at r = 0.25: emission 0.5 seen directly, plus what the
  * photons of up to 8 bounces bring, 0.5 (1 - 0.5^8) = 0.498047, as the density estimate on the
@@ -603,7 +632,10 @@ static fv_status fpm_create(const fv_scene *s, fv_params *p, const fv_log *log, 
 const fv_technique_class fv_technique_pm = {
     .name = "pm",
     .summary = "photon mapping, all photons retraced every frame (the paper's PM baseline)",
-    .params_help = COMMON_HELP "passes=int (1): independent passes averaged (for references)\n",
+    .family = FV_FAMILY_PHOTON,
+    .baseline = "pt", /* the truth its gather's bias is measured against (docs/photon-mapping.md) */
+    FV_CLASS_PARAMS(k_pm_params),
+    .main = PHOTON_STEPS,
     .create = pm_create,
     .render = pm_render,
     .destroy = pm_destroy,
@@ -613,7 +645,12 @@ const fv_technique_class fv_technique_pm = {
 const fv_technique_class fv_technique_pm_t = {
     .name = "pm-t",
     .summary = "photon mapping with the temporal strategy: static photons once, dynamic ones every frame (PM^t)",
-    .params_help = COMMON_HELP "dyn_fraction=float (0.2): share of photons sent towards dynamic objects each frame\n",
+    .family = FV_FAMILY_PHOTON,
+    /* PM^t only changes which photons are retraced: measured against pm at the same photon count
+     * (the fpm-* benchmarks' Table 1) */
+    .baseline = "pm",
+    FV_CLASS_PARAMS(k_pmt_params),
+    .main = PHOTON_STEPS,
     .create = pmt_create,
     .render = pm_render,
     .destroy = pm_destroy,
@@ -623,13 +660,10 @@ const fv_technique_class fv_technique_pm_t = {
 const fv_technique_class fv_technique_fpm = {
     .name = "fpm",
     .summary = "foveated photon mapping: foveated photons in the focus region, temporal photon management",
-    .params_help = COMMON_HELP "dyn_fraction=float (0.2): share of light photons sent towards dynamic objects each frame\n"
-                               "fov_fraction=float (0.4): share of foveated photons in the total\n"
-                               "light_photons=int, fov_photons=int: absolute counts instead of photons and fov_fraction\n"
-                               "paths_per_pixel=int (from the budget): N foveated paths per focus pixel\n"
-                               "tpm=bool (true): temporal photon management (false: retrace all foveated paths)\n"
-                               "eta_region=fovea|focus (fovea): the pixels whose gathered flux Eq. 1 sums (r_i)\n"
-                               "terms=all|light|foveated (all): the focus region's estimate, or only one map pair's share of it (analysis)\n",
+    .family = FV_FAMILY_PHOTON,
+    .baseline = "pm", /* the paper's PM_3M, at the same photon count (Table 1) */
+    FV_CLASS_PARAMS(k_fpm_params),
+    .main = PHOTON_STEPS,
     .create = fpm_create,
     .render = pm_render,
     .destroy = pm_destroy,

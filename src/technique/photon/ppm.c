@@ -35,6 +35,10 @@
 /* The photon stream of pass i (core/rng.h): above every pm pass's (100 + pass). */
 #define PPM_STREAM_BASE (1ULL << 32)
 
+/* Block bounds: 10^7 passes are 156250 blocks of FV_SAMPLE_BLOCK, the most any passes makes. */
+#define PPM_MAX_PASSES 10000000
+#define PPM_MAX_BLOCKS ((PPM_MAX_PASSES + FV_SAMPLE_BLOCK - 1) / FV_SAMPLE_BLOCK)
+
 typedef struct ppm_opts {
     int photons;      /* per pass */
     int passes;
@@ -55,7 +59,7 @@ static fv_status read_opts(fv_params *p, ppm_opts *o, fv_error *err)
     fv_status s;
     memset(o, 0, sizeof *o);
     if ((s = fv_params_int(p, "photons", 100000, 1, 500000000, &o->photons, err)) ||
-        (s = fv_params_int(p, "passes", 64, 1, 10000000, &o->passes, err)) ||
+        (s = fv_params_int(p, "passes", 64, 1, PPM_MAX_PASSES, &o->passes, err)) ||
         (s = fv_params_float(p, "alpha", 2.0 / 3.0, 0.0, 1.0, &o->alpha, err)) ||
         (s = fv_photon_read_radius(p, "initial gather radius", &o->radius, err)) ||
         (s = fv_params_int(p, "max_depth", 8, 1, 64, &o->max_depth, err)) || (s = fv_params_int(p, "eye_depth", 8, 1, 64, &o->eye_depth, err)))
@@ -238,17 +242,29 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
 
 /* The furnace at r_1 = 0.25, as pm's (FURNACE_TEST in pm.c): 1 - 0.5^9 whatever the radius below 1,
  * the gather keeping every photon of the disc on the unit sphere. */
+static const fv_param_info k_params[] = {
+    FV_PARAM_INT("passes", "64", 1, PPM_MAX_PASSES, "passes averaged, each with its own photon map and a jittered eye path per pixel (--spp)"),
+    FV_PARAM_INT("photons", "100000", 1, 500000000, "photons per pass"),
+    FV_PHOTON_RADIUS_PARAM("gather radius of the first pass, in scene units"),
+    /* 2/3 to the last bit: what the reader's default is */
+    {.key = "alpha", .type = FV_PARAM_FLOAT, .def = "0.66666666666666663", .min = 0.0, .max = 1.0, .min_open = true, .max_open = true,
+     .help = "radius shrinking, r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1) (Eq. 15; 2/3)"},
+    FV_PARAM_INT("max_depth", "8", 1, 64, "photon bounces"),
+    FV_PARAM_INT("eye_depth", "8", 1, 64, "mirror/glass bounces of eye rays"),
+    FV_PARAM_INT("block_first", "0", 0, PPM_MAX_BLOCKS - 1,
+                 "first block of 64 passes rendered (a reference split over MPI ranks), below the passes' blocks"),
+    {.key = "block_count", .type = FV_PARAM_INT, .def_note = "all from block_first", .min = 1, .max = PPM_MAX_BLOCKS,
+     .help = "blocks of passes rendered, at most those from block_first on; the image is their mean"},
+};
+
 const fv_technique_class fv_technique_ppm = {
     .name = "ppm",
     .summary = "progressive photon mapping: passes with a shrinking radius averaged, converging to the truth (photon reference)",
-    .params_help = "passes=int (64): passes averaged, each with its own photon map and a jittered eye path per pixel (--spp)\n"
-                   "photons=int (100000): photons per pass\n"
-                   "radius=float (Eq. 8): gather radius of the first pass, in scene units\n"
-                   "alpha=float (0.667): radius shrinking, r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1), in (0, 1)\n"
-                   "max_depth=int (8): photon bounces\n"
-                   "eye_depth=int (8): mirror/glass bounces of eye rays\n"
-                   "block_first=int (0): first block of 64 passes rendered (a reference split over MPI ranks)\n"
-                   "block_count=int (all from block_first): blocks of passes rendered; the image is their mean\n",
+    .family = FV_FAMILY_PHOTON,
+    .baseline = "pt", /* it converges to the path tracer's image (docs/photon-mapping.md, "ppm") */
+    FV_CLASS_PARAMS(k_params),
+    /* passes cost linearly and each frame starts afresh: a still view may average its frames */
+    .main = {"passes", {"1", "4", "16", "64", "256"}, true},
     .create = ppm_create,
     .render = ppm_render,
     .destroy = ppm_destroy,

@@ -225,14 +225,26 @@ static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv
     return done ? FV_OK : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
 }
 
+/* transport/path.c reads the first three (fv_path_read_opts), this file the blocks: 2^20 samples
+ * are 16384 blocks of FV_SAMPLE_BLOCK, the most any spp makes. */
+static const fv_param_info k_params[] = {
+    FV_PARAM_INT("spp", "16", 1, 1 << 20, "samples per pixel"),
+    FV_PARAM_INT("max_depth", "8", 1, 1024, "path vertices that gather light, 1 = direct light only"),
+    FV_PARAM_INT("rr_depth", "3", 1, 1024, "depth from which Russian roulette may end paths"),
+    FV_PARAM_INT("block_first", "0", 0, (1 << 20) / FV_SAMPLE_BLOCK - 1,
+                 "first block of 64 samples rendered (cpu; a still split over MPI ranks), below the spp's blocks"),
+    {.key = "block_count", .type = FV_PARAM_INT, .def_note = "all from block_first", .min = 1, .max = (1 << 20) / FV_SAMPLE_BLOCK,
+     .help = "blocks rendered, at most those from block_first on; the image is their mean"},
+};
+
 const fv_technique_class fv_technique_pt = {
     .name = "pt",
     .summary = "reference path tracer: NEE + MIS, Russian roulette (ground truth)",
-    .params_help = "spp=int (16): samples per pixel\n"
-                   "max_depth=int (8): path vertices that gather light, 1 = direct light only\n"
-                   "rr_depth=int (3): depth from which Russian roulette may end paths\n"
-                   "block_first=int (0): first block of 64 samples rendered (cpu; a still split over MPI ranks)\n"
-                   "block_count=int (all from block_first): blocks rendered; the image is their mean\n",
+    .family = FV_FAMILY_PT,
+    .baseline = NULL, /* the reference every chain of baselines ends at */
+    FV_CLASS_PARAMS(k_params),
+    /* The viewer starts it at 1 spp and averages its frames while nothing moves. */
+    .main = {"spp", {"1", "2", "4", "8", "16", "32", "64"}, true},
     .create_on = pt_create,
     .devices = (1u << FV_DEVICE_PORTABLE) | (1u << FV_DEVICE_CUDA),
     .render = pt_render,

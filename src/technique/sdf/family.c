@@ -11,7 +11,14 @@ typedef struct family_state {
     fv_sdf_pipeline *pipe;
 } family_state;
 
-static const char *const k_show[] = {"image", "steps", "level", "mask", "edges", NULL};
+/* The show modes each method has, in fv_sdf_show's order: the baselines one level, ipr the level
+ * each pixel came from, only fipr a mask and edges. The reader and the parameter tables share them. */
+static const char *const k_show_traced[] = {"image", "steps", NULL};
+static const char *const k_show_ipr[] = {"image", "steps", "level", NULL};
+static const char *const k_show_fipr[] = {"image", "steps", "level", "mask", "edges", NULL};
+/* The sample grids (1x1, 2x2, 4x4) and fipr's refresh periods: the only values of two int parameters. */
+static const char *const k_spp[] = {"1", "4", "16", NULL};
+static const char *const k_refresh[] = {"1", "2", "4", NULL};
 
 static fv_status bad(fv_error *err, const char *key, double v, const char *what)
 {
@@ -26,16 +33,14 @@ static fv_status read_opts(fv_sdf_method m, fv_params *p, fv_sdf_opts *o, fv_err
     int show;
     double hit, ambient, relax = 1.0;
     bool shadows, wide;
-    /* the show modes each method has: the baselines one level, only fipr a mask and edges */
-    int show_max = m == FV_SDF_FIPR ? FV_SDF_SHOW_EDGES : m == FV_SDF_IPR ? FV_SDF_SHOW_LEVEL : FV_SDF_SHOW_STEPS;
+    const char *const *shows = m == FV_SDF_FIPR ? k_show_fipr : m == FV_SDF_IPR ? k_show_ipr : k_show_traced;
     if ((s = fv_params_int(p, "spp", 1, 1, 16, &o->spp, err)) ||
         (s = fv_params_int(p, "max_steps", 256, 1, 65535, &o->march.max_steps, err)) ||
         (s = fv_params_float(p, "hit", 0.25, 1e-4, 16.0, &hit, err)) ||
         (s = fv_params_float(p, "ambient", 0.0, 0.0, 1.0, &ambient, err)) || (s = fv_params_bool(p, "shadows", true, &shadows, err)) ||
-        (s = fv_params_bool(p, "simd", true, &wide, err)) || (s = fv_params_choice(p, "show", 0, k_show, &show, err)))
+        (s = fv_params_bool(p, "simd", true, &wide, err)) || (s = fv_params_choice(p, "show", 0, shows, &show, err)))
         return s;
     if (o->spp != 1 && o->spp != 4 && o->spp != 16) return bad(err, "spp", o->spp, "must be 1, 4 or 16 (1, 2 or 4 samples per pixel along each axis)");
-    if (show > show_max) return fv_error_set(err, FV_ERR_INVALID, "parameter show=%s is not an output of this method", k_show[show]);
     if (m == FV_SDF_RELAXED || m == FV_SDF_IPR || m == FV_SDF_FIPR) {
         if ((s = fv_params_float(p, "relax", m == FV_SDF_RELAXED ? 1.6 : 1.0, -1e9, 1e9, &relax, err))) return s;
         if (!(relax >= 1.0 && relax < 2.0)) return bad(err, "relax", relax, "must be in [1, 2) (1: plain sphere tracing)");
@@ -119,13 +124,56 @@ static fv_status create_relaxed(const fv_scene *s, fv_params *p, const fv_log *l
 static fv_status create_ipr(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e) { return create_method(FV_SDF_IPR, s, p, l, st, e); }
 static fv_status create_fipr(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e) { return create_method(FV_SDF_FIPR, s, p, l, st, e); }
 
-#define COMMON_HELP                                                                                                  \
-    "spp=int (1): samples per pixel, 1, 4 or 16 (a regular 1x1, 2x2 or 4x4 grid)\n"                                 \
-    "max_steps=int (256): field evaluations per ray; a ray still marching then counts as a hit\n"                     \
-    "hit=float (0.25): hit distance as a fraction of the ray's footprint at its distance\n"                           \
-    "ambient=float (0): constant light, ambient x albedo (0: direct light only, as pt max_depth=1)\n"                 \
-    "shadows=bool (true): hard shadows by sphere tracing towards each light\n"                                      \
-    "simd=bool (true): evaluate the field for 8 rays at once (false: the scalar loop; same image)\n"
+#define COMMON_PARAMS                                                                                                    \
+    {.key = "spp", .type = FV_PARAM_INT, .def = "1", .min = 1, .max = 16, .choices = k_spp,                               \
+     .help = "samples per pixel: a regular 1x1, 2x2 or 4x4 grid"},                                                          \
+        FV_PARAM_INT("max_steps", "256", 1, 65535, "field evaluations per ray; a ray still marching then counts as a hit"), \
+        FV_PARAM_FLOAT("hit", "0.25", 1e-4, 16.0, "hit distance as a fraction of the ray's footprint at its distance"),      \
+        FV_PARAM_FLOAT("ambient", "0", 0.0, 1.0, "constant light, ambient x albedo (0: direct light only, as pt max_depth=1)"), \
+        FV_PARAM_BOOL("shadows", "true", "hard shadows by sphere tracing towards each light"),                              \
+        FV_PARAM_BOOL("simd", "true", "evaluate the field for 8 rays at once (false: the scalar loop; same image)")
+
+/* relax: plain sphere tracing at 1; the over-relaxed step needs it below 2 (Keinert et al. 2014). */
+#define RELAX_PARAM(d, h)                                                                                                \
+    {.key = "relax", .type = FV_PARAM_FLOAT, .def = (d), .min = 1.0, .max = 2.0, .max_open = true, .help = (h)}
+
+static const fv_param_info k_gt_params[] = {
+    COMMON_PARAMS,
+    FV_PARAM_CHOICE("show", "image", k_show_traced, "the image, or steps per ray from blue (1) to red (256)"),
+};
+static const fv_param_info k_relaxed_params[] = {
+    COMMON_PARAMS,
+    RELAX_PARAM("1.6", "step factor"),
+    FV_PARAM_CHOICE("show", "image", k_show_traced, "the image, or steps per ray from blue (1) to red (256)"),
+};
+static const fv_param_info k_ipr_params[] = {
+    COMMON_PARAMS,
+    FV_PARAM_INT("levels", "3", 1, FV_PYRAMID_MAX_LEVELS, "pyramid levels, 1 = sdf-gt (the tip has 1/4^(levels-1) of the rays)"),
+    FV_PARAM_BOOL("min_filter", "true", "start at the 3x3 minimum of the depths below (false: the parent's depth)"),
+    RELAX_PARAM("1", "over-relaxation of every level's march"),
+    FV_PARAM_BOOL("shadow_reuse", "false", "ours, for a CPU: take shadows from the level below where its 3x3 agree"),
+    FV_PARAM_CHOICE("show", "image", k_show_ipr, "the image, steps per ray, or the level each pixel came from"),
+};
+static const fv_param_info k_fipr_params[] = {
+    COMMON_PARAMS,
+    FV_PARAM_INT("levels", "3", 3, FV_PYRAMID_MAX_LEVELS, "pyramid levels (a tip, a middle and a target level at least)"),
+    FV_PARAM_BOOL("min_filter", "true", "start at the 3x3 minimum of the depths below"),
+    RELAX_PARAM("1", "over-relaxation of every level's march"),
+    FV_PARAM_BOOL("shadow_reuse", "false", "ours, for a CPU: take shadows from the level below where its 3x3 agree"),
+    {.key = "fovea_deg", .type = FV_PARAM_FLOAT, .def = "7.5", .min = 0.0, .max = 180.0, .max_open = true,
+     .help = "eccentricity traced at the target level (the mask is 1)"},
+    {.key = "outer_deg", .type = FV_PARAM_FLOAT, .def = "30", .min = 0.0, .min_open = true, .max = 1e9,
+     .help = "eccentricity beyond which the mask is 0, edges included; greater than fovea_deg"},
+    FV_PARAM_FLOAT("edge", "0.25", 0.0, 1e6, "Sobel threshold on the tip's depth, relative to the depth"),
+    {.key = "refresh", .type = FV_PARAM_INT, .def = "1", .min = 1, .max = 4, .choices = k_refresh,
+     .help = "frames between refreshes of the pixels outside the mask"},
+    FV_PARAM_BOOL("blur", "false", "pass 5, a Gaussian blur of the mask's transitions"),
+    FV_PARAM_FLOAT("blur_sigma", "2", 0.0, 100.0, "its standard deviation in pixels"),
+    FV_PARAM_CHOICE("show", "image", k_show_fipr, "the image or a pass's output"),
+};
+
+/* The viewer's steps of spp: every grid there is. */
+#define SDF_STEPS {"spp", {"1", "4", "16"}, false}
 
 /* The conformance suite's scenes for this family are its SDF twins (tests/conformance): in
  * sdf-furnace the camera and a point light of intensity 2 pi sit at the centre of a hollow sphere
@@ -137,34 +185,20 @@ static fv_status create_fipr(const fv_scene *s, fv_params *p, const fv_log *l, v
  * one-process frames bit for bit (tests/cli/test_mpi.sh). */
 #define FIPR_WARMUP 3
 
-#define SDF_CLASS(id, nm, sum, help, fn, fov, warmup)                                                                 \
-    const fv_technique_class id = {.name = nm, .summary = sum, .params_help = COMMON_HELP help, .create = fn, .render = render, \
-                                   .destroy = destroy, .sdf_only = true, .test_params = "spp=1", .furnace_radiance = 1.0,      \
-                                   .furnace_tolerance = 0.01, .spp_param = "spp", .foveated = fov, .warmup_frames = warmup}
+#define SDF_CLASS(id, nm, sum, base, table, fn, fov, warmup)                                                          \
+    const fv_technique_class id = {.name = nm, .summary = sum, .family = FV_FAMILY_SDF, .baseline = base, FV_CLASS_PARAMS(table), \
+                                   .main = SDF_STEPS, .create = fn, .render = render, .destroy = destroy, .sdf_only = true,       \
+                                   .test_params = "spp=1", .furnace_radiance = 1.0, .furnace_tolerance = 0.01, .spp_param = "spp", \
+                                   .foveated = fov, .warmup_frames = warmup}
 
-SDF_CLASS(fv_technique_sdf_gt, "sdf-gt", "sphere tracing of every target sample from the camera (ground truth of ipr/fipr)",
-          "show=image|steps (image): the image, or steps per ray from blue (1) to red (256)\n", create_gt, false, 0);
-SDF_CLASS(fv_technique_sdf_relaxed, "sdf-relaxed", "over-relaxed sphere tracing (Keinert et al. 2014) of every target sample",
-          "relax=float (1.6): step factor in [1, 2)\n"
-          "show=image|steps (image): the image, or steps per ray from blue (1) to red (256)\n",
-          create_relaxed, false, 0);
-SDF_CLASS(fv_technique_ipr, "ipr", "inverted-pyramid sphere tracing: each level starts at the min-filtered depth of the one below",
-          "levels=int (3): pyramid levels, 1 = sdf-gt (the tip has 1/4^(levels-1) of the rays)\n"
-          "min_filter=bool (true): start at the 3x3 minimum of the depths below (false: the parent's depth)\n"
-          "relax=float (1): over-relaxation of every level's march, in [1, 2)\n"
-          "shadow_reuse=bool (false): ours, for a CPU: take shadows from the level below where its 3x3 agree\n"
-          "show=image|steps|level (image): the image, steps per ray, or the level each pixel came from\n",
-          create_ipr, false, 0);
-SDF_CLASS(fv_technique_fipr, "fipr", "foveated inverted-pyramid sphere tracing: the five passes of Polychronakis et al. 2023",
-          "levels=int (3): pyramid levels, 3 to 6\n"
-          "min_filter=bool (true): start at the 3x3 minimum of the depths below\n"
-          "relax=float (1): over-relaxation of every level's march, in [1, 2)\n"
-          "shadow_reuse=bool (false): ours, for a CPU: take shadows from the level below where its 3x3 agree\n"
-          "fovea_deg=float (7.5): eccentricity traced at the target level (the mask is 1)\n"
-          "outer_deg=float (30): eccentricity beyond which the mask is 0, edges included\n"
-          "edge=float (0.25): Sobel threshold on the tip's depth, relative to the depth\n"
-          "refresh=int (1): frames between refreshes of the pixels outside the mask: 1, 2 or 4\n"
-          "blur=bool (false): pass 5, a Gaussian blur of the mask's transitions\n"
-          "blur_sigma=float (2): its standard deviation in pixels\n"
-          "show=image|steps|level|mask|edges (image): the image or a pass's output\n",
-          create_fipr, true, FIPR_WARMUP);
+/* Baselines: sdf-gt is the ground truth of the paper's Sec. 4.5, which pt with direct light only
+ * renders too (docs/sdf-tracing.md, "Shading"); the others are measured against sdf-gt (Table 1,
+ * the sdf-* benchmarks). */
+SDF_CLASS(fv_technique_sdf_gt, "sdf-gt", "sphere tracing of every target sample from the camera (ground truth of ipr/fipr)", "pt",
+          k_gt_params, create_gt, false, 0);
+SDF_CLASS(fv_technique_sdf_relaxed, "sdf-relaxed", "over-relaxed sphere tracing (Keinert et al. 2014) of every target sample", "sdf-gt",
+          k_relaxed_params, create_relaxed, false, 0);
+SDF_CLASS(fv_technique_ipr, "ipr", "inverted-pyramid sphere tracing: each level starts at the min-filtered depth of the one below", "sdf-gt",
+          k_ipr_params, create_ipr, false, 0);
+SDF_CLASS(fv_technique_fipr, "fipr", "foveated inverted-pyramid sphere tracing: the five passes of Polychronakis et al. 2023", "sdf-gt",
+          k_fipr_params, create_fipr, true, FIPR_WARMUP);

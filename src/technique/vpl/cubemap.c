@@ -77,6 +77,7 @@ fv_vec3 fv_cubemaps_centre(const fv_cubemaps *m, int i) { return m->meta[i].cent
 const float *fv_cubemaps_depths(const fv_cubemaps *m, int i) { return m->depth + (size_t)i * m->texels; }
 
 const char *const fv_cube_build_names[] = {"auto", "raster", "rays", NULL};
+const char *const fv_cube_filter_names[] = {"nearest", "pcf", NULL};
 
 void fv_cubemaps_set_build(fv_cubemaps *m, fv_cube_build how) { m->how = how; }
 

@@ -129,9 +129,14 @@ void fv_cubemaps_destroy(fv_cubemaps *maps);
 fv_status fv_vpl_cubemaps_create(int count, int face_size, fv_cubemaps **out, fv_error *err);
 /* The parameter cube_build=auto|raster|rays of the techniques with cube maps, in enum order. */
 extern const char *const fv_cube_build_names[];
-#define FV_CUBE_BUILD_HELP                                                                                             \
-    "cube_build=auto|raster|rays (auto): how depth cube maps are made: rasterising the triangles (the paper's way), " \
-    "a ray per texel, or auto (raster up to " FV_CUBE_STR(FV_CUBE_RASTER_MAX_TRIANGLES) " triangles and without SDFs)\n"
+/* The parameter cube_filter=nearest|pcf, in fv_cube_filter's order. */
+extern const char *const fv_cube_filter_names[];
+/* The two parameters' entries in a class's parameter table (technique/class.h). */
+#define FV_CUBE_BUILD_PARAM                                                                                             \
+    FV_PARAM_CHOICE("cube_build", "auto", fv_cube_build_names,                                                         \
+                    "how depth cube maps are made: rasterising the triangles (the paper's way), a ray per texel, or auto " \
+                    "(raster up to " FV_CUBE_STR(FV_CUBE_RASTER_MAX_TRIANGLES) " triangles and without SDFs)")
+#define FV_CUBE_FILTER_PARAM(h) FV_PARAM_CHOICE("cube_filter", "nearest", fv_cube_filter_names, h)
 /* How maps are built from now on (FV_CUBE_BUILD_AUTO at creation). */
 void fv_cubemaps_set_build(fv_cubemaps *maps, fv_cube_build how);
 /* Whether `how` rasterises in scene s. */

@@ -59,7 +59,6 @@ typedef struct build_key {
 
 enum { FILTER_BOX = 0, FILTER_ATROUS, FILTER_NONE };
 static const char *const k_filters[] = {"box", "atrous", "none", NULL};
-static const char *const k_cube_filters[] = {"nearest", "pcf", NULL};
 static const char *const k_visibility[] = {"cube", "rays", NULL};
 
 typedef struct fir_state {
@@ -161,7 +160,7 @@ static fv_status read_params(fir_state *st, fv_params *p, fv_error *err)
                             "parameters tiles_x=%d, tiles_y=%d: %d tiles do not divide vpls=%d (each tile needs a VPL)", st->tiles_x,
                             st->tiles_y, st->tiles_x * st->tiles_y, st->total);
     if ((s = fv_params_float(p, "rebuild", 0.2, 0.0, 1.0, &rebuild, err)) != FV_OK ||
-        (s = fv_params_choice(p, "cube_filter", 0, k_cube_filters, &st->cube_filter, err)) != FV_OK ||
+        (s = fv_params_choice(p, "cube_filter", 0, fv_cube_filter_names, &st->cube_filter, err)) != FV_OK ||
         (s = fv_params_choice(p, "filter", FILTER_BOX, k_filters, &st->filter, err)) != FV_OK ||
         (s = fv_params_float(p, "radius", 0.25, -1e30, 1e30, &radius, err)) != FV_OK ||
         (s = fv_params_int(p, "area_samples", 16, 1, 4096, &st->area_samples, err)) != FV_OK ||
@@ -796,32 +795,39 @@ static fv_status fir_render(void *state, const fv_frame *frame, fv_film *film, f
     return fv_vpl_frame_end(vf, (fv_vpl_show)st->show, ok, status, stats, err);
 }
 
+static const fv_param_info k_params[] = {
+    FV_PARAM_INT("vpls", "1000", 1, 1000000, "TOTALNUMBER, valid VPLs (Sec. 4.1)"),
+    FV_PARAM_INT("candidates", "1000", 1, 1000000, "VPL candidates bounced from the fovea per frame (Sec. 3.1)"),
+    FV_PARAM_FLOAT("resample", "0.1", 0.0, 1.0, "fraction of vpls resampled from the candidates per frame (Sec. 4.1)"),
+    FV_PARAM_INT("resolution", "64", 8, 1024, "voxels along the scene's longest axis (Alg. 1)"),
+    FV_PARAM_INT("directions", "32", 1, FV_VPL_MAX_DIRECTIONS, "fixed directions cast per VPL for its importance (Alg. 3)"),
+    FV_PARAM_INT("density_grid", "16", 1, 256, "density-grid cells along the longest axis (Alg. 5)"),
+    FV_PARAM_INT("density_limit", "4", 1, 1000000, "DENSITYLIMIT, VPLs a density cell may take (Alg. 5)"),
+    FV_PARAM_FLOAT("density_c", "1", 1e-6, 1e6, "C in the score Imp + 1/(vd + C) (Alg. 5)"),
+    FV_PARAM_FLOAT("drop_importance", "0.01", 0.0, 1.0, "an old VPL below this importance is dropped (Sec. 3.3)"),
+    FV_PARAM_FLOAT("drop_normal_deg", "60", 0.0, 180.0, "an old VPL whose voxel normal turned more than this is dropped (Sec. 3.3)"),
+    FV_PARAM_INT("tiles_x", "5", 1, 64, "interleaved-sampling tiles across (Sec. 3.4; 5x5 so the 5x5 box sees each tile once)"),
+    FV_PARAM_INT("tiles_y", "5", 1, 64, "interleaved-sampling tiles down; tiles_x * tiles_y <= vpls"),
+    FV_PARAM_INT("cube_size", "128", FV_CUBE_MIN_SIZE, FV_CUBE_MAX_SIZE, "texels per cube-map face edge of a VPL's depth map (Sec. 4.1)"),
+    FV_PARAM_FLOAT("rebuild", "0.2", 0.0, 1.0, "fraction of the VPLs' cube maps rebuilt per frame, new VPLs' always (Sec. 4.1)"),
+    FV_CUBE_FILTER_PARAM("cube-map lookup"),
+    FV_CUBE_BUILD_PARAM,
+    FV_PARAM_CHOICE("filter", "box", k_filters, "filter of the interleaved indirect light (Sec. 3.4: a 5x5 box)"),
+    {.key = "radius", .type = FV_PARAM_FLOAT, .def = "0.25", .min = 0.0, .min_open = true, .max = 1.0,
+     .help = "foveal radius as a fraction of the image width (Sec. 4.1)"},
+    FV_VPL_AREA_SAMPLES_PARAM,
+    FV_VPL_CLAMP_PARAM,
+    FV_PARAM_CHOICE("visibility", "cube", k_visibility, "VPL visibility from the cube maps (the paper) or exact shadow rays (no maps built)"),
+    FV_VPL_SHOW_PARAM,
+};
+
 const fv_technique_class fv_technique_fir = {
     .name = "fir",
     .summary = "Foveated Instant Radiosity: VPLs chosen and reused by foveated importance, interleaved shading",
-    .params_help =
-        "vpls=int (1000): TOTALNUMBER, valid VPLs (Sec. 4.1)\n"
-        "candidates=int (1000): VPL candidates bounced from the fovea per frame (Sec. 3.1)\n"
-        "resample=float (0.1): fraction of vpls resampled from the candidates per frame (Sec. 4.1)\n"
-        "resolution=int (64): voxels along the scene's longest axis (Alg. 1)\n"
-        "directions=int (32): fixed directions cast per VPL for its importance (Alg. 3)\n"
-        "density_grid=int (16): density-grid cells along the longest axis (Alg. 5)\n"
-        "density_limit=int (4): DENSITYLIMIT, VPLs a density cell may take (Alg. 5)\n"
-        "density_c=float (1): C in the score Imp + 1/(vd + C) (Alg. 5)\n"
-        "drop_importance=float (0.01): an old VPL below this importance is dropped (Sec. 3.3)\n"
-        "drop_normal_deg=float (60): an old VPL whose voxel normal turned more than this is dropped (Sec. 3.3)\n"
-        "tiles_x=int (5): interleaved-sampling tiles across (Sec. 3.4; 5x5 so the 5x5 box sees each tile once)\n"
-        "tiles_y=int (5): interleaved-sampling tiles down; tiles_x * tiles_y <= vpls\n"
-        "cube_size=int (128): texels per cube-map face edge of a VPL's depth map (Sec. 4.1)\n"
-        "rebuild=float (0.2): fraction of the VPLs' cube maps rebuilt per frame, new VPLs' always (Sec. 4.1)\n"
-        "cube_filter=nearest|pcf (nearest): cube-map lookup\n"
-        FV_CUBE_BUILD_HELP
-        "filter=box|atrous|none (box): filter of the interleaved indirect light (Sec. 3.4: a 5x5 box)\n"
-        "radius=float (0.25): foveal radius as a fraction of the image width (Sec. 4.1)\n"
-        "area_samples=int (16): light samples per pixel for area lights (point and spot lights are exact)\n"
-        "clamp=float (0.03): geometry-term clamp, as a fraction of the scene's bounding-sphere radius (0 = off)\n"
-        "visibility=cube|rays (cube): VPL visibility from the cube maps (the paper) or exact shadow rays (no maps built)\n"
-        "show=all|direct|indirect (all): the image, or one of its two terms alone (without emitted light)\n",
+    .family = FV_FAMILY_VPL,
+    .baseline = "ir", /* the paper's IR, 2000 VPLs with exact visibility (Tables 1-2) */
+    FV_CLASS_PARAMS(k_params),
+    .main = {"vpls", {FV_VPL_STEPS}, false},
     .create = fir_create,
     .render = fir_render,
     .destroy = fir_destroy,

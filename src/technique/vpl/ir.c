@@ -36,8 +36,6 @@ typedef struct ir_state {
     int *slots;
 } ir_state;
 
-static const char *const k_filters[] = {"nearest", "pcf", NULL};
-
 static void ir_destroy(void *state)
 {
     ir_state *st = state;
@@ -70,7 +68,7 @@ static fv_status ir_create_common(const fv_scene *scene, fv_params *params, bool
     st->clamp = (float)clamp;
     if (low) {
         if ((s = fv_params_int(params, "cube_size", 128, FV_CUBE_MIN_SIZE, FV_CUBE_MAX_SIZE, &st->cube_size, err)) != FV_OK ||
-            (s = fv_params_choice(params, "cube_filter", 0, k_filters, &st->cube_filter, err)) != FV_OK ||
+            (s = fv_params_choice(params, "cube_filter", 0, fv_cube_filter_names, &st->cube_filter, err)) != FV_OK ||
             (s = fv_params_choice(params, "cube_build", FV_CUBE_BUILD_AUTO, fv_cube_build_names, &cube_build, err)) != FV_OK)
             goto fail;
         size_t per_map = 6u * (size_t)st->cube_size * (size_t)st->cube_size * sizeof(float);
@@ -178,17 +176,26 @@ static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv
     return fv_vpl_frame_end(vf, (fv_vpl_show)st->show, ok, status, stats, err);
 }
 
-#define IR_COMMON_HELP                                                                                                 \
-    "vpls=int (2000): VPLs from light random walks, all regenerated every frame\n"                                     \
-    "bounces=int (7): light-path vertices that become VPLs (1 = one-bounce indirect light)\n"                          \
-    "area_samples=int (16): light samples per pixel for area lights (point and spot lights are exact)\n"              \
-    "clamp=float (0.03): geometry-term clamp, as a fraction of the scene's bounding-sphere radius (0 = off)\n"          \
-    "show=all|direct|indirect (all): the image, or one of its two terms alone (without emitted light)\n"
+#define IR_COMMON_PARAMS                                                                                              \
+    FV_PARAM_INT("vpls", "2000", 1, 1000000, "VPLs from light random walks, all regenerated every frame"),                \
+        FV_PARAM_INT("bounces", "7", 1, 64, "light-path vertices that become VPLs (1 = one-bounce indirect light)"),      \
+        FV_VPL_AREA_SAMPLES_PARAM, FV_VPL_CLAMP_PARAM, FV_VPL_SHOW_PARAM
+
+static const fv_param_info k_ir_params[] = {IR_COMMON_PARAMS};
+static const fv_param_info k_ir_low_params[] = {
+    IR_COMMON_PARAMS,
+    FV_PARAM_INT("cube_size", "128", FV_CUBE_MIN_SIZE, FV_CUBE_MAX_SIZE, "texels per cube-map face edge"),
+    FV_CUBE_FILTER_PARAM("cube-map lookup (pcf: 2x2 percentage-closer)"),
+    FV_CUBE_BUILD_PARAM,
+};
 
 const fv_technique_class fv_technique_ir = {
     .name = "ir",
     .summary = "instant radiosity (Keller): VPLs from light walks, exact shadow rays to every VPL (FIR's IR baseline)",
-    .params_help = IR_COMMON_HELP,
+    .family = FV_FAMILY_VPL,
+    .baseline = "pt", /* the reference of the fir-* benchmarks (docs/instant-radiosity.md) */
+    FV_CLASS_PARAMS(k_ir_params),
+    .main = {"vpls", {FV_VPL_STEPS, "8000"}, false},
     .create = ir_create,
     .render = ir_render,
     .destroy = ir_destroy,
@@ -203,9 +210,10 @@ const fv_technique_class fv_technique_ir = {
 const fv_technique_class fv_technique_ir_low = {
     .name = "ir-low",
     .summary = "instant radiosity with a 128^2 depth cube map per VPL rebuilt every frame (FIR's IR' baseline)",
-    .params_help = IR_COMMON_HELP "cube_size=int (128): texels per cube-map face edge\n"
-                                  "cube_filter=nearest|pcf (nearest): cube-map lookup (pcf: 2x2 percentage-closer)\n"
-                                  FV_CUBE_BUILD_HELP,
+    .family = FV_FAMILY_VPL,
+    .baseline = "ir", /* FIR's IR' beside its IR: the same VPLs, visibility from 128^2 maps */
+    FV_CLASS_PARAMS(k_ir_low_params),
+    .main = {"vpls", {FV_VPL_STEPS, "8000"}, false},
     .create = ir_low_create,
     .render = ir_render,
     .destroy = ir_destroy,

@@ -45,6 +45,17 @@ bool fv_vpl_pass_indirect(const fv_vpl_gather *g, const fv_gbuffer *gb, const fv
 typedef enum fv_vpl_show { FV_VPL_SHOW_ALL = 0, FV_VPL_SHOW_DIRECT, FV_VPL_SHOW_INDIRECT } fv_vpl_show;
 extern const char *const fv_vpl_show_names[]; /* "all", "direct", "indirect", NULL */
 
+/* The parameters every method of the family reads, as entries of its parameter table
+ * (technique/class.h). */
+#define FV_VPL_AREA_SAMPLES_PARAM                                                                                      \
+    FV_PARAM_INT("area_samples", "16", 1, 4096, "light samples per pixel for area lights (point and spot lights are exact)")
+#define FV_VPL_CLAMP_PARAM                                                                                             \
+    FV_PARAM_FLOAT("clamp", "0.03", 0.0, 1.0, "geometry-term clamp, as a fraction of the scene's bounding-sphere radius (0 = off)")
+#define FV_VPL_SHOW_PARAM                                                                                              \
+    FV_PARAM_CHOICE("show", "all", fv_vpl_show_names, "the image, or one of its two terms alone (without emitted light)")
+/* The viewer's steps of `vpls` (the paper: 2000 for IR, about 1000 for FIR). */
+#define FV_VPL_STEPS "250", "500", "1000", "2000", "4000"
+
 typedef struct fv_vpl_frame {
     fv_gbuffer gb;
     fv_vec3 *direct, *indirect; /* E_direct and the VPL sum per pixel */

@@ -311,16 +311,70 @@ static fv_status create_logpolar(const fv_scene *s, fv_params *p, const fv_log *
  * gathered at the two vertices; the denoiser and the blur preserve a constant image. */
 #define FURNACE_TEST .test_params = "", .furnace_radiance = 0.875, .furnace_tolerance = 0.03
 
-#define COMMON_HELP                                                                                                      \
-    "bounces=int (1): indirect bounces per path (Sec. 3.1: one)\n"                                                       \
-    "spp=int (1): paths averaged per sample of the grid (Sec. 3.1: one)\n"                                               \
-    "denoise=bool (true): SVGF in the sample space\n"                                                                    \
-    "svgf_iterations=int (5), svgf_alpha=float (0.2), sigma_lum=float (4), sigma_normal=float (128), sigma_depth=float (1)\n" \
-    "blur_sigma=float (6.8): blur sigma in pixels at blur_ramp_deg, for 1280 pixels wide (scaled with the width)\n"     \
-    "blur_fovea_deg=float, blur_ramp_deg=float (30): the blur is 0 inside the first, rises linearly to the second\n"    \
-    "order=grid|random (grid): launch order of the samples (random: Sec. 6's incoherent launch)\n"                       \
-    "offscreen=trace|skip (skip): trace the polar grids' cells no screen pixel sees, or not (same image either way)\n"   \
-    "show=screen|space|density (screen): the image, the sample-space image, or samples per pixel\n"
+/* The parameters every kind reads (read_opts), with the kind's default for blur_fovea_deg. */
+#define COMMON_PARAMS(blur_fovea_def)                                                                                    \
+    FV_PARAM_INT("bounces", "1", 0, 64, "indirect bounces per path (Sec. 3.1: one)"),                                    \
+        FV_PARAM_INT("spp", "1", 1, 1 << 16, "paths averaged per sample of the grid (Sec. 3.1: one)"),                  \
+        FV_PARAM_BOOL("denoise", "true", "SVGF in the sample space"),                                                    \
+        FV_PARAM_INT("svgf_iterations", "5", 0, 10, "SVGF's A-Trous passes"),                                            \
+        {.key = "svgf_alpha", .type = FV_PARAM_FLOAT, .def = "0.2", .min = 0.0, .min_open = true, .max = 1.0,            \
+         .help = "SVGF's temporal blend of colour and moments"},                                                         \
+        {.key = "sigma_lum", .type = FV_PARAM_FLOAT, .def = "4", .min = 0.0, .min_open = true, .max = 1e6,               \
+         .help = "SVGF's luminance edge-stopping"},                                                                      \
+        {.key = "sigma_normal", .type = FV_PARAM_FLOAT, .def = "128", .min = 0.0, .min_open = true, .max = 1e6,          \
+         .help = "SVGF's normal edge-stopping exponent"},                                                                \
+        {.key = "sigma_depth", .type = FV_PARAM_FLOAT, .def = "1", .min = 0.0, .min_open = true, .max = 1e6,             \
+         .help = "SVGF's depth edge-stopping"},                                                                          \
+        FV_PARAM_FLOAT("blur_sigma", "6.8", 0.0, 100.0, "blur sigma in pixels at blur_ramp_deg, for 1280 pixels wide (scaled with the width)"), \
+        FV_PARAM_FLOAT("blur_fovea_deg", blur_fovea_def, 0.0, 180.0, "the blur is 0 inside this eccentricity"),          \
+        FV_PARAM_FLOAT("blur_ramp_deg", "30", 0.0, 180.0, "the blur rises linearly to blur_sigma here; greater than blur_fovea_deg"), \
+        FV_PARAM_CHOICE("order", "grid", k_orders, "launch order of the samples (random: Sec. 6's incoherent launch)"),     \
+        FV_PARAM_CHOICE("offscreen", "skip", k_offscreen, "trace the polar grids' cells no screen pixel sees, or not (same image either way)"), \
+        FV_PARAM_CHOICE("show", "screen", k_show, "the image, the sample-space image, or samples per pixel")
+
+#define REDUCTION_PARAM(h)                                                                                               \
+    {.key = "reduction", .type = FV_PARAM_FLOAT, .def = "0.61", .min = 0.0, .max = 1.0, .min_open = true, .max_open = true, .help = (h)}
+#define NO_BLUR_PARAM FV_PARAM_BOOL("blur", "false", "the foveated blur")
+
+static const fv_param_info k_vpolar_params[] = {
+    COMMON_PARAMS("5.79"),
+    REDUCTION_PARAM("share of screen pixels not sampled (the paper: 0.61, 0.71, 0.88)"),
+    FV_PARAM_FLOAT("fovea_deg", "5.79", 0.01, 90.0, "radius of the linear, clipped fovea in planar degrees"),
+    FV_PARAM_INT("fit_degree", "6", 2, 10, "degree of the polynomial inverse of Eq. 2"),
+    FV_PARAM_BOOL("blur", "true", "foveated blur (its fovea stretched with the space)"),
+    FV_PARAM_INT("periphery_passes", "3", 0, 10, "SVGF passes for the columns beyond periphery_deg (svgf_iterations or more: all)"),
+    {.key = "periphery_deg", .type = FV_PARAM_FLOAT, .def = "20", .def_note = "at most blur_ramp_deg", .min = 0.0, .max = 180.0,
+     .help = "eccentricity where periphery_passes starts, on the blur's profile"},
+};
+static const fv_param_info k_cartesian_params[] = {
+    COMMON_PARAMS("5.79"),
+    REDUCTION_PARAM("share of screen pixels not sampled"),
+    NO_BLUR_PARAM,
+};
+static const fv_param_info k_cartesian_full_params[] = {
+    COMMON_PARAMS("5.79"),
+    NO_BLUR_PARAM,
+};
+static const fv_param_info k_linear_falloff_params[] = {
+    COMMON_PARAMS("10"),
+    FV_PARAM_FLOAT("falloff_fovea_deg", "10", 0.0, 180.0, "survival 1 inside this eccentricity"),
+    FV_PARAM_FLOAT("falloff_periphery_deg", "20", 0.0, 180.0, "survival falloff_probability beyond; greater than falloff_fovea_deg"),
+    {.key = "falloff_probability", .type = FV_PARAM_FLOAT, .def = "0.2", .min = 0.0, .min_open = true, .max = 1.0,
+     .help = "survival in the periphery"},
+    FV_PARAM_BOOL("blur", "true", "foveated blur"),
+};
+static const fv_param_info k_logpolar_params[] = {
+    COMMON_PARAMS("5.79"),
+    {.key = "sigma", .type = FV_PARAM_FLOAT, .def = "1.8", .min = 1.0, .min_open = true, .max = 100.0,
+     .help = "screen / grid size ratio per axis"},
+    {.key = "alpha", .type = FV_PARAM_FLOAT, .def = "4", .min = 0.0, .min_open = true, .max = 100.0, .help = "kernel exponent"},
+    NO_BLUR_PARAM,
+};
+
+/* The viewer's steps: the paper's three reductions; the bounce count of the full-resolution
+ * launches, which have no share of pixels to step. */
+#define REDUCTION_STEPS {"reduction", {"0.61", "0.71", "0.88"}, false}
+#define BOUNCE_STEPS {"bounces", {"1", "2", "3"}, false}
 
 /* Warm-up of a block of a sequence split over MPI ranks (class.h): SVGF's history blends each
  * frame in with weight 0.2 (Schied et al. 2017, Sec. 4.1), so after 16 frames a missing past
@@ -330,52 +384,45 @@ static fv_status create_logpolar(const fv_scene *s, fv_params *p, const fv_log *
  * state's (vpolar, cornell at 128x128, tests/cli/test_still_warmup.sh). */
 #define SVGF_WARMUP 16
 
+/* Baselines: cartesian-full, one sample per pixel at full resolution, is what the paper's sample
+ * distributions are measured against (its cost reference, Fig. 12; the vp-* benchmarks); it is
+ * itself measured against the converged path tracer. */
 const fv_technique_class fv_technique_vpolar = {
-    "vpolar",
-    "foveated path tracing in Visual-Polar space: 1 spp on the VP grid, SVGF in VP space, φ-mipmapped mapping, foveated blur",
-    COMMON_HELP "reduction=float (0.61): share of screen pixels not sampled, in (0,1) (the paper: 0.61, 0.71, 0.88)\n"
-                "fovea_deg=float (5.79): radius of the linear, clipped fovea in planar degrees\n"
-                "fit_degree=int (6): degree of the polynomial inverse of Eq. 2\n"
-                "blur=bool (true): foveated blur (blur_fovea_deg default 5.79, stretched with the space)\n"
-                "periphery_passes=int (3): SVGF passes for the columns beyond periphery_deg (svgf_iterations or more: all)\n"
-                "periphery_deg=float (20, at most blur_ramp_deg): eccentricity where periphery_passes starts, on the blur's profile\n",
-    create_vpolar, vp_render, vp_destroy,
+    .name = "vpolar",
+    .summary = "foveated path tracing in Visual-Polar space: 1 spp on the VP grid, SVGF in VP space, φ-mipmapped mapping, foveated blur",
+    .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_vpolar_params), .main = REDUCTION_STEPS,
+    .create = create_vpolar, .render = vp_render, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
 
 const fv_technique_class fv_technique_cartesian = {
-    "cartesian",
-    "uniform screen grid with vpolar's sample count, SVGF, bilinear upscaling (Visual-Polar Sec. 4.3 baseline)",
-    COMMON_HELP "reduction=float (0.61): share of screen pixels not sampled, in (0,1)\n"
-                "blur=bool (false)\n",
-    create_cartesian, vp_render, vp_destroy,
+    .name = "cartesian",
+    .summary = "uniform screen grid with vpolar's sample count, SVGF, bilinear upscaling (Visual-Polar Sec. 4.3 baseline)",
+    .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_cartesian_params), .main = REDUCTION_STEPS,
+    .create = create_cartesian, .render = vp_render, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp",
 };
 
 const fv_technique_class fv_technique_cartesian_full = {
-    "cartesian-full",
-    "1 spp at full resolution with SVGF: the cost reference of Visual-Polar Fig. 12",
-    COMMON_HELP "blur=bool (false)\n",
-    create_cartesian_full, vp_render, vp_destroy,
+    .name = "cartesian-full",
+    .summary = "1 spp at full resolution with SVGF: the cost reference of Visual-Polar Fig. 12",
+    .family = FV_FAMILY_VPOLAR, .baseline = "pt", FV_CLASS_PARAMS(k_cartesian_full_params), .main = BOUNCE_STEPS,
+    .create = create_cartesian_full, .render = vp_render, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp",
 };
 
 const fv_technique_class fv_technique_linear_falloff = {
-    "linear-falloff",
-    "full-resolution launch, paths killed at random outside the fovea (Weier et al. 2016), SVGF, blur",
-    COMMON_HELP "falloff_fovea_deg=float (10), falloff_periphery_deg=float (20): survival 1 inside, falloff_probability beyond\n"
-                "falloff_probability=float (0.2)\n"
-                "blur=bool (true): foveated blur (blur_fovea_deg default 10)\n",
-    create_linear_falloff, vp_render, vp_destroy,
+    .name = "linear-falloff",
+    .summary = "full-resolution launch, paths killed at random outside the fovea (Weier et al. 2016), SVGF, blur",
+    .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_linear_falloff_params), .main = BOUNCE_STEPS,
+    .create = create_linear_falloff, .render = vp_render, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
 
 const fv_technique_class fv_technique_logpolar = {
-    "log-polar",
-    "kernel log-polar space (Meng et al. 2018), SVGF in log-polar space, φ-mipmapped mapping",
-    COMMON_HELP "sigma=float (1.8): screen / grid size ratio per axis, > 1\n"
-                "alpha=float (4): kernel exponent\n"
-                "blur=bool (false)\n",
-    create_logpolar, vp_render, vp_destroy,
+    .name = "log-polar",
+    .summary = "kernel log-polar space (Meng et al. 2018), SVGF in log-polar space, φ-mipmapped mapping",
+    .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_logpolar_params), .main = BOUNCE_STEPS,
+    .create = create_logpolar, .render = vp_render, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
