@@ -1,6 +1,8 @@
 """Rendering through the package: what comes back (shape, type, finite, lit), and that it is the
 image `fovea render` writes for the same settings, bit for bit (both go through the sequence
 driver; PFM keeps the floats exactly)."""
+import os
+
 import numpy as np
 import pytest
 
@@ -102,3 +104,16 @@ def test_set_gaze_and_scene_queries(cornell):
     assert cornell.camera(SIZE) == {"pos": (278, 273, -800), "look": (278, 273, 0), "up": (0, 1, 0), "fov_y": 37.5}
     lo, hi = cornell.bounds
     assert all(lo[i] < hi[i] for i in range(3))
+
+
+def test_scene_files_as_the_tool_loads_them(cli, tmp_path):
+    src = os.path.normpath(os.path.join(os.path.dirname(__file__), "..", ".."))
+    mesh = os.path.join(src, "tests", "data", "box_closed.obj")  # no light: the default one, with a warning
+    with pytest.warns(fovea.FoveaWarning, match="no lights"):
+        scene = fovea.Scene(mesh)
+    with scene:
+        img = scene.render("pt", size=SIZE, spp=2)
+    assert img.rgb.mean() > 0.01
+    assert np.array_equal(img.rgb, cli_pfm(cli, tmp_path, "mesh", mesh, "--method", "pt", "--spp", 2))
+    with fovea.Scene(os.path.join(src, "scenes", "cornell-obj.json")) as scene:  # a JSON scene naming an OBJ file
+        assert scene.triangle_count > 1000 and scene.light_count >= 1
