@@ -40,6 +40,11 @@ typedef struct fv_bench_options {
     /* The command that ran this, recorded in the reports as it is (e.g. "fovea bench pt-cornell
      * --quick"); may be NULL. */
     const char *command;
+    /* Called once when the run has written its reports, with the JSON report's text (what
+     * <out_dir>/<name>.json holds), so a caller that wants the figures (the Python package) need
+     * not work out the report's name and read it back; may be NULL. Gets status_user. Not called
+     * when the run fails. */
+    void (*report)(void *user, const char *json);
 } fv_bench_options;
 
 /* Runs the scenario file at `path`. Bad scenario -> FV_ERR_INVALID naming file and field. Writes

@@ -172,7 +172,8 @@ static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *
     return o;
 }
 
-static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
+/* *json: a copy of the text written (NULL when out of memory), for fv_bench_options.report. */
+static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result *res, int n, char **json, fv_error *err)
 {
     const fv_scenario *sc = info->sc;
     cJSON *root = cJSON_CreateObject();
@@ -269,7 +270,8 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     char path[4096 + 128];
     snprintf(path, sizeof path, "%s/%s.json", info->out_dir, sc->name);
     fv_status st = fv_file_write_atomic(path, textj, strlen(textj), err);
-    free(textj);
+    if (st == FV_OK && info->opt->report) *json = textj;
+    else free(textj);
     return st;
 }
 
@@ -465,12 +467,14 @@ static fv_status write_sweep(const fv_bench_run_info *info, const fv_bench_resul
 
 fv_status fv_bench_write_reports(const fv_bench_run_info *info, const fv_bench_result *res, int n, fv_error *err)
 {
-    char *table = NULL;
-    fv_status st = write_json(info, res, n, err);
+    char *table = NULL, *json = NULL;
+    fv_status st = write_json(info, res, n, &json, err);
     if (st == FV_OK) st = write_markdown(info, res, n, &table, err);
     for (int k = 0; k < info->sc->nsweeps && st == FV_OK; k++) st = write_sweep(info, res, n, k, err);
     /* Shown only once every file is written. */
     if (st == FV_OK && table && info->opt->table) info->opt->table(info->opt->status_user, table);
+    if (st == FV_OK && json) info->opt->report(info->opt->status_user, json);
     free(table);
+    free(json);
     return st;
 }

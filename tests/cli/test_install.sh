@@ -2,7 +2,8 @@
 # (examples/) is built from a copy elsewhere against that prefix twice, with pkg-config and with
 # find_package(fovea), and each binary renders the same PNG as `fovea render`; the installed tool
 # lists and finds its scenarios from an unrelated folder, and the installed scenes resolve their
-# files. Finally the prefix is moved: pkg-config and the tool still find everything.
+# files; the installed Python package loads the prefix's library and renders the same PNG. Finally
+# the prefix is moved: pkg-config, the tool and the Python package still find everything.
 # Run as `bash test_install.sh FOVEA SRCDIR BUILDDIR`; no network, no root.
 . "$(dirname "$0")/lib.sh"
 BUILD=${3:-$(dirname "$FOVEA")}
@@ -88,6 +89,26 @@ check_tool() { # $1 = prefix
 }
 check_tool "$P"
 
+# The Python package (docs/python.md), with the python3 the build found with numpy (FV_PYTHON,
+# set by tests/CMakeLists.txt; empty, e.g. in a sanitized build: skipped): from an unrelated folder,
+# without FOVEA_LIB, it loads the prefix's own library, finds the prefix's scenarios and renders
+# the example's image, byte for byte.
+check_python() { # $1 = prefix
+  [ -n "${FV_PYTHON:-}" ] || return 0
+  local paths
+  paths=$(find "$1" -name _paths.py -path '*/fovea/_paths.py' | head -n 1)
+  [ -n "$paths" ] || { fail "the Python package (fovea/_paths.py) is not installed under $1"; return; }
+  (cd "$TMP/elsewhere" && env -u FOVEA_LIB PYTHONPATH="$(dirname "$(dirname "$paths")")" "$FV_PYTHON" -B -c '
+import os, sys, fovea
+prefix = os.path.realpath(sys.argv[1])
+assert os.path.realpath(fovea.library_path()).startswith(prefix + "/"), fovea.library_path()
+assert os.path.realpath(fovea.find_scenario("pt-cornell")) == prefix + "/share/fovea/bench/pt-cornell.json", fovea.find_scenario("pt-cornell")
+fovea.render("cornell", "pt", spp=4, size=(64, 64), seed=1, gaze=(0.5, 0.5)).write(sys.argv[2], metadata=False)
+' "$1" "$TMP/py.png") >"$TMP/py.log" 2>&1 || { fail "installed Python package under $1: $(tail -n 3 "$TMP/py.log")"; return; }
+  cmp -s "$TMP/py.png" "$TMP/ref.png" || fail "the installed Python package renders another image than fovea render"
+}
+check_python "$P"
+
 # Scenarios name scene files relative to themselves ("../scenes/showroom.json"): each must exist in
 # the installed layout and load, with the files it names in turn (meshes, gaze trace).
 for j in "$P"/share/fovea/bench/*.json; do
@@ -111,5 +132,6 @@ mv "$P" "$TMP/moved"
 [ "$(realpath "$(PKG_CONFIG_PATH="$TMP/moved/${LIB#"$P"/}/pkgconfig" pkg-config --variable=includedir fovea)")" = "$(realpath "$TMP/moved/include")" ] ||
   fail "fovea.pc does not follow a moved prefix"
 check_tool "$TMP/moved"
+check_python "$TMP/moved"
 
 finish
