@@ -27,4 +27,15 @@
 #include "fovea/limits.h"
 #include "fovea/provenance.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+/* sizeof the public struct called type_name ("fv_drive_opts", ...), 0 for a name it does not know:
+ * a binding that mirrors the structs (the Python package) checks its layouts against the library
+ * it loaded before passing any of them. */
+FV_API size_t fv_abi_sizeof(const char *type_name);
+#ifdef __cplusplus
+}
+#endif
+
 #endif

@@ -16,13 +16,13 @@ from ._capi import library_version as _library_version
 from ._bench import bench, find_scenario
 from ._errors import FoveaError, FoveaWarning, Status
 from ._images import Image, read_image, read_metadata, write_image
-from ._registry import Method, Param, method, methods, parse_params_help, scenes
+from ._registry import Method, Param, families, method, methods, scenes
 from ._metrics import compare
 from ._render import Renderer
 from ._scene import Scene
 
 __all__ = ["FoveaError", "FoveaWarning", "Image", "Method", "Param", "Renderer", "Scene", "Status", "bench", "compare",
-           "find_scenario", "library_path", "library_version", "method", "methods", "parse_params_help", "read_image",
+           "find_scenario", "library_path", "library_version", "method", "methods", "families", "read_image",
            "read_metadata", "render", "scenes", "write_image"]
 
 

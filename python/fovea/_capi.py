@@ -102,7 +102,7 @@ class DriveOpts(Structure):
                 ("threads", c_int), ("eye_separation", c_float), ("camera_path", POINTER(CameraPath)),
                 ("camera_set", c_uint), ("pos", Vec3), ("look", Vec3), ("up", Vec3), ("fov_y", c_float),
                 ("fixed_gaze", c_bool), ("gaze", Gaze), ("gaze_path", c_void_p), ("gaze_missing", c_int),
-                ("eye_model", POINTER(EyeModel))]
+                ("eye_model", POINTER(EyeModel)), ("warmup", c_int)]
 
 
 class FrameViews(Structure):
@@ -169,13 +169,15 @@ def _proto(name, restype, *argtypes):
 
 for _name, _res, _args in [
     ("fv_status_name", c_char_p, [c_int]),
+    ("fv_abi_sizeof", ctypes.c_size_t, [c_char_p]),
     ("fv_build_info_get", None, [POINTER(BuildInfo)]),
     ("fv_threads_used", c_int, [c_int]),
     # technique.h, device.h
     ("fv_technique_count", c_int, []),
     ("fv_technique_name", c_char_p, [c_int]),
     ("fv_technique_summary", c_char_p, [c_int]),
-    ("fv_technique_params_help", c_char_p, [c_int]),
+    ("fv_methods_json", c_void_p, [c_char_p, _E]),
+    ("fv_methods_json_free", None, [c_void_p]),
     ("fv_technique_index", c_int, [c_char_p]),
     ("fv_technique_spp_param", c_char_p, [c_int]),
     ("fv_technique_foveated", c_bool, [c_int]),
@@ -231,6 +233,7 @@ for _name, _res, _args in [
     ("fv_driver_eye_count", c_int, [_P]),
     ("fv_driver_eye_model", POINTER(EyeModel), [_P]),
     ("fv_driver_set_gaze", None, [_P, Gaze]),
+    ("fv_driver_warm_up", c_int, [_P, _P, POINTER(c_void_p), POINTER(Stats), PROGRESS_FN, c_void_p, _E]),
     ("fv_driver_render", c_int, [_P, _P, c_int, c_bool, POINTER(c_void_p), POINTER(Stats), PROGRESS_FN, c_void_p, _E]),
     # film.h
     ("fv_film_check_size", c_int, [c_int, c_int, _E]),
@@ -276,6 +279,29 @@ def _check_version():
 
 _check_version()
 
+# The structs this module mirrors, by their C names: each must have the library's size, else a
+# call would read or write past the end of one (fv_abi_sizeof, include/fovea/fovea.h).
+_MIRRORED = {"fv_error": Error, "fv_log": Log, "fv_vec3": Vec3, "fv_camera": Camera, "fv_camera_key": CameraKey,
+             "fv_camera_path": CameraPath, "fv_gaze": Gaze, "fv_gaze_key": GazeKey, "fv_eye_model": EyeModel,
+             "fv_light_desc": LightDesc, "fv_env_desc": EnvDesc, "fv_stat_entry": StatEntry, "fv_stats": Stats,
+             "fv_drive_opts": DriveOpts, "fv_frame_views": FrameViews, "fv_image": Image, "fv_metric_opts": MetricOpts,
+             "fv_metric_values": MetricValues, "fv_metric_report": MetricReport, "fv_bench_options": BenchOptions,
+             "fv_build_info": BuildInfo}
+
+
+def _check_layouts():
+    bad = []
+    for name, cls in _MIRRORED.items():
+        have = lib.fv_abi_sizeof(name.encode())
+        if have != ctypes.sizeof(cls):
+            bad.append(f"{name} ({ctypes.sizeof(cls)} bytes here, {have} in the library)")
+    if bad:
+        raise ImportError(f"fovea: {library_path} lays out its structs differently from this package: {', '.join(bad)} "
+                          "(set FOVEA_LIB to the build this package came with)")
+
+
+_check_layouts()
+
 
 def call(fn, *args):
     """Calls fn(*args, &err) and raises FoveaError with fovea's message when it fails."""
@@ -283,6 +309,19 @@ def call(fn, *args):
     status = fn(*args, ctypes.byref(err))
     if status != Status.OK:
         raise FoveaError(err.msg.decode("utf-8", "replace") or lib.fv_status_name(status).decode(), status)
+
+
+def methods_json(name=None):
+    """fv_methods_json: the registry as a JSON text (one method's when name is given); FoveaError
+    naming the known methods for an unknown name."""
+    err = Error()
+    p = lib.fv_methods_json(name.encode() if name is not None else None, ctypes.byref(err))
+    if not p:
+        raise FoveaError(err.msg.decode("utf-8", "replace") or "out of memory", Status.INVALID if err.msg else Status.NOMEM)
+    try:
+        return ctypes.string_at(p).decode("utf-8")
+    finally:
+        lib.fv_methods_json_free(p)
 
 
 def text(p):

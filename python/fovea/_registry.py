@@ -1,43 +1,62 @@
 """fovea — the rendering methods of the registry and their parameters (include/fovea/technique.h).
 
-What a method takes is read from its parameter help, lines "key=type (default): meaning", by
-:func:`parse_params_help` alone: the one place to switch when the library describes its
-parameters in structured form (a JSON list of methods), so nothing else here depends on the help
-text's layout.
+Everything here is read from the library's own description of its methods, `fv_methods_json`
+(what `fovea methods --json` prints): one place per method, typed parameters with their defaults
+and ranges, the family, the baseline its paper measures it against, its warm-up frames.
 """
 import dataclasses
-import re
+import json
 
 from . import _capi
 from ._errors import FoveaError
 
-DEVICES = (("portable", 1), ("cuda", 2))  # fv_device values besides the CPU, which every method has
-
 
 @dataclasses.dataclass(frozen=True)
 class Param:
-    """One parameter: ``key``, ``type`` as the help gives it ("int", "float", "bool", or the choices
-    "grid|random"), ``choices`` (a tuple, for a choice), ``default`` as text ("16", "Eq. 8",
-    None when the help gives none) and ``help`` (the meaning; shared by keys listed together)."""
+    """One parameter: ``key``; ``type`` "int", "float", "bool", "choice" or "string"; ``default``
+    as a Python value (None when the method derives it: ``default_note`` says how); ``min`` and
+    ``max`` (None when unbounded), ``min_open``/``max_open`` when an end is excluded; ``choices`` (a
+    tuple of the accepted values, else None); ``help``, what it means."""
 
     key: str
     type: str
-    default: str = None
-    help: str = ""
+    default: object = None
+    default_note: str = None
+    min: float = None
+    max: float = None
+    min_open: bool = False
+    max_open: bool = False
     choices: tuple = None
+    help: str = ""
+
+    def accepts(self, value):
+        """Whether value lies within the declared range or choices (other parameters may narrow
+        it further; the library has the last word)."""
+        if self.choices is not None:
+            return value in self.choices or str(value) in [str(c) for c in self.choices]
+        if self.type in ("int", "float"):
+            v = float(value)
+            lo_ok = self.min is None or (v > self.min if self.min_open else v >= self.min)
+            hi_ok = self.max is None or (v < self.max if self.max_open else v <= self.max)
+            return lo_ok and hi_ok
+        return True
 
 
 @dataclasses.dataclass(frozen=True)
 class Method:
-    """A method of the registry, as `fovea methods` lists it."""
+    """A method of the registry, as `fovea methods NAME` describes it."""
 
     name: str
     summary: str
-    foveated: bool     # its image depends on the gaze
-    spp_param: str     # the key spp= sets (None: the method has no samples-per-pixel notion)
-    devices: tuple     # ("cpu", ...) where it runs
-    params: tuple      # of Param
-    params_help: str   # the registry's help text, as it is
+    family: str              # "path tracing", "photon mapping", ...
+    foveated: bool           # its image depends on the gaze
+    baseline: str            # the method its paper measures it against (None: the reference, pt)
+    spp_param: str           # the key spp= sets (None: the method has no samples-per-pixel notion)
+    devices: tuple           # ("cpu", ...) where it runs
+    warmup_frames: int       # an MPI block of a sequence starts with these (docs/distributed.md)
+    still_warmup_frames: int # frames rendered before a converged still (render(warmup=None))
+    main_parameter: dict     # {"key", "steps", "default_step", "progressive"} or None
+    params: tuple            # of Param
 
     def param(self, key):
         for p in self.params:
@@ -46,69 +65,37 @@ class Method:
         raise FoveaError(f"method {self.name} has no parameter '{key}' (it has: {', '.join(p.key for p in self.params)})")
 
 
-def _split_top(s, sep):
-    """s split at sep where it is outside parentheses."""
-    out, depth, start, i = [], 0, 0, 0
-    while i < len(s):
-        c = s[i]
-        if c == "(":
-            depth += 1
-        elif c == ")":
-            depth = max(0, depth - 1)
-        elif depth == 0 and s.startswith(sep, i):
-            out.append(s[start:i])
-            start = i + len(sep)
-            i = start
-            continue
-        i += 1
-    out.append(s[start:])
-    return out
+def _param(d):
+    ch = d.get("choices")
+    return Param(key=d["key"], type=d["type"], default=d.get("default"), default_note=d.get("default_note"), min=d.get("min"),
+                 max=d.get("max"), min_open=bool(d.get("min_open")), max_open=bool(d.get("max_open")),
+                 choices=tuple(ch) if ch is not None else None, help=d.get("help") or "")
 
 
-_ENTRY = re.compile(r"^\s*([a-z0-9_-]+)=([^\s(]+)\s*(?:\((.*)\))?\s*$")
-
-
-def parse_params_help(text):
-    """Params from help lines "key=type (default): meaning"; several keys may share a line
-    ("a=int (1), b=float (0.2): ..."). A line that does not read so is skipped, not guessed."""
-    params = []
-    for line in (text or "").splitlines():
-        parts = _split_top(line, ": ")
-        head, meaning = parts[0], ": ".join(parts[1:]).strip()
-        for entry in _split_top(head, ", "):
-            m = _ENTRY.match(entry)
-            if not m:
-                continue
-            key, typ, default = m.group(1), m.group(2), m.group(3)
-            choices = tuple(typ.split("|")) if "|" in typ else None
-            params.append(Param(key, typ, default, meaning, choices))
-    return tuple(params)
-
-
-def _method(i):
-    lib = _capi.lib
-    devices = ("cpu",) + tuple(name for name, bit in DEVICES if lib.fv_technique_has_device(i, bit))
-    help_text = _capi.text(lib.fv_technique_params_help(i))
-    spp = lib.fv_technique_spp_param(i)
-    return Method(name=_capi.text(lib.fv_technique_name(i)), summary=_capi.text(lib.fv_technique_summary(i)),
-                  foveated=bool(lib.fv_technique_foveated(i)), spp_param=_capi.text(spp) if spp else None,
-                  devices=devices, params=parse_params_help(help_text), params_help=help_text)
+def _method(d):
+    return Method(name=d["name"], summary=d["summary"], family=d["family"], foveated=bool(d["foveated"]), baseline=d.get("baseline"),
+                  spp_param=d.get("spp_param"), devices=tuple(d["devices"]), warmup_frames=int(d["warmup_frames"]),
+                  still_warmup_frames=int(d["still_warmup_frames"]), main_parameter=d.get("main_parameter"),
+                  params=tuple(_param(p) for p in d["parameters"]))
 
 
 def methods():
-    """Every method of the registry, in its order (that of `fovea methods`)."""
-    return [_method(i) for i in range(_capi.lib.fv_technique_count())]
+    """Every method of the registry, in its order (that of `fovea methods --json`)."""
+    return [_method(d) for d in json.loads(_capi.methods_json())["methods"]]
+
+
+def families():
+    """{family: [method names]}, in the registry's order."""
+    return {f["name"]: list(f["methods"]) for f in json.loads(_capi.methods_json())["families"]}
 
 
 def method(name):
-    """The method called name; FoveaError for an unknown name."""
+    """The method called name; FoveaError naming the known ones for an unknown name."""
     if not isinstance(name, str):
         raise TypeError(f"method: expected a str, not {type(name).__name__}")
-    i = _capi.lib.fv_technique_index(name.encode()) if "\0" not in name else -1
-    if i < 0:
-        known = ", ".join(_capi.text(_capi.lib.fv_technique_name(k)) for k in range(_capi.lib.fv_technique_count()))
-        raise FoveaError(f"unknown method '{name}' (known: {known})")
-    return _method(i)
+    if "\0" in name:
+        raise FoveaError(f"unknown method {name!r}")
+    return _method(json.loads(_capi.methods_json(name))["methods"][0])
 
 
 def scenes():

@@ -29,12 +29,14 @@ class Renderer:
       camera_trace=path [--camera-trace], camera_pos, camera_look, camera_up=(x, y, z), fov
       [--camera-pos, ...], time [--time], fps [--fps], seed [--seed], threads [--threads],
       stereo=separation [--stereo], aux=True or names ("depth", "normal", "albedo", "id",
-      "position"): the auxiliary buffers to return (what an EXR of `fovea render` holds).
+      "position"): the auxiliary buffers to return (what an EXR of `fovea render` holds),
+      warmup=N [--warmup]: frames rendered at frame 0's view before frame 0 when a sequence starts
+      there (None: the method's ``still_warmup_frames``, so a temporal method's still is converged).
     """
 
     def __init__(self, scene, method="pt", *, size=(512, 512), spp=None, params=None, device=None, gaze=None,
                  gaze_trace=None, gaze_missing=None, camera_trace=None, camera_pos=None, camera_look=None,
-                 camera_up=None, fov=None, time=0.0, fps=30.0, seed=1, threads=0, stereo=0.0, aux=False):
+                 camera_up=None, fov=None, time=0.0, fps=30.0, seed=1, threads=0, stereo=0.0, aux=False, warmup=None):
         self._tech = self._driver = self._gaze_path = None
         self._films = []
         self._cam_keys = None
@@ -59,6 +61,10 @@ class Renderer:
         opts.seed = _convert.integer(seed, "seed", 0, (1 << 64) - 1)
         opts.threads = _convert.integer(threads, "threads", 0, 256)
         opts.eye_separation = _convert.number(stereo, "stereo")
+        if warmup is None:
+            info = _registry.method(method) if isinstance(method, str) else None
+            warmup = info.still_warmup_frames if info else 0
+        opts.warmup = _convert.integer(warmup, "warmup", 0, 1000)
         if gaze is not None and gaze_trace is not None:
             raise FoveaError("gaze and gaze_trace exclude each other")
         if gaze is not None:
@@ -196,6 +202,11 @@ class Renderer:
         cb, raised = _progress(progress)
         t0 = _time.perf_counter()
         try:
+            if frame == 0 and not continues and self._opts.warmup > 0:
+                # the method's warm-up frames first, as `fovea render` renders them (unwritten)
+                _capi.call(lib.fv_driver_warm_up, self._driver, self._tech, films, ctypes.byref(_capi.Stats()), cb, None)
+                continues = True
+                t0 = _time.perf_counter()
             _capi.call(lib.fv_driver_render, self._driver, self._tech, frame, continues, films, ctypes.byref(stats), cb, None)
         except FoveaError:
             self._last = None  # the method's state is now mid-frame: the next render starts afresh
@@ -242,6 +253,7 @@ class Renderer:
             "camera": json.dumps(_compact(camera_dict(views.camera[e])), separators=(",", ":")),
             "gaze": f"{views.gaze[e].x:.7g},{views.gaze[e].y:.7g}", "gaze_known": "true" if views.gaze_known else "false",
             "eye": eye, "frame": str(frame), "frame_time": f"{views.time:.9g}", "seed": str(self._seed),
+            "warmup_frames": str(self._opts.warmup),
             "size": f"{w}x{h}", "threads": str(lib.fv_threads_used(self._threads)), "render_ms": f"{ms:.3f}",
             "version": _capi.text(b.version), "commit": _capi.text(b.commit) + ("-dirty" if b.dirty > 0 else ""),
             "date": _time.strftime("%Y-%m-%dT%H:%M:%SZ", _time.gmtime()),

@@ -1,62 +1,49 @@
-"""The registry as Python sees it: the same methods, summaries, parameters and devices as
-`fovea methods` lists, and the help-line parser on hand-written lines."""
+"""The registry as Python sees it: the same methods, families, baselines, typed parameters and
+devices as `fovea methods --json` lists (both read fv_methods_json), and hand-checked facts."""
+import json
+
 import pytest
 
 import fovea
 
 
 def test_methods_match_the_tool(cli):
-    text = cli("methods").stdout
-    blocks, cur = [], None
-    for line in text.splitlines():
-        if not line.startswith(" "):
-            name, summary = line.split(None, 1)
-            cur = {"name": name, "summary": summary.strip(), "params": [], "devices": None}
-            blocks.append(cur)
-        elif line.strip().startswith("--param "):
-            cur["params"].append(line.strip()[len("--param "):])
-        elif line.strip().startswith("devices: "):
-            cur["devices"] = tuple(d.strip() for d in line.strip()[len("devices: "):].split("(")[0].split(","))
+    doc = json.loads(cli("methods", "--json").stdout)
     ms = fovea.methods()
-    assert [m.name for m in ms] == [b["name"] for b in blocks]
-    for m, b in zip(ms, blocks):
-        assert m.summary == b["summary"]
-        assert m.params_help.splitlines() == b["params"]
-        assert m.devices == (b["devices"] or ("cpu",))
-        # every key the tool lists is a Param, in order
-        keys = [p.key for p in m.params]
-        for line in b["params"]:
-            assert line.split("=", 1)[0] in keys, (m.name, line)
+    assert [m.name for m in ms] == [d["name"] for d in doc["methods"]]
+    for m, d in zip(ms, doc["methods"]):
+        assert (m.summary, m.family, m.foveated, m.baseline) == (d["summary"], d["family"], d["foveated"], d["baseline"])
+        assert m.devices == tuple(d["devices"])
+        assert (m.warmup_frames, m.still_warmup_frames) == (d["warmup_frames"], d["still_warmup_frames"])
+        assert [p.key for p in m.params] == [p["key"] for p in d["parameters"]]
+        # the plain listing names the same methods, each at the start of a line
+        assert any(line.split()[:1] == [m.name] for line in cli("methods").stdout.splitlines())
+    assert fovea.families() == {f["name"]: f["methods"] for f in doc["families"]}
 
 
 def test_method_facts():
     pt = fovea.method("pt")
-    assert pt.spp_param == "spp" and not pt.foveated
+    assert pt.spp_param == "spp" and not pt.foveated and pt.baseline is None
     spp = pt.param("spp")
-    assert (spp.type, spp.default, spp.help) == ("int", "16", "samples per pixel")
+    assert (spp.type, spp.default) == ("int", 16) and "samples per pixel" in spp.help
+    assert spp.accepts(16) and not spp.accepts(0)
     fpm = fovea.method("fpm")
-    assert fpm.foveated
+    assert fpm.foveated and fpm.baseline == "pm" and fpm.family == "photon mapping"
     assert fpm.param("eta_region").choices == ("fovea", "focus")
+    assert fpm.param("eta_region").accepts("focus") and not fpm.param("eta_region").accepts("nope")
+    assert fpm.still_warmup_frames == 0 and fovea.method("vpolar").still_warmup_frames == 16
     with pytest.raises(fovea.FoveaError, match="has no parameter 'nope'"):
         fpm.param("nope")
     assert "cornell" in fovea.scenes() and "furnace" in fovea.scenes()
-
-
-def test_parse_params_help_by_hand():
-    ps = fovea.parse_params_help(
-        "spp=int (16): samples per pixel\n"
-        "a=int (5), b=float (0.2), c=float: shared meaning: with a colon\n"
-        "order=grid|random (grid): launch order\n"
-        "radius=float (Eq. 8, scaled): gather radius\n"
-        "not a parameter line\n")
-    got = [(p.key, p.type, p.default, p.help, p.choices) for p in ps]
-    assert got == [("spp", "int", "16", "samples per pixel", None),
-                   ("a", "int", "5", "shared meaning: with a colon", None),
-                   ("b", "float", "0.2", "shared meaning: with a colon", None),
-                   ("c", "float", None, "shared meaning: with a colon", None),
-                   ("order", "grid|random", "grid", "launch order", ("grid", "random")),
-                   ("radius", "float", "Eq. 8, scaled", "gather radius", None)]
-    assert fovea.parse_params_help("") == ()
+    # every baseline is a registered method and following them ends at pt
+    names = {m.name: m for m in fovea.methods()}
+    for m in names.values():
+        seen, cur = set(), m
+        while cur.baseline is not None:
+            assert cur.baseline in names and cur.name not in seen
+            seen.add(cur.name)
+            cur = names[cur.baseline]
+        assert cur.name == "pt"
 
 
 def test_unknown_method():
