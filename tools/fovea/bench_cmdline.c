@@ -134,7 +134,24 @@ int fv_bench_cmdline_json(const char *cmd, const fv_bench_cmdline *c, char **jso
         cJSON_AddItemToArray(size, cJSON_CreateNumber(c->width));
         cJSON_AddItemToArray(size, cJSON_CreateNumber(c->height));
     }
-    if (c->frames > 0) cJSON_AddNumberToObject(root, "frames", c->frames);
+    if (c->frames > 0) {
+        cJSON_AddNumberToObject(root, "frames", c->frames);
+    } else {
+        /* One measured frame, converged: a temporal method's still warm-up frames (SVGF's history,
+         * fovea methods NAME) come first, timed like the others but not measured, as `fovea render`
+         * runs them before a still. */
+        int warm = 0;
+        cJSON *m;
+        cJSON_ArrayForEach(m, methods)
+        {
+            int w = fv_technique_still_warmup(fv_technique_index(cJSON_GetObjectItemCaseSensitive(m, "method")->valuestring));
+            if (w > warm) warm = w;
+        }
+        if (warm > 0) {
+            cJSON_AddNumberToObject(root, "frames", warm + 1);
+            cJSON_AddNumberToObject(root, "measure_from", warm);
+        }
+    }
     if (c->has_gaze || c->gaze_trace) {
         cJSON *g = cJSON_AddObjectToObject(root, "gaze");
         if (c->gaze_trace) {

@@ -40,7 +40,8 @@ static void usage(FILE *f)
                "                    speed-ups are relative to the first\n"
                "  --reference SPEC  the reference, METHOD[:KEY=VALUE...] [pt:spp=1024]\n"
                "  --gaze X,Y        a fixed gaze [the scene's gaze, else the centre];  --gaze-trace F: a CSV trace\n"
-               "  --frames N        frames [1];  --size WxH: image size [256x256]\n"
+               "  --frames N        frames [1; with a temporal method, its still warm-up before one measured frame]\n"
+               "  --size WxH        image size [256x256]\n"
                "  --save-scenario F write the scenario built as a JSON file (to rerun or edit)\n"
                "  --quiet           no progress lines\n");
 }
