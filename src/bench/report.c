@@ -345,7 +345,29 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
                 sci(g, r->has_temporal ? r->temporal_mse[FV_REGION_FOVEA] : NAN),
                 sci(h, r->has_temporal ? r->temporal_mse[FV_REGION_PERIPHERY] : NAN));
     }
-    if (!t.oom && t.s) *table = strdup(t.s + table_at);
+    if (!t.oom && t.s) *table = strdup(t.s + table_at);    /* Each family's own metrics beside the common ones: instant radiosity reports E (Foveated
+     * Instant Radiosity Eq. 3) per region and its temporal E' (Eq. 4), which the table above
+     * leaves out. */
+    bool ir_family = false;
+    for (int i = 0; i < n; i++) {
+        const char *fam = fv_technique_family(fv_technique_index(res[i].m->method));
+        ir_family |= fam && !strcmp(fam, "instant radiosity");
+    }
+    if (ir_family) {
+        tprintf(&t, "\nInstant radiosity's metrics (Foveated Instant Radiosity Sec. 5): E per region (Eq. 3) and E' over the sequence (Eq. 4):\n\n"
+                    "| method | E fovea | E transition | E periphery | E all | E' fovea | E' transition | E' periphery | E' all |\n"
+                    "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+        for (int i = 0; i < n; i++) {
+            const fv_bench_result *r = &res[i];
+            const fv_metric_values *v = r->error.region;
+            char ep[FV_REGION_COUNT][32];
+            for (int q = 0; q < FV_REGION_COUNT; q++) sci(ep[q], r->has_temporal ? r->temporal_e[q] : NAN);
+            tprintf(&t, "| %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", r->m->label, sci(a, v[FV_REGION_FOVEA].e), sci(b, v[FV_REGION_TRANSITION].e),
+                    sci(c, v[FV_REGION_PERIPHERY].e), sci(d, v[FV_REGION_ALL].e), ep[FV_REGION_FOVEA], ep[FV_REGION_TRANSITION],
+                    ep[FV_REGION_PERIPHERY], ep[FV_REGION_ALL]);
+        }
+    }
+
     /* Ray throughput where a method counts its rays: one camera ray per sample is primary, the
      * rest (bounces and shadow rays) secondary. */
     bool rays = false;
