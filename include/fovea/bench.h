@@ -7,6 +7,8 @@
 #ifndef FOVEA_BENCH_H
 #define FOVEA_BENCH_H
 
+#include <stdbool.h>
+#include <stddef.h>
 #include "fovea/export.h"
 #include "fovea/status.h"
 
@@ -19,6 +21,27 @@ typedef enum fv_bench_mode {
     FV_BENCH_QUICK,       /* under a minute: used by the tests */
     FV_BENCH_FULL         /* the papers' sizes */
 } fv_bench_mode;
+
+/* A run split over cooperating processes (the CLI implements it over MPI ranks, src/dist): every
+ * process runs fv_bench_run with the same scenario and options and renders its share of the rows
+ * (methods, sweep points; rank r times the rows i with i % size == r, all their repeats); rank 0
+ * renders the references and the match searches, gathers the rows and writes every file. What a
+ * report says equals a one-process run's except timings (each row records the rank that timed it).
+ * Every process calls the callbacks at the same points of a run, so that a failure anywhere ends
+ * every process at the next one. */
+typedef struct fv_bench_split {
+    int rank, size;
+    void *user; /* given to the callbacks */
+    /* Moves n bytes from rank `from`'s buf into rank `to`'s; called by those two ranks only. */
+    fv_status (*move)(void *user, int from, int to, void *buf, size_t n, fv_error *err);
+    /* Called by every rank with its own status: the job's, FV_OK when every rank succeeded (err is
+     * then left alone); otherwise a failure on every rank, err saying why where it is known. */
+    fv_status (*agree)(void *user, fv_status s, fv_error *err);
+    /* Polled while rendering: true once another rank has failed (this rank then stops at its next
+     * frame); and said by a rank that has just failed. Both may be NULL. */
+    bool (*stopped)(void *user);
+    void (*failed)(void *user);
+} fv_bench_split;
 
 typedef struct fv_bench_options {
     const char *out_dir;    /* where reports and images go (created if missing) */
@@ -45,6 +68,8 @@ typedef struct fv_bench_options {
      * not work out the report's name and read it back; may be NULL. Gets status_user. Not called
      * when the run fails. */
     void (*report)(void *user, const char *json);
+    /* NULL: one process; else the run is split over size processes (above). */
+    const fv_bench_split *split;
 } fv_bench_options;
 
 /* Runs the scenario file at `path`. Bad scenario -> FV_ERR_INVALID naming file and field. Writes

@@ -144,7 +144,7 @@ LINE_FN = CFUNCTYPE(None, c_void_p, c_char_p)
 class BenchOptions(Structure):
     _fields_ = [("out_dir", c_char_p), ("cache_dir", c_char_p), ("mode", c_int), ("threads", c_int), ("repeats", c_int),
                 ("log", POINTER(Log)), ("status", LINE_FN), ("status_user", c_void_p), ("device", c_char_p),
-                ("table", LINE_FN), ("command", c_char_p), ("report", LINE_FN)]
+                ("table", LINE_FN), ("command", c_char_p), ("report", LINE_FN), ("split", c_void_p)]
 
 # ---- provenance.h ----
 

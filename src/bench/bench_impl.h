@@ -24,6 +24,7 @@ typedef struct fv_bench_result {
     fv_stats counters;          /* mean per frame, last repeat */
     fv_metric_report error;     /* mean over frames, per region */
     fv_metric_report error_vs[FV_BENCH_MAX_EXTRA]; /* the same against each extra reference */
+    int rank;                   /* the process that timed it (fv_bench_split); 0 in one process */
     bool has_temporal;
     double temporal_mse[FV_REGION_COUNT], temporal_e[FV_REGION_COUNT];
     double image_mean[3];       /* the last frame's mean linear RGB (devices compared: gpu-pt) */

@@ -128,6 +128,8 @@ static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *
         cJSON_AddItemToObject(one, "max", num(r->stages_max.stage[i].value));
     }
     cJSON_AddItemToObject(o, "speedup", num(r->speedup));
+    /* split over processes: who timed the row, sharing the machine (or cluster) with the others */
+    if (info->opt->split) cJSON_AddNumberToObject(o, "timed_on_rank", r->rank);
     cJSON *er = cJSON_AddObjectToObject(o, "error");
     for (int g = 0; g < FV_REGION_COUNT; g++) {
         const fv_metric_values *v = &r->error.region[g];
@@ -209,6 +211,9 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     cJSON_AddNumberToObject(root, "repeats", info->opt->repeats > 0 ? info->opt->repeats : sc->repeats);
     /* The threads the renders used (0 asked for "all": this says how many that was). */
     cJSON_AddNumberToObject(root, "threads", fv_threads_used(info->threads));
+    /* Processes the rows were dealt to (fv_bench_split): each timed its rows with `threads`
+     * threads while the others ran theirs, so a row's time depends on what shared its machine. */
+    cJSON_AddNumberToObject(root, "ranks", info->opt->split ? info->opt->split->size : 1);
     cJSON_AddStringToObject(root, "mode", mode_name(info->opt->mode));
     cJSON_AddNumberToObject(root, "start_time", sc->start_time);
     cJSON_AddNumberToObject(root, "exposure", sc->exposure);
@@ -325,6 +330,10 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
         fv_bench_ref_noise_message(&info->ref_noise, sc, w, sizeof w);
         tprintf(&t, ". **Warning:** %s", w);
     }
+    if (info->opt->split)
+        tprintf(&t, ". The rows were dealt to %d processes (MPI ranks; the JSON's `timed_on_rank`), each timing its rows with %d "
+                    "thread(s) while the others ran theirs: a row's time includes that sharing",
+                info->opt->split->size, fv_threads_used(info->threads));
     int reps = info->opt->repeats > 0 ? info->opt->repeats : sc->repeats;
     tprintf(&t, ". Times are medians of %d repeat(s) (ms per frame, render call only); speed-up is relative to `%s`. "
                 "Errors are means over frames on display values (exposure %g, sRGB); MSE' is the temporal error "

@@ -125,9 +125,17 @@ typedef struct render_job {
     fv_driver *driver;
     const fv_bench_method *m;
     const fv_log *log;
+    const fv_bench_split *split; /* NULL: one process */
 } render_job;
 
 typedef fv_status (*frame_fn)(void *user, int index, fv_film *film, double ms, const fv_stats *stats, fv_error *err);
+
+static bool keep_going(void *user, double fraction)
+{
+    (void)fraction;
+    const fv_bench_split *sp = user;
+    return !sp->stopped(sp->user);
+}
 
 static fv_status render_sequence(const render_job *j, int first, int nframes, frame_fn on_frame, void *user, fv_error *err)
 {
@@ -141,7 +149,9 @@ static fv_status render_sequence(const render_job *j, int first, int nframes, fr
         fv_stats_clear(&stats);
         fv_film_clear(film);
         double t0 = fv_time_ms();
-        st = fv_driver_render(j->driver, t, i, i > first, &film, &stats, NULL, NULL, err);
+        /* split over processes: a frame stops early once another rank has failed */
+        const bool poll = j->split && j->split->stopped;
+        st = fv_driver_render(j->driver, t, i, i > first, &film, &stats, poll ? keep_going : NULL, poll ? (void *)j->split : NULL, err);
         double ms = fv_time_ms() - t0;
         if (st != FV_OK) {
             fv_error_prefix(err, "%s, frame %d: ", j->m->label, i);
@@ -211,7 +221,7 @@ static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene,
          * compared, so they need no reference. */
         say(info->opt, "%s: rendering %d frame(s) with %s (%d cached)", m->label, n - first, m->method, *cached);
         /* References are rendered on their own random stream (core/rng.h). */
-        render_job j = {sc, scene, info->ref_driver, m, info->opt->log};
+        render_job j = {sc, scene, info->ref_driver, m, info->opt->log, info->opt->split};
         ref_ctx c = {frames, (const char *const *)paths, slot, 0.0};
         st = render_sequence(&j, first, n, on_reference_frame, &c, err);
         *ms = c.ms / (n - first);
@@ -273,7 +283,7 @@ static fv_status probe_reference(fv_bench_run_info *info, fv_scene *scene, const
     fv_drive_opts o = *dopt;
     o.seed = fv_seed_reference_probe(sc->seed);
     if ((st = fv_driver_create(scene, view, &o, &driver, err)) != FV_OK) goto done;
-    render_job j = {sc, scene, driver, &probe, info->opt->log};
+    render_job j = {sc, scene, driver, &probe, info->opt->log, info->opt->split};
     probe_ctx c = {rgb, path};
     if ((st = render_sequence(&j, last, last + 1, on_probe_frame, &c, err)) != FV_OK) {
         fv_error_prefix(err, "the reference's noise probe: ");
@@ -420,7 +430,7 @@ static fv_status method_begin(const fv_bench_run_info *info, fv_scene *scene, fr
     c->last = fv_alloc_array(npix, 3 * sizeof(float));
     if (!res->ms || !mr->stage_per_rep || !c->flip_map || !c->last) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_stats_clear(&mr->stage_names);
-    mr->j = (render_job){sc, scene, info->driver, res->m, info->opt->log};
+    mr->j = (render_job){sc, scene, info->driver, res->m, info->opt->log, info->opt->split};
     return render_sequence(&mr->j, 0, 1, on_warmup_frame, NULL, err);
 }
 
@@ -455,7 +465,8 @@ static fv_status method_repeat(method_run *mr, int index, int total, int r, fv_e
 }
 
 /* Medians over the repeats, the errors' PSNR, and the images of the last frame. */
-static fv_status method_end(method_run *mr, fv_error *err)
+/* A row's figures from its repeats: medians, stage and counter means, PSNR, temporal errors. */
+static void method_figures(method_run *mr)
 {
     method_ctx *c = &mr->c;
     const fv_bench_run_info *info = c->info;
@@ -498,14 +509,21 @@ static fv_status method_end(method_run *mr, fv_error *err)
         for (size_t q = 0; q < npix; q++) sum += c->last[3 * q + k];
         res->image_mean[k] = sum / (double)npix;
     }
-    /* Images of the last frame: the frame, its FLIP heat map with the region rings and the colour
-     * bar of the scale every method shares, the fovea. */
-    char path[4096 + 128];
-    const frame_setup *lf = &c->frames[sc->frames - 1];
     const char *label = res->m->label;
     snprintf(res->img, sizeof res->img, "%s/%s.png", sc->name, label);
     snprintf(res->heat, sizeof res->heat, "%s/%s-flip.png", sc->name, label);
     snprintf(res->crop, sizeof res->crop, "%s/%s-fovea.png", sc->name, label);
+}
+
+/* A row's images of the last frame (its colours `last` and FLIP map `flip`): the frame, its FLIP
+ * heat map with the region rings and the colour bar of the scale every method shares, the fovea.
+ * Written by rank 0 only, with the rows other ranks timed received from them. */
+static fv_status write_row_images(const fv_bench_run_info *info, const frame_setup *frames, const fv_bench_result *res, const float *last,
+                                  const float *flip, fv_error *err)
+{
+    const fv_scenario *sc = info->sc;
+    char path[4096 + 128];
+    const frame_setup *lf = &frames[sc->frames - 1];
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->img);
     /* The frame says how it was made, as `fovea render`'s images do (drive/frame_meta.h). */
     fv_frame_views v;
@@ -513,14 +531,20 @@ static fv_status method_end(method_run *mr, fv_error *err)
     fv_frame_meta_run run = {res->m->method, sc->scene, res->m->params, sc->width, sc->height, info->threads, sc->seed, sc->exposure, 0};
     fv_params *meta = NULL;
     fv_status st = fv_frame_meta(&run, sc->frames - 1, &v, 0, res->ms_median, &meta, err);
-    if (st == FV_OK) st = fv_image_write_meta(path, c->last, sc->width, sc->height, sc->exposure, meta, err);
+    if (st == FV_OK) st = fv_image_write_meta(path, last, sc->width, sc->height, sc->exposure, meta, err);
     fv_params_destroy(meta);
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->heat);
     const fv_heatmap_opts ho = {FV_BENCH_HEAT_MAX, &sc->eye, lf->gaze, FV_BENCH_HEAT_LABEL};
-    if (st == FV_OK) st = fv_heatmap_write(path, c->flip_map, sc->width, sc->height, &ho, err);
+    if (st == FV_OK) st = fv_heatmap_write(path, flip, sc->width, sc->height, &ho, err);
     snprintf(path, sizeof path, "%s/%s", info->out_dir, res->crop);
-    if (st == FV_OK) st = write_crop(sc, c->last, lf->gaze, path, err);
+    if (st == FV_OK) st = write_crop(sc, last, lf->gaze, path, err);
     return st;
+}
+
+static fv_status method_end(method_run *mr, fv_error *err)
+{
+    method_figures(mr);
+    return write_row_images(mr->c.info, mr->c.frames, mr->c.res, mr->c.last, mr->c.flip_map, err);
 }
 
 /* One method on its own, every repeat in a row (the match searches). */
@@ -539,23 +563,89 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
  * machine that slows down or speeds up (other processes, a shared host) does so for all of them
  * alike, and the speed-up is the median over rounds of the baseline's time over the method's, each
  * ratio taken within one round. */
+/* The job's status when the run is split over processes (fv_bench_split), else this one's. A
+ * rank that failed says so first, so that the others stop rendering at their next frame. */
+static fv_status agree(const fv_bench_split *sp, fv_status s, fv_error *err)
+{
+    if (!sp) return s;
+    if (s != FV_OK && sp->failed) sp->failed(sp->user);
+    return sp->agree(sp->user, s, err);
+}
+
+/* Rank `rank` of a split run (fv_bench_split) times the rows i with i % size == rank. */
+static bool owns(const fv_bench_split *sp, int i) { return !sp || i % sp->size == sp->rank; }
+
+/* A row another rank timed, to rank 0: its figures (the struct, its pointers re-made there), its
+ * repeats' times, its last frame and FLIP map (which rank 0 writes as images). */
+static fv_status gather_row(const fv_bench_run_info *info, const frame_setup *frames, int i, fv_bench_result *res, method_run *mr,
+                            int reps, fv_status *written, fv_error *err)
+{
+    const fv_bench_split *sp = info->opt->split;
+    const int from = i % sp->size;
+    const size_t npix = (size_t)info->sc->width * info->sc->height;
+    if (sp->rank != 0 && sp->rank != from) return FV_OK;
+    fv_bench_result r = *res;
+    r.m = NULL;
+    r.ms = NULL;
+    float *last = sp->rank == 0 ? fv_alloc_array(npix, 3 * sizeof(float)) : mr->c.last;
+    float *flip = sp->rank == 0 ? fv_alloc_array(npix, sizeof(float)) : mr->c.flip_map;
+    double *ms = sp->rank == 0 ? fv_calloc_array((size_t)reps, sizeof(double)) : res->ms;
+    fv_status st = last && flip && ms ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (st == FV_OK) st = sp->move(sp->user, from, 0, &r, sizeof r, err);
+    if (st == FV_OK) st = sp->move(sp->user, from, 0, ms, (size_t)reps * sizeof(double), err);
+    if (st == FV_OK) st = sp->move(sp->user, from, 0, last, npix * 3 * sizeof(float), err);
+    if (st == FV_OK) st = sp->move(sp->user, from, 0, flip, npix * sizeof(float), err);
+    if (sp->rank == 0) {
+        if (st == FV_OK) {
+            r.m = res->m;
+            r.ms = ms;
+            ms = NULL;
+            free(res->ms);
+            *res = r;
+            /* a file that cannot be written fails the run, after every row has arrived: the
+             * ranks still sending must not wait for a receive that never comes */
+            if (*written == FV_OK) *written = write_row_images(info, frames, res, last, flip, err);
+        }
+        free(last);
+        free(flip);
+        free(ms);
+    }
+    return st;
+}
+
 static fv_status run_methods(const fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, fv_bench_result *res,
                              int total, fv_error *err)
 {
     const fv_scenario *sc = info->sc;
+    const fv_bench_split *sp = info->opt->split;
+    const int reps = info->opt->repeats > 0 ? info->opt->repeats : sc->repeats;
     method_run *mr = fv_calloc_array((size_t)sc->nmethods, sizeof *mr);
-    if (!mr) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    fv_status st = FV_OK;
-    int begun = 0;
-    for (; begun < sc->nmethods && st == FV_OK; begun++) {
-        res[begun].m = &sc->methods[begun];
-        st = method_begin(info, scene, frames, &res[begun], &mr[begun], err);
+    fv_status st = mr ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    for (int i = 0; i < sc->nmethods; i++) {
+        res[i].m = &sc->methods[i];
+        res[i].rank = sp ? i % sp->size : 0;
     }
-    const int reps = st == FV_OK && sc->nmethods > 0 ? mr[0].reps : 0;
+    /* Each rank its rows, their repeats interleaved as in one process; rank 0 writes the images of
+     * its own rows at once and those of the others' once they arrive. */
+    for (int i = 0; i < sc->nmethods && st == FV_OK; i++)
+        if (owns(sp, i)) st = method_begin(info, scene, frames, &res[i], &mr[i], err);
     for (int r = 0; r < reps && st == FV_OK; r++)
-        for (int i = 0; i < sc->nmethods && st == FV_OK; i++) st = method_repeat(&mr[i], i, total, r, err);
-    for (int i = 0; i < sc->nmethods && st == FV_OK; i++) st = method_end(&mr[i], err);
-    if (st == FV_OK) {
+        for (int i = 0; i < sc->nmethods && st == FV_OK; i++)
+            if (owns(sp, i)) st = method_repeat(&mr[i], i, total, r, err);
+    for (int i = 0; i < sc->nmethods && st == FV_OK; i++) {
+        if (!owns(sp, i)) continue;
+        if (sp && sp->rank != 0) method_figures(&mr[i]);
+        else st = method_end(&mr[i], err);
+    }
+    /* Every rank agrees once its rows are done, and again once rank 0 has them all; after a
+     * failed agreement no rank calls another. */
+    if (sp && (st = agree(sp, st, err)) == FV_OK) {
+        fv_status written = FV_OK;
+        for (int i = 0; i < sc->nmethods && st == FV_OK; i++)
+            if (i % sp->size != 0) st = gather_row(info, frames, i, &res[i], &mr[i], reps, &written, err);
+        st = agree(sp, st != FV_OK ? st : written, err);
+    }
+    if (st == FV_OK && (!sp || sp->rank == 0)) {
         int b = -1;
         for (int i = 0; i < sc->nmethods; i++)
             if (strcmp(sc->methods[i].label, sc->baseline) == 0) b = i;
@@ -567,7 +657,7 @@ static fv_status run_methods(const fv_bench_run_info *info, fv_scene *scene, fra
         }
         free(ratio);
     }
-    for (int i = 0; i < begun; i++) method_free(&mr[i]);
+    for (int i = 0; mr && i < sc->nmethods; i++) method_free(&mr[i]);
     free(mr);
     return st;
 }
@@ -779,6 +869,19 @@ fv_status fv_bench_check_text(const char *json, const char *label, const char *d
     return st == FV_OK ? check_loaded(sc, label, err) : st;
 }
 
+/* Rank 0's references (every measured frame, every slot) to the other ranks. */
+static fv_status share_references(const fv_bench_split *sp, const fv_scenario *sc, frame_setup *frames, fv_error *err)
+{
+    fv_status st = FV_OK;
+    const size_t bytes = (size_t)sc->width * sc->height * 3 * sizeof(float);
+    for (int to = 1; sp && to < sp->size && st == FV_OK; to++) {
+        if (sp->rank != 0 && sp->rank != to) continue;
+        for (int i = sc->measure_from; i < sc->frames && st == FV_OK; i++)
+            for (int k = 0; k <= sc->nextra && st == FV_OK; k++) st = sp->move(sp->user, 0, to, frames[i].ref[k], bytes, err);
+    }
+    return agree(sp, st, err);
+}
+
 /* Runs a loaded scenario (destroyed here); path names it in messages. */
 static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_options *opt, fv_error *err)
 {
@@ -800,14 +903,17 @@ static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_op
     if (!opt->cache_dir) snprintf(cache_dir, sizeof cache_dir, "%s/cache", info.out_dir);
     snprintf(img_dir, sizeof img_dir, "%s/%s", info.out_dir, sc->name);
 
+    const fv_bench_split *sp = opt->split;
+    const int rank = sp ? sp->rank : 0;
     say(opt, "scenario %s: scene %s, %dx%d, %d frame(s), %d method(s)", sc->name, sc->scene, sc->width, sc->height, sc->frames,
         sc->nmethods);
-    if ((st = apply_device(sc, opt->device, err)) != FV_OK) goto done;
+    if ((st = apply_device(sc, opt->device, err)) != FV_OK) goto setup_end;
     /* Everything --check checks, before anything is rendered. */
-    if ((st = validate(sc, path, opt->log, &scene, &view, err)) != FV_OK) goto done;
+    if ((st = validate(sc, path, opt->log, &scene, &view, err)) != FV_OK) goto setup_end;
     /* Folders only once the scenario, its scene and every method are known to be good: bad input
      * writes nothing. */
-    if ((st = fv_mkdirs(info.out_dir, err)) || (st = fv_mkdirs(cache_dir, err)) || (st = fv_mkdirs(img_dir, err))) goto done;
+    if (rank == 0 && ((st = fv_mkdirs(info.out_dir, err)) || (st = fv_mkdirs(cache_dir, err)) || (st = fv_mkdirs(img_dir, err))))
+        goto setup_end;
     /* The frames: the same driver policy as `fovea render`; the scenario's camera path, gaze and
      * eye model when it has them, else the scene file's. */
     fv_camera_path cpath;
@@ -815,14 +921,14 @@ static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_op
     scenario_drive_opts(sc, &cpath, &dopt);
     dopt.seed = sc->seed;
     dopt.threads = opt->threads;
-    if ((st = fv_driver_create(scene, view, &dopt, &info.driver, err)) != FV_OK) goto done;
+    if ((st = fv_driver_create(scene, view, &dopt, &info.driver, err)) != FV_OK) goto setup_end;
     dopt.seed = fv_seed_reference(sc->seed);
-    if ((st = fv_driver_create(scene, view, &dopt, &info.ref_driver, err)) != FV_OK) goto done;
+    if ((st = fv_driver_create(scene, view, &dopt, &info.ref_driver, err)) != FV_OK) goto setup_end;
     sc->eye = *fv_driver_eye_model(info.driver); /* what the reports and heat maps draw */
     size_t npix = (size_t)sc->width * sc->height;
     if (!(frames = fv_calloc_array((size_t)sc->frames, sizeof *frames))) {
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-        goto done;
+        goto setup_end;
     }
     for (int i = 0; i < sc->frames; i++) {
         frame_setup *f = &frames[i];
@@ -836,41 +942,51 @@ static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_op
         for (int k = 0; k <= sc->nextra; k++) ok = ok && (f->ref[k] = fv_alloc_array(npix, 3 * sizeof(float))) != NULL;
         if (!ok) {
             st = fv_error_set(err, FV_ERR_NOMEM, "out of memory for %d frames of %dx%d", sc->frames, sc->width, sc->height);
-            goto done;
+            goto setup_end;
         }
         fv_eye_region_labels(&sc->eye, f->gaze, f->labels);
     }
-    if ((st = load_references(&info, scene, frames, cache_dir, 0, &info.ref_cached, &info.ref_ms, err)) != FV_OK) goto done;
-    dopt.seed = sc->seed;
-    if ((st = probe_reference(&info, scene, view, &dopt, frames, cache_dir, err)) != FV_OK) goto done;
-    for (int k = 0; k < sc->nextra && st == FV_OK; k++)
-        st = load_references(&info, scene, frames, cache_dir, 1 + k, &info.extra_cached[k], &info.extra_ms[k], err);
-    if (st != FV_OK) goto done;
-    snprintf(info.ref_img, sizeof info.ref_img, "%s/reference.png", sc->name);
-    info.last_gaze = frames[sc->frames - 1].gaze;
-    {
-        char p[4096 + 160];
-        snprintf(p, sizeof p, "%s/%s", info.out_dir, info.ref_img);
-        fv_frame_views v;
-        fv_driver_views(info.ref_driver, sc->frames - 1, &v);
-        fv_frame_meta_run run = {sc->reference.method, sc->scene, sc->reference.params, sc->width, sc->height, info.threads,
-                                 fv_seed_reference(sc->seed), sc->exposure, 0};
-        fv_params *meta = NULL;
-        st = fv_frame_meta(&run, sc->frames - 1, &v, 0, info.ref_ms > 0 ? info.ref_ms : -1.0, &meta, err);
-        if (st == FV_OK) st = fv_image_write_meta(p, frames[sc->frames - 1].ref[0], sc->width, sc->height, sc->exposure, meta, err);
-        fv_params_destroy(meta);
-        if (st != FV_OK) goto done;
+setup_end:
+    /* Split over processes: every rank has checked the same scenario; a problem is said once. */
+    if ((st = agree(sp, st, err)) != FV_OK) goto done;
+    /* The references: rendered (or read from the cache) by rank 0, then handed to every rank. */
+    if (rank == 0) {
+        if ((st = load_references(&info, scene, frames, cache_dir, 0, &info.ref_cached, &info.ref_ms, err)) != FV_OK) goto refs_end;
+        dopt.seed = sc->seed;
+        if ((st = probe_reference(&info, scene, view, &dopt, frames, cache_dir, err)) != FV_OK) goto refs_end;
+        for (int k = 0; k < sc->nextra && st == FV_OK; k++)
+            st = load_references(&info, scene, frames, cache_dir, 1 + k, &info.extra_cached[k], &info.extra_ms[k], err);
+        if (st != FV_OK) goto refs_end;
+        snprintf(info.ref_img, sizeof info.ref_img, "%s/reference.png", sc->name);
+        info.last_gaze = frames[sc->frames - 1].gaze;
+        {
+            char p[4096 + 160];
+            snprintf(p, sizeof p, "%s/%s", info.out_dir, info.ref_img);
+            fv_frame_views v;
+            fv_driver_views(info.ref_driver, sc->frames - 1, &v);
+            fv_frame_meta_run run = {sc->reference.method, sc->scene, sc->reference.params, sc->width, sc->height, info.threads,
+                                     fv_seed_reference(sc->seed), sc->exposure, 0};
+            fv_params *meta = NULL;
+            st = fv_frame_meta(&run, sc->frames - 1, &v, 0, info.ref_ms > 0 ? info.ref_ms : -1.0, &meta, err);
+            if (st == FV_OK) st = fv_image_write_meta(p, frames[sc->frames - 1].ref[0], sc->width, sc->height, sc->exposure, meta, err);
+            fv_params_destroy(meta);
+            if (st != FV_OK) goto refs_end;
+        }
     }
+refs_end:
+    if ((st = agree(sp, st, err)) != FV_OK) goto done;
+    if ((st = share_references(sp, sc, frames, err)) != FV_OK) goto done;
 
     nrows = sc->nmethods + sc->nmatches;
     if (!(res = fv_calloc_array((size_t)nrows, sizeof *res)) || !(match_methods = fv_calloc_array((size_t)sc->nmatches + 1, sizeof *match_methods))) {
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-        goto done;
+        goto finish;
     }
-    st = run_methods(&info, scene, frames, res, nrows, err);
-    for (int k = 0; k < sc->nmatches && st == FV_OK; k++)
+    if ((st = run_methods(&info, scene, frames, res, nrows, err)) != FV_OK) goto done;
+    /* The match searches and the reports: rank 0's (its rows are all there now). */
+    for (int k = 0; rank == 0 && k < sc->nmatches && st == FV_OK; k++)
         st = run_match(&info, scene, frames, res, k, &match_methods[k], &res[sc->nmethods + k], err);
-    if (st != FV_OK) goto done;
+    if (rank != 0 || st != FV_OK) goto finish;
     /* The match searches ran after the rounds: their speed-up is the ratio of medians. */
     double base = 0.0;
     for (int i = 0; i < sc->nmethods; i++)
@@ -883,6 +999,8 @@ static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_op
         fv_log_warn(opt->log, "bench %s: %s", sc->name, line);
     }
     st = fv_bench_write_reports(&info, res, nrows, err);
+finish:
+    st = agree(sp, st, err);
 done:
     if (frames)
         for (int i = 0; i < sc->frames; i++) {

@@ -202,29 +202,34 @@ fv_status fv_dist_agree(fv_dist *d, fv_status s, bool *print_it, bool *name_rank
 /* MPI counts are ints: a large image goes in pieces. */
 #define PIECE ((size_t)1 << 26)
 
-fv_status fv_dist_send(fv_dist *d, int peer, const double *v, size_t n, fv_error *err)
+/* n items of `type` (size bytes each) to or from peer, in pieces below MPI's int count. */
+static fv_status transfer(fv_dist *d, bool send, int peer, void *v, size_t n, MPI_Datatype type, size_t size, fv_error *err)
 {
     double t0 = fv_time_ms();
     for (size_t i = 0; i < n; i += PIECE) {
         size_t m = n - i < PIECE ? n - i : PIECE;
-        int rc = MPI_Send(v + i, (int)m, MPI_DOUBLE, peer, TAG_DATA, MPI_COMM_WORLD);
-        if (rc != MPI_SUCCESS) return mpi_fail(rc, "send", err);
+        char *at = (char *)v + i * size;
+        int rc = send ? MPI_Send(at, (int)m, type, peer, TAG_DATA, MPI_COMM_WORLD)
+                      : MPI_Recv(at, (int)m, type, peer, TAG_DATA, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        if (rc != MPI_SUCCESS) return mpi_fail(rc, send ? "send" : "receive", err);
     }
     d->comm_s += (fv_time_ms() - t0) * 1e-3;
     return FV_OK;
 }
 
-fv_status fv_dist_recv(fv_dist *d, int peer, double *v, size_t n, fv_error *err)
+fv_status fv_dist_send(fv_dist *d, int peer, const double *v, size_t n, fv_error *err)
 {
-    double t0 = fv_time_ms();
-    for (size_t i = 0; i < n; i += PIECE) {
-        size_t m = n - i < PIECE ? n - i : PIECE;
-        int rc = MPI_Recv(v + i, (int)m, MPI_DOUBLE, peer, TAG_DATA, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-        if (rc != MPI_SUCCESS) return mpi_fail(rc, "receive", err);
-    }
-    d->comm_s += (fv_time_ms() - t0) * 1e-3;
-    return FV_OK;
+    return transfer(d, true, peer, (void *)v, n, MPI_DOUBLE, sizeof *v, err);
 }
+
+fv_status fv_dist_recv(fv_dist *d, int peer, double *v, size_t n, fv_error *err) { return transfer(d, false, peer, v, n, MPI_DOUBLE, sizeof *v, err); }
+
+fv_status fv_dist_send_bytes(fv_dist *d, int peer, const void *v, size_t n, fv_error *err)
+{
+    return transfer(d, true, peer, (void *)v, n, MPI_BYTE, 1, err);
+}
+
+fv_status fv_dist_recv_bytes(fv_dist *d, int peer, void *v, size_t n, fv_error *err) { return transfer(d, false, peer, v, n, MPI_BYTE, 1, err); }
 
 fv_status fv_dist_sum(fv_dist *d, double *v, int n, fv_error *err)
 {

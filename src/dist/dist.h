@@ -51,6 +51,9 @@ bool fv_dist_poll(fv_dist *d);
 /* Sends / receives n doubles to / from rank `peer` (in pieces below MPI's int count). */
 fv_status fv_dist_send(fv_dist *d, int peer, const double *v, size_t n, fv_error *err);
 fv_status fv_dist_recv(fv_dist *d, int peer, double *v, size_t n, fv_error *err);
+/* The same for n bytes (a bench row's result, images). */
+fv_status fv_dist_send_bytes(fv_dist *d, int peer, const void *v, size_t n, fv_error *err);
+fv_status fv_dist_recv_bytes(fv_dist *d, int peer, void *v, size_t n, fv_error *err);
 /* The sum over ranks of n doubles, the result on every rank. Used for counters only (order-free
  * values), never for pixels. */
 fv_status fv_dist_sum(fv_dist *d, double *v, int n, fv_error *err);

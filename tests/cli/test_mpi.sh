@@ -92,9 +92,38 @@ n=$(ls w_*.pfm 2>/dev/null | grep -vc w_0010)
 [ "$n" -lt 10 ] || fail "rank 0 went on to write $n frames after rank 1 failed"
 [ -e w_ranks.json ] && fail "a failed sequence wrote its manifest"
 
-# The bench is not split yet: said once, no report.
-expect 2 "not split over MPI ranks yet" -- $MPI -n 2 "$FOVEA" bench pt-spp --quick --out benchout
-[ -e benchout ] && fail "a refused bench left $(ls benchout)"
+# The bench split over ranks (rows dealt round-robin, rank 0 gathers them): one report, equal to a
+# one-process run's except the timings (and the command, date and rank fields that say so); the
+# images' pixels equal; the table printed once.
+B="bench pt-cornell --quick --threads 1"
+"$FOVEA" $B --out bone >/dev/null 2>&1 || fail "one-process bench"
+$MPI -n 2 "$FOVEA" $B --out btwo >btwo.out 2>btwo.err || fail "2-rank bench: $(cat btwo.err)"
+python3 - bone/pt-cornell.json btwo/pt-cornell.json <<'EOS' || fail "the 2-rank bench report differs from one process's beyond timings"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+timing = {"ms_per_frame", "stages_ms", "stages_ms_range", "speedup", "date", "command", "ranks", "timed_on_rank"}
+def strip(x):
+    if isinstance(x, dict):
+        return {k: strip(v) for k, v in x.items() if k not in timing}
+    return [strip(v) for v in x] if isinstance(x, list) else x
+a["reference"].pop("ms_per_frame", None), b["reference"].pop("ms_per_frame", None)
+assert b["ranks"] == 2 and sorted(r["timed_on_rank"] for r in b["results"]) == [0, 0, 1], b["results"]
+sys.exit(0 if strip(a) == strip(b) else 1)
+EOS
+for f in bone/pt-cornell/pt-spp=*[0-9].png; do
+  mse=$("$FOVEA" compare "$f" "btwo/pt-cornell/$(basename "$f")" --json | python3 -c 'import json, sys; print(json.load(sys.stdin)["regions"]["all"]["mse"])')
+  [ "$mse" = 0 ] || fail "$(basename "$f"): the 2-rank image differs (MSE $mse)"
+done
+n=$(grep -c '^| pt-spp=4 ' btwo.out)
+[ "$n" = 1 ] || fail "the 2-rank bench printed its table $n times"
+# Bad input every rank sees: one line, no folder.
+expect 2 "unknown scenario 'no-such'" -- $MPI -n 2 "$FOVEA" bench no-such --quick --out bbad
+expect 2 "spp=0: out of range" -- $MPI -n 2 "$FOVEA" bench --scene cornell --methods pt:spp=0 --out bbad
+[ -e bbad ] && fail "a refused bench left $(ls bbad)"
+# A failure on rank 0 while it writes a row rank 1 timed: one line, and no report.
+mkdir -p bfail/cornell-pt-pt-2/pt-2.png
+expect 2 "pt-2.png" -- $MPI -n 2 "$FOVEA" bench --scene cornell --methods pt:spp=1,pt:spp=2 --reference pt:spp=4 --size 16x16 --quiet --out bfail
+ls bfail/*.json >/dev/null 2>&1 && fail "a failed split bench wrote its report"
 
 # A rank killed mid-render: the job ends within seconds, nonzero, with no image and no temporary.
 cat >killme.sh <<EOS

@@ -181,6 +181,54 @@ static void on_status(void *user, const char *line)
     fprintf(stderr, "fovea bench: %s\n", line);
 }
 
+#ifdef FOVEA_HAVE_MPI
+#include "dist/dist.h"
+/* `mpirun -n N fovea bench`: the library deals the rows to the ranks (fv_bench_split); here its
+ * callbacks over src/dist, and the one line a failed job prints. */
+typedef struct bench_dist {
+    fv_dist *d;
+    bool agreed;             /* the library ran at least one agreement */
+    bool print_it, name_rank; /* from the last failed agreement: whether this rank says the job's line */
+} bench_dist;
+
+static fv_status split_move(void *user, int from, int to, void *buf, size_t n, fv_error *err)
+{
+    bench_dist *b = user;
+    return fv_dist_rank(b->d) == from ? fv_dist_send_bytes(b->d, to, buf, n, err) : fv_dist_recv_bytes(b->d, from, buf, n, err);
+}
+
+static fv_status split_agree(void *user, fv_status s, fv_error *err)
+{
+    bench_dist *b = user;
+    b->agreed = true;
+    fv_error mpi;
+    fv_error_clear(&mpi);
+    fv_status js = fv_dist_agree(b->d, s, &b->print_it, &b->name_rank, &mpi);
+    if (js != FV_OK) fv_cli_interrupt_mute(); /* the launcher may now signal this rank */
+    if (js != FV_OK && s == FV_OK) *err = mpi.msg[0] ? mpi : (fv_error_set(err, js, "another rank failed"), *err);
+    return js;
+}
+
+static bool split_stopped(void *user) { return fv_dist_poll(((bench_dist *)user)->d); }
+static void split_failed(void *user) { fv_dist_tell_failure(((bench_dist *)user)->d); }
+#else
+typedef struct bench_dist bench_dist;
+#endif
+
+/* A failed run's exit status, its line printed by the one rank whose words stand when split. */
+static int bench_fail(const bench_dist *bd, fv_status s, const char *msg)
+{
+#ifdef FOVEA_HAVE_MPI
+    if (bd && bd->agreed) {
+        if (!bd->print_it) return fv_cli_exit_code(s);
+        if (bd->name_rank) fprintf(stderr, "rank %d: ", fv_dist_rank(bd->d));
+    }
+#else
+    (void)bd;
+#endif
+    return fv_cli_fail("bench", s, msg);
+}
+
 /* --scene: the scenario built from the command line is checked first, then saved (--save-scenario:
  * nothing is written for bad input), then run as a scenario file would be. */
 /* argv as one line for the reports: "fovea bench ARG..." (arguments with spaces quoted). */
@@ -193,7 +241,7 @@ static void command_line(int argc, char **argv, char *out, size_t n)
     }
 }
 
-static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check, bool quiet, fv_bench_options *opt)
+static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check, bool quiet, fv_bench_options *opt, const bench_dist *bd)
 {
     const char *cmd = "bench";
     char *json = NULL, label[128];
@@ -201,56 +249,26 @@ static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check,
     if (rc) return rc;
     fv_log log = fv_cli_log(&quiet);
     opt->log = &log;
-    if (!quiet) opt->status = on_status;
-    opt->table = on_table;
+    const bool speaks = !opt->split || opt->split->rank == 0;
+    if (!quiet && speaks) opt->status = on_status;
+    if (speaks) opt->table = on_table;
     fv_error err;
     fv_error_clear(&err);
     /* Relative paths in the JSON are already absolute (bench_cmdline.c): "." is only a fallback. */
     fv_status s = fv_bench_check_text(json, label, ".", opt->mode, &err);
-    if (s == FV_OK && save) s = fv_file_write_atomic(save, json, strlen(json), &err);
+    if (s == FV_OK && save && speaks) s = fv_file_write_atomic(save, json, strlen(json), &err);
     if (s == FV_OK && !check) s = fv_bench_run_text(json, label, ".", opt, &err);
     free(json);
-    if (s != FV_OK) return fv_cli_fail(cmd, s, err.msg);
-    if (check) printf("%s: ok\n", save ? save : label);
-    else if (!quiet) fprintf(stderr, "fovea bench: wrote %s/\n", opt->out_dir);
+    if (s != FV_OK) return bench_fail(bd, s, err.msg);
+    if (check && speaks) printf("%s: ok\n", save ? save : label);
+    else if (!quiet && speaks) fprintf(stderr, "fovea bench: wrote %s/\n", opt->out_dir);
     return FV_EXIT_OK;
 }
 
-#ifdef FOVEA_HAVE_MPI
-#include "dist/dist.h"
-/* Under an MPI launcher with several ranks the bench is not split yet (docs/distributed.md, "Not
- * done yet"): rather than N copies of the same scenario writing the same report, every rank stops
- * and one says why. Returns the exit status, or -1 to run the bench as usual. */
-static int refuse_ranks(void)
-{
-    if (!fv_dist_launched()) return -1;
-    fv_dist *d = NULL;
-    fv_error err;
-    fv_error_clear(&err);
-    if (fv_dist_start(NULL, NULL, &d, &err) != FV_OK) return fv_cli_fail("bench", FV_ERR_IO, err.msg);
-    int size = fv_dist_size(d), rank = fv_dist_rank(d);
-    if (size == 1) {
-        fv_dist_end(d);
-        return -1;
-    }
-    /* Said before the job ends (MPI_Finalize waits for every rank), so that no rank exits, and
-     * has the launcher signal the others, before the line is out; a signal after it is silent. */
-    if (rank == 0)
-        fv_cli_usage_error("bench", "not split over MPI ranks yet (%d ranks): run `fovea bench` in one process (docs/distributed.md)", size);
-    fv_cli_interrupt_mute();
-    fv_dist_end(d);
-    return FV_EXIT_USAGE;
-}
-#endif
 
-int fv_cmd_bench(int argc, char **argv)
+/* bd: the MPI job when launched over several ranks, else NULL. */
+static int bench(int argc, char **argv, bench_dist *bd, const fv_bench_split *split)
 {
-    /* a built-in mode rather than a scenario: it sweeps the thread count, not methods' parameters */
-    if (argc > 1 && !strcmp(argv[1], "scaling")) return fv_cmd_bench_scaling(argc - 1, argv + 1);
-#ifdef FOVEA_HAVE_MPI
-    int refused = refuse_ranks();
-    if (refused >= 0) return refused;
-#endif
     enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_TPOLICY, O_CHECK, O_LIST, O_QUIET, O_HELP, O_SCENE,
            O_METHODS, O_REFERENCE, O_GAZE, O_GAZE_TRACE, O_FRAMES, O_SIZE, O_SAVE };
     static const struct option longs[] = {{"out", 1, 0, O_OUT},       {"device", 1, 0, O_DEVICE},   {"cache", 1, 0, O_CACHE},     {"quick", 0, 0, O_QUICK},
@@ -264,6 +282,9 @@ int fv_cmd_bench(int argc, char **argv)
     fv_bench_options opt;
     memset(&opt, 0, sizeof opt);
     opt.out_dir = "bench-out";
+    opt.split = split;
+    /* split: rank 0 alone reports progress and prints the table (it writes every file) */
+    const bool speaks = !split || split->rank == 0;
     /* Before getopt_long, which reorders argv. */
     char command[2048];
     command_line(argc, argv, command, sizeof command);
@@ -324,12 +345,12 @@ int fv_cmd_bench(int argc, char **argv)
         }
     }
     if (list) {
-        list_scenarios();
+        if (speaks) list_scenarios();
         return FV_EXIT_OK;
     }
     if (cl.scene) {
         if (optind != argc) return fv_cli_usage_error(cmd, "--scene builds the scenario: give no SCENARIO file ('%s')", argv[optind]);
-        return run_cmdline(&cl, save, check, quiet, &opt);
+        return run_cmdline(&cl, save, check, quiet, &opt, bd);
     }
     if (cmdline) return fv_cli_usage_error(cmd, "--methods, --reference, --gaze, --gaze-trace, --frames, --size and --save-scenario need --scene");
     if (optind != argc - 1) return fv_cli_usage_error(cmd, optind >= argc ? "missing SCENARIO (try fovea bench --list)" : "too many arguments");
@@ -338,16 +359,54 @@ int fv_cmd_bench(int argc, char **argv)
         return fv_cli_usage_error(cmd, "unknown scenario '%s' (try fovea bench --list)", argv[optind]);
     fv_log log = fv_cli_log(&quiet);
     opt.log = &log;
-    if (!quiet) opt.status = on_status;
-    opt.table = on_table;
+    if (!quiet && speaks) opt.status = on_status;
+    if (speaks) opt.table = on_table;
     fv_error err;
     fv_error_clear(&err);
     /* A regular file only: the JSON reader opens it by name, and a FIFO would block it. */
     fv_status s = fv_file_check_read(path, "scenario", &err);
     if (s != FV_OK) return fv_cli_fail(cmd, s, err.msg);
     s = check ? fv_bench_check(path, opt.mode, &err) : fv_bench_run(path, &opt, &err);
-    if (s != FV_OK) return fv_cli_fail(cmd, s, err.msg);
-    if (check) printf("%s: ok\n", path);
-    else if (!quiet) fprintf(stderr, "fovea bench: wrote %s/\n", opt.out_dir);
+    if (s != FV_OK) return bench_fail(bd, s, err.msg);
+    if (check && speaks) printf("%s: ok\n", path);
+    else if (!quiet && speaks) fprintf(stderr, "fovea bench: wrote %s/\n", opt.out_dir);
     return FV_EXIT_OK;
+}
+
+int fv_cmd_bench(int argc, char **argv)
+{
+    /* a built-in mode rather than a scenario: it sweeps the thread count, not methods' parameters */
+    if (argc > 1 && !strcmp(argv[1], "scaling")) return fv_cmd_bench_scaling(argc - 1, argv + 1);
+#ifdef FOVEA_HAVE_MPI
+    /* Launched as one rank of several (mpirun, srun): the rows are dealt to the ranks. */
+    if (fv_dist_launched()) {
+        bench_dist bd = {NULL, false, false, false};
+        fv_error err;
+        fv_error_clear(&err);
+        fv_status s = fv_dist_start(NULL, NULL, &bd.d, &err);
+        if (s != FV_OK) return fv_cli_fail("bench", s, err.msg);
+        if (fv_dist_size(bd.d) == 1) {
+            fv_dist_end(bd.d);
+            return bench(argc, argv, NULL, NULL);
+        }
+        if ((s = fv_dist_hold(bd.d, &err)) != FV_OK) {
+            fv_dist_end(bd.d);
+            return fv_cli_fail("bench", s, err.msg);
+        }
+        const fv_bench_split split = {fv_dist_rank(bd.d), fv_dist_size(bd.d), &bd, split_move, split_agree, split_stopped, split_failed};
+        int rc = bench(argc, argv, &bd, &split);
+        if (!bd.agreed) {
+            /* Ended before the run split (bad options, --check, --list, --help): every rank agrees
+             * once, so that what was said (held) is said by one rank only. */
+            bool print_it, name_rank;
+            fv_status js = fv_dist_agree(bd.d, rc == FV_EXIT_OK ? FV_OK : rc == FV_EXIT_INTERNAL ? FV_ERR_INTERNAL : FV_ERR_INVALID,
+                                         &print_it, &name_rank, &err);
+            if (js != FV_OK) fv_cli_interrupt_mute();
+            rc = fv_cli_exit_code(js);
+        }
+        fv_dist_end(bd.d);
+        return rc;
+    }
+#endif
+    return bench(argc, argv, NULL, NULL);
 }
