@@ -56,12 +56,12 @@ void fv_params_watch(fv_params *p, fv_params_watch_fn fn, void *user)
     p->watch_user = user;
 }
 
-/* The entry of key, after telling the watcher that a reader asked for it. */
-static fv_param_entry *ask(const fv_params *p, const char *key)
+/* The entry of r->key, after telling the watcher what a reader asked for. */
+static fv_param_entry *ask(const fv_params *p, const fv_params_read *r)
 {
     if (!p) return NULL;
-    if (p->watch) p->watch(p->watch_user, key);
-    return find(p, key);
+    if (p->watch) p->watch(p->watch_user, r);
+    return find(p, r->key);
 }
 
 static bool valid_key(const char *k)
@@ -124,7 +124,8 @@ fv_status fv_params_clone(const fv_params *p, fv_params **out, fv_error *err)
 
 fv_status fv_params_int(fv_params *p, const char *key, int def, int lo, int hi, int *out, fv_error *err)
 {
-    fv_param_entry *e = ask(p, key);
+    const fv_params_read r = {key, FV_READ_INT, def, lo, hi, NULL};
+    fv_param_entry *e = ask(p, &r);
     if (!e) {
         *out = def;
         return FV_OK;
@@ -144,7 +145,8 @@ fv_status fv_params_int(fv_params *p, const char *key, int def, int lo, int hi, 
 fv_status fv_params_float(fv_params *p, const char *key, double def, double lo, double hi, double *out,
                           fv_error *err)
 {
-    fv_param_entry *e = ask(p, key);
+    const fv_params_read r = {key, FV_READ_FLOAT, def, lo, hi, NULL};
+    fv_param_entry *e = ask(p, &r);
     if (!e) {
         *out = def;
         return FV_OK;
@@ -163,7 +165,8 @@ fv_status fv_params_float(fv_params *p, const char *key, double def, double lo, 
 
 fv_status fv_params_bool(fv_params *p, const char *key, bool def, bool *out, fv_error *err)
 {
-    fv_param_entry *e = ask(p, key);
+    const fv_params_read r = {key, FV_READ_BOOL, def, 0, 1, NULL};
+    fv_param_entry *e = ask(p, &r);
     if (!e) {
         *out = def;
         return FV_OK;
@@ -180,7 +183,8 @@ fv_status fv_params_bool(fv_params *p, const char *key, bool def, bool *out, fv_
 fv_status fv_params_choice(fv_params *p, const char *key, int def, const char *const *choices, int *out,
                            fv_error *err)
 {
-    fv_param_entry *e = ask(p, key);
+    const fv_params_read r = {key, FV_READ_CHOICE, def, 0, 0, choices};
+    fv_param_entry *e = ask(p, &r);
     if (!e) {
         *out = def;
         return FV_OK;
@@ -198,7 +202,11 @@ fv_status fv_params_choice(fv_params *p, const char *key, int def, const char *c
     return fv_error_set(err, FV_ERR_INVALID, "parameter %s=%s: expected one of %s", key, e->value, list);
 }
 
-bool fv_params_has(const fv_params *p, const char *key) { return ask(p, key) != NULL; }
+bool fv_params_has(const fv_params *p, const char *key)
+{
+    const fv_params_read r = {key, FV_READ_HAS, 0, 0, 0, NULL};
+    return ask(p, &r) != NULL;
+}
 
 fv_status fv_params_check_used(const fv_params *p, const char *technique, fv_error *err)
 {

@@ -22,7 +22,9 @@
  *               gaze; any other method's image is unchanged by the eye model and the gaze.
  *   history     a method without warm-up frames renders a frame alone as it does in sequence.
  *   table       the class's description (class.h) holds: every key create reads is in its
- *               parameter table and every key of the table is read; each entry's default lies in
+ *               parameter table and every key of the table is read, by a reader of the declared
+ *               type with the declared default and choices (fv_params_watch tells what each
+ *               reader was called with); each entry's default lies in
  *               its declared range or choices; the main parameter is declared, its steps are
  *               valid values and its default one of them; a family; a baseline that is another
  *               registered method, whose chain of baselines ends at the reference (no cycle),
@@ -688,19 +690,83 @@ static bool valid_value(const fv_param_info *p, const char *text)
     return false;
 }
 
-/* The keys a reader asked for, by fv_params_watch. */
+/* The keys a reader asked for, by fv_params_watch, each with what its first reader accepts. */
 typedef struct read_keys {
     int n;
     char key[64][32];
+    fv_params_read read[64];
 } read_keys;
 
-static void on_read(void *user, const char *key)
+static void on_read(void *user, const fv_params_read *rd)
 {
     read_keys *r = user;
     for (int i = 0; i < r->n; i++)
-        if (strcmp(r->key[i], key) == 0) return;
+        if (strcmp(r->key[i], rd->key) == 0) return;
     if (r->n == 64) fail_msg("more than 64 keys read");
-    snprintf(r->key[r->n++], sizeof r->key[0], "%s", key);
+    r->read[r->n] = *rd;
+    snprintf(r->key[r->n++], sizeof r->key[0], "%s", rd->key);
+}
+
+/* Whether declaration e says what reader rd reads: its type, its default where it states one, its
+ * choices, and a declared range that holds the reader's default when one is declared. (The ranges themselves may differ
+ * either way, by design: a reader's bounds may follow other parameters, pt's block_count its spp,
+ * and a reader may accept wide bounds and check the declared ones after, as the sphere tracers'
+ * relax; the "ranges" check below holds every declared bound to a refusal.) Writes what differs
+ * into why. */
+static bool agrees(const fv_param_info *e, const fv_params_read *rd, char *why, size_t n)
+{
+    why[0] = '\0';
+    switch (rd->reader) {
+    case FV_READ_INT:
+    case FV_READ_FLOAT: {
+        const bool is_int = rd->reader == FV_READ_INT;
+        if (e->type != (is_int ? FV_PARAM_INT : FV_PARAM_FLOAT)) {
+            snprintf(why, n, "read as %s, declared %s", is_int ? "int" : "float", fv_param_type_name(e->type));
+            return false;
+        }
+        if (e->def && strtod(e->def, NULL) != rd->def && fabs(strtod(e->def, NULL) - rd->def) > 1e-6 * fabs(rd->def)) {
+            snprintf(why, n, "default %g read, %s declared", rd->def, e->def);
+            return false;
+        }
+        if (e->choices) return true; /* an int of listed values: the list is the range */
+        /* a derived default (no def) is the reader's sentinel, 0 for pm's Eq. 8 radius */
+        if (e->def && (rd->def < e->min || rd->def > e->max || (e->min_open && rd->def == e->min) || (e->max_open && rd->def == e->max))) {
+            snprintf(why, n, "the reader's default %g lies outside the declared range", rd->def);
+            return false;
+        }
+        return true;
+    }
+    case FV_READ_BOOL:
+        if (e->type != FV_PARAM_BOOL) {
+            snprintf(why, n, "read as bool, declared %s", fv_param_type_name(e->type));
+            return false;
+        }
+        if (e->def && (strcmp(e->def, "true") == 0) != (rd->def != 0.0)) {
+            snprintf(why, n, "default %s read, %s declared", rd->def != 0.0 ? "true" : "false", e->def);
+            return false;
+        }
+        return true;
+    case FV_READ_CHOICE: {
+        if (e->type != FV_PARAM_CHOICE || !e->choices) {
+            snprintf(why, n, "read as a choice, declared %s", fv_param_type_name(e->type));
+            return false;
+        }
+        int k = 0;
+        for (; rd->choices[k] && e->choices[k]; k++)
+            if (strcmp(rd->choices[k], e->choices[k]) != 0) break;
+        if (rd->choices[k] || e->choices[k]) {
+            snprintf(why, n, "choices differ at '%s'", rd->choices[k] ? rd->choices[k] : e->choices[k]);
+            return false;
+        }
+        if (e->def && strcmp(e->def, rd->choices[(int)rd->def]) != 0) {
+            snprintf(why, n, "default %s read, %s declared", rd->choices[(int)rd->def], e->def);
+            return false;
+        }
+        return true;
+    }
+    case FV_READ_HAS: return true;
+    }
+    return true;
 }
 
 static void test_table(void **st)
@@ -721,6 +787,16 @@ static void test_table(void **st)
     fv_params_destroy(p);
     for (int i = 0; i < r.n; i++)
         if (!declared(c, r.key[i])) fail_msg("%s: create reads '%s', which its parameter table does not declare", c->name, r.key[i]);
+    /* ... and reads them as declared: the table is what the readers accept, both ways. */
+    int bad = 0;
+    for (int i = 0; i < r.n; i++) {
+        char why[256];
+        if (!agrees(declared(c, r.key[i]), &r.read[i], why, sizeof why)) {
+            print_error("%s: '%s': %s\n", c->name, r.key[i], why);
+            bad++;
+        }
+    }
+    if (bad) fail_msg("%s: %d parameter(s) read otherwise than declared", c->name, bad);
     for (int j = 0; j < c->param_count; j++) {
         bool read = false;
         for (int i = 0; i < r.n && !read; i++) read = strcmp(r.key[i], c->params[j].key) == 0;

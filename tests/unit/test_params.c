@@ -72,15 +72,20 @@ static void test_params_errors(void **st)
 typedef struct seen {
     int n;
     char keys[8][16];
+    fv_params_read r[8];
 } seen;
 
-static void note_key(void *user, const char *key)
+static void note_key(void *user, const fv_params_read *r)
 {
     seen *s = user;
-    if (s->n < 8) snprintf(s->keys[s->n++], sizeof s->keys[0], "%s", key);
+    if (s->n < 8) {
+        s->r[s->n] = *r;
+        snprintf(s->keys[s->n++], sizeof s->keys[0], "%s", r->key);
+    }
 }
 
-/* Every reader tells the watcher the key it asks for, in the bag or not; a clone has no watcher. */
+/* Every reader tells the watcher the key it asks for, in the bag or not, with its default and
+ * what it accepts; a clone has no watcher. */
 static void test_params_watch(void **st)
 {
     (void)st;
@@ -102,6 +107,13 @@ static void test_params_watch(void **st)
     assert_int_equal(s.n, 5);
     const char *want[5] = {"spp", "absent", "flag", "mode", "radius"};
     for (int k = 0; k < 5; k++) assert_string_equal(s.keys[k], want[k]);
+    assert_int_equal(s.r[0].reader, FV_READ_INT);
+    assert_true(s.r[0].def == 1 && s.r[0].lo == 1 && s.r[0].hi == 16);
+    assert_int_equal(s.r[1].reader, FV_READ_FLOAT);
+    assert_true(s.r[1].def == 0.5 && s.r[1].lo == 0.0 && s.r[1].hi == 1.0);
+    assert_true(s.r[2].reader == FV_READ_BOOL && s.r[2].def == 1);
+    assert_true(s.r[3].reader == FV_READ_CHOICE && s.r[3].def == 1 && s.r[3].choices == modes);
+    assert_int_equal(s.r[4].reader, FV_READ_HAS);
     assert_int_equal(fv_params_clone(p, &q, &err), FV_OK);
     assert_int_equal(fv_params_int(q, "spp", 1, 1, 16, &i, &err), FV_OK);
     assert_int_equal(s.n, 5);
