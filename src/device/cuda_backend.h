@@ -18,6 +18,9 @@ extern "C" {
 #endif
 
 struct fv_kscene;
+struct fv_ksdf_world;
+struct fv_ksdf_frame;
+struct fv_ksdf_counts;
 
 /* True when a CUDA device can run our kernels; else false with the reason in why. */
 bool fv_cuda_probe(char *why, size_t why_len);
@@ -33,6 +36,16 @@ fv_status fv_cuda_pt_update(fv_cuda_pt *c, const struct fv_kscene *host, fv_erro
 fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays, uint64_t *nan_samples,
                             double *kernel_ms, fv_error *err);
 void fv_cuda_pt_destroy(fv_cuda_pt *c);
+
+/* sdf-gt and sdf-relaxed (kernel/sdf_pixel.h): the GPU's buffers for the world and the film, kept
+ * between frames and grown when a frame needs more. */
+typedef struct fv_cuda_sdf fv_cuda_sdf;
+fv_status fv_cuda_sdf_create(fv_cuda_sdf **out, fv_error *err);
+/* Copies the world (host memory, the flat form) to the GPU, renders every pixel into the film's
+ * buffers (host memory), and adds the costs to *counts; *kernel_ms the kernel's own time. */
+fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, const struct fv_ksdf_frame *f, const fv_film_views *out,
+                             struct fv_ksdf_counts *counts, double *kernel_ms, fv_error *err);
+void fv_cuda_sdf_destroy(fv_cuda_sdf *c);
 
 #ifdef __cplusplus
 }

@@ -33,6 +33,21 @@ fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, const fv_film_
 }
 
 void fv_cuda_pt_destroy(fv_cuda_pt *c) { (void)c; }
+
+fv_status fv_cuda_sdf_create(fv_cuda_sdf **out, fv_error *err)
+{
+    *out = NULL;
+    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
+}
+
+fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, const struct fv_ksdf_frame *f, const fv_film_views *out,
+                             struct fv_ksdf_counts *counts, double *kernel_ms, fv_error *err)
+{
+    (void)c, (void)w, (void)f, (void)out, (void)counts, (void)kernel_ms;
+    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
+}
+
+void fv_cuda_sdf_destroy(fv_cuda_sdf *c) { (void)c; }
 #else
 typedef int fv_cuda_stub_unused; /* ISO C: a translation unit is not empty */
 #endif

@@ -89,6 +89,15 @@ FV_HD static inline float fv_klight_spot_falloff(const fv_light_desc *d, fv_vec3
     return t * t * (3.0f - 2.0f * t);
 }
 
+/* Radiant intensity of delta light l towards unit direction w (spot fall-off applied); a
+ * directional light's irradiance E whatever w (fv_light_delta_intensity, the SDF family's shading). */
+FV_HD static inline fv_vec3 fv_klight_delta_intensity(const struct fv_light *l, fv_vec3 w)
+{
+    if (l->desc.type == FV_LIGHT_DIRECTIONAL) return l->desc.intensity;
+    float fall = l->desc.type == FV_LIGHT_SPOT ? fv_klight_spot_falloff(&l->desc, w) : 1.0f;
+    return fv_scale(l->desc.intensity, fall);
+}
+
 /* The point uniform by area that two uniform numbers pick on a triangle, as its weights on the
  * vertices a, b, c (b's and c's are a hit's barycentrics u, v). */
 FV_HD static inline void fv_klight_triangle_bary(float u0, float u1, float w[3])

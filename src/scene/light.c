@@ -199,12 +199,7 @@ bool fv_light_delta_directional(const fv_light *l, fv_vec3 *dir)
     return true;
 }
 
-fv_vec3 fv_light_delta_intensity(const fv_light *l, fv_vec3 w)
-{
-    if (l->desc.type == FV_LIGHT_DIRECTIONAL) return l->desc.intensity;
-    float fall = l->desc.type == FV_LIGHT_SPOT ? fv_klight_spot_falloff(&l->desc, w) : 1.0f;
-    return fv_scale(l->desc.intensity, fall);
-}
+fv_vec3 fv_light_delta_intensity(const fv_light *l, fv_vec3 w) { return fv_klight_delta_intensity(l, w); }
 
 fv_vec3 fv_light_total_power(const fv_scene *s)
 {

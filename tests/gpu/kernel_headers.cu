@@ -2,9 +2,11 @@
  * pt's kernel (device/cuda/pt.cu) already instantiates the BSDFs, lights, textures, the flat
  * scene's traversal with SDF leaves and the path estimator; this unit calls what no CUDA kernel
  * uses yet (the eye model and the acuity models of kernel/eye.h, the light table's other queries),
- * so a change that makes them host-only fails the build, not a later GPU kernel. */
+ * so a change that makes them host-only fails the build, not a later GPU kernel. The sphere-tracing
+ * family's headers (kernel/sdf_*.h) are instantiated on their own below, outside any backend. */
 #include "kernel/eye.h"
 #include "kernel/pt.h"
+#include "kernel/sdf_pixel.h"
 
 __global__ void fv_check_eye(fv_eye_model m, fv_gaze g, double *out)
 {
@@ -22,4 +24,21 @@ __global__ void fv_check_lights(fv_kscene s, float *out)
     out[0] = ok ? ls.pdf : fv_klights_env_pdf(&s.lights, fv_v3(0, 1, 0)) + fv_klights_env_radiance(&s.lights, fv_v3(0, 1, 0)).x;
     fv_vec3 e = s.ntex > 0 ? fv_ktexture_sample(&s.tex[0], fv_vec2{0.5f, 0.5f}) : fv_v3s(0.0f);
     out[1] = e.x + (fv_kscene_occluded(&s, fv_v3(0, 0, 0), fv_v3(0, 0, 1), 1.0f) ? 1.0f : 0.0f);
+}
+
+/* The sphere-tracing family's kernels: the world's field, the march (over-relaxed, any hit), the
+ * shading of one hit and sdf-gt's pixel. */
+__global__ void fv_check_sdf(fv_ksdf_world w, fv_ksdf_frame f, fv_film_views out, float *res)
+{
+    fv_march_ray r;
+    fv_ksdf_camera_ray(&w, &f, 0.5f, 0.5f, &r);
+    fv_march_hit h;
+    fv_kmarch_one(&w, f.march.max_steps, FV_SDF_SHADOW_RELAX, &r, true, &h);
+    fv_sdf_shade_counts sc = {0, 0, 0};
+    fv_vec3 n;
+    fv_vec3 c = fv_ksdf_shade_one(&w, &f.march, &f.shade, &r, &h, &sc, &n);
+    fv_ksdf_counts pc;
+    memset(&pc, 0, sizeof pc);
+    fv_ksdf_pixel(&w, &f, 0, 0, &out, &pc);
+    res[0] = c.x + n.y + fv_ksdf_world_eval1(&w, 0.0f, 1.0f, 2.0f, 0) + (float)pc.steps + fv_ksdf_lobe_of(&w.mats[0]).norm;
 }

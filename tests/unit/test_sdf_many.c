@@ -491,11 +491,11 @@ static void test_world_moving(void **st)
     assert_int_equal(fv_scene_set_time(s, 0.6, &err), FV_OK);
     fv_sdf_world w;
     assert_int_equal(fv_sdf_world_build(&w, s, &err), FV_OK);
-    assert_int_equal(w.count, 8);
+    assert_int_equal(w.k.count, 8);
     assert_non_null(w.merged);
     assert_int_equal(culled_chains(w.merged), 1);
     /* the skip test is live for every moving object, the stretched one too */
-    for (int i = 0; i < w.count; i++) assert_true(w.objs[i].cull_c > 0.1f && w.objs[i].cull_c <= 1.0f);
+    for (int i = 0; i < w.k.count; i++) assert_true(w.objs[i].cull_c > 0.1f && w.objs[i].cull_c <= 1.0f);
     for (int b = 0; b < 2000; b++) {
         float x[8], y[8], z[8], d8[8];
         int m8[8];
@@ -514,14 +514,14 @@ static void test_world_moving(void **st)
                 float v = fv_sdf_distance1(fv_scene_object_sdf(s, o), x[k], y[k], z[k], &m);
                 if (v < best) best = v, bm = m;
             }
-            for (int i = 0; i < w.count; i++) {
-                const fv_sdf_world_object *o = &w.objs[i];
+            for (int i = 0; i < w.k.count; i++) {
+                const fv_ksdf_object *o = &w.objs[i];
                 const fv_xform *mm = &o->inv;
                 float lx = mm->m[0][0] * x[k] + mm->m[0][1] * y[k] + mm->m[0][2] * z[k] + mm->m[0][3];
                 float ly = mm->m[1][0] * x[k] + mm->m[1][1] * y[k] + mm->m[1][2] * z[k] + mm->m[1][3];
                 float lz = mm->m[2][0] * x[k] + mm->m[2][1] * y[k] + mm->m[2][2] * z[k] + mm->m[2][3];
                 int m;
-                float v = fv_sdf_distance1(o->sdf, lx, ly, lz, &m) * o->lip;
+                float v = fv_sdf_distance1(w.sdfs[i], lx, ly, lz, &m) * o->lip;
                 if (v < best) best = v, bm = m;
             }
             int m1;

@@ -13,6 +13,7 @@
 #include <cuda_runtime.h>
 #include <stdio.h>
 #include <string.h>
+#include "device/cuda/common.h"
 #include "device/cuda_backend.h"
 #include "kernel/pt.h"
 
@@ -24,17 +25,11 @@ struct fv_cuda_pt {
     void *owned[32];         /* every device allocation of the scene, freed at destroy */
     int nowned;
     fv_ktexture *tex_host;   /* the texture records with device texel pointers, as uploaded */
-    float *color, *depth, *normal, *albedo, *position;
-    uint32_t *id;
-    size_t film_pixels;
+    fv_cuda_film film;       /* kept between frames of one size */
     unsigned long long *counts; /* rays, non-finite estimates */
     cudaEvent_t start, stop;
 };
 
-static fv_status cuda_fail(cudaError_t e, const char *what, fv_error *err)
-{
-    return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %s while %s", cudaGetErrorString(e), what);
-}
 
 extern "C" bool fv_cuda_probe(char *why, size_t why_len)
 {
@@ -66,9 +61,9 @@ static fv_status upload(fv_cuda_pt *c, const void *src, size_t n, size_t bytes, 
         return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: too many scene arrays");
     cudaError_t e = cudaMalloc(dst, n * bytes);
     if (e != cudaSuccess) return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for the scene")
-                                                                : cuda_fail(e, "allocating the scene", err);
+                                                                : fv_cuda_fail(e, "allocating the scene", err);
     c->owned[c->nowned++] = *dst;
-    if ((e = cudaMemcpy(*dst, src, n * bytes, cudaMemcpyHostToDevice)) != cudaSuccess) return cuda_fail(e, "copying the scene", err);
+    if ((e = cudaMemcpy(*dst, src, n * bytes, cudaMemcpyHostToDevice)) != cudaSuccess) return fv_cuda_fail(e, "copying the scene", err);
     return FV_OK;
 }
 
@@ -121,7 +116,7 @@ static fv_status refresh(const void *dst, const void *src, size_t bytes, fv_erro
 {
     if (!dst || !src || !bytes) return FV_OK;
     cudaError_t e = cudaMemcpy((void *)dst, src, bytes, cudaMemcpyHostToDevice);
-    return e == cudaSuccess ? FV_OK : cuda_fail(e, "updating the scene", err);
+    return e == cudaSuccess ? FV_OK : fv_cuda_fail(e, "updating the scene", err);
 }
 
 extern "C" fv_status fv_cuda_pt_update(fv_cuda_pt *c, const fv_kscene *h, fv_error *err)
@@ -141,12 +136,7 @@ extern "C" void fv_cuda_pt_destroy(fv_cuda_pt *c)
 {
     if (!c) return;
     for (int i = 0; i < c->nowned; i++) cudaFree(c->owned[i]);
-    cudaFree(c->color);
-    cudaFree(c->depth);
-    cudaFree(c->normal);
-    cudaFree(c->albedo);
-    cudaFree(c->position);
-    cudaFree(c->id);
+    fv_cuda_film_free(&c->film);
     cudaFree(c->counts);
     if (c->start) cudaEventDestroy(c->start);
     if (c->stop) cudaEventDestroy(c->stop);
@@ -161,9 +151,9 @@ extern "C" fv_status fv_cuda_pt_create(const fv_kscene *host, fv_cuda_pt **out, 
     if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_status s = upload_scene(c, host, err);
     cudaError_t e;
-    if (s == FV_OK && (e = cudaMalloc((void **)&c->counts, 2 * sizeof(unsigned long long))) != cudaSuccess) s = cuda_fail(e, "allocating counters", err);
+    if (s == FV_OK && (e = cudaMalloc((void **)&c->counts, 2 * sizeof(unsigned long long))) != cudaSuccess) s = fv_cuda_fail(e, "allocating counters", err);
     if (s == FV_OK && ((e = cudaEventCreate(&c->start)) != cudaSuccess || (e = cudaEventCreate(&c->stop)) != cudaSuccess))
-        s = cuda_fail(e, "creating events", err);
+        s = fv_cuda_fail(e, "creating events", err);
     if (s != FV_OK) {
         fv_cuda_pt_destroy(c);
         return s;
@@ -182,64 +172,28 @@ __global__ void fv_cuda_pt_kernel(fv_kscene s, fv_kpt_frame f, fv_film_views out
     if (bad) atomicAdd(&counts[1], (unsigned long long)bad);
 }
 
-/* (Re)allocates the device film's buffer for a host buffer that is set, NULL for one that is not. */
-static cudaError_t film_buffer(void **dev, const void *host, size_t bytes, bool resize)
-{
-    if (resize || !host) {
-        cudaFree(*dev);
-        *dev = NULL;
-    }
-    if (host && !*dev) return cudaMalloc(dev, bytes);
-    return cudaSuccess;
-}
-
 extern "C" fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays,
                                        uint64_t *nan_samples, double *kernel_ms, fv_error *err)
 {
     const size_t n = (size_t)f->cam.width * (size_t)f->cam.height;
-    bool resize = n != c->film_pixels;
-    cudaError_t e;
-    if ((e = film_buffer((void **)&c->color, out->color, 3 * n * sizeof(float), resize)) != cudaSuccess ||
-        (e = film_buffer((void **)&c->depth, out->depth, n * sizeof(float), resize)) != cudaSuccess ||
-        (e = film_buffer((void **)&c->normal, out->normal, 3 * n * sizeof(float), resize)) != cudaSuccess ||
-        (e = film_buffer((void **)&c->albedo, out->albedo, 3 * n * sizeof(float), resize)) != cudaSuccess ||
-        (e = film_buffer((void **)&c->position, out->position, 3 * n * sizeof(float), resize)) != cudaSuccess ||
-        (e = film_buffer((void **)&c->id, out->id, n * sizeof(uint32_t), resize)) != cudaSuccess) {
-        c->film_pixels = 0;
-        return cuda_fail(e, "allocating the film", err);
-    }
-    c->film_pixels = n;
     fv_film_views dv;
-    dv.color = c->color;
-    dv.depth = c->depth;
-    dv.normal = c->normal;
-    dv.albedo = c->albedo;
-    dv.position = c->position;
-    dv.id = c->id;
-    if ((e = cudaMemset(c->counts, 0, 2 * sizeof(unsigned long long))) != cudaSuccess) return cuda_fail(e, "clearing counters", err);
+    fv_status s = fv_cuda_film_prepare(&c->film, out, n, &dv, err);
+    if (s != FV_OK) return s;
+    cudaError_t e;
+    if ((e = cudaMemset(c->counts, 0, 2 * sizeof(unsigned long long))) != cudaSuccess) return fv_cuda_fail(e, "clearing counters", err);
     dim3 block(FV_CUDA_BLOCK, FV_CUDA_BLOCK);
     dim3 grid((unsigned)((f->cam.width + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK), (unsigned)((f->cam.height + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK));
     cudaEventRecord(c->start);
     fv_cuda_pt_kernel<<<grid, block>>>(c->dev, *f, dv, c->counts);
     cudaEventRecord(c->stop);
-    if ((e = cudaGetLastError()) != cudaSuccess) return cuda_fail(e, "launching the pt kernel", err);
-    if ((e = cudaEventSynchronize(c->stop)) != cudaSuccess) return cuda_fail(e, "running the pt kernel", err);
+    if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the pt kernel", err);
+    if ((e = cudaEventSynchronize(c->stop)) != cudaSuccess) return fv_cuda_fail(e, "running the pt kernel", err);
     float ms = 0.0f;
     cudaEventElapsedTime(&ms, c->start, c->stop);
     *kernel_ms = ms;
     unsigned long long counts[2];
-    if ((e = cudaMemcpy(counts, c->counts, sizeof counts, cudaMemcpyDeviceToHost)) != cudaSuccess) return cuda_fail(e, "reading counters", err);
+    if ((e = cudaMemcpy(counts, c->counts, sizeof counts, cudaMemcpyDeviceToHost)) != cudaSuccess) return fv_cuda_fail(e, "reading counters", err);
     *rays = counts[0];
     *nan_samples = counts[1];
-    struct {
-        void *host;
-        const void *dev;
-        size_t bytes;
-    } back[6] = {{out->color, c->color, 3 * n * sizeof(float)},       {out->depth, c->depth, n * sizeof(float)},
-                 {out->normal, c->normal, 3 * n * sizeof(float)},     {out->albedo, c->albedo, 3 * n * sizeof(float)},
-                 {out->position, c->position, 3 * n * sizeof(float)}, {out->id, c->id, n * sizeof(uint32_t)}};
-    for (int i = 0; i < 6; i++)
-        if (back[i].host && (e = cudaMemcpy(back[i].host, back[i].dev, back[i].bytes, cudaMemcpyDeviceToHost)) != cudaSuccess)
-            return cuda_fail(e, "reading the film back", err);
-    return FV_OK;
+    return fv_cuda_film_read(&c->film, out, n, err);
 }

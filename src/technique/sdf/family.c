@@ -5,10 +5,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include "technique/class.h"
+#include "technique/sdf/device.h"
 #include "technique/sdf/pipeline.h"
 
 typedef struct family_state {
-    fv_sdf_pipeline *pipe;
+    fv_sdf_pipeline *pipe; /* the cpu device */
+    fv_sdf_device *dev;    /* sdf-gt and sdf-relaxed on portable and cuda (device.h) */
 } family_state;
 
 /* The show modes each method has, in fv_sdf_show's order: the baselines one level, ipr the level
@@ -84,11 +86,15 @@ static fv_status read_opts(fv_sdf_method m, fv_params *p, fv_sdf_opts *o, fv_err
     return FV_OK;
 }
 
-static fv_status create_method(fv_sdf_method m, const fv_scene *scene, fv_params *params, const fv_log *log, void **state, fv_error *err)
+static fv_status create_method(fv_sdf_method m, const fv_scene *scene, fv_params *params, fv_device device, const fv_log *log, void **state,
+                               fv_error *err)
 {
     fv_sdf_opts o;
     fv_status s = read_opts(m, params, &o, err);
     if (s != FV_OK) return s;
+    if (device != FV_DEVICE_CPU && o.show != FV_SDF_SHOW_IMAGE)
+        return fv_error_set(err, FV_ERR_INVALID, "parameter show=%s: only the cpu device draws diagnostics (device %s renders the image)",
+                            k_show_traced[o.show], fv_device_name(device));
     int meshes = fv_scene_object_count(scene) - fv_scene_sdf_object_count(scene);
     if (meshes > 0)
         fv_log_warn(log, "%d mesh object%s not sphere-traced: this method sees only the signed distance fields (pt renders both)",
@@ -98,7 +104,8 @@ static fv_status create_method(fv_sdf_method m, const fv_scene *scene, fv_params
         fv_log_warn(log, "the environment light is not shaded: this method shades point, spot and directional lights only (ambient=A adds a constant term; pt sees it)");
     family_state *st = calloc(1, sizeof *st);
     if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    if ((s = fv_sdf_pipeline_create(scene, &o, &st->pipe, err)) != FV_OK) {
+    s = device == FV_DEVICE_CPU ? fv_sdf_pipeline_create(scene, &o, &st->pipe, err) : fv_sdf_device_create(scene, &o, device, &st->dev, err);
+    if (s != FV_OK) {
         free(st);
         return s;
     }
@@ -108,7 +115,8 @@ static fv_status create_method(fv_sdf_method m, const fv_scene *scene, fv_params
 
 static fv_status render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
-    return fv_sdf_pipeline_render(((family_state *)state)->pipe, frame, film, stats, err);
+    family_state *st = state;
+    return st->dev ? fv_sdf_device_render(st->dev, frame, film, stats, err) : fv_sdf_pipeline_render(st->pipe, frame, film, stats, err);
 }
 
 static void destroy(void *state)
@@ -116,13 +124,28 @@ static void destroy(void *state)
     family_state *st = state;
     if (!st) return;
     fv_sdf_pipeline_destroy(st->pipe);
+    fv_sdf_device_destroy(st->dev);
     free(st);
 }
 
-static fv_status create_gt(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e) { return create_method(FV_SDF_GT, s, p, l, st, e); }
-static fv_status create_relaxed(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e) { return create_method(FV_SDF_RELAXED, s, p, l, st, e); }
-static fv_status create_ipr(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e) { return create_method(FV_SDF_IPR, s, p, l, st, e); }
-static fv_status create_fipr(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e) { return create_method(FV_SDF_FIPR, s, p, l, st, e); }
+/* sdf-gt and sdf-relaxed also run on the device backends (device.h), so the registry hands them
+ * the device; ipr and fipr are CPU-only. */
+static fv_status create_gt(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
+{
+    return create_method(FV_SDF_GT, s, p, d, l, st, e);
+}
+static fv_status create_relaxed(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
+{
+    return create_method(FV_SDF_RELAXED, s, p, d, l, st, e);
+}
+static fv_status create_ipr(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
+{
+    return create_method(FV_SDF_IPR, s, p, FV_DEVICE_CPU, l, st, e);
+}
+static fv_status create_fipr(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
+{
+    return create_method(FV_SDF_FIPR, s, p, FV_DEVICE_CPU, l, st, e);
+}
 
 #define COMMON_PARAMS                                                                                                    \
     {.key = "spp", .type = FV_PARAM_INT, .def = "1", .min = 1, .max = 16, .choices = k_spp,                               \
@@ -185,9 +208,12 @@ static const fv_param_info k_fipr_params[] = {
  * one-process frames bit for bit (tests/cli/test_mpi.sh). */
 #define FIPR_WARMUP 3
 
-#define SDF_CLASS(id, nm, sum, base, table, fn, fov, warmup)                                                          \
+/* The devices beyond the CPU of sdf-gt and sdf-relaxed. */
+#define SDF_DEVICES ((1u << FV_DEVICE_PORTABLE) | (1u << FV_DEVICE_CUDA))
+
+#define SDF_CLASS(id, nm, sum, base, table, fn, fn_on, devs, fov, warmup)                                             \
     const fv_technique_class id = {.name = nm, .summary = sum, .family = FV_FAMILY_SDF, .baseline = base, FV_CLASS_PARAMS(table), \
-                                   .main = SDF_STEPS, .create = fn, .render = render, .destroy = destroy, .sdf_only = true,       \
+                                   .main = SDF_STEPS, .create = fn, .create_on = fn_on, .devices = devs, .render = render, .destroy = destroy, .sdf_only = true,         \
                                    .test_params = "spp=1", .furnace_radiance = 1.0, .furnace_tolerance = 0.01, .spp_param = "spp", \
                                    .foveated = fov, .warmup_frames = warmup}
 
@@ -195,10 +221,10 @@ static const fv_param_info k_fipr_params[] = {
  * renders too (docs/sdf-tracing.md, "Shading"); the others are measured against sdf-gt (Table 1,
  * the sdf-* benchmarks). */
 SDF_CLASS(fv_technique_sdf_gt, "sdf-gt", "sphere tracing of every target sample from the camera (ground truth of ipr/fipr)", "pt",
-          k_gt_params, create_gt, false, 0);
+          k_gt_params, NULL, create_gt, SDF_DEVICES, false, 0);
 SDF_CLASS(fv_technique_sdf_relaxed, "sdf-relaxed", "over-relaxed sphere tracing (Keinert et al. 2014) of every target sample", "sdf-gt",
-          k_relaxed_params, create_relaxed, false, 0);
+          k_relaxed_params, NULL, create_relaxed, SDF_DEVICES, false, 0);
 SDF_CLASS(fv_technique_ipr, "ipr", "inverted-pyramid sphere tracing: each level starts at the min-filtered depth of the one below", "sdf-gt",
-          k_ipr_params, create_ipr, false, 0);
+          k_ipr_params, create_ipr, NULL, 0, false, 0);
 SDF_CLASS(fv_technique_fipr, "fipr", "foveated inverted-pyramid sphere tracing: the five passes of Polychronakis et al. 2023", "sdf-gt",
-          k_fipr_params, create_fipr, true, FIPR_WARMUP);
+          k_fipr_params, create_fipr, NULL, 0, true, FIPR_WARMUP);

@@ -14,6 +14,8 @@
  * result depends only on the ray: the 8-wide and the scalar tracer (`wide` false, the "plain
  * scalar loop" the issue compares against) give bit-identical results in any order.
  *
+ * The step rule is kernel/sdf_march.h's, shared with the portable and CUDA backends.
+ *
  * Termination, after the shader convention of the paper's scenes: a hit when the distance is under
  * max(eps, eps_k t) (eps_k: a fraction of a target sample's footprint per unit distance, the same
  * on every pyramid level); a miss when t passes t1; a ray still marching
@@ -29,27 +31,10 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include "kernel/sdf_march.h"
 #include "technique/sdf/world.h"
 
-typedef struct fv_march_opts {
-    int max_steps;  /* evaluations per ray (the paper's heat maps stop at 256) */
-    float relax;    /* 1: plain sphere tracing; (1, 2): over-relaxation factor */
-    bool wide;      /* eight lanes with the 8-wide field, or the scalar loop */
-} fv_march_opts;
-
-typedef struct fv_march_ray {
-    fv_vec3 o, d;     /* d unit */
-    float t0, t1;     /* where the march starts and gives up */
-    float eps, eps_k; /* hit distance max(eps, eps_k * t) */
-} fv_march_ray;
-
-typedef struct fv_march_hit {
-    float t;          /* where the ray stopped (a hit) */
-    uint16_t steps;   /* field evaluations spent */
-    uint8_t hit;      /* 1 hit, 0 miss */
-    uint8_t exhausted;/* stopped by max_steps */
-    int mat;          /* material of the nearest leaf at the hit */
-} fv_march_hit;
+/* fv_march_opts, fv_march_ray, fv_march_hit and the step rule: kernel/sdf_march.h. */
 
 /* Marches n rays. any_hit: stop at the first surface (shadow rays: hit = blocked, an exhausted
  * ray counts as not blocked). */

@@ -8,20 +8,17 @@
  * of their `specular` tint: no reflection or refraction rays, as in the paper's shaders. The lobe is
  * normalised ((n + 8) / 8 pi), so a diffuse scene shades exactly as `pt max_depth=1` (direct light
  * only) and the two can be compared. Area lights (emissive triangles) are not seen.
+ *
+ * This is the CPU's batched form: the field evaluations of many hits go eight at a time, and every
+ * per-hit step is kernel/sdf_shade.h's, which the portable and CUDA backends run a hit at a time.
  */
 #ifndef FV_SDF_SHADE_H
 #define FV_SDF_SHADE_H
 
+#include "kernel/sdf_shade.h"
 #include "technique/sdf/march.h"
 
-typedef struct fv_sdf_shade_opts {
-    float ambient;  /* constant term: ambient x albedo (0: direct light only) */
-    bool shadows;   /* trace shadow rays (off: every light is visible) */
-} fv_sdf_shade_opts;
-
-typedef struct fv_sdf_shade_counts {
-    uint64_t shadow_rays, shadow_steps, normal_evals;
-} fv_sdf_shade_counts;
+/* fv_sdf_shade_opts, fv_sdf_shade_counts and the per-hit steps: kernel/sdf_shade.h. */
 
 /* Which lights reach a shaded point: bit l for light l (scenes with up to 31 delta lights), or
  * FV_SDF_VIS_UNKNOWN (also for a miss). */

@@ -3,7 +3,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
-#include "core/ray_box.h"
 #include "sdf/sdf_eval.h"
 #include "technique/sdf/world.h"
 
@@ -39,6 +38,30 @@ static float abs_det(const fv_xform *x)
     return (float)fabs(d);
 }
 
+/* The flat form's program array: the static union's ops, then each moving object's. */
+static fv_status flatten(fv_sdf_world *w, int nmoving, fv_error *err)
+{
+    int n = w->statics ? w->statics->count : 0;
+    for (int i = 0; i < nmoving; i++) n += w->sdfs[i]->count;
+    w->ops = fv_alloc_array((size_t)(n > 0 ? n : 1), sizeof *w->ops);
+    if (!w->ops) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    int at = 0;
+    if (w->statics) {
+        memcpy(w->ops, w->statics->ops, (size_t)w->statics->count * sizeof *w->ops);
+        at = w->statics->count;
+    }
+    for (int i = 0; i < nmoving; i++) {
+        w->objs[i].first = at;
+        w->objs[i].count = w->sdfs[i]->count;
+        memcpy(w->ops + at, w->sdfs[i]->ops, (size_t)w->sdfs[i]->count * sizeof *w->ops);
+        at += w->sdfs[i]->count;
+    }
+    w->k.ops = w->ops;
+    w->k.nops = n;
+    w->k.statics_count = w->statics ? w->statics->count : 0;
+    return FV_OK;
+}
+
 fv_status fv_sdf_world_build(fv_sdf_world *w, const fv_scene *s, fv_error *err)
 {
     memset(w, 0, sizeof *w);
@@ -47,28 +70,31 @@ fv_status fv_sdf_world_build(fv_sdf_world *w, const fv_scene *s, fv_error *err)
     if (n == 0) return fv_error_set(err, FV_ERR_INVALID, "the scene has no signed distance field object");
     int nl = fv_light_delta_count(s);
     w->objs = fv_calloc_array((size_t)n, sizeof *w->objs);
+    w->sdfs = fv_calloc_array((size_t)n, sizeof *w->sdfs);
     w->lights = fv_calloc_array((size_t)(nl > 0 ? nl : 1), sizeof *w->lights);
     const fv_sdf **statics = fv_calloc_array((size_t)n, sizeof *statics);
-    if (!w->objs || !w->lights || !statics) {
+    if (!w->objs || !w->sdfs || !w->lights || !statics) {
         free(statics);
         fv_sdf_world_free(w);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     }
-    w->lo = fv_v3s(INFINITY);
-    w->hi = fv_v3s(-INFINITY);
-    int ns = 0;
+    fv_ksdf_world *k = &w->k;
+    k->lo = fv_v3s(INFINITY);
+    k->hi = fv_v3s(-INFINITY);
+    int ns = 0, count = 0;
     for (int i = 0; i < fv_scene_object_count(s); i++) {
         if (fv_scene_object_kind(s, i) != FV_OBJECT_SDF) continue;
         fv_vec3 lo, hi;
         fv_scene_object_bounds(s, i, &lo, &hi);
-        w->lo = fv_vmin(w->lo, lo);
-        w->hi = fv_vmax(w->hi, hi);
+        k->lo = fv_vmin(k->lo, lo);
+        k->hi = fv_vmax(k->hi, hi);
         if (!fv_scene_object_dynamic(s, i)) {
             statics[ns++] = fv_scene_object_sdf(s, i);
             continue;
         }
-        fv_sdf_world_object *o = &w->objs[w->count++];
-        o->sdf = fv_scene_object_sdf(s, i);
+        fv_ksdf_object *o = &w->objs[count];
+        const fv_sdf *sdf = fv_scene_object_sdf(s, i);
+        w->sdfs[count++] = sdf;
         o->lo = lo;
         o->hi = hi;
         fv_scene_object_world_to_local(s, i, &o->inv);
@@ -78,33 +104,41 @@ fv_status fv_sdf_world_build(fv_sdf_world *w, const fv_scene *s, fv_error *err)
         /* The world box holds the moved local box; a world point e from it is at least
          * e * (smallest stretch of inv) from the local box, where the field is >= c times that.
          * The smallest stretch is at least |det| / S^2 (S under-estimated by the same hair). */
-        o->cull_c = st > 0.0f ? o->lip * fv_sdf_bound_c(o->sdf) * 0.998f * abs_det(&o->inv) / (st * st) : 0.0f;
+        o->cull_c = st > 0.0f ? o->lip * fv_sdf_bound_c(sdf) * 0.998f * abs_det(&o->inv) / (st * st) : 0.0f;
     }
     fv_status status = FV_OK;
     if (ns == 1) w->statics = statics[0];
     else if (ns > 1 && (status = fv_sdf_union_create(statics, ns, &w->merged, err)) == FV_OK) w->statics = w->merged;
     free(statics);
+    if (status == FV_OK) status = flatten(w, count, err);
     if (status != FV_OK) {
         fv_sdf_world_free(w);
         return status;
     }
-    float diag = fv_length(fv_sub(w->hi, w->lo));
-    w->eps_abs = 1e-5f * diag;
-    const float box[6] = {w->lo.x, w->lo.y, w->lo.z, w->hi.x, w->hi.y, w->hi.z};
+    k->objs = w->objs;
+    k->count = count;
+    float diag = fv_length(fv_sub(k->hi, k->lo));
+    k->eps_abs = w->eps_abs = 1e-5f * diag;
+    const float box[6] = {k->lo.x, k->lo.y, k->lo.z, k->hi.x, k->hi.y, k->hi.z};
     float mag = 0.0f;
-    for (int k = 0; k < 6; k++) mag = fmaxf(mag, fabsf(box[k]));
-    w->cull_margin = FV_SDF_WORLD_CULL_REL * 2.0f * mag;
+    for (int i = 0; i < 6; i++) mag = fmaxf(mag, fabsf(box[i]));
+    k->cull_margin = FV_SDF_WORLD_CULL_REL * 2.0f * mag;
     fv_vec3 pad = fv_v3s(1e-3f * diag);
-    w->lo = fv_sub(w->lo, pad);
-    w->hi = fv_add(w->hi, pad);
+    k->lo = fv_sub(k->lo, pad);
+    k->hi = fv_add(k->hi, pad);
     for (int i = 0; i < nl; i++) {
         const fv_light *l = fv_light_delta_at(s, i);
-        w->lights[i].light = l;
+        fv_vec3 dir = fv_v3s(0.0f);
+        w->lights[i].light = *l;
         w->lights[i].pos = fv_light_delta_pos(l);
-        w->lights[i].directional = fv_light_delta_directional(l, &w->lights[i].dir);
-        w->lights[i].far = 2.0f * fv_length(fv_sub(w->hi, w->lo));
+        w->lights[i].directional = fv_light_delta_directional(l, &dir);
+        w->lights[i].dir = dir;
+        w->lights[i].far = 2.0f * fv_length(fv_sub(k->hi, k->lo));
     }
-    w->light_count = nl;
+    k->lights = w->lights;
+    k->nlights = nl;
+    k->mats = fv_scene_material(s, 0);
+    k->nmat = fv_scene_material_count(s);
     return FV_OK;
 }
 
@@ -112,38 +146,16 @@ void fv_sdf_world_free(fv_sdf_world *w)
 {
     fv_sdf_destroy(w->merged);
     free(w->objs);
+    free(w->sdfs);
     free(w->lights);
+    free(w->ops);
     memset(w, 0, sizeof *w);
-}
-
-/* Distance from p to the box (0 inside). */
-static inline float box_distance(fv_vec3 lo, fv_vec3 hi, float x, float y, float z)
-{
-    float dx = fmaxf(fmaxf(lo.x - x, x - hi.x), 0.0f);
-    float dy = fmaxf(fmaxf(lo.y - y, y - hi.y), 0.0f);
-    float dz = fmaxf(fmaxf(lo.z - z, z - hi.z), 0.0f);
-    return sqrtf(dx * dx + dy * dy + dz * dz);
-}
-
-static inline void to_local(const fv_xform *m, float x, float y, float z, float *lx, float *ly, float *lz)
-{
-    *lx = m->m[0][0] * x + m->m[0][1] * y + m->m[0][2] * z + m->m[0][3];
-    *ly = m->m[1][0] * x + m->m[1][1] * y + m->m[1][2] * z + m->m[1][3];
-    *lz = m->m[2][0] * x + m->m[2][1] * y + m->m[2][2] * z + m->m[2][3];
-}
-
-/* True when moving object o cannot be nearer than best at p: outside its box its distance is at
- * least cull_c times the distance to the box, so beyond best plus the rounding margin (kernel.h's
- * argument for FV_OP_CULL) the union keeps best and its material. */
-static inline bool far_from(const fv_sdf_world *w, const fv_sdf_world_object *o, float x, float y, float z, float best)
-{
-    float m = w->cull_margin + FV_SDF_WORLD_CULL_REL * (fabsf(x) + fabsf(y) + fabsf(z));
-    return o->cull_c * box_distance(o->lo, o->hi, x, y, z) > fmaxf(best + m, 0.0f);
 }
 
 void fv_sdf_world_eval8(const fv_sdf_world *w, const float *x, const float *y, const float *z, float *d, int *mat)
 {
-    if (w->count == 0) { /* static objects only: one field */
+    const fv_ksdf_world *k = &w->k;
+    if (k->count == 0) { /* static objects only: one field */
         fv_sdf_distance8(w->statics, x, y, z, d, mat);
         return;
     }
@@ -152,48 +164,26 @@ void fv_sdf_world_eval8(const fv_sdf_world *w, const float *x, const float *y, c
     if (w->statics) {
         fv_sdf_distance8(w->statics, x, y, z, best, bm);
     } else {
-        for (int k = 0; k < 8; k++) best[k] = INFINITY, bm[k] = 0;
+        for (int i = 0; i < 8; i++) best[i] = INFINITY, bm[i] = 0;
     }
-    for (int i = 0; i < w->count; i++) {
-        const fv_sdf_world_object *o = &w->objs[i];
+    for (int i = 0; i < k->count; i++) {
+        const fv_ksdf_object *o = &k->objs[i];
         bool all_far = true;
-        for (int k = 0; k < 8; k++) all_far = all_far && far_from(w, o, x[k], y[k], z[k], best[k]);
+        for (int l = 0; l < 8; l++) all_far = all_far && fv_ksdf_far_from(k, o, x[l], y[l], z[l], best[l]);
         if (all_far) continue;
-        for (int k = 0; k < 8; k++) to_local(&o->inv, x[k], y[k], z[k], &lx[k], &ly[k], &lz[k]);
-        fv_sdf_distance8(o->sdf, lx, ly, lz, od, om);
-        for (int k = 0; k < 8; k++) {
-            float v = od[k] * o->lip;
-            if (v < best[k]) best[k] = v, bm[k] = om[k];
+        for (int l = 0; l < 8; l++) fv_ksdf_to_local(&o->inv, x[l], y[l], z[l], &lx[l], &ly[l], &lz[l]);
+        fv_sdf_distance8(w->sdfs[i], lx, ly, lz, od, om);
+        for (int l = 0; l < 8; l++) {
+            float v = od[l] * o->lip;
+            if (v < best[l]) best[l] = v, bm[l] = om[l];
         }
     }
-    for (int k = 0; k < 8; k++) {
-        d[k] = best[k];
-        if (mat) mat[k] = bm[k];
+    for (int l = 0; l < 8; l++) {
+        d[l] = best[l];
+        if (mat) mat[l] = bm[l];
     }
 }
 
-float fv_sdf_world_eval1(const fv_sdf_world *w, float x, float y, float z, int *mat)
-{
-    if (w->count == 0) return fv_sdf_distance1(w->statics, x, y, z, mat);
-    float best = INFINITY;
-    int bm = 0;
-    if (w->statics) best = fv_sdf_distance1(w->statics, x, y, z, &bm);
-    for (int i = 0; i < w->count; i++) {
-        const fv_sdf_world_object *o = &w->objs[i];
-        if (far_from(w, o, x, y, z, best)) continue;
-        float lx, ly, lz;
-        to_local(&o->inv, x, y, z, &lx, &ly, &lz);
-        int om = 0;
-        float v = fv_sdf_distance1(o->sdf, lx, ly, lz, &om) * o->lip;
-        if (v < best) best = v, bm = om;
-    }
-    if (mat) *mat = bm;
-    return best;
-}
+float fv_sdf_world_eval1(const fv_sdf_world *w, float x, float y, float z, int *mat) { return fv_ksdf_world_eval1(&w->k, x, y, z, mat); }
 
-bool fv_sdf_world_clip(const fv_sdf_world *w, fv_vec3 o, fv_vec3 d, float *t0, float *t1)
-{
-    *t0 = 0.0f;
-    *t1 = INFINITY;
-    return fv_ray_box_clip(o, d, w->lo, w->hi, t0, t1);
-}
+bool fv_sdf_world_clip(const fv_sdf_world *w, fv_vec3 o, fv_vec3 d, float *t0, float *t1) { return fv_ksdf_world_clip(&w->k, o, d, t0, t1); }

@@ -11,45 +11,32 @@
  * static union, each skipped when its box proves it cannot be nearer than what was found (which
  * changes no value): the 8-wide and the scalar evaluation give the same numbers bit for bit.
  *
+ * The world is also built in the flat form of kernel/sdf_world.h, which the scalar evaluation, the
+ * portable backend and the CUDA backend read (one evaluation of the world, docs/gpu.md).
+ *
  * Meshes are not sphere-traced (the family's techniques warn once); pt renders mixed scenes.
  */
 #ifndef FV_SDF_WORLD_H
 #define FV_SDF_WORLD_H
 
 #include <stdbool.h>
+#include "kernel/sdf_world.h"
 #include "scene/light.h"
 #include "scene/query.h"
-
-/* Relative rounding margin of the moving objects' skip test (as FV_K_CULL_REL, sdf/kernel.h). */
-#define FV_SDF_WORLD_CULL_REL 2.44140625e-4f
-
-typedef struct fv_sdf_world_object {
-    const fv_sdf *sdf;
-    fv_xform inv;      /* world to the object's space */
-    float lip;         /* 1 / the largest stretch of inv: world distance >= lip * local distance */
-    float cull_c;      /* outside the world box, lip * local distance >= cull_c * distance to it */
-    fv_vec3 lo, hi;    /* world box */
-} fv_sdf_world_object;
-
-typedef struct fv_sdf_point_light {
-    const fv_light *light;
-    fv_vec3 pos;
-    bool directional; /* a directional light: light along dir, from beyond the world's box (pos unused) */
-    fv_vec3 dir;
-    float far;        /* directional: a distance that leaves the world's box from anywhere in it */
-} fv_sdf_point_light;
 
 typedef struct fv_sdf_world {
     const fv_scene *scene;
     const fv_sdf *statics;     /* the static objects' union (NULL: none); owned when merged */
     fv_sdf *merged;            /* statics when several were merged, else NULL */
-    fv_sdf_world_object *objs; /* the moving objects, in scene order */
-    int count;                 /* how many moving objects */
-    fv_vec3 lo, hi;            /* box around every object, padded by a few hit distances */
-    float eps_abs;             /* smallest hit distance: 1e-5 of the box diagonal */
-    float cull_margin;         /* the rounding margin of skipping a moving object, without the point's part */
-    fv_sdf_point_light *lights;
-    int light_count;
+    const fv_sdf **sdfs;       /* the moving objects' fields, in the order of k.objs */
+    /* The flat form (kernel/sdf_world.h): what the scalar evaluation, the portable backend and a
+     * GPU's copy read. Its arrays (the static union's program then each moving object's, the
+     * moving objects, the lights) are owned here; mats is the scene's. */
+    fv_ksdf_world k;
+    fv_sdf_op *ops;
+    fv_ksdf_object *objs;
+    fv_ksdf_light *lights;
+    float eps_abs;             /* = k.eps_abs */
 } fv_sdf_world;
 
 /* The scene's SDF objects and delta lights at its current time. FV_ERR_INVALID when the scene has
@@ -59,7 +46,7 @@ void fv_sdf_world_free(fv_sdf_world *w);
 
 /* The field at eight points (x, y, z need no alignment), with the nearest leaf's material. */
 void fv_sdf_world_eval8(const fv_sdf_world *w, const float *x, const float *y, const float *z, float *d, int *mat);
-/* The same at one point, bit-identical to a lane of fv_sdf_world_eval8. */
+/* The same at one point (fv_ksdf_world_eval1), bit-identical to a lane of fv_sdf_world_eval8. */
 float fv_sdf_world_eval1(const fv_sdf_world *w, float x, float y, float z, int *mat);
 
 /* Clips the ray o + t d (d unit) to the world's box: false when it misses the box. */

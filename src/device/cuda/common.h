@@ -1,0 +1,90 @@
+/* fovea — what the CUDA backends share (device/cuda/pt.cu, device/cuda/sdf.cu): the error line of a
+ * failed CUDA call, and a film on the GPU, its buffers kept between frames of one size and read
+ * back into the host film's buffers that are set. Host code only; included by .cu files.
+ */
+#ifndef FV_DEVICE_CUDA_COMMON_H
+#define FV_DEVICE_CUDA_COMMON_H
+
+#include <cuda_runtime.h>
+#include <stdint.h>
+#include "fovea/film.h"
+#include "fovea/status.h"
+
+static inline fv_status fv_cuda_fail(cudaError_t e, const char *what, fv_error *err)
+{
+    return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %s while %s", cudaGetErrorString(e), what);
+}
+
+typedef struct fv_cuda_film {
+    float *color, *depth, *normal, *albedo, *position;
+    uint32_t *id;
+    size_t pixels; /* the size the buffers have, 0: none */
+} fv_cuda_film;
+
+/* (Re)allocates a device buffer for a host buffer that is set, none for one that is not. */
+static inline cudaError_t fv_cuda_film_buffer(void **dev, const void *host, size_t bytes, bool resize)
+{
+    if (resize || !host) {
+        cudaFree(*dev);
+        *dev = NULL;
+    }
+    if (host && !*dev) return cudaMalloc(dev, bytes);
+    return cudaSuccess;
+}
+
+/* Makes the device film match host's buffers for n pixels; *dv receives its views. */
+static inline fv_status fv_cuda_film_prepare(fv_cuda_film *f, const fv_film_views *host, size_t n, fv_film_views *dv, fv_error *err)
+{
+    bool resize = n != f->pixels;
+    cudaError_t e;
+    if ((e = fv_cuda_film_buffer((void **)&f->color, host->color, 3 * n * sizeof(float), resize)) != cudaSuccess ||
+        (e = fv_cuda_film_buffer((void **)&f->depth, host->depth, n * sizeof(float), resize)) != cudaSuccess ||
+        (e = fv_cuda_film_buffer((void **)&f->normal, host->normal, 3 * n * sizeof(float), resize)) != cudaSuccess ||
+        (e = fv_cuda_film_buffer((void **)&f->albedo, host->albedo, 3 * n * sizeof(float), resize)) != cudaSuccess ||
+        (e = fv_cuda_film_buffer((void **)&f->position, host->position, 3 * n * sizeof(float), resize)) != cudaSuccess ||
+        (e = fv_cuda_film_buffer((void **)&f->id, host->id, n * sizeof(uint32_t), resize)) != cudaSuccess) {
+        f->pixels = 0;
+        return fv_cuda_fail(e, "allocating the film", err);
+    }
+    f->pixels = n;
+    dv->color = f->color;
+    dv->depth = f->depth;
+    dv->normal = f->normal;
+    dv->albedo = f->albedo;
+    dv->position = f->position;
+    dv->id = f->id;
+    return FV_OK;
+}
+
+/* Copies the device film's n pixels into host's buffers that are set. */
+static inline fv_status fv_cuda_film_read(const fv_cuda_film *f, const fv_film_views *host, size_t n, fv_error *err)
+{
+    struct {
+        void *host;
+        const void *dev;
+        size_t bytes;
+    } back[6] = {{host->color, f->color, 3 * n * sizeof(float)},       {host->depth, f->depth, n * sizeof(float)},
+                 {host->normal, f->normal, 3 * n * sizeof(float)},     {host->albedo, f->albedo, 3 * n * sizeof(float)},
+                 {host->position, f->position, 3 * n * sizeof(float)}, {host->id, f->id, n * sizeof(uint32_t)}};
+    for (int i = 0; i < 6; i++) {
+        cudaError_t e;
+        if (back[i].host && (e = cudaMemcpy(back[i].host, back[i].dev, back[i].bytes, cudaMemcpyDeviceToHost)) != cudaSuccess)
+            return fv_cuda_fail(e, "reading the film back", err);
+    }
+    return FV_OK;
+}
+
+static inline void fv_cuda_film_free(fv_cuda_film *f)
+{
+    cudaFree(f->color);
+    cudaFree(f->depth);
+    cudaFree(f->normal);
+    cudaFree(f->albedo);
+    cudaFree(f->position);
+    cudaFree(f->id);
+    f->color = f->depth = f->normal = f->albedo = f->position = NULL;
+    f->id = NULL;
+    f->pixels = 0;
+}
+
+#endif

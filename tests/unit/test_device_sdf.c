@@ -1,0 +1,191 @@
+/* `sdf-gt` and `sdf-relaxed` on the portable backend (kernel/sdf_pixel.h run a pixel at a time on
+ * the CPU's threads, the code CUDA runs) against the CPU pipeline (technique/sdf/pipeline.c: eight
+ * rays at a time through the 8-wide field, shading in batches), on the three sphere-tracing scenes.
+ *
+ * The bound is equality, bit for bit, in the colour, in every auxiliary buffer and in every
+ * counter. Measured, not assumed: the first renders of the two backends agreed exactly on all six
+ * method/scene pairs (0 differing pixels, max |difference| 0, the same steps, shadow steps and
+ * normal evaluations). That is what the design gives: both backends step every ray with the same
+ * function (kernel/sdf_march.h's fv_kmarch_advance), shade every hit with the same steps in the
+ * same order (kernel/sdf_shade.h), and evaluate the world's field with the scalar build of
+ * sdf/kernel.h, whose result the CPU's 8-wide lanes equal bit for bit (test_sdf_many checks that
+ * with moving objects too); nothing is compiled with FMA contraction. So any difference here is a
+ * divergence of the two paths, not rounding, and the test allows none. (CUDA against portable,
+ * tests/gpu/test_gpu_sdf.c, needs a tolerance: the GPU's powf differs in the last bits.)
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+#include "fovea/fovea.h"
+#include "testkit.h"
+
+#define AUX (FV_AUX_DEPTH | FV_AUX_NORMAL | FV_AUX_ALBEDO | FV_AUX_ID | FV_AUX_POSITION)
+
+static fv_film *render(const char *method, const char *params, const fv_scene *s, const fv_camera *cam, fv_stats *stats)
+{
+    fv_params *p = fv_test_params_str(params);
+    fv_technique *t = NULL;
+    fv_error err;
+    if (fv_technique_create(method, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s %s: %s", method, params, err.msg);
+    fv_film *film = NULL;
+    if (fv_film_create(cam->width, cam->height, AUX, &film, &err) != FV_OK) fail_msg("%s", err.msg);
+    fv_frame f;
+    fv_frame_init(&f, cam);
+    f.seed = 3;
+    fv_test_render_frames(t, &f, 1, film, stats);
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+    return film;
+}
+
+static size_t differing(const float *a, const float *b, size_t n, double *max_abs)
+{
+    size_t d = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (memcmp(&a[i], &b[i], sizeof(float)) != 0) d++;
+        double e = fabs((double)a[i] - (double)b[i]);
+        if (e > *max_abs) *max_abs = e; /* inf - inf: NaN, not counted; the bits above are */
+    }
+    return d;
+}
+
+static void compare(const char *scene, const char *method, int w, int h, int spp)
+{
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load(scene, &s, &v) != 0) fail_msg("cannot load %s", scene);
+    fv_camera cam;
+    fv_view_camera(v, s, 0.0, w, h, &cam);
+    char pc[64], pp[64];
+    snprintf(pc, sizeof pc, "spp=%d device=cpu", spp);
+    snprintf(pp, sizeof pp, "spp=%d device=portable", spp);
+    fv_stats sc, sp;
+    fv_film *a = render(method, pc, s, &cam, &sc), *b = render(method, pp, s, &cam, &sp);
+    const size_t n = (size_t)w * h;
+    double max_abs = 0.0, sum = 0.0;
+    const float *ca = fv_film_color_const(a);
+    for (size_t i = 0; i < 3 * n; i++) sum += ca[i];
+    size_t dc = differing(ca, fv_film_color_const(b), 3 * n, &max_abs);
+    size_t dd = differing(fv_film_depth(a), fv_film_depth(b), n, &max_abs);
+    size_t dn = differing(fv_film_normal(a), fv_film_normal(b), 3 * n, &max_abs);
+    size_t da = differing(fv_film_albedo(a), fv_film_albedo(b), 3 * n, &max_abs);
+    size_t dp = differing(fv_film_position(a), fv_film_position(b), 3 * n, &max_abs);
+    size_t di = memcmp(fv_film_id(a), fv_film_id(b), n * sizeof(uint32_t)) != 0;
+    printf("%s %s %dx%d spp=%d: mean %.5f, %zu colour values differ (max |difference| %g), aux %zu/%zu/%zu/%zu/%zu, steps %g / %g\n", method,
+           scene, w, h, spp, sum / (3.0 * (double)n), dc, max_abs, dd, dn, da, dp, di, fv_stats_get_count(&sc, "steps"),
+           fv_stats_get_count(&sp, "steps"));
+    if (!(sum > 0.0)) fail_msg("%s %s rendered black on the CPU", method, scene);
+    if (dc || dd || dn || da || dp || di) fail_msg("%s %s: the portable backend's image differs from the CPU's", method, scene);
+    static const char *const keys[] = {"rays", "steps", "shadow_rays", "shadow_steps", "normal_evals", "exhausted_rays", "samples", "nan_samples"};
+    for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
+        if (fv_stats_get_count(&sc, keys[k]) != fv_stats_get_count(&sp, keys[k]))
+            fail_msg("%s %s: counter %s: cpu %g, portable %g", method, scene, keys[k], fv_stats_get_count(&sc, keys[k]),
+                     fv_stats_get_count(&sp, keys[k]));
+    if (!(fv_stats_get_count(&sp, "steps") > fv_stats_get_count(&sp, "rays"))) fail_msg("%s %s: no marching counted", method, scene);
+    fv_film_destroy(a);
+    fv_film_destroy(b);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+static void test_primitives(void **st)
+{
+    (void)st;
+    compare("sdf-primitives", "sdf-gt", 64, 48, 4);
+    compare("sdf-primitives", "sdf-relaxed", 64, 48, 4);
+}
+
+static void test_columns(void **st)
+{
+    (void)st;
+    compare("sdf-columns", "sdf-gt", 56, 40, 1);
+    compare("sdf-columns", "sdf-relaxed", 56, 40, 1);
+}
+
+static void test_temple(void **st)
+{
+    (void)st;
+    compare("sdf-temple", "sdf-gt", 32, 24, 16);
+    compare("sdf-temple", "sdf-relaxed", 32, 24, 16);
+}
+
+/* Over-relaxation with another factor, shadows off, an ambient term and a low step limit that
+ * exhausts rays: every branch of the step rule and the shading on both backends. */
+static void test_options(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    assert_int_equal(fv_test_load("sdf-temple", &s, &v), 0);
+    fv_camera cam;
+    fv_view_camera(v, s, 0.0, 40, 30, &cam);
+    const char *opts[] = {"relax=1.9 max_steps=12", "shadows=false ambient=0.3", "hit=2 max_steps=40"};
+    for (int i = 0; i < 3; i++) {
+        char pc[96], pp[96];
+        snprintf(pc, sizeof pc, "%s device=cpu", opts[i]);
+        snprintf(pp, sizeof pp, "%s device=portable", opts[i]);
+        fv_stats sc, sp;
+        fv_film *a = render("sdf-relaxed", pc, s, &cam, &sc), *b = render("sdf-relaxed", pp, s, &cam, &sp);
+        if (memcmp(fv_film_color_const(a), fv_film_color_const(b), (size_t)3 * 40 * 30 * sizeof(float)) != 0)
+            fail_msg("sdf-relaxed %s: portable differs from cpu", opts[i]);
+        if (fv_stats_get_count(&sc, "exhausted_rays") != fv_stats_get_count(&sp, "exhausted_rays"))
+            fail_msg("sdf-relaxed %s: exhausted rays differ", opts[i]);
+        if (i == 0 && !(fv_stats_get_count(&sp, "exhausted_rays") > 0)) fail_msg("max_steps=12 exhausted no ray");
+        if (i == 1 && fv_stats_get_count(&sp, "shadow_rays") != 0) fail_msg("shadows=false traced shadow rays");
+        fv_film_destroy(a);
+        fv_film_destroy(b);
+    }
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+/* What the device backends refuse: diagnostics, and the pyramid methods (not ported yet). */
+static void test_refusals(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    assert_int_equal(fv_test_load("sdf-primitives", &s, &v), 0);
+    const struct {
+        const char *method, *params, *needle;
+    } cases[] = {
+        {"sdf-gt", "device=portable show=steps", "parameter show=steps: only the cpu device draws diagnostics (device portable renders the image)"},
+        {"ipr", "device=portable", "method 'ipr' does not run on device portable (methods that do: pt, sdf-gt, sdf-relaxed)"},
+        {"fipr", "device=cuda", "method 'fipr' does not run on device cuda"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        fv_params *p = fv_test_params_str(cases[i].params);
+        fv_technique *t = NULL;
+        fv_error err;
+        fv_test_expect_fail(fv_technique_create(cases[i].method, s, p, NULL, &t, &err), &err, FV_ERR_INVALID, cases[i].needle, cases[i].params);
+        assert_null(t);
+        fv_params_destroy(p);
+    }
+    /* CUDA: refused where it cannot run (this build or this machine), created where it can. */
+    fv_params *p = fv_test_params_str("device=cuda");
+    fv_technique *t = NULL;
+    fv_error err;
+    bool can = fv_device_available(FV_DEVICE_CUDA, NULL, 0);
+    fv_status got = fv_technique_create("sdf-gt", s, p, NULL, &t, &err);
+    if (can) {
+        assert_int_equal(got, FV_OK);
+    } else {
+        assert_int_equal(got, FV_ERR_INVALID);
+        if (!strstr(err.msg, "built without CUDA") && !strstr(err.msg, "no CUDA device")) fail_msg("refusal '%s' names no cause", err.msg);
+    }
+    fv_technique_destroy(t);
+    fv_params_destroy(p);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_primitives), cmocka_unit_test(test_columns), cmocka_unit_test(test_temple),
+                                       cmocka_unit_test(test_options), cmocka_unit_test(test_refusals)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
