@@ -72,7 +72,7 @@ fv_status fv_atrous_filter(float *rgb, const float *normal, const float *positio
     float scale = 1.0f;
     /* One region for the whole filter (docs/threads.md): every pass is an `omp for` whose implicit
      * barrier orders it before the next, instead of a region per pass that wakes the team again. */
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel num_threads(fv_thread_count(o->threads))
     {
         #pragma omp for schedule(static)
@@ -167,6 +167,7 @@ fv_status fv_atrous_filter(float *rgb, const float *normal, const float *positio
                 }
         }
     }
+    fv_region_end();
     free(tmp), free(row_lum), free(row_count);
     return FV_OK;
 }

@@ -15,7 +15,7 @@ long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, cons
     const int S0 = o->step > 1 ? o->step : 1;
     const float inv_s2 = o->sigma_position > 0.0f ? 1.0f / (o->sigma_position * o->sigma_position) : 0.0f;
     long missing = 0;
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(static) reduction(+ : missing)
     for (int y = 0; y < h; y++) {
         for (int x = 0; x < w; x++) {
@@ -58,6 +58,7 @@ long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, cons
             }
         }
     }
+    fv_region_end();
     return missing;
 }
 

@@ -302,7 +302,7 @@ static void gather_needed(gd_ctx *c, uint64_t *gathers)
     const int w = c->cam.width;
     long n = (long)st->bufn;
     uint64_t g = 0;
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(dynamic, 64) reduction(+ : g) num_threads(fv_thread_count(c->frame->threads))
     for (long i = 0; i < n; i++) {
         const float *nq = &st->nbuf[3 * i];
@@ -322,6 +322,7 @@ static void gather_needed(gd_ctx *c, uint64_t *gathers)
         if (!fv_is_finite3(R)) R = fv_v3s(0.0f); /* counted when the colour is composed */
         for (int q = 0; q < 3; q++) st->refl[3 * i + q] = (&R.x)[q] / st->alb[3 * i + q];
     }
+    fv_region_end();
     *gathers += g;
 }
 

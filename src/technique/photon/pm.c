@@ -404,12 +404,13 @@ static fv_status finish_fpm(render_ctx *c, fv_film *film, fv_stats *stats, fv_er
     free(l), free(f), free(mask);
     float *col = fv_film_color(film);
     uint64_t bad = 0;
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(static) reduction(+ : bad) num_threads(fv_thread_count(c->frame->threads))
     for (long long i = 0; i < (long long)n; i++) {
         fv_vec3 L = fv_kit_guard(estimate_sums(c, &c->sums[i]), &bad);
         col[3 * i] = L.x, col[3 * i + 1] = L.y, col[3 * i + 2] = L.z;
     }
+    fv_region_end();
     fv_stats_add_count(stats, "nan_samples", (double)bad);
     return FV_OK;
 }

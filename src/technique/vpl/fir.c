@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "core/stage_time.h"
 #include "filter/atrous.h"
 #include "scene/light.h"
 #include "technique/class.h"
@@ -503,46 +504,13 @@ static int cmp_build_key(const void *a, const void *b)
     return (x->index > y->index) - (x->index < y->index);
 }
 
-static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_basis *cam, fv_stats *stats, uint64_t *rays,
-                        fv_error *err)
+/* The management's serial steps, done by one thread between the parallel ones (manage). */
+
+/* After the update (Alg. 4 line 3): the moved count, the dropped VPLs' maps freed and the kept
+ * ones packed; returns how many candidates to bounce (Sec. 3.1), *n_old the VPLs kept and *need
+ * the VPLs to resample. */
+static int manage_after_update(fir_state *st, int *n_old_out, int *need_out)
 {
-    const fv_scene *s = st->scene;
-    const int threads = frame->threads;
-    par_ctx pc;
-    memset(&pc, 0, sizeof pc);
-    pc.st = st;
-    pc.frame = frame;
-    pc.cam = cam;
-    pc.gx = frame->gaze.x * (float)cam->width;
-    pc.gy = frame->gaze.y * (float)cam->height;
-    /* The foveal radius is the paper's fraction of the width (`radius`), unless the frame's eye
-     * model has a fovea covering the whole screen (a missing gaze under `widen`, docs/gaze.md):
-     * then every visible voxel has acuity 1 and candidates come from the whole screen. */
-    fv_eye_model def;
-    const fv_eye_model *eye = fv_frame_eye_model(frame, cam->width, cam->height, &def);
-    pc.whole = fv_frame_fovea_covers(frame, eye, cam->width, cam->height);
-    pc.R = pc.whole ? (float)fv_eye_fovea_radius_px(eye) : st->radius * (float)cam->width;
-
-    /* Alg. 1 line 4: the dynamic objects at this frame's time; light injected when anything moved. */
-    double t0 = fv_time_ms();
-    const double now = fv_scene_time(s);
-    const bool moved = !st->have_time || now != st->last_time;
-    if (st->has_dynamic && moved) {
-        fv_voxels_update_dynamic(st->vox);
-        count_density_voxels(st);
-    }
-    double t1 = fv_time_ms();
-    if (!st->have_time || (moved && (st->has_dynamic || fv_scene_lights_move(s))))
-        *rays += fv_vpl_inject(st->vox, s, frame->seed, (uint64_t)frame->index, st->area_samples, st->scratch, threads);
-    st->have_time = true;
-    st->last_time = now;
-    double t2 = fv_time_ms();
-
-    /* Alg. 2 */
-    st->fovea_cells = fv_vpl_foveated_weights(st->vox, cam, &st->vf.gb, pc.gx, pc.gy, pc.R, st->weight, threads);
-    /* Alg. 4 line 3 */
-    memset(st->moved_count, 0, sizeof st->moved_count);
-    fv_parallel_for(st->nvpl, 16, threads, update_range, &pc);
     st->moved = 0;
     for (int t = 0; t < FV_MAX_THREADS; t++) st->moved += st->moved_count[t];
     int n_old = 0;
@@ -562,12 +530,15 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     if (st->total - n_old > need) need = st->total - n_old;
     int m = st->ncand > 2 * need ? st->ncand : 2 * need;
     if (m > st->ncand_cap) m = st->ncand_cap;
-    fv_parallel_for(m, 16, threads, candidates_range, &pc);
-    int made = 0;
-    for (int j = 0; j < m; j++)
-        if (st->cand_ok[j]) st->cand[made++] = st->cand[j];
-    st->made_candidates = made;
-    fv_parallel_for(made, 8, threads, cand_importance_range, &pc);
+    *n_old_out = n_old;
+    *need_out = need;
+    return m;
+}
+
+/* After the candidates' importance: resampling, the selection (Eq. 2, Alg. 4 and 5), the new set,
+ * its tiles and the areas its VPLs stand for; returns the new set's size. */
+static int manage_select(fir_state *st, const fv_frame *frame, int made, int n_old, int need)
+{
     /* a candidate the update would drop next frame is not worth a VPL (nor a cube map) */
     for (int j = 0; j < made; j++)
         if (st->cand_imp[j] < st->drop_importance) st->cand_imp[j] = 0.0f;
@@ -622,11 +593,100 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     for (int i = 0; i < n; i++) fv_density_grid_add(st->grid, st->vpl[i].p, 1);
     mark_reached(st);
     vpl_cell_areas(st);
-    double t3 = fv_time_ms();
+    return n;
+}
 
-    /* Eq. 3 */
-    fv_parallel_for(n, 8, threads, radiosity_range, &pc);
-    double t4 = fv_time_ms();
+static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_basis *cam, fv_stats *stats, uint64_t *rays,
+                        fv_error *err)
+{
+    const fv_scene *s = st->scene;
+    const int threads = frame->threads;
+    par_ctx pc;
+    memset(&pc, 0, sizeof pc);
+    pc.st = st;
+    pc.frame = frame;
+    pc.cam = cam;
+    pc.gx = frame->gaze.x * (float)cam->width;
+    pc.gy = frame->gaze.y * (float)cam->height;
+    /* The foveal radius is the paper's fraction of the width (`radius`), unless the frame's eye
+     * model has a fovea covering the whole screen (a missing gaze under `widen`, docs/gaze.md):
+     * then every visible voxel has acuity 1 and candidates come from the whole screen. */
+    fv_eye_model def;
+    const fv_eye_model *eye = fv_frame_eye_model(frame, cam->width, cam->height, &def);
+    pc.whole = fv_frame_fovea_covers(frame, eye, cam->width, cam->height);
+    pc.R = pc.whole ? (float)fv_eye_fovea_radius_px(eye) : st->radius * (float)cam->width;
+
+    /* Alg. 1 line 4: the dynamic objects at this frame's time; light injected when anything moved. */
+    const double now = fv_scene_time(s);
+    const bool moved = !st->have_time || now != st->last_time;
+    const bool inject = !st->have_time || (moved && (st->has_dynamic || fv_scene_lights_move(s)));
+    st->have_time = true;
+    st->last_time = now;
+    memset(st->moved_count, 0, sizeof st->moved_count);
+    st->fovea_cells = 0;
+    uint64_t inject_rays = 0;
+    int n = 0, m = 0, made = 0, n_old = 0, need = 0;
+    fv_stage_clock c0, c1, c2, c3, c4;
+    /* One parallel region from the voxels to the VPLs' radiosity (docs/threads.md): each parallel
+     * step is a work-sharing loop of the team (fv_team_for, its barrier orders it before the next),
+     * each serial step (the management's bookkeeping between them) is done by the thread that opened
+     * the region (`master`, so its time counts as serial in --stats) while the others wait at the
+     * barrier after it. Every step reads and writes what it did as separate regions. */
+    c0 = fv_stage_clock_now();
+    fv_region_begin();
+#pragma omp parallel num_threads(fv_thread_count(threads))
+    {
+#pragma omp master
+        {
+            const double ts = fv_time_ms();
+            if (st->has_dynamic && moved) {
+                fv_voxels_update_dynamic(st->vox);
+                count_density_voxels(st);
+            }
+            fv_region_serial(fv_time_ms() - ts);
+            c1 = fv_stage_clock_now();
+        }
+#pragma omp barrier
+        if (inject) fv_vpl_inject_team(st->vox, s, frame->seed, (uint64_t)frame->index, st->area_samples, st->scratch, &inject_rays);
+#pragma omp master
+        c2 = fv_stage_clock_now();
+        /* Alg. 2 (no barrier needed before it: the injection's last one ordered everything) */
+        fv_vpl_foveated_weights_team(st->vox, cam, &st->vf.gb, pc.gx, pc.gy, pc.R, st->weight, &st->fovea_cells);
+        /* Alg. 4 line 3 */
+        fv_team_for(st->nvpl, 16, update_range, &pc);
+#pragma omp master
+        {
+            const double ts = fv_time_ms();
+            m = manage_after_update(st, &n_old, &need);
+            fv_region_serial(fv_time_ms() - ts);
+        }
+#pragma omp barrier
+        fv_team_for(m, 16, candidates_range, &pc);
+#pragma omp master
+        {
+            const double ts = fv_time_ms();
+            made = 0;
+            for (int j = 0; j < m; j++)
+                if (st->cand_ok[j]) st->cand[made++] = st->cand[j];
+            st->made_candidates = made;
+            fv_region_serial(fv_time_ms() - ts);
+        }
+#pragma omp barrier
+        fv_team_for(made, 8, cand_importance_range, &pc);
+#pragma omp master
+        {
+            const double ts = fv_time_ms();
+            n = manage_select(st, frame, made, n_old, need);
+            fv_region_serial(fv_time_ms() - ts);
+            c3 = fv_stage_clock_now();
+        }
+#pragma omp barrier
+        /* Eq. 3 */
+        fv_team_for(n, 8, radiosity_range, &pc);
+    }
+    fv_region_end();
+    c4 = fv_stage_clock_now();
+    *rays += inject_rays;
 
     /* cube maps: every VPL without one, then moved ones and the oldest, up to rebuild x n */
     int budget = st->visibility == 0 ? (int)ceilf(st->rebuild * (float)n) : 0;
@@ -646,15 +706,15 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     }
     fv_status status = st->maps ? fv_cubemaps_build_many(st->maps, s, st->build_idx, st->build_pos, st->build_nrm, nb, threads, err) : FV_OK;
     st->built_maps = nb;
-    double t5 = fv_time_ms();
+    fv_stage_clock c5 = fv_stage_clock_now();
     st->frames++;
 
     for (int t = 0; t < FV_MAX_THREADS; t++) *rays += pc.rays[t];
-    fv_stats_add_ms(stats, "voxelize", t1 - t0);
-    fv_stats_add_ms(stats, "inject", t2 - t1);
-    fv_stats_add_ms(stats, "vpl_generation", t3 - t2);
-    fv_stats_add_ms(stats, "radiosity", t4 - t3);
-    fv_stats_add_ms(stats, "cube_maps", t5 - t4);
+    fv_stage_add(stats, "voxelize", c0, c1);
+    fv_stage_add(stats, "inject", c1, c2);
+    fv_stage_add(stats, "vpl_generation", c2, c3);
+    fv_stage_add(stats, "radiosity", c3, c4);
+    fv_stage_add(stats, "cube_maps", c4, c5);
     return status;
 }
 
