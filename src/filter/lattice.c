@@ -63,7 +63,8 @@ long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, cons
 }
 
 fv_status fv_lattice_filter(float *rgb, const uint8_t *known, const uint8_t *filter_mask, const float *normal,
-                            const float *position, int w, int h, int step, int iterations, float sigma_position, fv_error *err)
+                            const float *position, int w, int h, int step, int iterations, fv_atrous *workspace, int threads,
+                            float sigma_position, fv_error *err)
 {
     const int S = step > 1 ? step : 1, lw = (w + S - 1) / S, lh = (h + S - 1) / S;
     size_t n = (size_t)lw * lh;
@@ -85,6 +86,8 @@ fv_status fv_lattice_filter(float *rgb, const uint8_t *known, const uint8_t *fil
     fv_atrous_opts_default(&ao);
     ao.sigma_position = sigma_position;
     ao.iterations = iterations;
+    ao.workspace = workspace;
+    ao.threads = threads;
     fv_status rc = fv_atrous_filter(c, nb, pb, lw, lh, &ao, err);
     if (rc == FV_OK)
         for (int ly = 0; ly < lh; ly++)

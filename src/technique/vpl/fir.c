@@ -109,6 +109,7 @@ typedef struct fir_state {
     fv_vpl_frame vf;
     fv_vec3 *tmp;       /* the box filter's horizontal pass */
     float *fbuf;        /* atrous: rgb, normal, position */
+    fv_atrous *atrous;  /* atrous: the filter's scratch, kept from frame to frame */
     size_t ntmp;
     /* last management's counts, reported by both eyes */
     int moved_count[FV_MAX_THREADS];
@@ -124,6 +125,7 @@ static void fir_destroy(void *state)
     fv_voxels_destroy(st->vox);
     fv_density_grid_destroy(st->grid);
     fv_cubemaps_destroy(st->maps);
+    fv_atrous_destroy(st->atrous);
     fv_vpl_frame_free(&st->vf);
     void *bufs[] = {st->reached, st->owner, st->queue, st->cell_area, st->weight,   st->scratch,   st->dens_vox,    st->vpl,       st->next,         st->cand,
                     st->cand_ok,  st->cand_imp,  st->picked,      st->old_pos,   st->cand_pos,     st->sel_cand_pos,
@@ -203,6 +205,7 @@ static fv_status fir_create(const fv_scene *scene, fv_params *params, const fv_l
     fv_status s = read_params(st, params, err);
     if (s != FV_OK) goto fail;
     if ((s = fv_voxels_create(scene, st->resolution, &st->vox, err)) != FV_OK) goto fail;
+    if (st->filter == FILTER_ATROUS && (s = fv_atrous_create(&st->atrous, err)) != FV_OK) goto fail;
     int dims[3];
     fv_voxels_dims(st->vox, 0, dims);
     st->ncells = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
@@ -780,7 +783,7 @@ static void box5(fir_state *st)
         }
 }
 
-static fv_status filter_indirect(fir_state *st, fv_error *err)
+static fv_status filter_indirect(fir_state *st, int threads, fv_error *err)
 {
     if (st->filter == FILTER_BOX) {
         box5(st);
@@ -800,6 +803,8 @@ static fv_status filter_indirect(fir_state *st, fv_error *err)
     fv_atrous_opts o;
     fv_atrous_opts_default(&o);
     o.sigma_position = INFINITY;
+    o.threads = threads;
+    o.workspace = st->atrous;
     fv_status s = fv_atrous_filter(rgb, nrm, NULL, st->vf.gb.width, st->vf.gb.height, &o, err);
     if (s != FV_OK) return s;
     for (size_t i = 0; i < n; i++) st->vf.indirect[i] = fv_v3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
@@ -824,7 +829,7 @@ static fv_status fir_render(void *state, const fv_frame *frame, fv_film *film, f
         st->managed_index = frame->index;
     }
     if (status == FV_OK) {
-        double t1 = fv_time_ms();
+        fv_stage_clock t1 = fv_stage_clock_now();
         build_tile_lists(st);
         fv_vpl_gather g = {s, st->lights, st->visibility == 0 ? st->maps : NULL, (fv_cube_filter)st->cube_filter, 0.0f};
         const float c = fv_vpl_clamp_distance(s, st->clamp);
@@ -834,13 +839,13 @@ static fv_status fir_render(void *state, const fv_frame *frame, fv_film *film, f
         ok = fv_vpl_pass_indirect(&g, &vf->gb, &tiles, frame->threads, vf->indirect, vf->counters, &vf->prog);
         if (ok) {
             scale_tiles(st);
-            status = filter_indirect(st, err);
+            status = filter_indirect(st, frame->threads, err);
         }
-        double t2 = fv_time_ms();
-        fv_stats_add_ms(stats, "shading", t2 - t1);
+        fv_stage_clock t2 = fv_stage_clock_now();
+        fv_stage_add(stats, "shading", t1, t2);
         fv_kit_phase(&vf->prog, frame, 0.8, 0.2);
         if (ok && status == FV_OK) ok = fv_vpl_pass_direct(s, &vf->gb, frame, st->area_samples, vf->direct, vf->counters, &vf->prog);
-        fv_stats_add_ms(stats, "direct", fv_time_ms() - t2);
+        fv_stage_stop(stats, "direct", t2);
     }
     if (status == FV_OK && ok) {
         fv_stats_add_count(stats, "valid_vpls", st->nvpl);
