@@ -89,7 +89,8 @@ class StatEntry(Structure):
 
 
 class Stats(Structure):
-    _fields_ = [("n_stages", c_int), ("n_counters", c_int), ("stage", StatEntry * 32), ("counter", StatEntry * 32)]
+    _fields_ = [("n_stages", c_int), ("n_counters", c_int), ("stage", StatEntry * 32), ("counter", StatEntry * 32),
+                ("n_serial", c_int), ("serial", StatEntry * 32)]
 
 
 PROGRESS_FN = CFUNCTYPE(c_bool, c_void_p, c_double)

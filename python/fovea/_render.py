@@ -220,6 +220,7 @@ class Renderer:
         views = _capi.FrameViews()
         lib.fv_driver_views(self._driver, frame, ctypes.byref(views))
         st = {"stages_ms": {_capi.text(stats.stage[i].name): stats.stage[i].value for i in range(stats.n_stages)},
+              "serial_ms": {_capi.text(stats.serial[i].name): stats.serial[i].value for i in range(stats.n_serial)},
               "counters": {_capi.text(stats.counter[i].name): stats.counter[i].value for i in range(stats.n_counters)}}
         out = []
         w, h = self.size

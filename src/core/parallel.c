@@ -1,16 +1,55 @@
 /* fovea — tile loop and parallel-for over OpenMP (see parallel.h). */
 #include <omp.h>
 #include "core/parallel.h"
+#include "fovea/stats.h"
 
 /* The one piece of mutable state in the library, and why it is per thread: regions are opened by
- * the thread that renders (nested regions are off), so its own count is exactly the regions of
- * its frames, whatever other renders other threads run; passing a counter to every stage and
- * filter that opens a region would thread one more argument through forty call sites for a
- * number that never changes a pixel. */
-static _Thread_local uint64_t t_regions;
+ * the thread that renders (nested regions are off), so its own count and clock are exactly those
+ * of its frames' regions, whatever other renders other threads run; passing a counter to every
+ * stage and filter that opens a region would thread one more argument through forty call sites
+ * for numbers that never change a pixel. */
+static _Thread_local struct {
+    uint64_t regions;
+    bool open;         /* between fv_region_begin and fv_region_end */
+    double start;      /* fv_time_ms() at fv_region_begin */
+    double parallel;   /* ms inside closed regions, less their serial parts (and the open one's) */
+} t_clock;
 
-uint64_t fv_region_count(void) { return t_regions; }
-void fv_region_opened(void) { t_regions++; }
+uint64_t fv_region_count(void) { return t_clock.regions; }
+void fv_region_opened(void) { t_clock.regions++; }
+
+void fv_region_begin(void)
+{
+    t_clock.regions++;
+    t_clock.open = true;
+    t_clock.start = fv_time_ms();
+}
+
+void fv_region_end(void)
+{
+    if (!t_clock.open) return;
+    t_clock.parallel += fv_time_ms() - t_clock.start;
+    t_clock.open = false;
+}
+
+void fv_region_serial(double ms)
+{
+    if (ms > 0.0) t_clock.parallel -= ms;
+}
+
+double fv_region_parallel_ms(void) { return t_clock.parallel + (t_clock.open ? fv_time_ms() - t_clock.start : 0.0); }
+
+void fv_team_for(int64_t n, int64_t chunk, fv_range_fn fn, void *ctx)
+{
+    if (chunk < 1) chunk = 1;
+    const int64_t nchunks = (n + chunk - 1) / chunk;
+    /* orphaned: binds to the enclosing region's team (a team of one outside any) */
+#pragma omp for schedule(dynamic, 1)
+    for (int64_t c = 0; c < nchunks; c++) {
+        const int64_t b = c * chunk, e = b + chunk < n ? b + chunk : n;
+        fn(ctx, b, e, omp_get_thread_num());
+    }
+}
 
 int fv_thread_count(int requested)
 {
@@ -28,7 +67,7 @@ bool fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *
     const int ntiles = tx * ty;
     const int nthreads = fv_thread_count(threads);
     int done = 0, stop = 0;
-    fv_region_opened();
+    fv_region_begin();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
     for (int i = 0; i < ntiles; i++) {
         int halt;
@@ -51,6 +90,7 @@ bool fv_parallel_tiles(int width, int height, int threads, fv_tile_fn fn, void *
             stop = 1;
         }
     }
+    fv_region_end();
     if (stop) return false;
     return !progress || progress(progress_user, 1.0);
 }
@@ -63,7 +103,7 @@ bool fv_parallel_for_progress(int64_t n, int64_t chunk, int threads, fv_range_fn
     const int nthreads = fv_thread_count(threads);
     int64_t done = 0;
     int stop = 0;
-    fv_region_opened();
+    fv_region_begin();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
     for (int64_t c = 0; c < nchunks; c++) {
         int halt;
@@ -81,6 +121,7 @@ bool fv_parallel_for_progress(int64_t n, int64_t chunk, int threads, fv_range_fn
             stop = 1;
         }
     }
+    fv_region_end();
     if (stop) return false;
     return !progress || progress(progress_user, 1.0);
 }

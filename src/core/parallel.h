@@ -38,11 +38,32 @@ bool fv_parallel_for_progress(int64_t n, int64_t chunk, int threads, fv_range_fn
                               void *progress_user);
 
 /* The parallel regions the calling thread has opened so far. Every `#pragma omp parallel` in
- * fovea is preceded by fv_region_opened() (fv_parallel_* call it themselves), so that
- * fv_technique_render can report "parallel_regions" per frame: each region wakes the team, and
- * the wake-ups are what pacing depends on (docs/threads.md). tests/cli/test_regions.sh checks the
- * count against the runtime's own. */
+ * fovea is preceded by fv_region_begin() and followed by fv_region_end() (fv_parallel_* and
+ * fv_team_for needs none), so that fv_technique_render can report "parallel_regions" per
+ * frame: each region wakes the team, and the wake-ups are what pacing depends on
+ * (docs/threads.md). tests/cli/test_regions.sh checks the count against the runtime's own.
+ * fv_region_opened() counts a region without timing it (for code not yet paired with an end). */
 uint64_t fv_region_count(void);
 void fv_region_opened(void);
+
+/* The time a frame spends in parallel regions, for each stage's serial share (core/stage_time.h).
+ * fv_region_begin counts the region and starts its clock; fv_region_end, after the region, adds
+ * its wall time to the calling thread's parallel time. Inside a region, the thread that opened it
+ * (`omp master`) reports work only it does while the others wait (before a barrier) with
+ * fv_region_serial(ms), which takes it back out. Regions are not nested (nested parallelism is
+ * off), so one open region per thread is all there is to track. */
+void fv_region_begin(void);
+void fv_region_end(void);
+void fv_region_serial(double ms);
+/* The calling thread's milliseconds inside its regions so far, less their serial parts, an open
+ * region counted up to now. */
+double fv_region_parallel_ms(void);
+
+/* Work-sharing loops for merged regions: called by every thread of an enclosing region (each with
+ * the same arguments), they share [0, n) among the team in chunks of `chunk`, handed out
+ * dynamically as fv_parallel_for does, and end with the team's barrier; no region is opened.
+ * Outside any region the calling thread runs all chunks. fn's `thread` is the team's thread
+ * number. */
+void fv_team_for(int64_t n, int64_t chunk, fv_range_fn fn, void *ctx);
 
 #endif

@@ -34,6 +34,16 @@ void fv_stats_add_count(fv_stats *s, const char *counter, double v)
 {
     if (s) add(s->counter, &s->n_counters, counter, v);
 }
+void fv_stats_add_serial_ms(fv_stats *s, const char *stage, double ms)
+{
+    if (s) add(s->serial, &s->n_serial, stage, ms);
+}
+double fv_stats_get_serial_ms(const fv_stats *s, const char *stage)
+{
+    for (int i = 0; i < s->n_serial; i++)
+        if (strcmp(s->serial[i].name, stage) == 0) return s->serial[i].value;
+    return -1.0;
+}
 double fv_stats_get_ms(const fv_stats *s, const char *stage) { return get(s->stage, s->n_stages, stage); }
 double fv_stats_get_count(const fv_stats *s, const char *counter) { return get(s->counter, s->n_counters, counter); }
 

@@ -9,7 +9,8 @@
  *    weight 0.72, a 90-degree crease (|dn|^2 = 2) is cut at e^-22.
  *  - sigma_position is off by default because only the caller knows the scene's scale (the photon
  *    mappers pass twice their gather radius).
- * Limits: 25 taps per pixel per pass, one image-sized scratch buffer; pixels whose colour is not
+ * Limits: 25 taps per pixel per pass, one image-sized scratch buffer (a workspace's, kept from call
+ * to call, or the call's own); pixels whose colour is not
  * finite are never used as taps and keep their own value.
  */
 #include <math.h>
@@ -30,6 +31,53 @@ void fv_atrous_opts_default(fv_atrous_opts *o)
     o->sigma_position = 0.0f;
     o->demod = NULL;
     o->threads = 0;
+    o->workspace = NULL;
+}
+
+struct fv_atrous {
+    float *tmp;       /* the ping-pong image, 3 floats per pixel */
+    double *row_lum;  /* per-row luminance sums */
+    long *row_count;
+    size_t npix;      /* capacity of tmp, in pixels */
+    int rows;         /* capacity of the row sums */
+};
+
+fv_status fv_atrous_create(fv_atrous **out, fv_error *err)
+{
+    *out = calloc(1, sizeof **out);
+    return *out ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+}
+
+void fv_atrous_destroy(fv_atrous *a)
+{
+    if (!a) return;
+    free(a->tmp), free(a->row_lum), free(a->row_count);
+    free(a);
+}
+
+/* Grows a's buffers to a w x h image; on failure a keeps what it had. */
+static bool reserve(fv_atrous *a, int w, int h)
+{
+    const size_t n = (size_t)w * (size_t)h;
+    if (n > a->npix) {
+        float *t = fv_alloc_array(n, 3 * sizeof(float));
+        if (!t) return false;
+        free(a->tmp);
+        a->tmp = t;
+        a->npix = n;
+    }
+    if (h > a->rows) {
+        double *l = fv_alloc_array((size_t)h, sizeof(double));
+        long *c = fv_alloc_array((size_t)h, sizeof(long));
+        if (!l || !c) {
+            free(l), free(c);
+            return false;
+        }
+        free(a->row_lum), free(a->row_count);
+        a->row_lum = l, a->row_count = c;
+        a->rows = h;
+    }
+    return true;
 }
 
 static const float k_b3[5] = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
@@ -57,22 +105,22 @@ fv_status fv_atrous_filter(float *rgb, const float *normal, const float *positio
     if (!(o->sigma_position >= 0.0f))
         return fv_error_set(err, FV_ERR_INVALID, "A-Trous filter: sigma_position %g must be >= 0 (0 = off)",
                             (double)o->sigma_position);
-    size_t n = (size_t)w * h;
-    float *tmp = fv_alloc_array(n, 3 * sizeof(float));
-    /* per-row luminance sums: added up in row order after, the same whatever the thread count */
-    double *row_lum = fv_alloc_array((size_t)h, sizeof(double));
-    long *row_count = fv_alloc_array((size_t)h, sizeof(long));
-    if (!tmp || !row_lum || !row_count) {
-        free(tmp), free(row_lum), free(row_count);
+    fv_atrous own = {0}, *ws = o->workspace ? o->workspace : &own;
+    if (!reserve(ws, w, h)) {
+        free(own.tmp), free(own.row_lum), free(own.row_count);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory filtering a %dx%d image", w, h);
     }
+    float *tmp = ws->tmp;
+    /* per-row luminance sums: added up in row order after, the same whatever the thread count */
+    double *row_lum = ws->row_lum;
+    long *row_count = ws->row_count;
     const float inv_n2 = 1.0f / (o->sigma_normal * o->sigma_normal);
     const float inv_x2 = o->sigma_position > 0.0f ? 1.0f / (o->sigma_position * o->sigma_position) : 0.0f;
     const float *demod = o->demod;
     float scale = 1.0f;
     /* One region for the whole filter (docs/threads.md): every pass is an `omp for` whose implicit
      * barrier orders it before the next, instead of a region per pass that wakes the team again. */
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel num_threads(fv_thread_count(o->threads))
     {
         #pragma omp for schedule(static)
@@ -167,6 +215,7 @@ fv_status fv_atrous_filter(float *rgb, const float *normal, const float *positio
                 }
         }
     }
-    free(tmp), free(row_lum), free(row_count);
+    fv_region_end();
+    free(own.tmp), free(own.row_lum), free(own.row_count);
     return FV_OK;
 }

@@ -16,6 +16,13 @@
 
 #include "fovea/status.h"
 
+/* Reusable scratch for the filter (one image of colour and two rows of sums), grown to the largest
+ * image filtered and kept, so that a technique filtering every frame allocates nothing once warmed
+ * up. Owned by the caller (its state); one filter at a time per workspace. */
+typedef struct fv_atrous fv_atrous;
+fv_status fv_atrous_create(fv_atrous **out, fv_error *err);
+void fv_atrous_destroy(fv_atrous *a);
+
 typedef struct fv_atrous_opts {
     int iterations;        /* 5: taps 1, 2, 4, 8, 16 pixels apart (reach 2*31 = 62 pixels) */
     float sigma_color;     /* relative to the image's mean luminance, so exposure does not matter */
@@ -25,7 +32,8 @@ typedef struct fv_atrous_opts {
      * pixel); the colour is divided by its demodulation factors before filtering and multiplied
      * back after, inside the filter's one parallel region. NULL (default): colour as it is. */
     const float *demod;
-    int threads;           /* OpenMP threads, 0 (default): all (core/parallel.h) */
+    int threads;           /* OpenMP threads, 0 (default): all (core/parallel.h); the frame's --threads */
+    fv_atrous *workspace;  /* reused scratch; NULL (default): allocated for this call and freed */
 } fv_atrous_opts;
 
 void fv_atrous_opts_default(fv_atrous_opts *o);
@@ -33,7 +41,8 @@ void fv_atrous_opts_default(fv_atrous_opts *o);
 /* Filters rgb (w*h*3 linear floats) in place, in one parallel region (a barrier between passes), guided by normal and position (3 floats per pixel
  * each, either may be NULL: its weight is then 1). o NULL means the defaults; an infinite sigma
  * turns its term off. Deterministic and independent of the thread count. Bad sizes or sigmas ->
- * FV_ERR_INVALID, no scratch memory -> FV_ERR_NOMEM (rgb is then unchanged). */
+ * FV_ERR_INVALID, no scratch memory -> FV_ERR_NOMEM (rgb is then unchanged). The scratch is
+ * o->workspace's when given (grown if this image is larger), else allocated for the call. */
 fv_status fv_atrous_filter(float *rgb, const float *normal, const float *position, int w, int h, const fv_atrous_opts *o,
                            fv_error *err);
 

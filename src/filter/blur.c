@@ -480,7 +480,7 @@ fv_status fv_blur_variable(float *rgb, int w, int h, const float *sigma, int thr
     if (!cost) return fv_error_set(err, FV_ERR_NOMEM, "out of memory blurring a %dx%d image", w, h);
     float smax = 0.0f;
     int bad = 0;
-fv_region_opened();
+fv_region_begin();
 #pragma omp parallel for schedule(static) num_threads(nt) reduction(max : smax) reduction(| : bad)
     for (int y = 0; y < h; y++) {
         const float *row = sigma + (size_t)y * w;
@@ -498,6 +498,7 @@ fv_region_opened();
         smax = m > smax ? m : smax;
         bad |= b;
     }
+fv_region_end();
     if (bad) {
         free(cost);
         for (size_t i = 0; i < (size_t)w * h; i++)
@@ -545,7 +546,7 @@ fv_region_opened();
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory blurring a %dx%d image", w, h);
     }
 
-fv_region_opened();
+fv_region_begin();
 #pragma omp parallel num_threads(nt)
     {
 #pragma omp for schedule(static, 1)
@@ -554,6 +555,7 @@ fv_region_opened();
 #pragma omp for schedule(static, 1)
         for (int i = 0; i < nslab; i++) slab_run(&j, &slabs[i]);
     }
+fv_region_end();
     for (int i = 0; i < nslab; i++) slab_free(&slabs[i]);
     free(slabs), free(zero), free(j.ks.off), free(j.ks.k);
     return FV_OK;

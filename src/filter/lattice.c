@@ -15,7 +15,7 @@ long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, cons
     const int S0 = o->step > 1 ? o->step : 1;
     const float inv_s2 = o->sigma_position > 0.0f ? 1.0f / (o->sigma_position * o->sigma_position) : 0.0f;
     long missing = 0;
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(static) reduction(+ : missing)
     for (int y = 0; y < h; y++) {
         for (int x = 0; x < w; x++) {
@@ -58,11 +58,13 @@ long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, cons
             }
         }
     }
+    fv_region_end();
     return missing;
 }
 
 fv_status fv_lattice_filter(float *rgb, const uint8_t *known, const uint8_t *filter_mask, const float *normal,
-                            const float *position, int w, int h, int step, int iterations, float sigma_position, fv_error *err)
+                            const float *position, int w, int h, int step, int iterations, fv_atrous *workspace, int threads,
+                            float sigma_position, fv_error *err)
 {
     const int S = step > 1 ? step : 1, lw = (w + S - 1) / S, lh = (h + S - 1) / S;
     size_t n = (size_t)lw * lh;
@@ -84,6 +86,8 @@ fv_status fv_lattice_filter(float *rgb, const uint8_t *known, const uint8_t *fil
     fv_atrous_opts_default(&ao);
     ao.sigma_position = sigma_position;
     ao.iterations = iterations;
+    ao.workspace = workspace;
+    ao.threads = threads;
     fv_status rc = fv_atrous_filter(c, nb, pb, lw, lh, &ao, err);
     if (rc == FV_OK)
         for (int ly = 0; ly < lh; ly++)

@@ -14,6 +14,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 #include "fovea/status.h"
+#include "filter/atrous.h"
 
 typedef struct fv_lattice_opts {
     int step;             /* lattice spacing in pixels (>= 1); the lattice is x % step == 0 && y % step == 0 */
@@ -34,8 +35,10 @@ long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, cons
 /* Filters the lattice's known pixels among themselves with `iterations` passes of the À-Trous
  * filter (filter/atrous.h), as an image of ceil(w/step) x ceil(h/step) pixels, before the fill: the
  * periphery is denoised at the resolution it was estimated at. Only pixels with filter_mask[i] != 0
- * are written back (others still guide and feed the filter). sigma_position as for fv_atrous_opts. */
+ * are written back (others still guide and feed the filter). sigma_position, workspace (may be NULL)
+ * and threads as for fv_atrous_opts. */
 fv_status fv_lattice_filter(float *rgb, const uint8_t *known, const uint8_t *filter_mask, const float *normal,
-                            const float *position, int w, int h, int step, int iterations, float sigma_position, fv_error *err);
+                            const float *position, int w, int h, int step, int iterations, fv_atrous *workspace, int threads,
+                            float sigma_position, fv_error *err);
 
 #endif

@@ -142,7 +142,7 @@ void fv_phi_mips_build(fv_phi_mips *m, const float *rgb, int threads)
     if (!m || !rgb) return;
     const size_t stride = 3 * (size_t)m->w;
     const int h0 = m->grid[0].h;
-fv_region_opened();
+fv_region_begin();
 #pragma omp parallel num_threads(fv_thread_count(threads))
     {
 #pragma omp for schedule(static)
@@ -154,6 +154,7 @@ fv_region_opened();
             for (int j = 0; j < m->grid[k].h; j++) halve_row(m, k, j);
         }
     }
+fv_region_end();
 }
 
 /* floor(f) for f > -1 (lookups only see f >= -0.5): truncation, minus one for negative f. */

@@ -395,7 +395,7 @@ static void sweep_holes(fv_svgf *f, float *color, int nt)
     const int w = g->w, h = g->h;
     const uint8_t *kind = f->kind;
     const int max_step = f->o.iterations > 1 ? 1 << (f->o.iterations - 1) : 1;
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
     for (int y = 0; y < h; y++) {
         if (!f->row_holes[y]) continue;
@@ -417,6 +417,7 @@ static void sweep_holes(fv_svgf *f, float *color, int nt)
             for (int ch = 0; ch < 3; ch++) color[3 * p + ch] = ws > 0.0f ? s[ch] / ws : 0.0f;
         }
     }
+    fv_region_end();
 }
 
 /* ---- the frame */
@@ -448,7 +449,7 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
      * region per sweep that wakes the team again (about twenty a frame before). Everything a thread
      * keeps between sweeps (cur) is private and the same on every thread; the state shared between
      * sweeps (pass_cut) is written by one thread inside `single`, whose barrier publishes it. */
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel num_threads(nt)
     {
         sweep_accumulate(f, fr, history);
@@ -471,6 +472,7 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
         }
         sweep_finish(f, fr, cur, f->o.iterations == 0);
     }
+    fv_region_end();
 
     long n_surface = 0, n_hist = 0, n_holes = 0;
     double len_sum = 0.0;

@@ -64,7 +64,7 @@ static float hyab(const float *a, const float *b)
 /* 1D convolution along x (dir 0) or y (dir 1) with clamp-to-edge, one channel. */
 static void conv1d(const float *in, float *out, int w, int h, const float *k, int r, int dir)
 {
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(static)
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -77,6 +77,7 @@ static void conv1d(const float *in, float *out, int w, int h, const float *k, in
             }
             out[(size_t)y * w + x] = s;
         }
+    fv_region_end();
 }
 
 /* Filters one opponent channel with its CSF, a sum of Gaussian terms
@@ -164,7 +165,7 @@ fv_status fv_metrics_flip_map(const float *ref, const float *test, int w, int h,
     /* To YyCxCz (planar); in parallel, like the filters after it (the colour conversion's pow per
      * channel was a serial share of the bench's metrics). */
     for (int k = 0; k < 2; k++) {
-        fv_region_opened();
+        fv_region_begin();
         #pragma omp parallel for schedule(static)
         for (long long i = 0; i < (long long)n; i++) {
             float lin[3], xyz[3];
@@ -175,6 +176,7 @@ fv_status fv_metrics_flip_map(const float *ref, const float *test, int w, int h,
             opp[k][n + i] = 500.0f * (xyz[0] / k_white[0] - yr);
             opp[k][2 * n + i] = 200.0f * (yr - xyz[2] / k_white[2]);
         }
+        fv_region_end();
     }
 
     /* Spatial CSF filtering: the kernel reaches 3 standard deviations of the widest Gaussian. */
@@ -194,7 +196,7 @@ fv_status fv_metrics_flip_map(const float *ref, const float *test, int w, int h,
     hunt_lab(green, lg);
     hunt_lab(blue, lb);
     const float cmax = powf(hyab(lg, lb), qc);
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(static)
     for (long long ii = 0; ii < (long long)n; ii++) {
         size_t i = (size_t)ii;
@@ -212,6 +214,7 @@ fv_status fv_metrics_flip_map(const float *ref, const float *test, int w, int h,
         float de = powf(hyab(lab[0], lab[1]), qc);
         map[i] = de < pc * cmax ? pt / (pc * cmax) * de : pt + (de - pc * cmax) / (cmax - pc * cmax) * (1.0f - pt);
     }
+    fv_region_end();
 
     /* Feature error on the achromatic channel normalised to [0, 1]. */
     const float sigma = 0.5f * 0.082f * ppd;

@@ -23,13 +23,14 @@ void fv_metric_opts_default(fv_metric_opts *o)
 void fv_metrics_prepare(const float *rgb, size_t n, const fv_metric_opts *o, float *out)
 {
     /* parallel: the sRGB encoding's pow per channel was a serial share of the bench's metrics */
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(static)
     for (long long i = 0; i < (long long)(3 * n); i++) {
         float v = rgb[i] * o->exposure;
         if (!isfinite(v)) v = 0.0f; /* a NaN or inf pixel counts as black, not as a poisoned mean */
         out[i] = o->linear ? v : fv_srgb_encode(v);
     }
+    fv_region_end();
 }
 
 /* ---- SSIM (Wang, Bovik, Sheikh, Simoncelli 2004) on luminance, 11x11 Gaussian window, sigma 1.5,
@@ -40,7 +41,7 @@ void fv_metrics_prepare(const float *rgb, size_t n, const fv_metric_opts *o, flo
 
 static void blur_sep(const float *in, float *tmp, float *out, int w, int h, const float *k)
 {
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(static)
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -53,7 +54,8 @@ static void blur_sep(const float *in, float *tmp, float *out, int w, int h, cons
             }
             tmp[(size_t)y * w + x] = (float)(s / ws);
         }
-    fv_region_opened();
+    fv_region_end();
+    fv_region_begin();
     #pragma omp parallel for schedule(static)
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -66,6 +68,7 @@ static void blur_sep(const float *in, float *tmp, float *out, int w, int h, cons
             }
             out[(size_t)y * w + x] = (float)(s / ws);
         }
+    fv_region_end();
 }
 
 fv_status fv_metrics_ssim_map(const float *a, const float *b, int w, int h, float *map, fv_error *err)
@@ -144,7 +147,7 @@ fv_status fv_metrics_compare(const float *ref, const float *test, int w, int h, 
     }
     if (st != FV_OK) goto done;
     /* Per row and region: count, squared error, E, SSIM, FLIP, pixels with a non-finite value. */
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(static)
     for (int y = 0; y < h; y++) {
         double *r = rows + (size_t)y * FV_REGION_COUNT * 6;
@@ -171,6 +174,7 @@ fv_status fv_metrics_compare(const float *ref, const float *test, int w, int h, 
             }
         }
     }
+    fv_region_end();
     memset(out, 0, sizeof *out);
     for (int g = 0; g < FV_REGION_COUNT; g++) {
         double s[6] = {0, 0, 0, 0, 0, 0};

@@ -23,7 +23,7 @@ bound() { # the most regions any of the three frames opened after the merges (be
     cartesian-full) echo 4 ;;
     cartesian | log-polar) echo 5 ;;
     vpolar | linear-falloff) echo 6 ;;       # 34 before (SVGF: about 28 -> 1)
-    fir) echo 10 ;;
+    fir) echo 5 ;;                           # 10 before (its management: 6 regions -> 1)
     fpm-guided) echo 13 ;;
     fpm) echo 15 ;;                          # 21 before
     ir-low) echo 18 ;;
@@ -55,7 +55,7 @@ for m in $("$FOVEA" methods | awk '/^[a-z]/ {print $1}'); do
 done
 # The merged regions give the same bits whatever the thread count (a barrier or a `single` too few
 # would show here as a race): the methods whose stages were restructured, 1 against 3 threads.
-for m in pm fpm vpolar cartesian fipr; do
+for m in pm fpm vpolar cartesian fipr fir; do
   for t in 1 3; do
     "$FOVEA" render "$(scene "$m")" --method "$m" $(params "$m") --size 41x29 --frames 2 --gaze 0.3,0.6 --threads $t \
       --quiet --out "$TMP/t$t.pfm" || fail "$m --threads $t: exited $?"

@@ -282,6 +282,37 @@ static void test_exposure_and_threads(void **st)
     free(a), free(b), free(c1), free(n);
 }
 
+/* A workspace reused across images of other sizes (a larger one first, so the smaller one reads
+ * buffers holding its leftovers) and an explicit thread count give the bytes of a call with its
+ * own scratch. */
+static void test_workspace(void **st)
+{
+    (void)st;
+    fv_error err;
+    fv_atrous *ws;
+    assert_int_equal(fv_atrous_create(&ws, &err), FV_OK);
+    const int sizes[3][2] = {{31, 23}, {12, 9}, {40, 30}};
+    for (int k = 0; k < 3; k++) {
+        const int w = sizes[k][0], h = sizes[k][1];
+        float *a = image(w, h, 0), *b = image(w, h, 0), *n = normals(w, h, 0, 0, 1);
+        unsigned s = 11u + (unsigned)k;
+        for (int i = 0; i < 3 * w * h; i++) {
+            s = s * 1664525u + 1013904223u;
+            a[i] = b[i] = (float)(s >> 8) / 16777216.0f;
+        }
+        fv_atrous_opts o;
+        fv_atrous_opts_default(&o);
+        assert_int_equal(fv_atrous_filter(a, n, NULL, w, h, &o, &err), FV_OK);
+        o.workspace = ws;
+        o.threads = 1 + k % 2;
+        assert_int_equal(fv_atrous_filter(b, n, NULL, w, h, &o, &err), FV_OK);
+        assert_memory_equal(a, b, sizeof(float) * 3 * w * h);
+        free(a), free(b), free(n);
+    }
+    fv_atrous_destroy(ws);
+    fv_atrous_destroy(NULL);
+}
+
 /* Bad arguments fail with FV_ERR_INVALID and a message naming the field; a non-finite pixel is
  * not used by its neighbours. */
 static void test_invalid_and_nonfinite(void **st)
@@ -344,7 +375,7 @@ int main(void)
         cmocka_unit_test(test_constant), cmocka_unit_test(test_noise),      cmocka_unit_test(test_edge),
         cmocka_unit_test(test_one_iteration), cmocka_unit_test(test_two_iterations),
         cmocka_unit_test(test_color_sigma_halves), cmocka_unit_test(test_small_images),
-        cmocka_unit_test(test_position_guide), cmocka_unit_test(test_exposure_and_threads),
+        cmocka_unit_test(test_position_guide), cmocka_unit_test(test_exposure_and_threads), cmocka_unit_test(test_workspace),
         cmocka_unit_test(test_invalid_and_nonfinite), cmocka_unit_test(test_background),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

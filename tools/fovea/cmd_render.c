@@ -97,6 +97,15 @@ static void print_frame(int f, double ms, const fv_stats *stats, bool show_stats
         fprintf(stderr, "  counters:");
         for (int i = 0; i < stats->n_counters; i++) fprintf(stderr, " %s=%.10g", stats->counter[i].name, stats->counter[i].value);
         fputc('\n', stderr);
+        /* each stage's serial part: its time outside parallel regions (docs/threads.md) */
+        if (stats->n_serial > 0) {
+            fprintf(stderr, "  serial:");
+            for (int i = 0; i < stats->n_stages; i++) {
+                const double ser = fv_stats_get_serial_ms(stats, stats->stage[i].name), stage_ms = stats->stage[i].value;
+                if (ser >= 0.0) fprintf(stderr, "  %s %.1f ms (%.0f%%)", stats->stage[i].name, ser, stage_ms > 0.0 ? 100.0 * ser / stage_ms : 0.0);
+            }
+            fputc('\n', stderr);
+        }
     }
 }
 

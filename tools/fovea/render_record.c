@@ -62,6 +62,9 @@ fv_status fv_stats_log_add(fv_stats_log *log, int frame, const fv_frame_views *v
     }
     cJSON *st = cJSON_AddObjectToObject(f, "stages_ms");
     for (int i = 0; i < stats->n_stages; i++) cJSON_AddNumberToObject(st, stats->stage[i].name, stats->stage[i].value);
+    /* the stages whose serial part was measured (docs/threads.md) */
+    cJSON *se = cJSON_AddObjectToObject(f, "serial_ms");
+    for (int i = 0; i < stats->n_serial; i++) cJSON_AddNumberToObject(se, stats->serial[i].name, stats->serial[i].value);
     cJSON *co = cJSON_AddObjectToObject(f, "counters");
     for (int i = 0; i < stats->n_counters; i++) cJSON_AddNumberToObject(co, stats->counter[i].name, stats->counter[i].value);
     return co ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory");

@@ -143,7 +143,7 @@ fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera 
     int *src = fv_alloc_array(np, sizeof(int));
     if (!src) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     int nthreads = fv_thread_count(threads);
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(dynamic, 4) num_threads(nthreads)
     for (int y = 0; y < f->h; y++)
         for (int x = 0; x < f->w; x++) {
@@ -159,6 +159,7 @@ fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera 
             bool ok = !fv_scene_object_dynamic(s, hit.obj) && fv_bsdf_is_smooth(fv_scene_material(s, hit.mat));
             src[i] = ok ? q : -2 - q; /* -2 - q: v is not on a static diffuse surface */
         }
+    fv_region_end();
     /* Lines 8-12. Each previous pixel's paths go to at most one current pixel (the first to claim
      * it, in pixel order). */
     for (size_t i = 0; i < np; i++) {
@@ -352,13 +353,14 @@ fv_status fv_foveated_trace(fv_foveated *f, const fv_scene *s, const fv_camera *
         for (int k = 0; k < f->fbm[i]; k++) task_px[t++] = (int)i;
     trace_ctx c = {s, &cb, m_ls, m_ld, radius, f->max_depth, seed, frame};
     int nthreads = fv_thread_count(threads);
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(dynamic, 64) num_threads(nthreads)
     for (long j = 0; j < ntasks; j++) {
         int px = task_px[j] % f->w, py = task_px[j] / f->w;
         /* The random stream of a path: its pixel, its task number and the frame. */
         trace_path(&c, px, py, (int)j, &res[j]);
     }
+    fv_region_end();
     /* Merge in task order (deterministic): static paths into the pool and fbp, dynamic ones
      * into M_fd. */
     fv_photon_map_clear(&f->fd);

@@ -237,7 +237,7 @@ fv_status fv_photon_guide_learn(fv_photon_guide *g, const fv_photon_job *job, fv
     if (!w) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     uint64_t in = 0, all = 0, nrays = 0;
     /* Integer sums: the same q whatever the thread count or schedule. */
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(dynamic, 256) reduction(+ : in, all, nrays) num_threads(fv_thread_count(job->threads))
     for (int64_t i = 0; i < job->count; i++) {
         fv_rng rng = fv_rng_stream(job->seed, FV_STREAM_PHOTONS(job->stream), (uint64_t)i, 4, (uint64_t)job->frame);
@@ -255,6 +255,7 @@ fv_status fv_photon_guide_learn(fv_photon_guide *g, const fv_photon_job *job, fv
         in += pw.in;
         all += pw.all;
     }
+    fv_region_end();
     build(g, w);
     g->focus_share = all > 0 ? (double)in / (double)all : 0.0;
     free(w);

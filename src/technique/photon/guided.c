@@ -28,6 +28,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/stage_time.h"
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "filter/atrous.h"
@@ -74,6 +75,7 @@ typedef struct gd_state {
     /* per pixel: first-hit normal and position (filters, fill), albedo and emission of the first
      * surface, the periphery's demodulated reflected light; masks */
     float *nbuf, *pbuf, *alb, *emit, *refl;
+    fv_atrous *atrous; /* the filters' scratch, kept from frame to frame */
     uint8_t *need, *focus_px, *lattice_px, *level;
     size_t bufn;
 } gd_state;
@@ -110,6 +112,7 @@ static void gd_destroy(void *state)
     fv_focus_cells_destroy(st->focus);
     fv_focus_cells_destroy(st->mg_focus);
     fv_photon_guide_destroy(st->guide);
+    fv_atrous_destroy(st->atrous);
     free(st->nbuf), free(st->pbuf), free(st->alb), free(st->emit), free(st->refl);
     free(st->need), free(st->focus_px), free(st->lattice_px), free(st->level);
     free(st);
@@ -131,6 +134,7 @@ static fv_status gd_create(const fv_scene *scene, fv_params *params, const fv_lo
     if (s == FV_OK) s = fv_focus_cells_create(&st->focus, err);
     if (s == FV_OK) s = fv_focus_cells_create(&st->mg_focus, err);
     if (s == FV_OK) s = fv_photon_guide_create(st->o.alpha, &st->guide, err);
+    if (s == FV_OK) s = fv_atrous_create(&st->atrous, err);
     if (s != FV_OK) {
         gd_destroy(st);
         return s;
@@ -302,7 +306,7 @@ static void gather_needed(gd_ctx *c, uint64_t *gathers)
     const int w = c->cam.width;
     long n = (long)st->bufn;
     uint64_t g = 0;
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(dynamic, 64) reduction(+ : g) num_threads(fv_thread_count(c->frame->threads))
     for (long i = 0; i < n; i++) {
         const float *nq = &st->nbuf[3 * i];
@@ -322,6 +326,7 @@ static void gather_needed(gd_ctx *c, uint64_t *gathers)
         if (!fv_is_finite3(R)) R = fv_v3s(0.0f); /* counted when the colour is composed */
         for (int q = 0; q < 3; q++) st->refl[3 * i + q] = (&R.x)[q] / st->alb[3 * i + q];
     }
+    fv_region_end();
     *gathers += g;
 }
 
@@ -359,17 +364,17 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
     uint64_t rays = 0;
     int64_t again = 0, again_g = 0;
     fv_kit_phase(&c->prog, f, 0.0, 0.2);
-    double t0 = fv_time_ms();
+    fv_stage_clock t0 = fv_stage_clock_now();
     fv_status rc = fv_dyn_dirs_build(st->dirs, st->scene, err);
     if (rc == FV_OK && (!fv_path_store_ready(st->ls_store) || st->lights_move)) {
         rc = fv_path_store_trace(st->ls_store, &job, &rays, err);
         st->map_ls_n = -1;
     }
     st->n_ls = (double)job.count;
-    fv_stats_add_ms(stats, "light_tracing", fv_time_ms() - t0);
+    fv_stage_stop(stats, "light_tracing", t0);
 
     /* The cells the focus region gathers from. */
-    t0 = fv_time_ms();
+    t0 = fv_stage_clock_now();
     if (rc == FV_OK && !(c->focus_pts = fv_alloc_array((size_t)w * h * 2, sizeof(fv_vec3))))
         rc = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if (rc == FV_OK && !fv_parallel_tiles(w, h, f->threads, focus_tile, c, NULL, NULL)) rc = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
@@ -379,13 +384,13 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
     free(c->focus_pts);
     c->focus_pts = NULL;
     double overlap = fv_focus_cells_overlap(st->focus, st->mg_focus);
-    fv_stats_add_ms(stats, "focus_cells", fv_time_ms() - t0);
+    fv_stage_stop(stats, "focus_cells", t0);
     fv_stats_add_count(stats, "focus_cells", fv_focus_cells_count(st->focus));
 
     /* M_g: kept while the focus region gathers from (mostly) the cells it was guided towards. */
     bool retrace = !st->mg_valid || st->lights_move || st->maps_gamma != c->gamma || overlap < st->o.retrace_overlap;
     fv_kit_phase(&c->prog, f, 0.2, 0.2);
-    t0 = fv_time_ms();
+    t0 = fv_stage_clock_now();
     if (rc == FV_OK && retrace) {
         st->mg_valid = false;
         st->n_g = 0.0;
@@ -413,10 +418,10 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
             st->focus = tmp;
         }
     }
-    fv_stats_add_ms(stats, "guided_tracing", fv_time_ms() - t0);
+    fv_stage_stop(stats, "guided_tracing", t0);
     /* The frame's map: both sets, refreshed near the dynamic objects, weighted, in one grid; kept
      * as it is while nothing moves and neither set was traced again. */
-    t0 = fv_time_ms();
+    t0 = fv_stage_clock_now();
     bool remake = st->map_ls_n < 0 || fv_dyn_dirs_count(st->dirs) > 0 || st->map.cell != c->gamma;
     if (rc == FV_OK && remake) {
         fv_photon_map_clear(&st->map);
@@ -431,7 +436,7 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
         st->map_ls_n = -1;
         fv_photon_map_clear(&st->map);
     }
-    fv_stats_add_ms(stats, "photon_map", fv_time_ms() - t0);
+    fv_stage_stop(stats, "photon_map", t0);
     fv_stats_add_count(stats, "light_photons", n_ls);
     fv_stats_add_count(stats, "guided_photons", st->map.n - n_ls);
     fv_stats_add_count(stats, "guided_retraced", retrace ? 1.0 : 0.0);
@@ -454,16 +459,16 @@ static fv_status finish(gd_ctx *c, fv_film *film, fv_stats *stats, fv_error *err
     const int w = c->cam.width, h = c->cam.height;
     const size_t n = (size_t)w * h;
     fv_status rc = FV_OK;
-    double t0 = fv_time_ms();
+    fv_stage_clock t0 = fv_stage_clock_now();
     if (st->o.filter && st->o.periphery_step > 1)
         /* One pass (taps one lattice pixel apart): more smooth the periphery's light into blotches
          * and raise its MSE (0.000303 with one pass, 0.000354 with four, cornell-fpm at 270x300)
          * without lowering its temporal error. */
-        rc = fv_lattice_filter(st->refl, st->lattice_px, st->lattice_px, st->nbuf, st->pbuf, w, h, st->o.periphery_step, 1,
+        rc = fv_lattice_filter(st->refl, st->lattice_px, st->lattice_px, st->nbuf, st->pbuf, w, h, st->o.periphery_step, 1, st->atrous, c->frame->threads,
                                2.0f * c->gamma, err);
-    fv_stats_add_ms(stats, "lattice_filter", fv_time_ms() - t0);
+    fv_stage_stop(stats, "lattice_filter", t0);
     if (rc != FV_OK) return rc;
-    t0 = fv_time_ms();
+    t0 = fv_stage_clock_now();
     /* The fill reads lattice pixels only: focus pixels hold colour, not demodulated light. */
     fv_lattice_opts lo = {st->o.periphery_step, st->level, 8.0f, 2.0f * c->gamma};
     long missing = fv_lattice_fill(st->refl, st->lattice_px, st->focus_px, st->nbuf, st->pbuf, w, h, &lo, st->need);
@@ -480,12 +485,12 @@ static fv_status finish(gd_ctx *c, fv_film *film, fv_stats *stats, fv_error *err
         memcpy(&c->color[3 * i], &L, sizeof L);
     }
     fv_stats_add_count(stats, "nan_samples", (double)bad);
-    fv_stats_add_ms(stats, "fill", fv_time_ms() - t0);
+    fv_stage_stop(stats, "fill", t0);
     if (!st->o.filter) return FV_OK;
     /* The focus region's bounding box, a few pixels wider so its edge pixels see neighbours on
      * every side. Wider boxes pull the periphery's filled light into the transition (its MSE
      * grew 25% with 32 pixels in cornell-fpm at 270x300, docs/results.md). */
-    t0 = fv_time_ms();
+    t0 = fv_stage_clock_now();
     int x0 = w, y0 = h, x1 = -1, y1 = -1;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++)
@@ -516,6 +521,8 @@ static fv_status finish(gd_ctx *c, fv_film *film, fv_stats *stats, fv_error *err
          * fovea MSE over the caustic (0.000121; 0.000142 with three, 0.000248 with none) and
          * nearly the lowest on a wall (1.6e-5; 3.2e-5 with three, 7.0e-6 with none). */
         ao.iterations = st->o.focus_passes;
+        ao.threads = c->frame->threads;
+        ao.workspace = st->atrous;
         if (rc == FV_OK) rc = fv_atrous_filter(cc, cn, cp, bw, bh, &ao, err);
         for (int y = 0; rc == FV_OK && y < bh; y++)
             for (int x = 0; x < bw; x++) {
@@ -524,7 +531,7 @@ static fv_status finish(gd_ctx *c, fv_film *film, fv_stats *stats, fv_error *err
             }
         free(cc), free(cn), free(cp);
     }
-    fv_stats_add_ms(stats, "filter", fv_time_ms() - t0);
+    fv_stage_stop(stats, "filter", t0);
     (void)film;
     return rc;
 }
@@ -558,10 +565,10 @@ static fv_status gd_render(void *state, const fv_frame *frame, fv_film *film, fv
     if (rc == FV_OK && !reuse) rc = update_maps(c, stats, err);
     if (rc == FV_OK) {
         fv_kit_phase(&c->prog, frame, 0.4, 0.6);
-        double t0 = fv_time_ms();
+        fv_stage_clock t0 = fv_stage_clock_now();
         if (!fv_parallel_tiles(w, h, frame->threads, main_tile, c, fv_kit_progress_fn, &c->prog))
             rc = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
-        fv_stats_add_ms(stats, "render", fv_time_ms() - t0);
+        fv_stage_stop(stats, "render", t0);
         fv_kit_report(c->counters, stats);
         fv_stats_add_count(stats, "fovea_paths", (double)fv_kit_sum(c->counters, FV_KIT_USER1));
     }

@@ -198,7 +198,7 @@ fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, f
     blk *b = fv_calloc_array((size_t)nblocks + 1, sizeof *b);
     if (!b) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     int64_t again = 0;
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(dynamic, 1) reduction(+ : again) num_threads(fv_thread_count(threads))
     for (int64_t k = 0; k < nblocks; k++) {
         blk *o = &b[k];
@@ -228,6 +228,7 @@ fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, f
             }
         }
     }
+    fv_region_end();
     fv_status st = FV_OK;
     for (int64_t k = 0; k < nblocks; k++) {
         if (b[k].oom && st == FV_OK) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory for this frame's photons");

@@ -106,7 +106,7 @@ static void grid_extent(fv_photon_map *m, int nt)
 {
     int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
     const int n = m->n;
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel num_threads(nt)
     {
         int l[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, h[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
@@ -125,6 +125,7 @@ static void grid_extent(fv_photon_map *m, int nt)
             if (h[a] > hi[a]) hi[a] = h[a];
         }
     }
+    fv_region_end();
     long long d[3];
     for (int a = 0; a < 3; a++) {
         if (n == 0) lo[a] = hi[a] = 0;
@@ -176,7 +177,7 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
     const int n = m->n;
     /* per thread: the running offset where its block of cells starts (the scan's second level) */
     uint32_t block_sum[FV_MAX_THREADS + 1];
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel num_threads(nt)
     {
         const int t = omp_get_thread_num(), T = omp_get_num_threads();
@@ -226,6 +227,7 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
             m->nz[d] = ph->n.z;
         }
     }
+    fv_region_end();
     /* Padding far away: a block reading past the last photon never accepts it. */
     for (int k = 0; k < FV_PHOTON_BLOCK; k++) {
         m->px[n + k] = m->py[n + k] = m->pz[n + k] = INFINITY;

@@ -49,7 +49,7 @@ bool fv_photon_blocks(const fv_photon_job *job, int64_t nblocks, fv_photon_block
 {
     int64_t done = 0;
     int stop = 0;
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(dynamic, 1) num_threads(fv_thread_count(job->threads))
     for (int64_t b = 0; b < nblocks; b++) {
         int halt;
@@ -66,6 +66,7 @@ bool fv_photon_blocks(const fv_photon_job *job, int64_t nblocks, fv_photon_block
             stop = 1;
         }
     }
+    fv_region_end();
     return !stop;
 }
 

@@ -30,6 +30,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/stage_time.h"
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "core/rng.h"
@@ -73,6 +74,7 @@ typedef struct pm_state {
     /* first-hit buffers of the left eye: normal, position, what it reflects, object id (filter,
      * stereo) */
     float *nbuf, *pbuf, *rbuf;
+    fv_atrous *atrous; /* the filter's scratch, kept from frame to frame */
     int32_t *obuf;
     size_t bufn;
     /* the left eye of a stereo frame, for the right eye (Sec. 3.3) */
@@ -131,8 +133,10 @@ static fv_status pm_create_mode(pm_mode mode, const fv_scene *scene, fv_params *
     fv_photon_map_init(&st->all);
     fv_status s = read_opts(mode, params, &st->o, err);
     if (s == FV_OK && mode != MODE_PM) s = fv_pmt_maps_init(&st->tm, scene, err);
+    if (s == FV_OK) s = fv_atrous_create(&st->atrous, err);
     if (s != FV_OK) {
         fv_pmt_maps_free(&st->tm);
+        fv_atrous_destroy(st->atrous);
         free(st);
         return s;
     }
@@ -151,6 +155,7 @@ static void pm_destroy(void *state)
     fv_photon_map_free(&st->all);
     fv_pmt_maps_free(&st->tm);
     fv_foveated_destroy(st->fov);
+    fv_atrous_destroy(st->atrous);
     free(st->nbuf);
     free(st->pbuf);
     free(st->rbuf);
@@ -372,9 +377,9 @@ static fv_status render_eye_pass(render_ctx *c, fv_film *film, bool right, fv_st
     c->right = right;
     c->out = fv_film_views_of(film);
     memset(c->counters, 0, sizeof *c->counters);
-    double t0 = fv_time_ms();
+    fv_stage_clock t0 = fv_stage_clock_now();
     bool done = fv_parallel_tiles(cam->width, cam->height, c->frame->threads, render_tile, c, fv_kit_progress_fn, &c->prog);
-    fv_stats_add_ms(stats, "render", fv_time_ms() - t0);
+    fv_stage_stop(stats, "render", t0);
     fv_kit_report(c->counters, stats);
     if (right)
         fv_stats_add_count(stats, "reprojected_fraction", (double)fv_kit_sum(c->counters, FV_KIT_USER0) / ((double)cam->width * cam->height));
@@ -404,12 +409,13 @@ static fv_status finish_fpm(render_ctx *c, fv_film *film, fv_stats *stats, fv_er
     free(l), free(f), free(mask);
     float *col = fv_film_color(film);
     uint64_t bad = 0;
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel for schedule(static) reduction(+ : bad) num_threads(fv_thread_count(c->frame->threads))
     for (long long i = 0; i < (long long)n; i++) {
         fv_vec3 L = fv_kit_guard(estimate_sums(c, &c->sums[i]), &bad);
         col[3 * i] = L.x, col[3 * i + 1] = L.y, col[3 * i + 2] = L.z;
     }
+    fv_region_end();
     fv_stats_add_count(stats, "nan_samples", (double)bad);
     return FV_OK;
 }
@@ -417,7 +423,7 @@ static fv_status finish_fpm(render_ctx *c, fv_film *film, fv_stats *stats, fv_er
 static fv_status filter_film(pm_state *st, fv_film *film, float gamma, int threads, fv_stats *stats, fv_error *err)
 {
     if (!st->o.filter) return FV_OK;
-    double t0 = fv_time_ms();
+    fv_stage_clock t0 = fv_stage_clock_now();
     fv_atrous_opts ao;
     fv_atrous_opts_default(&ao);
     ao.sigma_position = 2.0f * gamma; /* surfaces further apart than the gather disc do not mix */
@@ -426,8 +432,9 @@ static fv_status filter_film(pm_state *st, fv_film *film, float gamma, int threa
      * colour instead of taking their neighbours' (issue 25). */
     ao.demod = st->rbuf;
     ao.threads = threads;
+    ao.workspace = st->atrous;
     fv_status rc = fv_atrous_filter(fv_film_color(film), st->nbuf, st->pbuf, fv_film_width(film), fv_film_height(film), &ao, err);
-    fv_stats_add_ms(stats, "filter", fv_time_ms() - t0);
+    fv_stage_stop(stats, "filter", t0);
     return rc;
 }
 
@@ -448,16 +455,16 @@ static fv_status foveated_photons(pm_state *st, render_ctx *c, int w, int h, flo
     }
     fv_fov_stats fs;
     memset(&fs, 0, sizeof fs);
-    double t0 = fv_time_ms();
+    fv_stage_clock t0 = fv_stage_clock_now();
     /* No previous camera: Alg. 2 then deletes every old path, whose flux moving lights made stale. */
     const fv_camera *prev = st->o.tpm && !st->lights_move ? frame->prev_camera : NULL;
     if (rc == FV_OK) rc = fv_foveated_manage(st->fov, s, frame->camera, prev, c->eye, frame->gaze, frame->threads, &fs, err);
-    fv_stats_add_ms(stats, "tpm", fv_time_ms() - t0);
-    t0 = fv_time_ms();
+    fv_stage_stop(stats, "tpm", t0);
+    t0 = fv_stage_clock_now();
     if (rc == FV_OK)
         rc = fv_foveated_trace(st->fov, s, frame->camera, &st->tm.ls, &st->tm.ld, c->gamma, cell, frame->seed, frame->index, frame->threads, &fs,
                                err);
-    fv_stats_add_ms(stats, "foveated_tracing", fv_time_ms() - t0);
+    fv_stage_stop(stats, "foveated_tracing", t0);
     fv_stats_add_count(stats, "foveated_photons", fs.photons_static + fs.photons_dynamic);
     fv_stats_add_count(stats, "paths_traced", (double)fs.paths_traced);
     fv_stats_add_count(stats, "paths_reused", (double)fs.paths_reused);
@@ -509,9 +516,9 @@ static fv_status render_left(pm_state *st, render_ctx *c, fv_film *film, fv_stat
         /* Progress: each pass an equal share; in it, tracing light the first 40%, pixels the rest. */
         double base = (double)pass / passes, span = 1.0 / passes;
         fv_kit_phase(&c->prog, frame, base, 0.4 * span);
-        double t0 = fv_time_ms();
+        fv_stage_clock t0 = fv_stage_clock_now();
         rc = light_tracing(st, frame, cell, pass, n_light, &c->prog, stats, err);
-        fv_stats_add_ms(stats, "light_tracing", fv_time_ms() - t0);
+        fv_stage_stop(stats, "light_tracing", t0);
         if (rc == FV_OK && st->mode == MODE_FPM) rc = foveated_photons(st, c, w, h, cell, stats, err);
         c->pass = pass;
         if (rc == FV_OK && st->mode == MODE_FPM && !(c->sums = fv_alloc_array((size_t)w * h, sizeof *c->sums)))
@@ -519,9 +526,9 @@ static fv_status render_left(pm_state *st, render_ctx *c, fv_film *film, fv_stat
         fv_kit_phase(&c->prog, frame, base + 0.4 * span, 0.6 * span);
         if (rc == FV_OK) rc = render_eye_pass(c, film, false, stats, err);
         if (rc == FV_OK && c->sums) {
-            double t1 = fv_time_ms();
+            fv_stage_clock t1 = fv_stage_clock_now();
             rc = finish_fpm(c, film, stats, err);
-            fv_stats_add_ms(stats, "render", fv_time_ms() - t1);
+            fv_stage_stop(stats, "render", t1);
             fv_stats_add_count(stats, "eta", c->eta);
         }
         free(c->sums);

@@ -13,6 +13,7 @@
  */
 #include <stdlib.h>
 #include <string.h>
+#include "core/stage_time.h"
 #include "core/blocks.h"
 #include "device/cuda_backend.h"
 #include "film/film_sums.h"
@@ -165,10 +166,10 @@ static fv_status pt_render_flat(pt_state *st, const fv_frame *frame, fv_film *fi
     memset(&j, 0, sizeof j);
     fv_status s = fv_frame_camera(cam, film, &j.f.cam, err);
     if (s != FV_OK) return s;
-    double t0 = fv_time_ms();
+    fv_stage_clock t0 = fv_stage_clock_now();
     if ((s = fv_scene_export_update(st->flat, st->scene, err)) != FV_OK) return s;
     if (st->cuda && (s = fv_cuda_pt_update(st->cuda, fv_scene_export_view(st->flat), err)) != FV_OK) return s;
-    fv_stats_add_ms(stats, "scene", fv_time_ms() - t0);
+    fv_stage_stop(stats, "scene", t0);
     j.scene = fv_scene_export_view(st->flat);
     j.f.seed = frame->seed;
     j.f.eye = frame->eye;
@@ -179,9 +180,10 @@ static fv_status pt_render_flat(pt_state *st, const fv_frame *frame, fv_film *fi
     if (st->cuda) {
         uint64_t rays = 0, bad = 0;
         double kernel_ms = 0.0;
-        t0 = fv_time_ms();
+        /* on the device: no serial share (the CPU only waits) */
+        const double tk = fv_time_ms();
         if ((s = fv_cuda_pt_render(st->cuda, &j.f, &j.out, &rays, &bad, &kernel_ms, err)) != FV_OK) return s;
-        fv_stats_add_ms(stats, "trace", fv_time_ms() - t0);
+        fv_stats_add_ms(stats, "trace", fv_time_ms() - tk);
         fv_stats_add_ms(stats, "kernel", kernel_ms);
         fv_stats_add_count(stats, "rays", (double)rays);
         fv_stats_add_count(stats, "nan_samples", (double)bad);
@@ -190,9 +192,9 @@ static fv_status pt_render_flat(pt_state *st, const fv_frame *frame, fv_film *fi
     if (!(j.counters = fv_kit_counters_create())) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_kit_progress prog = {0};
     fv_kit_phase(&prog, frame, 0.0, 1.0);
-    t0 = fv_time_ms();
+    t0 = fv_stage_clock_now();
     bool done = fv_parallel_tiles(cam->width, cam->height, frame->threads, pt_flat_tile, &j, fv_kit_progress_fn, &prog);
-    fv_stats_add_ms(stats, "trace", fv_time_ms() - t0);
+    fv_stage_stop(stats, "trace", t0);
     fv_kit_report(j.counters, stats);
     fv_kit_counters_destroy(j.counters);
     return done ? FV_OK : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
@@ -214,9 +216,9 @@ static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv
     j.sums = fv_film_sums(film);
     fv_kit_progress prog = {0};
     fv_kit_phase(&prog, frame, 0.0, 1.0);
-    double t0 = fv_time_ms();
+    fv_stage_clock t0 = fv_stage_clock_now();
     bool done = fv_parallel_tiles(cam->width, cam->height, frame->threads, pt_tile, &j, fv_kit_progress_fn, &prog);
-    fv_stats_add_ms(stats, "trace", fv_time_ms() - t0);
+    fv_stage_stop(stats, "trace", t0);
     fv_kit_report(j.counters, stats);
     int range_spp = 0;
     for (int b = st->block_first; b < st->block_first + st->block_count; b++) range_spp += fv_blocks_samples(st->opt.spp, b);

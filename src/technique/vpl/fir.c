@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "core/stage_time.h"
 #include "filter/atrous.h"
 #include "scene/light.h"
 #include "technique/class.h"
@@ -108,6 +109,7 @@ typedef struct fir_state {
     fv_vpl_frame vf;
     fv_vec3 *tmp;       /* the box filter's horizontal pass */
     float *fbuf;        /* atrous: rgb, normal, position */
+    fv_atrous *atrous;  /* atrous: the filter's scratch, kept from frame to frame */
     size_t ntmp;
     /* last management's counts, reported by both eyes */
     int moved_count[FV_MAX_THREADS];
@@ -123,6 +125,7 @@ static void fir_destroy(void *state)
     fv_voxels_destroy(st->vox);
     fv_density_grid_destroy(st->grid);
     fv_cubemaps_destroy(st->maps);
+    fv_atrous_destroy(st->atrous);
     fv_vpl_frame_free(&st->vf);
     void *bufs[] = {st->reached, st->owner, st->queue, st->cell_area, st->weight,   st->scratch,   st->dens_vox,    st->vpl,       st->next,         st->cand,
                     st->cand_ok,  st->cand_imp,  st->picked,      st->old_pos,   st->cand_pos,     st->sel_cand_pos,
@@ -202,6 +205,7 @@ static fv_status fir_create(const fv_scene *scene, fv_params *params, const fv_l
     fv_status s = read_params(st, params, err);
     if (s != FV_OK) goto fail;
     if ((s = fv_voxels_create(scene, st->resolution, &st->vox, err)) != FV_OK) goto fail;
+    if (st->filter == FILTER_ATROUS && (s = fv_atrous_create(&st->atrous, err)) != FV_OK) goto fail;
     int dims[3];
     fv_voxels_dims(st->vox, 0, dims);
     st->ncells = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
@@ -503,46 +507,13 @@ static int cmp_build_key(const void *a, const void *b)
     return (x->index > y->index) - (x->index < y->index);
 }
 
-static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_basis *cam, fv_stats *stats, uint64_t *rays,
-                        fv_error *err)
+/* The management's serial steps, done by one thread between the parallel ones (manage). */
+
+/* After the update (Alg. 4 line 3): the moved count, the dropped VPLs' maps freed and the kept
+ * ones packed; returns how many candidates to bounce (Sec. 3.1), *n_old the VPLs kept and *need
+ * the VPLs to resample. */
+static int manage_after_update(fir_state *st, int *n_old_out, int *need_out)
 {
-    const fv_scene *s = st->scene;
-    const int threads = frame->threads;
-    par_ctx pc;
-    memset(&pc, 0, sizeof pc);
-    pc.st = st;
-    pc.frame = frame;
-    pc.cam = cam;
-    pc.gx = frame->gaze.x * (float)cam->width;
-    pc.gy = frame->gaze.y * (float)cam->height;
-    /* The foveal radius is the paper's fraction of the width (`radius`), unless the frame's eye
-     * model has a fovea covering the whole screen (a missing gaze under `widen`, docs/gaze.md):
-     * then every visible voxel has acuity 1 and candidates come from the whole screen. */
-    fv_eye_model def;
-    const fv_eye_model *eye = fv_frame_eye_model(frame, cam->width, cam->height, &def);
-    pc.whole = fv_frame_fovea_covers(frame, eye, cam->width, cam->height);
-    pc.R = pc.whole ? (float)fv_eye_fovea_radius_px(eye) : st->radius * (float)cam->width;
-
-    /* Alg. 1 line 4: the dynamic objects at this frame's time; light injected when anything moved. */
-    double t0 = fv_time_ms();
-    const double now = fv_scene_time(s);
-    const bool moved = !st->have_time || now != st->last_time;
-    if (st->has_dynamic && moved) {
-        fv_voxels_update_dynamic(st->vox);
-        count_density_voxels(st);
-    }
-    double t1 = fv_time_ms();
-    if (!st->have_time || (moved && (st->has_dynamic || fv_scene_lights_move(s))))
-        *rays += fv_vpl_inject(st->vox, s, frame->seed, (uint64_t)frame->index, st->area_samples, st->scratch, threads);
-    st->have_time = true;
-    st->last_time = now;
-    double t2 = fv_time_ms();
-
-    /* Alg. 2 */
-    st->fovea_cells = fv_vpl_foveated_weights(st->vox, cam, &st->vf.gb, pc.gx, pc.gy, pc.R, st->weight, threads);
-    /* Alg. 4 line 3 */
-    memset(st->moved_count, 0, sizeof st->moved_count);
-    fv_parallel_for(st->nvpl, 16, threads, update_range, &pc);
     st->moved = 0;
     for (int t = 0; t < FV_MAX_THREADS; t++) st->moved += st->moved_count[t];
     int n_old = 0;
@@ -562,12 +533,15 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     if (st->total - n_old > need) need = st->total - n_old;
     int m = st->ncand > 2 * need ? st->ncand : 2 * need;
     if (m > st->ncand_cap) m = st->ncand_cap;
-    fv_parallel_for(m, 16, threads, candidates_range, &pc);
-    int made = 0;
-    for (int j = 0; j < m; j++)
-        if (st->cand_ok[j]) st->cand[made++] = st->cand[j];
-    st->made_candidates = made;
-    fv_parallel_for(made, 8, threads, cand_importance_range, &pc);
+    *n_old_out = n_old;
+    *need_out = need;
+    return m;
+}
+
+/* After the candidates' importance: resampling, the selection (Eq. 2, Alg. 4 and 5), the new set,
+ * its tiles and the areas its VPLs stand for; returns the new set's size. */
+static int manage_select(fir_state *st, const fv_frame *frame, int made, int n_old, int need)
+{
     /* a candidate the update would drop next frame is not worth a VPL (nor a cube map) */
     for (int j = 0; j < made; j++)
         if (st->cand_imp[j] < st->drop_importance) st->cand_imp[j] = 0.0f;
@@ -622,11 +596,100 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     for (int i = 0; i < n; i++) fv_density_grid_add(st->grid, st->vpl[i].p, 1);
     mark_reached(st);
     vpl_cell_areas(st);
-    double t3 = fv_time_ms();
+    return n;
+}
 
-    /* Eq. 3 */
-    fv_parallel_for(n, 8, threads, radiosity_range, &pc);
-    double t4 = fv_time_ms();
+static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_basis *cam, fv_stats *stats, uint64_t *rays,
+                        fv_error *err)
+{
+    const fv_scene *s = st->scene;
+    const int threads = frame->threads;
+    par_ctx pc;
+    memset(&pc, 0, sizeof pc);
+    pc.st = st;
+    pc.frame = frame;
+    pc.cam = cam;
+    pc.gx = frame->gaze.x * (float)cam->width;
+    pc.gy = frame->gaze.y * (float)cam->height;
+    /* The foveal radius is the paper's fraction of the width (`radius`), unless the frame's eye
+     * model has a fovea covering the whole screen (a missing gaze under `widen`, docs/gaze.md):
+     * then every visible voxel has acuity 1 and candidates come from the whole screen. */
+    fv_eye_model def;
+    const fv_eye_model *eye = fv_frame_eye_model(frame, cam->width, cam->height, &def);
+    pc.whole = fv_frame_fovea_covers(frame, eye, cam->width, cam->height);
+    pc.R = pc.whole ? (float)fv_eye_fovea_radius_px(eye) : st->radius * (float)cam->width;
+
+    /* Alg. 1 line 4: the dynamic objects at this frame's time; light injected when anything moved. */
+    const double now = fv_scene_time(s);
+    const bool moved = !st->have_time || now != st->last_time;
+    const bool inject = !st->have_time || (moved && (st->has_dynamic || fv_scene_lights_move(s)));
+    st->have_time = true;
+    st->last_time = now;
+    memset(st->moved_count, 0, sizeof st->moved_count);
+    st->fovea_cells = 0;
+    uint64_t inject_rays = 0;
+    int n = 0, m = 0, made = 0, n_old = 0, need = 0;
+    fv_stage_clock c0, c1, c2, c3, c4;
+    /* One parallel region from the voxels to the VPLs' radiosity (docs/threads.md): each parallel
+     * step is a work-sharing loop of the team (fv_team_for, its barrier orders it before the next),
+     * each serial step (the management's bookkeeping between them) is done by the thread that opened
+     * the region (`master`, so its time counts as serial in --stats) while the others wait at the
+     * barrier after it. Every step reads and writes what it did as separate regions. */
+    c0 = fv_stage_clock_now();
+    fv_region_begin();
+#pragma omp parallel num_threads(fv_thread_count(threads))
+    {
+#pragma omp master
+        {
+            const double ts = fv_time_ms();
+            if (st->has_dynamic && moved) {
+                fv_voxels_update_dynamic(st->vox);
+                count_density_voxels(st);
+            }
+            fv_region_serial(fv_time_ms() - ts);
+            c1 = fv_stage_clock_now();
+        }
+#pragma omp barrier
+        if (inject) fv_vpl_inject_team(st->vox, s, frame->seed, (uint64_t)frame->index, st->area_samples, st->scratch, &inject_rays);
+#pragma omp master
+        c2 = fv_stage_clock_now();
+        /* Alg. 2 (no barrier needed before it: the injection's last one ordered everything) */
+        fv_vpl_foveated_weights_team(st->vox, cam, &st->vf.gb, pc.gx, pc.gy, pc.R, st->weight, &st->fovea_cells);
+        /* Alg. 4 line 3 */
+        fv_team_for(st->nvpl, 16, update_range, &pc);
+#pragma omp master
+        {
+            const double ts = fv_time_ms();
+            m = manage_after_update(st, &n_old, &need);
+            fv_region_serial(fv_time_ms() - ts);
+        }
+#pragma omp barrier
+        fv_team_for(m, 16, candidates_range, &pc);
+#pragma omp master
+        {
+            const double ts = fv_time_ms();
+            made = 0;
+            for (int j = 0; j < m; j++)
+                if (st->cand_ok[j]) st->cand[made++] = st->cand[j];
+            st->made_candidates = made;
+            fv_region_serial(fv_time_ms() - ts);
+        }
+#pragma omp barrier
+        fv_team_for(made, 8, cand_importance_range, &pc);
+#pragma omp master
+        {
+            const double ts = fv_time_ms();
+            n = manage_select(st, frame, made, n_old, need);
+            fv_region_serial(fv_time_ms() - ts);
+            c3 = fv_stage_clock_now();
+        }
+#pragma omp barrier
+        /* Eq. 3 */
+        fv_team_for(n, 8, radiosity_range, &pc);
+    }
+    fv_region_end();
+    c4 = fv_stage_clock_now();
+    *rays += inject_rays;
 
     /* cube maps: every VPL without one, then moved ones and the oldest, up to rebuild x n */
     int budget = st->visibility == 0 ? (int)ceilf(st->rebuild * (float)n) : 0;
@@ -646,15 +709,15 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     }
     fv_status status = st->maps ? fv_cubemaps_build_many(st->maps, s, st->build_idx, st->build_pos, st->build_nrm, nb, threads, err) : FV_OK;
     st->built_maps = nb;
-    double t5 = fv_time_ms();
+    fv_stage_clock c5 = fv_stage_clock_now();
     st->frames++;
 
     for (int t = 0; t < FV_MAX_THREADS; t++) *rays += pc.rays[t];
-    fv_stats_add_ms(stats, "voxelize", t1 - t0);
-    fv_stats_add_ms(stats, "inject", t2 - t1);
-    fv_stats_add_ms(stats, "vpl_generation", t3 - t2);
-    fv_stats_add_ms(stats, "radiosity", t4 - t3);
-    fv_stats_add_ms(stats, "cube_maps", t5 - t4);
+    fv_stage_add(stats, "voxelize", c0, c1);
+    fv_stage_add(stats, "inject", c1, c2);
+    fv_stage_add(stats, "vpl_generation", c2, c3);
+    fv_stage_add(stats, "radiosity", c3, c4);
+    fv_stage_add(stats, "cube_maps", c4, c5);
     return status;
 }
 
@@ -720,7 +783,7 @@ static void box5(fir_state *st)
         }
 }
 
-static fv_status filter_indirect(fir_state *st, fv_error *err)
+static fv_status filter_indirect(fir_state *st, int threads, fv_error *err)
 {
     if (st->filter == FILTER_BOX) {
         box5(st);
@@ -740,6 +803,8 @@ static fv_status filter_indirect(fir_state *st, fv_error *err)
     fv_atrous_opts o;
     fv_atrous_opts_default(&o);
     o.sigma_position = INFINITY;
+    o.threads = threads;
+    o.workspace = st->atrous;
     fv_status s = fv_atrous_filter(rgb, nrm, NULL, st->vf.gb.width, st->vf.gb.height, &o, err);
     if (s != FV_OK) return s;
     for (size_t i = 0; i < n; i++) st->vf.indirect[i] = fv_v3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
@@ -764,7 +829,7 @@ static fv_status fir_render(void *state, const fv_frame *frame, fv_film *film, f
         st->managed_index = frame->index;
     }
     if (status == FV_OK) {
-        double t1 = fv_time_ms();
+        fv_stage_clock t1 = fv_stage_clock_now();
         build_tile_lists(st);
         fv_vpl_gather g = {s, st->lights, st->visibility == 0 ? st->maps : NULL, (fv_cube_filter)st->cube_filter, 0.0f};
         const float c = fv_vpl_clamp_distance(s, st->clamp);
@@ -774,13 +839,13 @@ static fv_status fir_render(void *state, const fv_frame *frame, fv_film *film, f
         ok = fv_vpl_pass_indirect(&g, &vf->gb, &tiles, frame->threads, vf->indirect, vf->counters, &vf->prog);
         if (ok) {
             scale_tiles(st);
-            status = filter_indirect(st, err);
+            status = filter_indirect(st, frame->threads, err);
         }
-        double t2 = fv_time_ms();
-        fv_stats_add_ms(stats, "shading", t2 - t1);
+        fv_stage_clock t2 = fv_stage_clock_now();
+        fv_stage_add(stats, "shading", t1, t2);
         fv_kit_phase(&vf->prog, frame, 0.8, 0.2);
         if (ok && status == FV_OK) ok = fv_vpl_pass_direct(s, &vf->gb, frame, st->area_samples, vf->direct, vf->counters, &vf->prog);
-        fv_stats_add_ms(stats, "direct", fv_time_ms() - t2);
+        fv_stage_stop(stats, "direct", t2);
     }
     if (status == FV_OK && ok) {
         fv_stats_add_count(stats, "valid_vpls", st->nvpl);

@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/stage_time.h"
 #include "core/alloc.h"
 #include "scene/light.h"
 #include "technique/class.h"
@@ -111,6 +112,14 @@ static fv_status ir_low_create(const fv_scene *scene, fv_params *params, const f
     return ir_create_common(scene, params, true, state, err);
 }
 
+/* A stage's time and serial part summed over ir-low's batches (none: 0 ms, 0 serial). */
+static void add_batches(fv_stats *stats, const fv_stats *sum, const char *stage)
+{
+    const double serial = fv_stats_get_serial_ms(sum, stage);
+    fv_stats_add_ms(stats, stage, fv_stats_get_ms(sum, stage));
+    fv_stats_add_serial_ms(stats, stage, serial > 0.0 ? serial : 0.0);
+}
+
 static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
     ir_state *st = state;
@@ -120,16 +129,16 @@ static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv
     if (status != FV_OK) return status;
 
     /* The same VPLs for both eyes of a frame: they depend on the frame, not the eye. */
-    double t1 = fv_time_ms();
+    fv_stage_clock t1 = fv_stage_clock_now();
     int64_t walks = 0;
     int n = fv_vpl_from_light_walks(s, frame->seed, (uint64_t)frame->index, st->vpls, st->bounces, st->lights, &walks, &vf->rays);
-    double t2 = fv_time_ms();
-    fv_stats_add_ms(stats, "vpls", t2 - t1);
+    fv_stage_clock t2 = fv_stage_clock_now();
+    fv_stage_add(stats, "vpls", t1, t2);
 
     fv_kit_phase(&vf->prog, frame, 0.0, 0.1);
     bool ok = fv_vpl_pass_direct(s, &vf->gb, frame, st->area_samples, vf->direct, vf->counters, &vf->prog);
-    double t3 = fv_time_ms();
-    fv_stats_add_ms(stats, "direct", t3 - t2);
+    fv_stage_clock t3 = fv_stage_clock_now();
+    fv_stage_add(stats, "direct", t2, t3);
 
     fv_vpl_gather g = {s, st->lights, NULL, FV_CUBE_NEAREST, 0.0f};
     const float c = fv_vpl_clamp_distance(s, st->clamp);
@@ -139,16 +148,16 @@ static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv
         fv_vpl_tiles all = {1, 1, st->ident, offset};
         fv_kit_phase(&vf->prog, frame, 0.1, 0.9);
         if (ok) ok = fv_vpl_pass_indirect(&g, &vf->gb, &all, frame->threads, vf->indirect, vf->counters, &vf->prog);
-        fv_stats_add_ms(stats, "shading", fv_time_ms() - t3);
+        fv_stage_stop(stats, "shading", t3);
     } else {
         /* ir-low: a batch of maps is built, every pixel gathers from it, then the next batch. */
         g.maps = st->maps;
         g.filter = (fv_cube_filter)st->cube_filter;
-        double cube_ms = 0.0, shade_ms = 0.0;
+        fv_stats cube = {0}, shade = {0}; /* the batches' sums, stage by stage */
         int built = 0;
         for (int b0 = 0; ok && b0 < n; b0 += st->batch) {
             const int m = n - b0 < st->batch ? n - b0 : st->batch;
-            double ta = fv_time_ms();
+            fv_stage_clock ta = fv_stage_clock_now();
             for (int k = 0; k < m; k++) {
                 st->lights[b0 + k].map = k;
                 st->pos[k] = st->lights[b0 + k].p;
@@ -157,16 +166,16 @@ static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv
             status = fv_cubemaps_build_many(st->maps, s, st->slots, st->pos, st->nrm, m, frame->threads, err);
             if (status != FV_OK) break;
             built += m;
-            double tb = fv_time_ms();
-            cube_ms += tb - ta;
+            fv_stage_clock tb = fv_stage_clock_now();
+            fv_stage_add(&cube, "cube_maps", ta, tb);
             int offset[2] = {0, m};
             fv_vpl_tiles batch = {1, 1, st->ident + b0, offset};
             fv_kit_phase(&vf->prog, frame, 0.1 + 0.9 * b0 / n, 0.9 * m / n);
             ok = fv_vpl_pass_indirect(&g, &vf->gb, &batch, frame->threads, vf->indirect, vf->counters, &vf->prog);
-            shade_ms += fv_time_ms() - tb;
+            fv_stage_stop(&shade, "shading", tb);
         }
-        fv_stats_add_ms(stats, "cube_maps", cube_ms);
-        fv_stats_add_ms(stats, "shading", shade_ms);
+        add_batches(stats, &cube, "cube_maps");
+        add_batches(stats, &shade, "shading");
         fv_stats_add_count(stats, "cube_maps_built", built);
     }
     if (status == FV_OK && ok) {

@@ -3,6 +3,7 @@
 #include <math.h>
 #include "core/parallel.h"
 #include "core/rng.h"
+#include "fovea/stats.h"
 #include "technique/vpl/direct.h"
 #include "technique/vpl/radiosity.h"
 
@@ -13,12 +14,14 @@ typedef struct inject_job {
     int area_samples;
     float *out;
     int dims[3];
-    uint64_t rays[FV_MAX_THREADS];
+    uint64_t *rays; /* shared by the team: each chunk adds its rays once */
 } inject_job;
 
 static void inject_range(void *ctx, int64_t b, int64_t e, int thread)
 {
+    (void)thread;
     inject_job *j = ctx;
+    uint64_t rays = 0;
     const float h = fv_voxels_cell_size(j->v);
     for (int64_t c = b; c < e; c++) {
         float *o = &j->out[3 * c];
@@ -34,16 +37,18 @@ static void inject_range(void *ctx, int64_t b, int64_t e, int thread)
         const float off = 0.5f * sqrtf(3.0f) * h;
         const fv_vec3 nb = fv_neg(vx.normal);
         fv_vec3 E1 = fv_vpl_direct_irradiance(j->s, fv_madd(centre, vx.normal, off), vx.normal, vx.normal, j->area_samples, &rng,
-                                              &j->rays[thread]);
-        fv_vec3 E2 = fv_vpl_direct_irradiance(j->s, fv_madd(centre, nb, off), nb, nb, j->area_samples, &rng, &j->rays[thread]);
+                                              &rays);
+        fv_vec3 E2 = fv_vpl_direct_irradiance(j->s, fv_madd(centre, nb, off), nb, nb, j->area_samples, &rng, &rays);
         fv_vec3 E = fv_max3(E1) >= fv_max3(E2) ? E1 : E2;
         fv_vec3 L = fv_scale(fv_mul(vx.albedo, E), 1.0f / (float)M_PI);
         o[0] = L.x, o[1] = L.y, o[2] = L.z;
     }
+#pragma omp atomic
+    *j->rays += rays;
 }
 
-uint64_t fv_vpl_inject(fv_voxels *v, const fv_scene *s, uint64_t seed, uint64_t frame, int area_samples, float *scratch,
-                       int threads)
+void fv_vpl_inject_team(fv_voxels *v, const fv_scene *s, uint64_t seed, uint64_t frame, int area_samples, float *scratch,
+                        uint64_t *rays)
 {
     inject_job j = {0};
     j.v = v;
@@ -52,16 +57,21 @@ uint64_t fv_vpl_inject(fv_voxels *v, const fv_scene *s, uint64_t seed, uint64_t 
     j.frame = frame;
     j.area_samples = area_samples;
     j.out = scratch;
+    j.rays = rays;
     fv_voxels_dims(v, 0, j.dims);
     const int64_t n = (int64_t)j.dims[0] * j.dims[1] * j.dims[2];
-    fv_parallel_for(n, 1024, threads, inject_range, &j);
-    /* the setters are not thread-safe (voxels.h): one pass after the parallel work */
-    for (int64_t c = 0; c < n; c++)
-        fv_voxels_set_radiance(v, (int)c, fv_v3(scratch[3 * c], scratch[3 * c + 1], scratch[3 * c + 2]));
-    fv_voxels_build_radiance(v);
-    uint64_t rays = 0;
-    for (int t = 0; t < FV_MAX_THREADS; t++) rays += j.rays[t];
-    return rays;
+    fv_team_for(n, 1024, inject_range, &j);
+    /* the setters are not thread-safe (voxels.h): one pass after the parallel work, by the thread
+     * that opened the region (its serial time is reported), the others waiting at the barrier */
+#pragma omp master
+    {
+        const double t0 = fv_time_ms();
+        for (int64_t c = 0; c < n; c++)
+            fv_voxels_set_radiance(v, (int)c, fv_v3(scratch[3 * c], scratch[3 * c + 1], scratch[3 * c + 2]));
+        fv_voxels_build_radiance(v);
+        fv_region_serial(fv_time_ms() - t0);
+    }
+#pragma omp barrier
 }
 
 fv_vec3 fv_vpl_cone_irradiance(const fv_voxels *v, fv_vec3 p, fv_vec3 n)

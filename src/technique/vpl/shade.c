@@ -2,6 +2,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/stage_time.h"
 #include "technique/vpl/direct.h"
 #include "technique/vpl/shade.h"
 
@@ -187,9 +188,9 @@ fv_status fv_vpl_frame_begin(fv_vpl_frame *vf, const fv_scene *s, const fv_frame
     vf->out = fv_film_views_of(film);
     memset(&vf->prog, 0, sizeof vf->prog);
     vf->rays = 0;
-    const double t0 = fv_time_ms();
+    fv_stage_clock t0 = fv_stage_clock_now();
     fv_gbuffer_trace(&vf->gb, s, &vf->cam, &vf->out, frame->threads, &vf->rays);
-    fv_stats_add_ms(stats, "gbuffer", fv_time_ms() - t0);
+    fv_stage_stop(stats, "gbuffer", t0);
     memset(vf->indirect, 0, n * sizeof *vf->indirect);
     return FV_OK;
 }
@@ -198,10 +199,10 @@ fv_status fv_vpl_frame_end(fv_vpl_frame *vf, fv_vpl_show show, bool ok, fv_statu
 {
     if (status == FV_OK && ok) {
         uint64_t bad = 0;
-        const double t0 = fv_time_ms();
+        fv_stage_clock t0 = fv_stage_clock_now();
         fv_vpl_compose(&vf->gb, show == FV_VPL_SHOW_INDIRECT ? NULL : vf->direct, show == FV_VPL_SHOW_DIRECT ? NULL : vf->indirect,
                        show == FV_VPL_SHOW_ALL, vf->out.color, &bad);
-        fv_stats_add_ms(stats, "compose", fv_time_ms() - t0);
+        fv_stage_stop(stats, "compose", t0);
         fv_kit_count(vf->counters, 0, FV_KIT_NAN, bad);
         fv_kit_count(vf->counters, 0, FV_KIT_RAYS, vf->rays);
         fv_kit_report(vf->counters, stats);

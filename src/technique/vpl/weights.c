@@ -30,12 +30,14 @@ typedef struct weight_job {
     float gx, gy, R;
     float *weight;
     int dims[3];
-    int counts[FV_MAX_THREADS];
+    int *count; /* shared by the team: each chunk adds its cells once */
 } weight_job;
 
 static void weight_range(void *ctx, int64_t b, int64_t e, int thread)
 {
+    (void)thread;
     weight_job *j = ctx;
+    int cells = 0;
     const float h = fv_voxels_cell_size(j->v);
     const float tol = h * sqrtf(3.0f);
     for (int64_t c = b; c < e; c++) {
@@ -53,12 +55,14 @@ static void weight_range(void *ctx, int64_t b, int64_t e, int thread)
         if (fv_gpixel_hit(g) && g->t < dist - tol) continue;
         const float d = hypotf(px - j->gx, py - j->gy);
         j->weight[c] = fv_vpl_acuity(d, j->R);
-        j->counts[thread]++;
+        cells++;
     }
+#pragma omp atomic
+    *j->count += cells;
 }
 
-int fv_vpl_foveated_weights(const fv_voxels *v, const fv_camera_basis *cam, const fv_gbuffer *gb, float gx, float gy, float R,
-                            float *weight, int threads)
+void fv_vpl_foveated_weights_team(const fv_voxels *v, const fv_camera_basis *cam, const fv_gbuffer *gb, float gx, float gy,
+                                  float R, float *weight, int *count)
 {
     weight_job j = {0};
     j.v = v;
@@ -68,12 +72,10 @@ int fv_vpl_foveated_weights(const fv_voxels *v, const fv_camera_basis *cam, cons
     j.gy = gy;
     j.R = R;
     j.weight = weight;
+    j.count = count;
     fv_voxels_dims(v, 0, j.dims);
     const int64_t n = (int64_t)j.dims[0] * j.dims[1] * j.dims[2];
-    fv_parallel_for(n, 4096, threads, weight_range, &j);
-    int count = 0;
-    for (int t = 0; t < FV_MAX_THREADS; t++) count += j.counts[t];
-    return count;
+    fv_team_for(n, 4096, weight_range, &j);
 }
 
 float fv_vpl_importance(const fv_voxels *v, const float *weight, const fv_vpl_dirs *dirs, fv_vec3 p, fv_vec3 n)

@@ -39,9 +39,10 @@ static inline float fv_vpl_acuity(float d, float R) { return d <= R ? 1.0f : R /
 
 /* Alg. 2: weight[c] for every level-0 cell c of the grid (0 for empty or hidden cells), seen by
  * camera cam whose first-hit buffer is gb, gaze at pixel (gx, gy), foveal radius R pixels.
- * Returns how many cells got a weight > 0. */
-int fv_vpl_foveated_weights(const fv_voxels *v, const fv_camera_basis *cam, const fv_gbuffer *gb, float gx, float gy, float R,
-                            float *weight, int threads);
+ * Runs inside a region the caller opened, called by every thread of its team (fv_team_for):
+ * adds how many cells got a weight > 0 to *count (shared); ends with the team's barrier. */
+void fv_vpl_foveated_weights_team(const fv_voxels *v, const fv_camera_basis *cam, const fv_gbuffer *gb, float gx, float gy,
+                                  float R, float *weight, int *count);
 
 /* Alg. 3: the importance of a VPL at p with unit normal n (rays start one cell off the surface). */
 float fv_vpl_importance(const fv_voxels *v, const float *weight, const fv_vpl_dirs *dirs, fv_vec3 p, fv_vec3 n);

@@ -9,6 +9,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/stage_time.h"
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "filter/blur.h"
@@ -381,10 +382,11 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     fv_kit_phase(&prog, frame, 0.0, 0.8);
     job.progress = &prog;
     fv_vp_trace_result tr;
-    double t0 = fv_time_ms();
+    fv_stage_clock t0 = fv_stage_clock_now();
     bool traced = fv_vp_trace(&job, &p->g, &tr);
-    double t_trace = fv_time_ms() - t0;
-    fv_stats_add_ms(stats, "trace", t_trace);
+    const fv_stage_clock t1 = fv_stage_clock_now();
+    const double t_trace = t1.wall - t0.wall;
+    fv_stage_add(stats, "trace", t0, t1);
     fv_stats_add_count(stats, "rays", (double)tr.rays);
     fv_stats_add_count(stats, "samples", (double)tr.paths);
     fv_stats_add_count(stats, "grid_samples", (double)fv_space_sample_count(p->space));
@@ -394,7 +396,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     if (!traced) return fv_error_set(err, FV_ERR_CANCELLED, "render cancelled"); /* history left as it was */
 
     /* 2. denoise in the sample space */
-    t0 = fv_time_ms();
+    t0 = fv_stage_clock_now();
     if (p->o.denoise) {
         bool hist = p->have_prev && prev_cam != NULL;
         if (hist) {
@@ -417,7 +419,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
         if ((s = fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err)) != FV_OK) return s;
         fv_stats_add_count(stats, "history_fraction", info.history_fraction);
     }
-    fv_stats_add_ms(stats, "denoise", fv_time_ms() - t0);
+    fv_stage_stop(stats, "denoise", t0);
     p->prev_cam = basis;
     p->prev_view = view;
     p->have_prev = true;
@@ -425,12 +427,12 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
 
     /* 3. mipmaps along φ (Sec. 3.4) */
     bool identity = fv_space_kind_of(p->space) == FV_SPACE_CARTESIAN && g->w == p->sw && g->h == p->sh;
-    t0 = fv_time_ms();
+    t0 = fv_stage_clock_now();
     if (!identity) fv_phi_mips_build(p->mips, p->g.color, frame->threads);
-    fv_stats_add_ms(stats, "mip", fv_time_ms() - t0);
+    fv_stage_stop(stats, "mip", t0);
 
     /* 4. back to the screen */
-    t0 = fv_time_ms();
+    t0 = fv_stage_clock_now();
     map_ctx mc;
     mc.p = p;
     mc.view = &view;
@@ -448,12 +450,12 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     if (p->coords_state != COORDS_READ) build_radial_lut(p, &view);
     fv_stats_add_count(stats, "map_reused", p->coords_state == COORDS_READ);
     fv_parallel_for(p->sh, 8, frame->threads, map_rows, &mc);
-    fv_stats_add_ms(stats, "map", fv_time_ms() - t0);
+    fv_stage_stop(stats, "map", t0);
 
     /* 5. foveated blur (Sec. 3.5) */
-    t0 = fv_time_ms();
+    t0 = fv_stage_clock_now();
     if (p->o.blur && (s = fv_blur_variable(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, err)) != FV_OK) return s;
-    fv_stats_add_ms(stats, "blur", fv_time_ms() - t0);
+    fv_stage_stop(stats, "blur", t0);
     fv_kit_phase(&prog, frame, 0.8, 0.2);
     return fv_kit_phase_end(&prog, err);
 }
