@@ -6,6 +6,7 @@
 #include <string.h>
 #include "core/alloc.h"
 #include "core/parallel.h"
+#include "core/stage_time.h"
 #include "core/rng.h"
 #include "filter/blur.h"
 #include "technique/kit.h"
@@ -472,7 +473,7 @@ static uint64_t build_mask(job *j, uint64_t *edge_pixels, uint64_t *refreshed)
      * [(x*S) >> 1, (x*S + S - 1) >> 1], and the min filter reads those +-1; so ray u is needed by
      * the pixels x with x*S <= 2u + 3 and x*S + S - 1 >= 2u - 2 (the same in y), and is needed
      * when any of them is in the mask: the same set the scatter marked. */
-    fv_region_opened();
+    fv_region_begin();
     #pragma omp parallel num_threads(fv_thread_count(f->threads))
     {
         #pragma omp for schedule(static) reduction(+ : masked, edges)
@@ -516,6 +517,7 @@ static uint64_t build_mask(job *j, uint64_t *edge_pixels, uint64_t *refreshed)
             }
         }
     }
+    fv_region_end();
     *edge_pixels = edges;
     *refreshed = fresh;
     return masked;
@@ -578,9 +580,9 @@ static fv_status run_pass(job *j, int gw, int gh, fv_tile_fn fn, fv_kit_progress
                           const char *stage, fv_error *err)
 {
     fv_kit_phase(prog, j->frame, base, span);
-    double t0 = fv_time_ms();
+    fv_stage_clock t0 = fv_stage_clock_now();
     fv_parallel_tiles(gw, gh, j->frame->threads, fn, j, fv_kit_progress_fn, prog);
-    fv_stats_add_ms(stats, stage, fv_time_ms() - t0);
+    fv_stage_stop(stats, stage, t0);
     fv_status s = fv_kit_phase_end(prog, err);
     return s != FV_OK ? s : first_error(j, fv_thread_count(j->frame->threads), err);
 }
@@ -621,9 +623,9 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
     }
     uint64_t masked = 0, edges = 0, refreshed = 0;
     if (s == FV_OK && m == FV_SDF_FIPR) {
-        double t0 = fv_time_ms();
+        fv_stage_clock t0 = fv_stage_clock_now();
         masked = build_mask(j, &edges, &refreshed);
-        fv_stats_add_ms(stats, "mask", fv_time_ms() - t0);
+        fv_stage_stop(stats, "mask", t0);
         double span = (double)p->lv[L - 2].w * p->lv[L - 2].h / total;
         j->level = L - 2;
         s = run_pass(j, p->lv[L - 2].w, p->lv[L - 2].h, level_tile, &prog, base, span, stats, "middle", err);
@@ -631,9 +633,9 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
     }
     if (s == FV_OK) s = run_pass(j, p->w, p->h, target_tile, &prog, base, 1.0 - base, stats, "target", err);
     if (s == FV_OK && m == FV_SDF_FIPR && p->o.blur) {
-        double t0 = fv_time_ms();
+        fv_stage_clock t0 = fv_stage_clock_now();
         s = blur_transitions(j, err);
-        fv_stats_add_ms(stats, "blur", fv_time_ms() - t0);
+        fv_stage_stop(stats, "blur", t0);
     }
     if (s != FV_OK) goto done;
     show(j);
