@@ -38,7 +38,7 @@ done
 # fir refines its VPLs over frames: one warm-up frame; the still's error is that of later frames.
 "$FOVEA" render cornell-fir --method pt --spp 256 --size $SIZE --out "$TMP/ref-fir.pfm" --quiet --no-metadata || fail "fir reference"
 out=$("$FOVEA" render cornell-fir --method fir --size $SIZE --out "$TMP/fir.png" 2>&1) || fail "fir still: $out"
-echo "$out" | grep -q '^warm-up: 1 frames' || fail "fir: expected 1 warm-up frame: $out"
+echo "$out" | grep -q '^warm-up: 1 frame at' || fail "fir: expected 1 warm-up frame: $out"
 
 # The metadata says how many frames came first; pt has no temporal state and warms up none.
 "$FOVEA" render cornell --method vpolar --size 32x32 --out "$TMP/v.png" --quiet || fail "vpolar png"

@@ -34,7 +34,8 @@ static void print_entry(int i)
     else printf("the reference; ");
     printf("devices: ");
     print_devices(i);
-    if (fv_technique_still_warmup(i) > 0) printf("; a still warms up %d frames", fv_technique_still_warmup(i));
+    if (fv_technique_still_warmup(i) > 0)
+        printf("; a still warms up %d frame%s", fv_technique_still_warmup(i), fv_technique_still_warmup(i) == 1 ? "" : "s");
     if (fv_technique_warmup_frames(i) > 0) printf("; an MPI block %d", fv_technique_warmup_frames(i));
     printf("; main parameter ");
     print_main(i);
@@ -75,7 +76,7 @@ static void print_method(int i)
     printf("  devices         ");
     print_devices(i);
     printf(" (--device D or --param device=D; docs/gpu.md)\n");
-    printf("  still warm-up   %d frames rendered at frame 0's view before the first written (--warmup N)\n", fv_technique_still_warmup(i));
+    printf("  still warm-up   %d frame(s) rendered at frame 0's view before the first written (--warmup N)\n", fv_technique_still_warmup(i));
     printf("  block warm-up   %d frames an MPI rank's block of a sequence starts with (docs/distributed.md)\n", fv_technique_warmup_frames(i));
     printf("  --spp N sets    %s\n", fv_technique_spp_param(i) ? fv_technique_spp_param(i) : "nothing (refused)");
     printf("  main parameter  ");

@@ -151,7 +151,8 @@ static fv_status warm_up(const render_opts *o, const fv_frame_meta_run *rec, fv_
     fv_status s = fv_driver_warm_up(driver, tech, film, &stats, progress, user, err);
     if (bar) fv_cli_progress_done(bar);
     if (s == FV_OK && bar && !o->quiet)
-        fprintf(stderr, "warm-up: %d frames at frame 0's view in %.1f ms (--warmup N changes it)\n", rec->warmup, fv_time_ms() - t0);
+        fprintf(stderr, "warm-up: %d frame%s at frame 0's view in %.1f ms (--warmup N changes it)\n", rec->warmup, rec->warmup == 1 ? "" : "s",
+                fv_time_ms() - t0);
     return s;
 }
 
