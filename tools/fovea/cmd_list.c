@@ -77,7 +77,7 @@ static void print_method(int i)
     print_devices(i);
     printf(" (--device D or --param device=D; docs/gpu.md)\n");
     printf("  still warm-up   %d frame(s) rendered at frame 0's view before the first written (--warmup N)\n", fv_technique_still_warmup(i));
-    printf("  block warm-up   %d frames an MPI rank's block of a sequence starts with (docs/distributed.md)\n", fv_technique_warmup_frames(i));
+    printf("  block warm-up   %d frame(s) an MPI rank's block of a sequence starts with (docs/distributed.md)\n", fv_technique_warmup_frames(i));
     printf("  --spp N sets    %s\n", fv_technique_spp_param(i) ? fv_technique_spp_param(i) : "nothing (refused)");
     printf("  main parameter  ");
     print_main(i);
