@@ -40,7 +40,8 @@ bool fv_bench_ref_noise_plan(const fv_scenario *sc, fv_bench_ref_noise *rn)
         snprintf(rn->why_not, sizeof rn->why_not, "%s keeps state between frames", m->method);
         return false;
     }
-    /* the reference's samples per pixel: its own parameter, else the method's default */
+    /* the reference's samples per pixel, as the scenario sets them (a reference left at its default is
+     * not probed: the default is rarely what a reference is rendered with) */
     int spp = 0;
     for (int i = 0; i < fv_params_count(m->params); i++)
         if (!strcmp(fv_params_key(m->params, i), key)) spp = atoi(fv_params_value(m->params, i));
