@@ -54,3 +54,21 @@ def emit_warnings(messages):
     for m in messages:
         warnings.warn(m, FoveaWarning, stacklevel=3)
     messages.clear()
+
+
+class Closing:
+    """What every handle-owning object shares: close() at the end of a ``with`` block and when
+    collected (quietly at interpreter shutdown, when the library may already be gone). Subclasses
+    define close(), safe to call twice."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass

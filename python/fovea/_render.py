@@ -14,12 +14,12 @@ import os
 import time as _time
 
 from . import _capi, _convert, _registry
-from ._errors import FoveaError, emit_warnings
+from ._errors import Closing, FoveaError, emit_warnings
 from ._images import Image, check_readable, film_arrays
 from ._scene import Scene, camera_dict
 
 
-class Renderer:
+class Renderer(Closing):
     """Renders frames of ``scene`` with ``method``.
 
     Options (the `fovea render` flag each stands for in brackets):
@@ -157,18 +157,6 @@ class Renderer:
             lib.fv_camera_keys_free(self._cam_keys)
             self._cam_keys = None
         self._scene = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:  # interpreter shutdown: the library may already be gone
-            pass
 
     @property
     def closed(self):

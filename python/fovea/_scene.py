@@ -11,10 +11,10 @@ import os
 import weakref
 
 from . import _capi, _convert
-from ._errors import FoveaError, emit_warnings
+from ._errors import Closing, FoveaError, emit_warnings
 
 
-class Scene:
+class Scene(Closing):
     """A committed scene, ready to render.
 
     ``source``: a built-in name (:func:`fovea.scenes`) or a path. ``point_lights``: (x, y, z, r, g,
@@ -77,18 +77,6 @@ class Scene:
         if getattr(self, "_scene", None) is not None:
             lib.fv_scene_destroy(self._scene)
             self._scene = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:  # interpreter shutdown: the library may already be gone
-            pass
 
     @property
     def closed(self):
