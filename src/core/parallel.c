@@ -51,6 +51,83 @@ void fv_team_for(int64_t n, int64_t chunk, fv_range_fn fn, void *ctx)
     }
 }
 
+void fv_team_progress_init(fv_team_progress *tp, fv_progress_fn fn, void *user)
+{
+    tp->fn = fn;
+    tp->user = user;
+    tp->done = 0;
+    tp->stop = 0;
+    tp->ok = 1;
+}
+
+bool fv_team_for_progress(int64_t n, int64_t chunk, fv_range_fn fn, void *ctx, fv_team_progress *tp)
+{
+    if (chunk < 1) chunk = 1;
+    const int64_t nchunks = (n + chunk - 1) / chunk;
+    /* Every thread enters the loop whatever the cancel says: a thread that skipped a work-sharing
+     * construct its team entered would leave the team's barriers unmatched. */
+#pragma omp for schedule(dynamic, 1)
+    for (int64_t c = 0; c < nchunks; c++) {
+        int halt;
+#pragma omp atomic read
+        halt = tp->stop;
+        if (halt) continue;
+        const int64_t b = c * chunk, e = b + chunk < n ? b + chunk : n;
+        const int thread = omp_get_thread_num();
+        fn(ctx, b, e, thread);
+        int64_t d;
+#pragma omp atomic capture
+        d = ++tp->done;
+        if (tp->fn && thread == 0 && !tp->fn(tp->user, (double)d / (double)nchunks)) {
+#pragma omp atomic write
+            tp->stop = 1;
+        }
+    }
+    /* The loop's barrier has ordered every chunk; thread 0 resets the count and reports the end.
+     * `ok` is written here only, and read by all after the barrier below, before any of them can
+     * reach the next loop's barrier (and so before thread 0 can write it again): the team agrees. */
+#pragma omp master
+    {
+        tp->done = 0;
+        if (!tp->stop && tp->fn && !tp->fn(tp->user, 1.0)) tp->stop = 1;
+        tp->ok = !tp->stop;
+    }
+#pragma omp barrier
+    return tp->ok != 0;
+}
+
+typedef struct team_tiles {
+    int width, height, tx;
+    fv_tile_fn fn;
+    void *ctx;
+} team_tiles;
+
+static void team_tile_range(void *ctx, int64_t b, int64_t e, int thread)
+{
+    const team_tiles *tt = ctx;
+    for (int64_t i = b; i < e; i++) {
+        fv_tile t;
+        t.x0 = (int)(i % tt->tx) * FV_TILE_SIZE;
+        t.y0 = (int)(i / tt->tx) * FV_TILE_SIZE;
+        t.x1 = t.x0 + FV_TILE_SIZE < tt->width ? t.x0 + FV_TILE_SIZE : tt->width;
+        t.y1 = t.y0 + FV_TILE_SIZE < tt->height ? t.y0 + FV_TILE_SIZE : tt->height;
+        t.thread = thread;
+        tt->fn(tt->ctx, &t);
+    }
+}
+
+bool fv_team_tiles(int width, int height, fv_tile_fn fn, void *ctx, fv_team_progress *tp)
+{
+    /* each thread's own copy of the same description (fv_team_for's ctx is the caller's) */
+    const int tx = (width + FV_TILE_SIZE - 1) / FV_TILE_SIZE, ty = (height + FV_TILE_SIZE - 1) / FV_TILE_SIZE;
+    team_tiles tt = {width, height, tx, fn, ctx};
+    if (!tp) {
+        fv_team_for((int64_t)tx * ty, 1, team_tile_range, &tt);
+        return true;
+    }
+    return fv_team_for_progress((int64_t)tx * ty, 1, team_tile_range, &tt, tp);
+}
+
 int fv_thread_count(int requested)
 {
     int n = requested > 0 ? requested : omp_get_max_threads();

@@ -66,4 +66,26 @@ double fv_region_parallel_ms(void);
  * number. */
 void fv_team_for(int64_t n, int64_t chunk, fv_range_fn fn, void *ctx);
 
+/* Progress and cancel for the work-sharing loops of one merged region: declared before the region
+ * (shared by the team), set with fv_team_progress_init. As in fv_parallel_for_progress, only the
+ * thread that opened the region (team thread 0) calls fn, so it never runs concurrently with
+ * itself and runs on the caller's thread. Once fn returns false the cancel is sticky: chunks not
+ * yet started, in this loop and in every later one of the region, run empty. */
+typedef struct fv_team_progress {
+    fv_progress_fn fn; /* NULL: no progress, no cancel */
+    void *user;
+    int64_t done;      /* chunks finished in the current loop */
+    int stop;          /* cancelled */
+    int ok;            /* the last loop's result, published to the team behind a barrier */
+} fv_team_progress;
+void fv_team_progress_init(fv_team_progress *tp, fv_progress_fn fn, void *user);
+
+/* fv_team_for with progress(user, fraction) from thread 0 and last 1, as fv_parallel_for_progress
+ * does; returns false (on every thread alike) when the region was cancelled. Two barriers more than
+ * fv_team_for: one to reset the count, one to publish the result. */
+bool fv_team_for_progress(int64_t n, int64_t chunk, fv_range_fn fn, void *ctx, fv_team_progress *tp);
+/* fv_parallel_tiles as a step of a merged region: the same tiles, handed out dynamically to the
+ * team, with tp's progress and cancel (tp NULL: none). */
+bool fv_team_tiles(int width, int height, fv_tile_fn fn, void *ctx, fv_team_progress *tp);
+
 #endif

@@ -239,8 +239,8 @@ static void build_range(void *ctx, int64_t b, int64_t e, int thread)
     for (int64_t k = b; k < e; k++) build_one(j->m, j->s, j->soup, j->idx[k], j->pos[k], j->nrm ? &j->nrm[k] : NULL);
 }
 
-fv_status fv_cubemaps_build_many(fv_cubemaps *m, const fv_scene *s, const int *indices, const fv_vec3 *positions,
-                                 const fv_vec3 *normals, int count, int threads, fv_error *err)
+fv_status fv_cubemaps_check(const fv_cubemaps *m, const int *indices, const fv_vec3 *positions, const fv_vec3 *normals,
+                            int count, fv_error *err)
 {
     for (int k = 0; k < count; k++) {
         if (indices[k] < 0 || indices[k] >= m->count)
@@ -248,12 +248,32 @@ fv_status fv_cubemaps_build_many(fv_cubemaps *m, const fv_scene *s, const int *i
         if (!fv_is_finite3(positions[k]) || (normals && !fv_is_finite3(normals[k])))
             return fv_error_set(err, FV_ERR_INVALID, "cube map %d: VPL position or normal is not finite", indices[k]);
     }
-    if (count == 0) return FV_OK;
-    fv_tri_soup *soup;
-    fv_status st = soup_for(m, s, &soup, err);
-    if (st != FV_OK) return st;
+    return FV_OK;
+}
+
+fv_status fv_cubemaps_prepare(const fv_cubemaps *m, const fv_scene *s, fv_tri_soup **soup, fv_error *err)
+{
+    return soup_for(m, s, soup, err);
+}
+
+void fv_cubemaps_release(fv_tri_soup *soup) { fv_tri_soup_destroy(soup); }
+
+void fv_cubemaps_build_team(fv_cubemaps *m, const fv_scene *s, const fv_tri_soup *soup, const int *indices,
+                            const fv_vec3 *positions, const fv_vec3 *normals, int count)
+{
     build_job j = {m, s, soup, indices, positions, normals};
     /* One map per chunk: a map is the unit of work and is written by one thread only. */
+    fv_team_for(count, 1, build_range, &j);
+}
+
+fv_status fv_cubemaps_build_many(fv_cubemaps *m, const fv_scene *s, const int *indices, const fv_vec3 *positions,
+                                 const fv_vec3 *normals, int count, int threads, fv_error *err)
+{
+    fv_status st = fv_cubemaps_check(m, indices, positions, normals, count, err);
+    if (st != FV_OK || count == 0) return st;
+    fv_tri_soup *soup;
+    if ((st = soup_for(m, s, &soup, err)) != FV_OK) return st;
+    build_job j = {m, s, soup, indices, positions, normals};
     fv_parallel_for(count, 1, threads, build_range, &j);
     fv_tri_soup_destroy(soup);
     return FV_OK;

@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/parallel.h"
 #include "core/stage_time.h"
 #include "core/alloc.h"
 #include "scene/light.h"
@@ -135,45 +136,84 @@ static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv
     fv_stage_clock t2 = fv_stage_clock_now();
     fv_stage_add(stats, "vpls", t1, t2);
 
-    fv_kit_phase(&vf->prog, frame, 0.0, 0.1);
-    bool ok = fv_vpl_pass_direct(s, &vf->gb, frame, st->area_samples, vf->direct, vf->counters, &vf->prog);
-    fv_stage_clock t3 = fv_stage_clock_now();
-    fv_stage_add(stats, "direct", t2, t3);
-
     fv_vpl_gather g = {s, st->lights, NULL, FV_CUBE_NEAREST, 0.0f};
     const float c = fv_vpl_clamp_distance(s, st->clamp);
     g.clamp2 = c * c;
+    bool ok = true;
     if (!st->low) {
+        fv_kit_phase(&vf->prog, frame, 0.0, 0.1);
+        ok = fv_vpl_pass_direct(s, &vf->gb, frame, st->area_samples, vf->direct, vf->counters, &vf->prog);
+        fv_stage_clock t3 = fv_stage_clock_now();
+        fv_stage_add(stats, "direct", t2, t3);
         int offset[2] = {0, n};
         fv_vpl_tiles all = {1, 1, st->ident, offset};
         fv_kit_phase(&vf->prog, frame, 0.1, 0.9);
         if (ok) ok = fv_vpl_pass_indirect(&g, &vf->gb, &all, frame->threads, vf->indirect, vf->counters, &vf->prog);
         fv_stage_stop(stats, "shading", t3);
     } else {
-        /* ir-low: a batch of maps is built, every pixel gathers from it, then the next batch. */
+        /* ir-low: a batch of maps is built, every pixel gathers from it, then the next batch; the
+         * direct pass and every batch in one parallel region (docs/threads.md): each parallel step
+         * is a work-sharing loop of the team whose barrier orders it before the next, each serial
+         * step (a batch's centres, the progress phase, the clocks) is done by the thread that opened
+         * the region while the others wait at the barrier after it. Same sums in the same order as
+         * a region per pass: a pixel's batches are added in batch order, each by one thread. */
         g.maps = st->maps;
         g.filter = (fv_cube_filter)st->cube_filter;
         fv_stats cube = {0}, shade = {0}; /* the batches' sums, stage by stage */
         int built = 0;
-        for (int b0 = 0; ok && b0 < n; b0 += st->batch) {
-            const int m = n - b0 < st->batch ? n - b0 : st->batch;
-            fv_stage_clock ta = fv_stage_clock_now();
-            for (int k = 0; k < m; k++) {
-                st->lights[b0 + k].map = k;
-                st->pos[k] = st->lights[b0 + k].p;
-                st->nrm[k] = st->lights[b0 + k].n;
+        fv_tri_soup *soup = NULL; /* the frame's triangles, rasterised into every batch's maps */
+        status = n > 0 ? fv_cubemaps_prepare(st->maps, s, &soup, err) : FV_OK;
+        fv_team_progress tp;
+        fv_team_progress_init(&tp, fv_kit_progress_fn, &vf->prog);
+        fv_stage_clock t3 = t2, ta = t2, tb = t2;
+        fv_kit_phase(&vf->prog, frame, 0.0, 0.1);
+        if (status == FV_OK) {
+            fv_region_begin();
+#pragma omp parallel num_threads(fv_thread_count(frame->threads))
+            {
+                bool go = fv_vpl_pass_direct_team(s, &vf->gb, frame, st->area_samples, vf->direct, vf->counters, &tp);
+#pragma omp master
+                {
+                    t3 = fv_stage_clock_now();
+                    fv_stage_add(stats, "direct", t2, t3);
+                }
+                /* every thread reads `status` after the barrier that follows its only writer */
+                for (int b0 = 0; go && b0 < n; b0 += st->batch) {
+                    const int m = n - b0 < st->batch ? n - b0 : st->batch;
+#pragma omp master
+                    {
+                        const double ts = fv_time_ms();
+                        ta = fv_stage_clock_now();
+                        for (int k = 0; k < m; k++) {
+                            st->lights[b0 + k].map = k;
+                            st->pos[k] = st->lights[b0 + k].p;
+                            st->nrm[k] = st->lights[b0 + k].n;
+                        }
+                        status = fv_cubemaps_check(st->maps, st->slots, st->pos, st->nrm, m, err);
+                        fv_kit_phase(&vf->prog, frame, 0.1 + 0.9 * b0 / n, 0.9 * m / n);
+                        fv_region_serial(fv_time_ms() - ts);
+                    }
+#pragma omp barrier
+                    if (status != FV_OK) break;
+                    fv_cubemaps_build_team(st->maps, s, soup, st->slots, st->pos, st->nrm, m);
+#pragma omp master
+                    {
+                        built += m;
+                        tb = fv_stage_clock_now();
+                        fv_stage_add(&cube, "cube_maps", ta, tb);
+                    }
+                    int offset[2] = {0, m};
+                    fv_vpl_tiles batch = {1, 1, st->ident + b0, offset};
+                    go = fv_vpl_pass_indirect_team(&g, &vf->gb, &batch, vf->indirect, vf->counters, &tp);
+#pragma omp master
+                    fv_stage_stop(&shade, "shading", tb);
+                }
+#pragma omp master
+                ok = go;
             }
-            status = fv_cubemaps_build_many(st->maps, s, st->slots, st->pos, st->nrm, m, frame->threads, err);
-            if (status != FV_OK) break;
-            built += m;
-            fv_stage_clock tb = fv_stage_clock_now();
-            fv_stage_add(&cube, "cube_maps", ta, tb);
-            int offset[2] = {0, m};
-            fv_vpl_tiles batch = {1, 1, st->ident + b0, offset};
-            fv_kit_phase(&vf->prog, frame, 0.1 + 0.9 * b0 / n, 0.9 * m / n);
-            ok = fv_vpl_pass_indirect(&g, &vf->gb, &batch, frame->threads, vf->indirect, vf->counters, &vf->prog);
-            fv_stage_stop(&shade, "shading", tb);
+            fv_region_end();
         }
+        fv_cubemaps_release(soup);
         add_batches(stats, &cube, "cube_maps");
         add_batches(stats, &shade, "shading");
         fv_stats_add_count(stats, "cube_maps_built", built);

@@ -42,6 +42,13 @@ bool fv_vpl_pass_direct(const fv_scene *s, const fv_gbuffer *gb, const fv_frame 
     return fv_parallel_tiles(gb->width, gb->height, frame->threads, direct_tile, &j, fv_kit_progress_fn, prog);
 }
 
+bool fv_vpl_pass_direct_team(const fv_scene *s, const fv_gbuffer *gb, const fv_frame *frame, int area_samples, fv_vec3 *direct,
+                             fv_kit_counters *counters, fv_team_progress *tp)
+{
+    direct_job j = {s, gb, frame, area_samples, direct, counters};
+    return fv_team_tiles(gb->width, gb->height, direct_tile, &j, tp);
+}
+
 typedef struct indirect_job {
     const fv_vpl_gather *g;
     const fv_gbuffer *gb;
@@ -79,7 +86,6 @@ static void indirect_tile_rays(indirect_job *j, const fv_tile *t)
 typedef struct map_job {
     indirect_job *j;
     int bx; /* blocks per row */
-    uint64_t lookups[FV_MAX_THREADS];
 } map_job;
 
 static void indirect_blocks_maps(void *ctx, int64_t b0, int64_t b1, int thread)
@@ -121,7 +127,8 @@ static void indirect_blocks_maps(void *ctx, int64_t b0, int64_t b1, int thread)
                 for (int i = 0; i < np; i++) j->sum[pix[i]] = fv_add(j->sum[pix[i]], acc[i]);
             }
     }
-    mj->lookups[thread] += lookups;
+    /* the kit's counters are per thread: no lock, the same sum whatever thread counted */
+    fv_kit_count(j->counters, thread, FV_VPL_SLOT_LOOKUPS, lookups);
 }
 
 static void indirect_tile(void *ctx, const fv_tile *t) { indirect_tile_rays(ctx, t); }
@@ -131,16 +138,19 @@ bool fv_vpl_pass_indirect(const fv_vpl_gather *g, const fv_gbuffer *gb, const fv
 {
     indirect_job j = {g, gb, tiles, sum, counters};
     if (!g->maps) return fv_parallel_tiles(gb->width, gb->height, threads, indirect_tile, &j, fv_kit_progress_fn, prog);
-    map_job mj;
-    memset(&mj, 0, sizeof mj);
-    mj.j = &j;
-    mj.bx = (gb->width + MAP_BLOCK - 1) / MAP_BLOCK;
+    map_job mj = {&j, (gb->width + MAP_BLOCK - 1) / MAP_BLOCK};
     const int64_t blocks = (int64_t)mj.bx * ((gb->height + MAP_BLOCK - 1) / MAP_BLOCK);
-    bool ok = fv_parallel_for_progress(blocks, 1, threads, indirect_blocks_maps, &mj, fv_kit_progress_fn, prog);
-    uint64_t lookups = 0;
-    for (int t = 0; t < FV_MAX_THREADS; t++) lookups += mj.lookups[t];
-    fv_kit_count(counters, 0, FV_VPL_SLOT_LOOKUPS, lookups);
-    return ok;
+    return fv_parallel_for_progress(blocks, 1, threads, indirect_blocks_maps, &mj, fv_kit_progress_fn, prog);
+}
+
+bool fv_vpl_pass_indirect_team(const fv_vpl_gather *g, const fv_gbuffer *gb, const fv_vpl_tiles *tiles, fv_vec3 *sum,
+                               fv_kit_counters *counters, fv_team_progress *tp)
+{
+    indirect_job j = {g, gb, tiles, sum, counters};
+    if (!g->maps) return fv_team_tiles(gb->width, gb->height, indirect_tile, &j, tp);
+    map_job mj = {&j, (gb->width + MAP_BLOCK - 1) / MAP_BLOCK};
+    const int64_t blocks = (int64_t)mj.bx * ((gb->height + MAP_BLOCK - 1) / MAP_BLOCK);
+    return fv_team_for_progress(blocks, 1, indirect_blocks_maps, &mj, tp);
 }
 
 void fv_vpl_compose(const fv_gbuffer *gb, const fv_vec3 *direct, const fv_vec3 *indirect, bool emitted, float *rgb,

@@ -39,6 +39,14 @@ bool fv_vpl_pass_direct(const fv_scene *s, const fv_gbuffer *gb, const fv_frame 
 bool fv_vpl_pass_indirect(const fv_vpl_gather *g, const fv_gbuffer *gb, const fv_vpl_tiles *tiles, int threads,
                           fv_vec3 *sum, fv_kit_counters *counters, fv_kit_progress *prog);
 
+/* The two passes as steps of a merged region (docs/threads.md): called by every thread of the
+ * region's team with the same arguments, progress and cancel through tp (core/parallel.h, its fn
+ * fv_kit_progress_fn); the same sums as the passes above. */
+bool fv_vpl_pass_direct_team(const fv_scene *s, const fv_gbuffer *gb, const fv_frame *frame, int area_samples, fv_vec3 *direct,
+                             fv_kit_counters *counters, fv_team_progress *tp);
+bool fv_vpl_pass_indirect_team(const fv_vpl_gather *g, const fv_gbuffer *gb, const fv_vpl_tiles *tiles, fv_vec3 *sum,
+                               fv_kit_counters *counters, fv_team_progress *tp);
+
 /* ---- the buffers of one frame, and its first and last steps ---- */
 
 /* What `show` selects: the image, or one of its two terms alone (without emitted light). */
