@@ -46,4 +46,13 @@ void fv_atrous_opts_default(fv_atrous_opts *o);
 fv_status fv_atrous_filter(float *rgb, const float *normal, const float *position, int w, int h, const fv_atrous_opts *o,
                            fv_error *err);
 
+/* The filter as a step of a caller's parallel region (docs/threads.md), for a frame that runs
+ * several stages in one: fv_atrous_prepare checks o (fv_atrous_filter's errors) and grows ws to a
+ * w x h image, once, before the region; fv_atrous_team is then called by every thread of the
+ * region's team with the same arguments and o->workspace = ws (the same passes and barriers as
+ * fv_atrous_filter, no region opened, nothing allocated; o->threads is the region's). Same result
+ * bit for bit. */
+fv_status fv_atrous_prepare(fv_atrous *ws, int w, int h, const fv_atrous_opts *o, fv_error *err);
+void fv_atrous_team(float *rgb, const float *normal, const float *position, int w, int h, const fv_atrous_opts *o);
+
 #endif

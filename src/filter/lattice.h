@@ -12,6 +12,7 @@
 #define FV_FILTER_LATTICE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 #include "fovea/status.h"
 #include "filter/atrous.h"
@@ -40,5 +41,18 @@ long fv_lattice_fill(float *rgb, const uint8_t *known, const uint8_t *skip, cons
 fv_status fv_lattice_filter(float *rgb, const uint8_t *known, const uint8_t *filter_mask, const float *normal,
                             const float *position, int w, int h, int step, int iterations, fv_atrous *workspace, int threads,
                             float sigma_position, fv_error *err);
+
+/* Both as steps of a caller's parallel region (docs/threads.md): called by every thread of the
+ * team with the same arguments, each ends with the team's barrier, neither opens a region nor
+ * allocates; same results bit for bit. fv_lattice_fill_team adds its count to *missing (shared,
+ * zeroed before the region). fv_lattice_filter_team takes ao (iterations, sigma_position;
+ * ao->workspace prepared with fv_atrous_prepare for at least the lattice's ceil(w/step) x
+ * ceil(h/step)) and scratch of fv_lattice_scratch_floats(w, h, step) floats, the caller's, kept
+ * from frame to frame. */
+void fv_lattice_fill_team(float *rgb, const uint8_t *known, const uint8_t *skip, const float *normal, const float *position,
+                          int w, int h, const fv_lattice_opts *o, uint8_t *need, long *missing);
+size_t fv_lattice_scratch_floats(int w, int h, int step);
+void fv_lattice_filter_team(float *rgb, const uint8_t *known, const uint8_t *filter_mask, const float *normal,
+                            const float *position, int w, int h, int step, const fv_atrous_opts *ao, float *scratch);
 
 #endif

@@ -77,7 +77,10 @@ typedef struct gd_state {
     float *nbuf, *pbuf, *alb, *emit, *refl;
     fv_atrous *atrous; /* the filters' scratch, kept from frame to frame */
     uint8_t *need, *focus_px, *lattice_px, *level;
+    fv_vec3 *focus_pts; /* focus pass: up to two gather points per sampled pixel (NaN: none) */
+    float *box;         /* the lattice's images, then the focus region's box: 9 floats per pixel */
     size_t bufn;
+    fv_kit_counters *counters; /* the frame's, zeroed at its start */
 } gd_state;
 
 static fv_status read_opts(fv_params *p, gd_opts *o, fv_error *err)
@@ -113,8 +116,10 @@ static void gd_destroy(void *state)
     fv_focus_cells_destroy(st->mg_focus);
     fv_photon_guide_destroy(st->guide);
     fv_atrous_destroy(st->atrous);
+    fv_kit_counters_destroy(st->counters);
     free(st->nbuf), free(st->pbuf), free(st->alb), free(st->emit), free(st->refl);
     free(st->need), free(st->focus_px), free(st->lattice_px), free(st->level);
+    free(st->focus_pts), free(st->box);
     free(st);
 }
 
@@ -135,6 +140,7 @@ static fv_status gd_create(const fv_scene *scene, fv_params *params, const fv_lo
     if (s == FV_OK) s = fv_focus_cells_create(&st->mg_focus, err);
     if (s == FV_OK) s = fv_photon_guide_create(st->o.alpha, &st->guide, err);
     if (s == FV_OK) s = fv_atrous_create(&st->atrous, err);
+    if (s == FV_OK && !(st->counters = fv_kit_counters_create())) s = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if (s != FV_OK) {
         gd_destroy(st);
         return s;
@@ -144,11 +150,14 @@ static fv_status gd_create(const fv_scene *scene, fv_params *params, const fv_lo
     return FV_OK;
 }
 
+/* The frame's buffers, made when the image size changes and kept while it does not, so that a
+ * frame allocates nothing once warmed up (docs/threads.md). */
 static fv_status ensure_buffers(gd_state *st, size_t n, fv_error *err)
 {
     if (st->bufn == n) return FV_OK;
     free(st->nbuf), free(st->pbuf), free(st->alb), free(st->emit), free(st->refl);
     free(st->need), free(st->focus_px), free(st->lattice_px), free(st->level);
+    free(st->focus_pts), free(st->box);
     st->nbuf = fv_alloc_array(n, 3 * sizeof(float));
     st->pbuf = fv_alloc_array(n, 3 * sizeof(float));
     st->alb = fv_alloc_array(n, 3 * sizeof(float));
@@ -158,7 +167,11 @@ static fv_status ensure_buffers(gd_state *st, size_t n, fv_error *err)
     st->focus_px = fv_alloc_array(n, 1);
     st->lattice_px = fv_alloc_array(n, 1);
     st->level = fv_alloc_array(n, 1);
-    bool ok = st->nbuf && st->pbuf && st->alb && st->emit && st->refl && st->need && st->focus_px && st->lattice_px && st->level;
+    st->focus_pts = fv_alloc_array(n, 2 * sizeof(fv_vec3));
+    /* a lattice (step >= 1) and the focus region's box are both at most the image */
+    st->box = fv_alloc_array(n, 9 * sizeof(float));
+    bool ok = st->nbuf && st->pbuf && st->alb && st->emit && st->refl && st->need && st->focus_px && st->lattice_px && st->level &&
+              st->focus_pts && st->box;
     st->bufn = ok ? n : 0;
     return ok ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory for fpm-guided's %zu-pixel buffers", n);
 }
@@ -175,7 +188,7 @@ typedef struct gd_ctx {
     double e_t;               /* eccentricity of the transition's outer edge, degrees */
     float *color;
     fv_film_views out;
-    fv_vec3 *focus_pts;       /* focus pass: up to two gather points per sampled pixel (NaN: none) */
+    fv_vec3 *focus_pts;       /* the state's, for the focus pass */
     fv_kit_counters *counters; /* rays, NaN, gathers (USER0), fovea paths (USER1) */
     fv_kit_progress prog;
 } gd_ctx;
@@ -299,15 +312,16 @@ static void main_tile(void *ctx, const fv_tile *t)
     fv_kit_count(c->counters, t->thread, FV_KIT_USER1, fov_paths);
 }
 
-/* Periphery pixels the fill could not reach: gathered after all, with the main pass's path. */
-static void gather_needed(gd_ctx *c, uint64_t *gathers)
+/* Periphery pixels the fill could not reach: gathered after all, with the main pass's path. A step
+ * of the frame's region (every thread): adds its gathers to *gathers (shared), the team's barrier
+ * after. */
+static void gather_needed_team(gd_ctx *c, uint64_t *gathers)
 {
     gd_state *st = c->st;
     const int w = c->cam.width;
     long n = (long)st->bufn;
     uint64_t g = 0;
-    fv_region_begin();
-    #pragma omp parallel for schedule(dynamic, 64) reduction(+ : g) num_threads(fv_thread_count(c->frame->threads))
+    #pragma omp for schedule(dynamic, 64) nowait
     for (long i = 0; i < n; i++) {
         const float *nq = &st->nbuf[3 * i];
         if (!st->need[i] || st->focus_px[i] || (nq[0] == 0.0f && nq[1] == 0.0f && nq[2] == 0.0f)) continue; /* no surface: no light to gather */
@@ -326,8 +340,9 @@ static void gather_needed(gd_ctx *c, uint64_t *gathers)
         if (!fv_is_finite3(R)) R = fv_v3s(0.0f); /* counted when the colour is composed */
         for (int q = 0; q < 3; q++) st->refl[3 * i + q] = (&R.x)[q] / st->alb[3 * i + q];
     }
-    fv_region_end();
+    #pragma omp atomic
     *gathers += g;
+    #pragma omp barrier
 }
 
 /* The two photon sets as one (multiple importance sampling, the balance heuristic over the
@@ -375,14 +390,11 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
 
     /* The cells the focus region gathers from. */
     t0 = fv_stage_clock_now();
-    if (rc == FV_OK && !(c->focus_pts = fv_alloc_array((size_t)w * h * 2, sizeof(fv_vec3))))
-        rc = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    c->focus_pts = st->focus_pts;
     if (rc == FV_OK && !fv_parallel_tiles(w, h, f->threads, focus_tile, c, NULL, NULL)) rc = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
     fv_focus_cells_reset(st->focus, c->gamma);
     for (size_t i = 0; rc == FV_OK && i < (size_t)w * h * 2; i++)
         if (!isnan(c->focus_pts[i].x)) rc = fv_focus_cells_add(st->focus, c->focus_pts[i], c->gamma, err);
-    free(c->focus_pts);
-    c->focus_pts = NULL;
     double overlap = fv_focus_cells_overlap(st->focus, st->mg_focus);
     fv_stage_stop(stats, "focus_cells", t0);
     fv_stats_add_count(stats, "focus_cells", fv_focus_cells_count(st->focus));
@@ -451,89 +463,133 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
     return rc;
 }
 
-/* The filters: the periphery's lattice at its own resolution, then the fill; the focus region at
- * full resolution, over its bounding box only. */
-static fv_status finish(gd_ctx *c, fv_film *film, fv_stats *stats, fv_error *err)
+/* The main pass and the filters, in one parallel region (docs/threads.md): the main pass's tiles,
+ * then the periphery's lattice filtered at its own resolution and filled in, the pixels the fill
+ * could not reach gathered, the periphery's colour composed, and the focus region filtered at full
+ * resolution over its bounding box only. Each step is a work-sharing loop of the team whose
+ * barrier orders it before the next (or a step of the lattice or A-Trous filter, which end with
+ * one); every pixel's value is what a region per step gave (each is written by one thread, and the
+ * counts and the box's extent are sums and minima), so the image is the same bit for bit whatever
+ * the thread count. Nothing is allocated: the scratch is the state's (ensure_buffers). */
+static fv_status frame_passes(gd_ctx *c, fv_stats *stats, fv_error *err)
 {
     gd_state *st = c->st;
+    const fv_frame *f = c->frame;
     const int w = c->cam.width, h = c->cam.height;
-    const size_t n = (size_t)w * h;
-    fv_status rc = FV_OK;
-    fv_stage_clock t0 = fv_stage_clock_now();
-    if (st->o.filter && st->o.periphery_step > 1)
-        /* One pass (taps one lattice pixel apart): more smooth the periphery's light into blotches
-         * and raise its MSE (0.000303 with one pass, 0.000354 with four, cornell-fpm at 270x300)
-         * without lowering its temporal error. */
-        rc = fv_lattice_filter(st->refl, st->lattice_px, st->lattice_px, st->nbuf, st->pbuf, w, h, st->o.periphery_step, 1, st->atrous, c->frame->threads,
-                               2.0f * c->gamma, err);
-    fv_stage_stop(stats, "lattice_filter", t0);
+    const bool lattice_filter = st->o.filter && st->o.periphery_step > 1;
+    /* One pass (taps one lattice pixel apart): more smooth the periphery's light into blotches and
+     * raise its MSE (0.000303 with one pass, 0.000354 with four, cornell-fpm at 270x300) without
+     * lowering its temporal error. */
+    fv_atrous_opts lao;
+    fv_atrous_opts_default(&lao);
+    lao.sigma_position = 2.0f * c->gamma;
+    lao.iterations = 1;
+    lao.threads = f->threads;
+    lao.workspace = st->atrous;
+    fv_atrous_opts ao;
+    fv_atrous_opts_default(&ao);
+    ao.sigma_position = 2.0f * c->gamma; /* as pm's filter: surfaces further apart than the disc do not mix */
+    /* Four split paths per fovea pixel over a denser map leave little noise, and every pass blurs
+     * what the reference keeps sharp: in cornell-fpm at 270x300 one pass gave the lowest fovea MSE
+     * over the caustic (0.000121; 0.000142 with three, 0.000248 with none) and nearly the lowest on
+     * a wall (1.6e-5; 3.2e-5 with three, 7.0e-6 with none). */
+    ao.iterations = st->o.focus_passes;
+    ao.threads = f->threads;
+    ao.workspace = st->atrous;
+    /* the workspace grown once for the largest image either filter sees (the whole frame) */
+    fv_status rc = fv_atrous_prepare(st->atrous, w, h, &lao, err);
+    if (rc == FV_OK && ao.iterations > 0) rc = fv_atrous_prepare(st->atrous, w, h, &ao, err);
     if (rc != FV_OK) return rc;
-    t0 = fv_stage_clock_now();
     /* The fill reads lattice pixels only: focus pixels hold colour, not demodulated light. */
-    fv_lattice_opts lo = {st->o.periphery_step, st->level, 8.0f, 2.0f * c->gamma};
-    long missing = fv_lattice_fill(st->refl, st->lattice_px, st->focus_px, st->nbuf, st->pbuf, w, h, &lo, st->need);
-    uint64_t gathers = 0;
-    gather_needed(c, &gathers);
+    const fv_lattice_opts lo = {st->o.periphery_step, st->level, 8.0f, 2.0f * c->gamma};
+    fv_team_progress tp;
+    fv_team_progress_init(&tp, fv_kit_progress_fn, &c->prog);
+    long missing = 0;
+    uint64_t gathers = 0, bad = 0;
+    /* The focus region's bounding box, a few pixels wider so its edge pixels see neighbours on every
+     * side. Wider boxes pull the periphery's filled light into the transition (its MSE grew 25%
+     * with 32 pixels in cornell-fpm at 270x300, docs/results.md). */
+    const int reach = 4;
+    int x0 = w, y0 = h, x1 = -1, y1 = -1;
+    bool ok = true;
+    fv_stage_clock t0 = fv_stage_clock_now(), t1 = t0, t2 = t0, t3 = t0;
+    fv_region_begin();
+#pragma omp parallel num_threads(fv_thread_count(f->threads))
+    {
+        const bool go = fv_team_tiles(w, h, main_tile, c, &tp);
+#pragma omp master
+        {
+            ok = go;
+            t1 = fv_stage_clock_now();
+        }
+        if (go) {
+            if (lattice_filter) fv_lattice_filter_team(st->refl, st->lattice_px, st->lattice_px, st->nbuf, st->pbuf, w, h, st->o.periphery_step, &lao, st->box);
+#pragma omp master
+            t2 = fv_stage_clock_now();
+            fv_lattice_fill_team(st->refl, st->lattice_px, st->focus_px, st->nbuf, st->pbuf, w, h, &lo, st->need, &missing);
+            gather_needed_team(c, &gathers);
+            uint64_t my_bad = 0;
+            int bx0 = w, by0 = h, bx1 = -1, by1 = -1;
+#pragma omp for schedule(static) nowait
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < w; x++) {
+                    const size_t i = (size_t)y * w + x;
+                    if (st->focus_px[i]) {
+                        bx0 = x < bx0 ? x : bx0, bx1 = x > bx1 ? x : bx1;
+                        by0 = y < by0 ? y : by0, by1 = y > by1 ? y : by1;
+                        continue;
+                    }
+                    fv_vec3 L;
+                    for (int k = 0; k < 3; k++) (&L.x)[k] = st->emit[3 * i + k] + st->alb[3 * i + k] * st->refl[3 * i + k];
+                    L = fv_kit_guard(L, &my_bad);
+                    memcpy(&c->color[3 * i], &L, sizeof L);
+                }
+#pragma omp critical
+            {
+                bad += my_bad;
+                x0 = bx0 < x0 ? bx0 : x0, x1 = bx1 > x1 ? bx1 : x1;
+                y0 = by0 < y0 ? by0 : y0, y1 = by1 > y1 ? by1 : y1;
+            }
+#pragma omp barrier
+#pragma omp master
+            t3 = fv_stage_clock_now();
+            if (st->o.filter && x1 >= 0 && ao.iterations > 0) {
+                const int bx = x0 - reach < 0 ? 0 : x0 - reach, by = y0 - reach < 0 ? 0 : y0 - reach;
+                const int ex = x1 + reach >= w ? w - 1 : x1 + reach, ey = y1 + reach >= h ? h - 1 : y1 + reach;
+                const int bw = ex - bx + 1, bh = ey - by + 1;
+                const size_t bn = (size_t)bw * bh;
+                float *cc = st->box, *cn = st->box + 3 * bn, *cp = st->box + 6 * bn;
+#pragma omp for schedule(static)
+                for (int y = 0; y < bh; y++) {
+                    size_t src = 3 * ((size_t)(by + y) * w + bx), dst = 3 * (size_t)y * bw;
+                    memcpy(&cc[dst], &c->color[src], 3 * sizeof(float) * bw);
+                    memcpy(&cn[dst], &st->nbuf[src], 3 * sizeof(float) * bw);
+                    memcpy(&cp[dst], &st->pbuf[src], 3 * sizeof(float) * bw);
+                }
+                fv_atrous_team(cc, cn, cp, bw, bh, &ao);
+#pragma omp for schedule(static)
+                for (int y = 0; y < bh; y++)
+                    for (int x = 0; x < bw; x++) {
+                        size_t i = (size_t)(by + y) * w + bx + x;
+                        if (st->focus_px[i]) memcpy(&c->color[3 * i], &cc[3 * ((size_t)y * bw + x)], 3 * sizeof(float));
+                    }
+            }
+        }
+    }
+    fv_region_end();
+    fv_stage_clock t4 = fv_stage_clock_now();
+    /* the stages and counts in the order a region per step reported them */
+    fv_stage_add(stats, "render", t0, t1);
+    fv_kit_report(c->counters, stats);
+    fv_stats_add_count(stats, "fovea_paths", (double)fv_kit_sum(c->counters, FV_KIT_USER1));
+    if (!ok) return fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    fv_stage_add(stats, "lattice_filter", t1, t2);
     fv_stats_add_count(stats, "fill_gathered", (double)missing);
     fv_stats_add_count(stats, "gathers", (double)fv_kit_sum(c->counters, FV_KIT_USER0) + (double)gathers);
-    uint64_t bad = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (st->focus_px[i]) continue;
-        fv_vec3 L;
-        for (int k = 0; k < 3; k++) (&L.x)[k] = st->emit[3 * i + k] + st->alb[3 * i + k] * st->refl[3 * i + k];
-        L = fv_kit_guard(L, &bad);
-        memcpy(&c->color[3 * i], &L, sizeof L);
-    }
     fv_stats_add_count(stats, "nan_samples", (double)bad);
-    fv_stage_stop(stats, "fill", t0);
-    if (!st->o.filter) return FV_OK;
-    /* The focus region's bounding box, a few pixels wider so its edge pixels see neighbours on
-     * every side. Wider boxes pull the periphery's filled light into the transition (its MSE
-     * grew 25% with 32 pixels in cornell-fpm at 270x300, docs/results.md). */
-    t0 = fv_stage_clock_now();
-    int x0 = w, y0 = h, x1 = -1, y1 = -1;
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++)
-            if (st->focus_px[(size_t)y * w + x]) {
-                x0 = x < x0 ? x : x0, x1 = x > x1 ? x : x1;
-                y0 = y < y0 ? y : y0, y1 = y > y1 ? y : y1;
-            }
-    if (x1 >= 0 && st->o.focus_passes > 0) {
-        const int reach = 4;
-        x0 = x0 - reach < 0 ? 0 : x0 - reach, y0 = y0 - reach < 0 ? 0 : y0 - reach;
-        x1 = x1 + reach >= w ? w - 1 : x1 + reach, y1 = y1 + reach >= h ? h - 1 : y1 + reach;
-        int bw = x1 - x0 + 1, bh = y1 - y0 + 1;
-        size_t bn = (size_t)bw * bh;
-        float *cc = fv_alloc_array(bn, 3 * sizeof(float)), *cn = fv_alloc_array(bn, 3 * sizeof(float)),
-              *cp = fv_alloc_array(bn, 3 * sizeof(float));
-        if (!cc || !cn || !cp) rc = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-        for (int y = 0; rc == FV_OK && y < bh; y++) {
-            size_t src = 3 * ((size_t)(y0 + y) * w + x0), dst = 3 * (size_t)y * bw;
-            memcpy(&cc[dst], &c->color[src], 3 * sizeof(float) * bw);
-            memcpy(&cn[dst], &st->nbuf[src], 3 * sizeof(float) * bw);
-            memcpy(&cp[dst], &st->pbuf[src], 3 * sizeof(float) * bw);
-        }
-        fv_atrous_opts ao;
-        fv_atrous_opts_default(&ao);
-        ao.sigma_position = 2.0f * c->gamma; /* as pm's filter: surfaces further apart than the disc do not mix */
-        /* Four split paths per fovea pixel over a denser map leave little noise, and every pass
-         * blurs what the reference keeps sharp: in cornell-fpm at 270x300 one pass gave the lowest
-         * fovea MSE over the caustic (0.000121; 0.000142 with three, 0.000248 with none) and
-         * nearly the lowest on a wall (1.6e-5; 3.2e-5 with three, 7.0e-6 with none). */
-        ao.iterations = st->o.focus_passes;
-        ao.threads = c->frame->threads;
-        ao.workspace = st->atrous;
-        if (rc == FV_OK) rc = fv_atrous_filter(cc, cn, cp, bw, bh, &ao, err);
-        for (int y = 0; rc == FV_OK && y < bh; y++)
-            for (int x = 0; x < bw; x++) {
-                size_t i = (size_t)(y0 + y) * w + x0 + x;
-                if (st->focus_px[i]) memcpy(&c->color[3 * i], &cc[3 * ((size_t)y * bw + x)], 3 * sizeof(float));
-            }
-        free(cc), free(cn), free(cp);
-    }
-    fv_stage_stop(stats, "filter", t0);
-    (void)film;
-    return rc;
+    fv_stage_add(stats, "fill", t2, t3);
+    if (st->o.filter) fv_stage_add(stats, "filter", t3, t4);
+    return FV_OK;
 }
 
 static fv_status gd_render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
@@ -541,15 +597,16 @@ static fv_status gd_render(void *state, const fv_frame *frame, fv_film *film, fv
     gd_state *st = state;
     const int w = fv_film_width(film), h = fv_film_height(film);
     fv_eye_model def;
-    gd_ctx *c = calloc(1, sizeof *c);
-    if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    gd_ctx ctx, *c = &ctx;
+    memset(c, 0, sizeof *c);
     c->st = st;
     c->frame = frame;
     c->eye = fv_frame_eye_model(frame, w, h, &def);
     c->gaze = frame->gaze;
+    c->counters = st->counters;
+    memset(c->counters, 0, sizeof *c->counters);
     fv_status rc = fv_frame_camera(frame->camera, film, &c->cam, err);
     if (rc == FV_OK) rc = ensure_buffers(st, (size_t)w * h, err);
-    if (rc == FV_OK && !(c->counters = fv_kit_counters_create())) rc = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if (rc == FV_OK) {
         fv_vec3 lo, hi;
         fv_scene_bounds(st->scene, &lo, &hi);
@@ -565,17 +622,9 @@ static fv_status gd_render(void *state, const fv_frame *frame, fv_film *film, fv
     if (rc == FV_OK && !reuse) rc = update_maps(c, stats, err);
     if (rc == FV_OK) {
         fv_kit_phase(&c->prog, frame, 0.4, 0.6);
-        fv_stage_clock t0 = fv_stage_clock_now();
-        if (!fv_parallel_tiles(w, h, frame->threads, main_tile, c, fv_kit_progress_fn, &c->prog))
-            rc = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
-        fv_stage_stop(stats, "render", t0);
-        fv_kit_report(c->counters, stats);
-        fv_stats_add_count(stats, "fovea_paths", (double)fv_kit_sum(c->counters, FV_KIT_USER1));
+        rc = frame_passes(c, stats, err);
     }
-    if (rc == FV_OK) rc = finish(c, film, stats, err);
     if (rc != FV_OK) st->maps_index = -1;
-    fv_kit_counters_destroy(c->counters);
-    free(c);
     return rc;
 }
 
