@@ -24,6 +24,8 @@ struct fv_path_store {
     seg *sg;
     int64_t *sstart;     /* count + 1 offsets into sg */
     float (*u)[5];       /* each path's emission numbers (what a flux scale may depend on) */
+    struct blk *fb;      /* fv_path_store_frame's blocks, kept with their buffers (grown, never shrunk) */
+    int64_t fb_cap;
 };
 
 /* What one block of paths produced, and per path how many photons and segments. */
@@ -90,6 +92,8 @@ void fv_path_store_destroy(fv_path_store *p)
 {
     if (!p) return;
     clear(p);
+    for (int64_t k = 0; k < p->fb_cap; k++) free(p->fb[k].p), free(p->fb[k].s);
+    free(p->fb);
     free(p);
 }
 
@@ -183,7 +187,7 @@ static bool meets(const seg *s, fv_vec3 c, float r)
     return fv_dot(q, q) <= r * r;
 }
 
-fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, fv_path_scale_fn scale, const void *scale_ctx,
+fv_status fv_path_store_frame(fv_path_store *p, const fv_dyn_dirs *dirs, fv_path_scale_fn scale, const void *scale_ctx,
                               int threads, fv_photon_map *out, int64_t *retraced, uint64_t *rays, fv_error *err)
 {
     *retraced = 0;
@@ -195,8 +199,17 @@ fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, f
     const int n = nsph < MAXS ? nsph : MAXS;
     for (int k = 0; k < n; k++) fv_dyn_dirs_sphere(dirs, k, &c[k], &r[k]);
     int64_t nblocks = (p->count + BLOCK - 1) / BLOCK;
-    blk *b = fv_calloc_array((size_t)nblocks + 1, sizeof *b);
-    if (!b) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    /* The blocks and their photon buffers are the store's, kept from frame to frame: once they have
+     * grown to what a frame needs, a frame allocates nothing (docs/threads.md). */
+    if (nblocks + 1 > p->fb_cap) {
+        blk *nb = realloc(p->fb, ((size_t)nblocks + 1) * sizeof *nb);
+        if (!nb) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        memset(nb + p->fb_cap, 0, ((size_t)(nblocks + 1 - p->fb_cap)) * sizeof *nb);
+        p->fb = nb;
+        p->fb_cap = nblocks + 1;
+    }
+    blk *b = p->fb;
+    for (int64_t k = 0; k <= nblocks; k++) b[k].np = b[k].ns = 0, b[k].rays = 0, b[k].oom = b[k].record = false;
     int64_t again = 0;
     fv_region_begin();
     #pragma omp parallel for schedule(dynamic, 1) reduction(+ : again) num_threads(fv_thread_count(threads))
@@ -234,9 +247,7 @@ fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, f
         if (b[k].oom && st == FV_OK) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory for this frame's photons");
         if (st == FV_OK) st = fv_photon_map_append(out, b[k].p, b[k].np, err);
         if (rays) *rays += b[k].rays;
-        free(b[k].p), free(b[k].s);
     }
-    free(b);
     *retraced = again;
     return st;
 }

@@ -36,7 +36,7 @@ typedef float (*fv_path_scale_fn)(const void *ctx, const float u[5]);
  * path that meets one of the spheres of dirs (the dynamic objects now; NULL: none), the photons of
  * the same path traced again through the whole scene at its current time; each path's flux times
  * scale(u) when scale is given. *retraced gets how many paths were traced again. */
-fv_status fv_path_store_frame(const fv_path_store *p, const fv_dyn_dirs *dirs, fv_path_scale_fn scale, const void *scale_ctx,
+fv_status fv_path_store_frame(fv_path_store *p, const fv_dyn_dirs *dirs, fv_path_scale_fn scale, const void *scale_ctx,
                               int threads, fv_photon_map *out, int64_t *retraced, uint64_t *rays, fv_error *err);
 
 #endif

@@ -153,9 +153,13 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
     if (nt > 1 && m->n < 65536) nt = 1; /* not worth waking threads */
     grid_extent(m, nt);
     const uint32_t nc = (uint32_t)m->dim[0] * (uint32_t)m->dim[1] * (uint32_t)m->dim[2];
-    uint32_t *start = realloc(m->start, ((size_t)nc + 1) * sizeof *start);
-    if (!start) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
-    m->start = start;
+    /* grown, never shrunk: a build of a grid no larger than before allocates nothing */
+    if ((size_t)nc + 1 > m->start_cap) {
+        uint32_t *start = realloc(m->start, ((size_t)nc + 1) * sizeof *start);
+        if (!start) return fv_error_set(err, FV_ERR_NOMEM, "out of memory building a photon grid");
+        m->start = start;
+        m->start_cap = (size_t)nc + 1;
+    }
     fv_status rc = reserve(m, err);
     if (rc != FV_OK) return rc;
     /* A stable counting sort by cell, in parallel: each thread counts the cells of its own
@@ -173,7 +177,7 @@ fv_status fv_photon_map_build_mt(fv_photon_map *m, float cell, int threads, fv_e
         m->count = c;
         m->count_cap = need;
     }
-    uint32_t *count = m->count;
+    uint32_t *count = m->count, *start = m->start;
     const int n = m->n;
     /* per thread: the running offset where its block of cells starts (the scan's second level) */
     uint32_t block_sum[FV_MAX_THREADS + 1];

@@ -44,6 +44,7 @@ typedef struct fv_photon_map {
     int org[3], dim[3];
     bool wrap[3];
     uint32_t *start;       /* ncells + 1 offsets into p */
+    size_t start_cap;      /* room in start, grown, never shrunk */
     uint32_t ncells;       /* 0: not built */
     /* Position and normal of p again, one array per component (SoA), padded by FV_PHOTON_BLOCK:
      * a query tests a block of photons at a time without loading the rest of each. */
