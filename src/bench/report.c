@@ -119,6 +119,14 @@ static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *
     for (int i = 0; i < reps; i++) cJSON_AddItemToArray(all, num(r->ms[i]));
     cJSON *st = cJSON_AddObjectToObject(o, "stages_ms");
     for (int i = 0; i < r->stages.n_stages; i++) cJSON_AddItemToObject(st, r->stages.stage[i].name, num(r->stages.stage[i].value));
+    /* Each stage's serial share in [0, 1]: the part of its time outside parallel regions, or inside
+     * them with one thread working while the others wait (core/stage_time.h, docs/threads.md);
+     * stages without a measured serial part are left out. */
+    cJSON *ss = cJSON_AddObjectToObject(o, "stages_serial_share");
+    for (int i = 0; i < r->stages.n_stages; i++) {
+        const double ser = fv_stats_get_serial_ms(&r->stages, r->stages.stage[i].name), sms = r->stages.stage[i].value;
+        if (ser >= 0.0) cJSON_AddItemToObject(ss, r->stages.stage[i].name, num(sms > 0.0 ? fmin(1.0, ser / sms) : 0.0));
+    }
     /* Every timing with its spread over the repeats (stages_ms keeps the medians, as before). */
     cJSON *sr = cJSON_AddObjectToObject(o, "stages_ms_range");
     for (int i = 0; i < r->stages.n_stages; i++) {

@@ -321,6 +321,8 @@ typedef struct method_ctx {
 static void stats_accumulate(fv_stats *sum, const fv_stats *s)
 {
     for (int k = 0; k < s->n_stages; k++) fv_stats_add_ms(sum, s->stage[k].name, s->stage[k].value);
+    /* each stage's serial part (core/stage_time.h), for its serial share */
+    for (int k = 0; k < s->n_serial; k++) fv_stats_add_serial_ms(sum, s->serial[k].name, s->serial[k].value);
     for (int k = 0; k < s->n_counters; k++) fv_stats_add_count(sum, s->counter[k].name, s->counter[k].value);
 }
 
@@ -489,6 +491,11 @@ static void method_figures(method_run *mr)
         fv_stats_add_ms(&res->stages, mr->stage_names.stage[q].name, median(v, reps));
         fv_stats_add_ms(&res->stages_min, mr->stage_names.stage[q].name, lo);
         fv_stats_add_ms(&res->stages_max, mr->stage_names.stage[q].name, hi);
+        /* The serial share of the measured (last) repeat's frames, as --stats-json gives it, kept as
+         * that share of the median: the report divides it back out. */
+        const char *name = mr->stage_names.stage[q].name;
+        const double tot = fv_stats_get_ms(&c->stage_sum, name), ser = fv_stats_get_serial_ms(&c->stage_sum, name);
+        if (ser >= 0.0 && tot > 0.0) fv_stats_add_serial_ms(&res->stages, name, median(v, reps) * fmin(1.0, ser / tot));
     }
     fv_stats_clear(&res->counters);
     for (int k = 0; k < c->counter_sum.n_counters; k++)

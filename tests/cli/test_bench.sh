@@ -17,6 +17,10 @@ for r in rows:
         for m in ("mse", "ssim", "flip"):
             assert r["error"][g][m] is not None, (g, m)
     assert r["counters"]["rays"] > 0
+    # every stage's serial share (as --stats-json gives it), a fraction of the stage's time
+    ss = r["stages_serial_share"]
+    assert set(ss) == set(r["stages_ms"]), (ss, r["stages_ms"])
+    assert all(0.0 <= v <= 1.0 for v in ss.values()), ss
 spp = [int(r["params"]["spp"]) for r in rows]
 assert spp == [1, 4, 16], spp
 for g in ("fovea", "transition", "periphery", "all"):

@@ -75,6 +75,12 @@ for m in pt vpolar; do
   done
 done
 cmp -s "$TMP/out" "$TMP/scaling.md" || fail "bench scaling: the report differs from what it printed"
+# the measured serial %% of every row (the column before regions/frame) and of vpolar's stages at the
+# most threads, each a share in [0, 100]
+awk -F'|' '/^\| (pt|vpolar) \| cornell/ {if ($11 !~ /%/) bad=1; v=$11; gsub(/[ %]/, "", v); if (v == "" || v+0 < 0 || v+0 > 100) bad=1; n++}
+  END {exit !(n == 4 && !bad)}' "$TMP/out" || fail "bench scaling: a row's serial % is missing or outside [0, 100]: $(cat "$TMP/out")"
+grep '^| vpolar |' "$TMP/out" | tail -n 1 | grep -oE '[a-z_]+: [0-9.-]+%, [0-9.]+%' | awk -F', ' '{v=$2; sub(/%/, "", v); if (v+0 < 0 || v+0 > 100) bad=1; n++}
+  END {exit !(n >= 3 && !bad)}' || fail "bench scaling: vpolar's stages have no measured serial %: $(cat "$TMP/out")"
 expect 2 "unknown method 'nope'" -- "$FOVEA" bench scaling --methods vpolar,nope
 expect 2 "--frames 0: expected an integer in [1, 100000]" -- "$FOVEA" bench scaling --frames 0
 expect 2 "unexpected argument 'x'" -- "$FOVEA" bench scaling x

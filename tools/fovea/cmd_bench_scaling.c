@@ -68,6 +68,10 @@ typedef struct run_result {
     int n_stages;
     char stage[FV_STATS_MAX][32];
     double stage_ms[FV_STATS_MAX]; /* medians */
+    /* measured serial shares (core/stage_time.h, as --stats gives them) over the timed frames: of
+     * the frame (its stages' serial ms over its ms) and of each stage (-1: none measured) */
+    double serial;
+    double stage_serial[FV_STATS_MAX];
 } run_result;
 
 /* Renders warmup + frames frames of a fresh technique with `threads` threads. */
@@ -94,6 +98,8 @@ static int run_one(const char *cmd, const char *method, fv_scene *scene, const f
     if (s == FV_OK) s = fv_driver_create(scene, view, &d, &driver, &err);
     if (s == FV_OK) s = fv_film_create(o->width, o->height, 0, &film, &err);
     memset(r, 0, sizeof *r);
+    double ser_frame = 0.0, frame_sum = 0.0, ser_stage[FV_STATS_MAX] = {0}, stage_sum[FV_STATS_MAX] = {0};
+    bool has_ser[FV_STATS_MAX] = {false};
     for (int f = 0; s == FV_OK && f < o->warmup + o->frames; f++) {
         fv_stats stats;
         fv_stats_clear(&stats);
@@ -109,11 +115,21 @@ static int run_one(const char *cmd, const char *method, fv_scene *scene, const f
             for (int i = 0; i < stats.n_stages; i++) snprintf(r->stage[i], sizeof r->stage[i], "%s", stats.stage[i].name);
         }
         for (int i = 0; i < r->n_stages; i++) st[(size_t)i * o->frames + k] = fv_stats_get_ms(&stats, r->stage[i]);
+        for (int i = 0; i < stats.n_serial; i++) ser_frame += stats.serial[i].value;
+        for (int i = 0; i < r->n_stages; i++) {
+            const double v = fv_stats_get_serial_ms(&stats, r->stage[i]);
+            if (v >= 0.0) ser_stage[i] += v, has_ser[i] = true;
+            stage_sum[i] += fv_stats_get_ms(&stats, r->stage[i]);
+        }
+        frame_sum += t;
     }
     if (s == FV_OK) {
         for (int i = 0; i < r->n_stages; i++) r->stage_ms[i] = percentile(&st[(size_t)i * o->frames], o->frames, 50.0);
         r->p99 = percentile(ms, o->frames, 99.0);
         r->p50 = percentile(ms, o->frames, 50.0);
+        r->serial = frame_sum > 0.0 ? fmin(1.0, ser_frame / frame_sum) : 0.0;
+        for (int i = 0; i < r->n_stages; i++)
+            r->stage_serial[i] = !has_ser[i] ? -1.0 : stage_sum[i] > 0.0 ? fmin(1.0, ser_stage[i] / stage_sum[i]) : 0.0;
     } else {
         rc = fv_cli_fail(cmd, s, err.msg);
     }
@@ -169,8 +185,8 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: fovea bench scaling [options]\n"
                "  every method's frame on one of its scenes at 1, 2, 4, ... threads up to all CPUs: frame p50/p99,\n"
-               "  speed-up, efficiency, parallel regions per frame and the serial share (Karp-Flatt) of the frame\n"
-               "  and of each stage (docs/threads.md)\n"
+               "  speed-up, efficiency, parallel regions per frame and the serial share of the frame and of each\n"
+               "  stage, estimated (Karp-Flatt) and measured (serial %%, as --stats gives it; docs/threads.md)\n"
                "  --size WxH            image size [640x360: the viewer's]\n"
                "  --frames N            timed frames per thread count [20]\n"
                "  --warmup N            frames rendered first and not timed [2]\n"
@@ -241,12 +257,13 @@ int fv_cmd_bench_scaling(int argc, char **argv)
     text rep = {0};
     put(&rep, "Frame times at %dx%d, %d timed frames after %d warm-up frames per thread count; "
               "threads: %s.\n\n"
-              "| method | scene | threads | p50 ms | p99 ms | p99/p50 | speed-up | efficiency | serial share | regions/frame |\n"
-              "|---|---|---|---|---|---|---|---|---|---|\n",
+              "| method | scene | threads | p50 ms | p99 ms | p99/p50 | speed-up | efficiency | serial share | serial %% | regions/frame |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|\n",
         o.width, o.height, o.frames, o.warmup, fv_cli_thread_plan());
     text stages = {0};
-    put(&stages, "\nSerial share (Karp-Flatt) of each stage at %d threads, and its share of the one-thread frame:\n\n"
-                 "| method | stage: serial share (share of the frame at 1 thread) |\n|---|---|\n", maxt);
+    put(&stages, "\nSerial share (Karp-Flatt) of each stage at %d threads, its measured serial %% there (as --stats gives it; "
+                 "-: none measured), and its share of the one-thread frame:\n\n"
+                 "| method | stage: serial share, serial %% (share of the frame at 1 thread) |\n|---|---|\n", maxt);
     rc = 0;
     for (int i = 0; i < fv_technique_count() && rc == 0; i++) {
         const char *m = fv_technique_name(i);
@@ -265,8 +282,8 @@ int fv_cmd_bench_scaling(int argc, char **argv)
             double sp = res[0].p50 / res[k].p50, kf = karp_flatt(res[0].p50, res[k].p50, counts[k]);
             char share[32] = "-"; /* one thread: no speed-up to read a serial share from */
             if (!isnan(kf)) snprintf(share, sizeof share, "%.1f%%", 100.0 * kf);
-            put(&rep, "| %s | %s | %d | %.1f | %.1f | %.2f | %.2f | %.2f | %s | %.0f |\n", m, scene_for(m), counts[k], res[k].p50,
-                res[k].p99, res[k].p99 / res[k].p50, sp, sp / counts[k], share, res[k].regions);
+            put(&rep, "| %s | %s | %d | %.1f | %.1f | %.2f | %.2f | %.2f | %s | %.1f%% | %.0f |\n", m, scene_for(m), counts[k], res[k].p50,
+                res[k].p99, res[k].p99 / res[k].p50, sp, sp / counts[k], share, 100.0 * res[k].serial, res[k].regions);
         }
         if (rc == 0 && nc > 1) {
             const run_result *a = &res[0], *b = &res[nc - 1];
@@ -275,8 +292,12 @@ int fv_cmd_bench_scaling(int argc, char **argv)
                 double tb = 0.0;
                 for (int u = 0; u < b->n_stages; u++)
                     if (!strcmp(b->stage[u], a->stage[s])) tb = b->stage_ms[u];
-                double kf = karp_flatt(a->stage_ms[s], tb, maxt);
-                put(&stages, " %s: %.1f%% (%.0f%%);", a->stage[s], 100.0 * kf, 100.0 * a->stage_ms[s] / a->p50);
+                double kf = karp_flatt(a->stage_ms[s], tb, maxt), sb = -1.0;
+                for (int u = 0; u < b->n_stages; u++)
+                    if (!strcmp(b->stage[u], a->stage[s])) sb = b->stage_serial[u];
+                char meas[32] = "-";
+                if (sb >= 0.0) snprintf(meas, sizeof meas, "%.1f%%", 100.0 * sb);
+                put(&stages, " %s: %.1f%%, %s (%.0f%%);", a->stage[s], 100.0 * kf, meas, 100.0 * a->stage_ms[s] / a->p50);
             }
             put(&stages, " |\n");
         }
