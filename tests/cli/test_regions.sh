@@ -24,16 +24,17 @@ bound() { # the most regions any of the three frames opened after the merges (be
     cartesian | log-polar) echo 5 ;;
     vpolar | linear-falloff) echo 6 ;;       # 34 before (SVGF: about 28 -> 1)
     fir) echo 5 ;;                           # 10 before (its management: 6 regions -> 1)
-    fpm-guided) echo 13 ;;
+    fpm-guided) echo 9 ;;                    # 13 before (its main pass and filters: 5 regions -> 1); 6 once warm
     fpm) echo 15 ;;                          # 21 before
-    ir-low) echo 18 ;;
+    ir-low) echo 2 ;;                        # 18 before (a region per batch of maps and per shading pass -> 1)
     ppm) echo 256 ;;                         # a reference: 4 per pass, 64 passes
     *) echo 0 ;;                             # a new method: give it a bound
   esac
 }
 scene() { case $1 in pm | pm-t | fpm | fpm-guided | ppm) echo cornell-fpm ;; sdf-* | ipr | fipr) echo sdf-temple ;;
           ir | ir-low | fir) echo cornell-fir ;; *) echo cornell ;; esac; }
-params() { case $1 in pm | pm-t | fpm | fpm-guided | ppm) echo "--param photons=3000" ;; pt) echo "--param spp=1" ;; esac; }
+params() { case $1 in pm | pm-t | fpm | fpm-guided | ppm) echo "--param photons=3000" ;; pt) echo "--param spp=1" ;;
+          ir-low) echo "--param vpls=600" ;; esac; } # ir-low: 3 batches of 266 maps
 
 for m in $("$FOVEA" methods | awk '/^[a-z]/ {print $1}'); do
   for n in 1 3; do
@@ -55,7 +56,7 @@ for m in $("$FOVEA" methods | awk '/^[a-z]/ {print $1}'); do
 done
 # The merged regions give the same bits whatever the thread count (a barrier or a `single` too few
 # would show here as a race): the methods whose stages were restructured, 1 against 3 threads.
-for m in pm fpm vpolar cartesian fipr fir; do
+for m in pm fpm vpolar cartesian fipr fir fpm-guided ir-low; do
   for t in 1 3; do
     "$FOVEA" render "$(scene "$m")" --method "$m" $(params "$m") --size 41x29 --frames 2 --gaze 0.3,0.6 --threads $t \
       --quiet --out "$TMP/t$t.pfm" || fail "$m --threads $t: exited $?"

@@ -45,4 +45,20 @@ out=$(check "$TMP/pt.json" trace:lt:0.5) || fail "pt: $out"
   --out "$TMP/fir.pfm" --quiet || fail "fir: render exited $?"
 out=$(check "$TMP/fir.json" voxelize:lt:1.01 inject:lt:1.01 vpl_generation:lt:1.01 radiosity:lt:1.01 cube_maps:lt:1.01) ||
   fail "fir: $out"
+
+# every method: each of its stages has a serial part (issue 29: --stats reports each stage's share)
+for m in $("$FOVEA" methods | awk '/^[a-z]/ {print $1}'); do
+  case $m in pm | pm-t | fpm | fpm-guided | ppm) a=(cornell-fpm --param photons=2000) ;; sdf-* | ipr | fipr) a=(sdf-temple) ;;
+    ir | ir-low) a=(cornell-fir --param vpls=32) ;; fir) a=(cornell-fir) ;; *) a=(cornell) ;; esac
+  [ "$m" = ppm ] && a+=(--param passes=2)
+  "$FOVEA" render "${a[@]}" --method "$m" --size 24x16 --threads 2 --stats-json "$TMP/m.json" --out "$TMP/m.pfm" --quiet ||
+    { fail "$m: render exited $?"; continue; }
+  python3 - "$TMP/m.json" "$m" <<'PY' || fail "$m: a stage without its serial part"
+import json, sys
+d = json.load(open(sys.argv[1]))
+for f in (d["frames"] if isinstance(d, dict) else d):
+    missing = [k for k in f["stages_ms"] if k not in (f.get("serial_ms") or {})]
+    assert f["stages_ms"] and not missing, (sys.argv[2], missing)
+PY
+done
 finish

@@ -25,6 +25,7 @@
 #include "core/alloc.h"
 #include "core/blocks.h"
 #include "core/parallel.h"
+#include "core/stage_time.h"
 #include "film/film_sums.h"
 #include "technique/class.h"
 #include "technique/kit.h"
@@ -166,7 +167,10 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
     for (int pass = 0; pass < p0; pass++) r2 = fv_ppm_next_r2(r2, st->o.alpha, pass + 1); /* Eq. 15 up to the range */
     fv_kit_progress prog = {0};
     uint64_t rays = 0;
-    double photons = 0.0, t_light = 0.0, t_render = 0.0;
+    double photons = 0.0;
+    /* the passes' stage times and serial parts, summed (core/stage_time.h) */
+    fv_stats pass_sum;
+    fv_stats_clear(&pass_sum);
     for (int pass = p0; pass < p1 && rc == FV_OK; pass++) {
         /* Progress: each pass an equal share; in it, tracing light the first 40%, pixels the rest. */
         const double base = (double)(pass - p0) / range, span = 1.0 / range;
@@ -174,7 +178,7 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
         c.r = (float)sqrt(r2);
         c.norm = 1.0f / (FV_PI * c.r * c.r);
         fv_kit_phase(&prog, frame, base, 0.4 * span);
-        double t0 = fv_time_ms();
+        fv_stage_clock t0 = fv_stage_clock_now();
         fv_photon_map_clear(&st->map);
         fv_photon_job job = {.scene = st->scene, .count = st->o.photons, .seed = frame->seed, .frame = frame->index,
                              .max_depth = st->o.max_depth, .threads = frame->threads, .stream = PPM_STREAM_BASE + (uint64_t)pass,
@@ -182,13 +186,13 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
         rc = fv_photon_trace_lights(&job, FV_TRACE_ALL, &st->map, &rays, err);
         if (rc == FV_OK) rc = fv_photon_map_build_mt(&st->map, c.r, frame->threads, err);
         photons += st->map.n;
-        t_light += fv_time_ms() - t0;
+        fv_stage_stop(&pass_sum, "light_tracing", t0);
         if (rc != FV_OK) break;
         fv_kit_phase(&prog, frame, base + 0.4 * span, 0.6 * span);
-        t0 = fv_time_ms();
+        t0 = fv_stage_clock_now();
         if (!fv_parallel_tiles(w, h, frame->threads, pass_tile, &c, fv_kit_progress_fn, &prog))
             rc = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
-        t_render += fv_time_ms() - t0;
+        fv_stage_stop(&pass_sum, "render", t0);
         r2 = fv_ppm_next_r2(r2, st->o.alpha, pass + 1);
         if (nb > 1 && ((pass + 1) % FV_SAMPLE_BLOCK == 0 || pass + 1 == p1)) {
             /* a block done: onto the counter, merged with equal neighbours (left += right) */
@@ -227,8 +231,12 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
         }
         fv_kit_count(c.counters, 0, FV_KIT_NAN, bad);
     }
-    fv_stats_add_ms(stats, "light_tracing", t_light);
-    fv_stats_add_ms(stats, "render", t_render);
+    const char *const stages[] = {"light_tracing", "render"};
+    for (int k = 0; k < 2; k++) {
+        const double serial = fv_stats_get_serial_ms(&pass_sum, stages[k]);
+        fv_stats_add_ms(stats, stages[k], fv_stats_get_ms(&pass_sum, stages[k]));
+        fv_stats_add_serial_ms(stats, stages[k], serial > 0.0 ? serial : 0.0);
+    }
     fv_kit_report(c.counters, stats);
     fv_stats_add_count(stats, "rays", (double)rays);
     fv_stats_add_count(stats, "light_photons", photons);
