@@ -16,12 +16,18 @@ typedef struct fv_dist_still_job {
     const fv_params *params; /* its parameters (cloned per range; the bag is not changed) */
     const fv_scene *scene;
     const fv_log *log;
-    fv_driver *driver;       /* frame 0 of it is the still */
+    fv_driver *driver;       /* frame `frame` of it is the still */
     int spp;                 /* the method's samples per pixel (pt) or passes (ppm); 0: its default */
     bool other_device;       /* a device other than the cpu was asked for */
-    fv_progress_fn progress; /* rank 0's bar (optional) */
+    fv_progress_fn progress; /* every rank's progress through its own share (optional) */
     void *progress_user;
+    int frame;               /* the driver's frame that is the still (0 for `fovea render`) */
 } fv_dist_still_job;
+
+/* A job for frame `frame` of driver with method and params, spp and other_device read from the
+ * parameters (the method's samples-per-pixel parameter, a device other than "cpu"). */
+void fv_dist_still_job_init(fv_dist_still_job *job, const char *method, const fv_params *params, const fv_scene *scene, const fv_log *log,
+                            fv_driver *driver, int frame);
 
 /* True when the still is split over `size` ranks: pt on the cpu or ppm with more than one block
  * of samples or passes. Otherwise rank 0 renders it alone. */

@@ -40,6 +40,18 @@ static bool on_progress(void *user, double f)
     return !p->fn || p->fn(p->user, p->base + p->span * f);
 }
 
+void fv_dist_still_job_init(fv_dist_still_job *job, const char *method, const fv_params *params, const fv_scene *scene, const fv_log *log,
+                            fv_driver *driver, int frame)
+{
+    *job = (fv_dist_still_job){.method = method, .params = params, .scene = scene, .log = log, .driver = driver, .frame = frame};
+    const char *spp_key = fv_technique_spp_param(fv_technique_index(method));
+    for (int i = 0; i < fv_params_count(params); i++) {
+        const char *k = fv_params_key(params, i), *v = fv_params_value(params, i);
+        if (spp_key && !strcmp(k, spp_key)) job->spp = atoi(v);
+        if (!strcmp(k, "device") && strcmp(v, "cpu")) job->other_device = true;
+    }
+}
+
 bool fv_dist_still_splits(const fv_dist_still_job *job, int size)
 {
     /* the methods whose estimate is core/blocks.h's sum: pt's samples, ppm's passes */
@@ -57,7 +69,7 @@ static fv_status render_node(const fv_dist_still_job *job, int lo, int hi, fv_fi
     if (s == FV_OK) snprintf(v, sizeof v, "%d", lo), s = fv_params_set(p, "block_first", v, err);
     if (s == FV_OK) snprintf(v, sizeof v, "%d", hi - lo), s = fv_params_set(p, "block_count", v, err);
     if (s == FV_OK) s = fv_technique_create(job->method, job->scene, p, job->log, &t, err);
-    if (s == FV_OK) s = fv_driver_render(job->driver, t, 0, false, films, stats, on_progress, prog, err);
+    if (s == FV_OK) s = fv_driver_render(job->driver, t, job->frame, false, films, stats, on_progress, prog, err);
     fv_technique_destroy(t);
     fv_params_destroy(p);
     return s;

@@ -363,12 +363,10 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
     fv_stats_clear(&stats);
     fv_cli_interrupt_defer(true);
     if (o->frames == 1) {
-        fv_dist_still_job job = {o->method, params, scene, log, driver, 0, false, on_dist_progress, &dp};
-        const char *spp_key = fv_technique_spp_param(fv_technique_index(o->method));
-        for (int i = 0; spp_key && i < fv_params_count(params); i++)
-            if (!strcmp(fv_params_key(params, i), spp_key)) job.spp = atoi(fv_params_value(params, i));
-        for (int i = 0; i < fv_params_count(params); i++)
-            if (!strcmp(fv_params_key(params, i), "device") && strcmp(fv_params_value(params, i), "cpu")) job.other_device = true;
+        fv_dist_still_job job;
+        fv_dist_still_job_init(&job, o->method, params, scene, log, driver, 0);
+        job.progress = on_dist_progress;
+        job.progress_user = &dp;
         if (fv_dist_still_splits(&job, size)) {
             s = fv_dist_still(d, &job, film, neyes, &stats, &print_it, &name_rank, &err);
         } else {
