@@ -24,8 +24,8 @@ static void share(int nb, int rank, int size, int *lo, int *hi)
     *hi = (int)(((long long)nb * (rank + 1) + size - 1) / size);
 }
 
-/* Progress of rank 0's own nodes as the job's (all ranks render equal shares at the same pace),
- * stopping when another rank failed. */
+/* Progress through this rank's own nodes (progress.h adds the ranks' shares up), stopping when
+ * another rank failed. */
 typedef struct node_progress {
     fv_dist *d;
     fv_progress_fn fn;
@@ -50,6 +50,14 @@ void fv_dist_still_job_init(fv_dist_still_job *job, const char *method, const fv
         if (spp_key && !strcmp(k, spp_key)) job->spp = atoi(v);
         if (!strcmp(k, "device") && strcmp(v, "cpu")) job->other_device = true;
     }
+}
+
+double fv_dist_still_share(const fv_dist_still_job *job, int rank, int size)
+{
+    const int nb = fv_blocks_count(job->spp);
+    int lo, hi;
+    share(nb, rank, size, &lo, &hi);
+    return nb > 0 ? (double)(hi - lo) / nb : 0.0;
 }
 
 bool fv_dist_still_splits(const fv_dist_still_job *job, int size)
@@ -108,7 +116,7 @@ fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *const
     /* This rank's nodes in block order (only block 0's range writes the auxiliary buffers). */
     int my_blocks = 0;
     for (int k = mine0; k < mine1; k++) my_blocks += nodes[k][1] - nodes[k][0];
-    node_progress prog = {d, rank == 0 ? job->progress : NULL, job->progress_user, 0.0, 0.0};
+    node_progress prog = {d, job->progress, job->progress_user, 0.0, 0.0};
     for (int i = 0; i < mine1 - mine0 && s == FV_OK; i++) {
         int k = mine0 + i;
         int n = nodes[k][1] - nodes[k][0];
