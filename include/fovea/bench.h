@@ -9,7 +9,10 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include "fovea/drive.h"
 #include "fovea/export.h"
+#include "fovea/film.h"
+#include "fovea/params.h"
 #include "fovea/status.h"
 
 #ifdef __cplusplus
@@ -22,13 +25,27 @@ typedef enum fv_bench_mode {
     FV_BENCH_FULL         /* the papers' sizes */
 } fv_bench_mode;
 
+/* One still that a split run renders across every process at once (fv_bench_split.still): frame
+ * `frame` of `driver` with a fresh technique `method` of `params` on `scene`. */
+typedef struct fv_bench_still {
+    const char *method;
+    const fv_params *params;
+    const fv_scene *scene;
+    fv_driver *driver;
+    int frame;
+    const fv_log *log;
+} fv_bench_still;
+
 /* A run split over cooperating processes (the CLI implements it over MPI ranks, src/dist): every
  * process runs fv_bench_run with the same scenario and options and renders its share of the rows
- * (methods, sweep points; rank r times the rows i with i % size == r, all their repeats); rank 0
- * renders the references and the match searches, gathers the rows and writes every file. What a
- * report says equals a one-process run's except timings (each row records the rank that timed it).
- * Every process calls the callbacks at the same points of a run, so that a failure anywhere ends
- * every process at the next one. */
+ * (methods, sweep points; rank r times the rows i with i % size == r, all their repeats) and of the
+ * references that are not in rank 0's cache (a single missing frame through `still` when it splits
+ * it, else the missing frames dealt round-robin when the method keeps no state between frames,
+ * else rank 0 renders them); rank 0 reads and writes the cache, runs the match searches, gathers
+ * the rows and writes every file. The cached references are a one-process run's bit for bit; what
+ * a report says equals a one-process run's except timings (each row records the rank that timed
+ * it). Every process calls the callbacks at the same points of a run, so that a failure anywhere
+ * ends every process at the next one. */
 typedef struct fv_bench_split {
     int rank, size;
     void *user; /* given to the callbacks */
@@ -41,6 +58,11 @@ typedef struct fv_bench_split {
      * frame); and said by a rank that has just failed. Both may be NULL. */
     bool (*stopped)(void *user);
     void (*failed)(void *user);
+    /* Optional (NULL: never split by samples): called by every rank with the same still. When it
+     * splits that still (the same answer on every rank) it sets *split, renders it across the
+     * ranks into film (on rank 0 then the one-process image bit for bit) and returns the job's
+     * status, as agree does; else it leaves *split false, renders nothing and returns FV_OK. */
+    fv_status (*still)(void *user, const fv_bench_still *still, fv_film *film, bool *split, fv_error *err);
 } fv_bench_split;
 
 typedef struct fv_bench_options {

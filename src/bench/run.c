@@ -166,6 +166,16 @@ static fv_status render_sequence(const render_job *j, int first, int nframes, fr
 
 /* ---- the reference ---- */
 
+/* The job's status when the run is split over processes (fv_bench_split), else this one's. A
+ * rank that failed says so first, so that the others stop rendering at their next frame. */
+static fv_status agree(const fv_bench_split *sp, fv_status s, fv_error *err)
+{
+    if (!sp) return s;
+    if (s != FV_OK && sp->failed) sp->failed(sp->user);
+    return sp->agree(sp->user, s, err);
+}
+
+
 typedef struct ref_ctx {
     frame_setup *frames;
     const char *const *paths;
@@ -184,19 +194,93 @@ static fv_status on_reference_frame(void *user, int i, fv_film *film, double ms,
     return fv_image_write(c->paths[i], c->frames[i].ref[c->slot], fv_film_width(film), fv_film_height(film), 1.0f, err);
 }
 
+/* Every rank agrees, then rank 0's n ints go to every other rank (a split run; nothing in one
+ * process): what rank 0 found in its cache, so that every rank knows what is left to render. */
+static fv_status share_plan(const fv_bench_split *sp, fv_status st, int *v, int n, fv_error *err)
+{
+    if (!sp) return st;
+    if ((st = agree(sp, st, err)) != FV_OK) return st;
+    for (int to = 1; to < sp->size && st == FV_OK; to++)
+        if (sp->rank == 0 || sp->rank == to) st = sp->move(sp->user, 0, to, v, (size_t)n * sizeof *v, err);
+    return agree(sp, st, err);
+}
+
+/* A still across every rank through the split's `still` (fv_bench_split): *split says whether it
+ * was; on rank 0 rgb then holds the image. A failure is the job's (agreed). */
+static fv_status split_still(const render_job *j, int index, float *rgb, bool *split, fv_error *err)
+{
+    *split = false;
+    const fv_bench_split *sp = j->split;
+    if (!sp || !sp->still) return FV_OK;
+    fv_film *film = NULL;
+    fv_status st = fv_film_create(j->sc->width, j->sc->height, 0, &film, err);
+    /* a film that cannot be made here fails the job before any rank splits */
+    if (st != FV_OK) return agree(sp, st, err);
+    const fv_bench_still still = {j->m->method, j->m->params, j->scene, j->driver, index, j->log};
+    st = sp->still(sp->user, &still, film, split, err);
+    if (*split && st == FV_OK && sp->rank == 0)
+        memcpy(rgb, fv_film_color(film), (size_t)j->sc->width * j->sc->height * 3 * sizeof(float));
+    fv_film_destroy(film);
+    return st;
+}
+
+/* The missing frames of a reference without state between frames, split over the ranks: one frame
+ * across every rank (sample blocks, split_still) when the split can; else the q-th missing frame
+ * rendered by rank q % size, on its own (the conformance suite's history check: such a method's
+ * frame is the same image alone or after its predecessors), and sent to rank 0, which writes it
+ * to the cache. Either way the cache holds the one-process frames bit for bit. */
+static fv_status split_references(const render_job *j, ref_ctx *c, const int *missing, int first, int n, fv_error *err)
+{
+    const fv_bench_split *sp = j->split;
+    const size_t bytes = (size_t)j->sc->width * j->sc->height * 3 * sizeof(float);
+    int k = 0, one = -1;
+    for (int i = first; i < n; i++)
+        if (missing[i]) k++, one = i;
+    fv_status st = FV_OK;
+    if (k == 1) {
+        bool split;
+        if ((st = split_still(j, one, c->frames[one].ref[c->slot], &split, err)) != FV_OK) return st;
+        if (split) {
+            if (sp->rank == 0 && c->paths[one])
+                st = fv_image_write(c->paths[one], c->frames[one].ref[c->slot], j->sc->width, j->sc->height, 1.0f, err);
+            return agree(sp, st, err);
+        }
+    }
+    for (int i = first, q = 0; i < n && st == FV_OK; i++)
+        if (missing[i] && q++ % sp->size == sp->rank) st = render_sequence(j, i, i + 1, on_reference_frame, c, err);
+    if ((st = agree(sp, st, err)) != FV_OK) return st;
+    /* a cache file that cannot be written fails the job once every frame has arrived: a rank still
+     * sending must not wait for a receive that never comes */
+    fv_status written = FV_OK;
+    for (int i = first, q = 0; i < n && st == FV_OK; i++) {
+        if (!missing[i]) continue;
+        const int from = q++ % sp->size;
+        if (from == 0 || (sp->rank != 0 && sp->rank != from)) continue;
+        st = sp->move(sp->user, from, 0, c->frames[i].ref[c->slot], bytes, err);
+        if (st == FV_OK && sp->rank == 0 && written == FV_OK && c->paths[i])
+            written = fv_image_write(c->paths[i], c->frames[i].ref[c->slot], j->sc->width, j->sc->height, 1.0f, err);
+    }
+    return agree(sp, st != FV_OK ? st : written, err);
+}
+
 /* Reference `slot` (0: the scenario's reference, k: extra reference k - 1) for every frame, from
- * the cache or rendered. */
+ * the cache or rendered. Split over processes, every rank calls it: rank 0 reads the cache and
+ * says what is missing, and the missing frames are split (split_references) unless the method
+ * keeps state between frames, whose sequence rank 0 renders alone (a frame needs its history).
+ * Returns the job's status (agreed: after a failure no rank agrees again). */
 static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, const char *cache_dir, int slot,
                                  int *cached, double *ms, fv_error *err)
 {
     const fv_scenario *sc = info->sc;
+    const fv_bench_split *sp = info->opt->split;
+    const int rank = sp ? sp->rank : 0;
     const fv_bench_method *m = slot == 0 ? &sc->reference : &sc->extra[slot - 1];
     int n = sc->frames, first = sc->measure_from;
     char **paths = calloc((size_t)n, sizeof *paths);
-    if (!paths) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    fv_status st = FV_OK;
-    int missing = 0;
-    for (int i = first; i < n && st == FV_OK; i++) {
+    int *missing = calloc((size_t)n, sizeof *missing);
+    fv_status st = paths && missing ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    int nmissing = 0;
+    for (int i = first; i < n && st == FV_OK && rank == 0; i++) {
         char key[2048];
         reference_key(sc, m, &frames[i], i, key, sizeof key);
         char path[4096 + 64];
@@ -213,24 +297,37 @@ static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene,
             fv_image_free(&img);
         }
         if (!(paths[i] = strdup(path))) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-        missing++;
+        missing[i] = 1;
     }
-    if (st == FV_OK && missing > 0) {
-        /* Render the whole measured sequence (a temporal reference needs its history); frames
-         * already cached are simply not written again. Frames before measure_from are never
-         * compared, so they need no reference. */
-        say(info->opt, "%s: rendering %d frame(s) with %s (%d cached)", m->label, n - first, m->method, *cached);
+    st = share_plan(sp, st, missing, n, err);
+    for (int i = first; i < n && st == FV_OK; i++) nmissing += missing[i];
+    if (st == FV_OK && nmissing > 0) {
+        const bool alone = !sp || fv_technique_warmup_frames(fv_technique_index(m->method)) > 0;
+        say(info->opt, "%s: rendering %d frame(s) with %s (%d cached)%s", m->label, alone ? n - first : nmissing, m->method, *cached,
+            alone ? "" : ", split over the ranks");
         /* References are rendered on their own random stream (core/rng.h). */
-        render_job j = {sc, scene, info->ref_driver, m, info->opt->log, info->opt->split};
+        render_job j = {sc, scene, info->ref_driver, m, info->opt->log, sp};
         ref_ctx c = {frames, (const char *const *)paths, slot, 0.0};
-        st = render_sequence(&j, first, n, on_reference_frame, &c, err);
-        *ms = c.ms / (n - first);
-        if (st != FV_OK) fv_error_prefix(err, "%s: ", m->label);
+        if (alone) {
+            /* Render the whole measured sequence (a temporal reference needs its history); frames
+             * already cached are simply not written again. Frames before measure_from are never
+             * compared, so they need no reference. */
+            if (rank == 0) st = render_sequence(&j, first, n, on_reference_frame, &c, err);
+            *ms = c.ms / (n - first);
+            if (st != FV_OK) fv_error_prefix(err, "%s: ", m->label);
+            st = agree(sp, st, err);
+        } else {
+            /* the job's wall time per frame rendered */
+            double t0 = fv_time_ms();
+            if ((st = split_references(&j, &c, missing, first, n, err)) != FV_OK) fv_error_prefix(err, "%s: ", m->label);
+            *ms = (fv_time_ms() - t0) / nmissing;
+        }
     } else if (st == FV_OK) {
         say(info->opt, "%s: %d frame(s) from the cache", m->label, n - first);
     }
-    for (int i = 0; i < n; i++) free(paths[i]);
+    for (int i = 0; paths && i < n; i++) free(paths[i]);
     free(paths);
+    free(missing);
     return st;
 }
 
@@ -251,10 +348,15 @@ static fv_status on_probe_frame(void *user, int i, fv_film *film, double ms, con
     return fv_image_write(c->path, c->rgb, w, h, 1.0f, err);
 }
 
+/* Split over processes, every rank calls it: rank 0 reads the cache and says whether the probe is
+ * in it; a missing probe is rendered across the ranks when the split's `still` splits it (as the
+ * reference's own frame is), else by rank 0 alone. Returns the job's status (agreed). */
 static fv_status probe_reference(fv_bench_run_info *info, fv_scene *scene, const fv_view *view, const fv_drive_opts *dopt, frame_setup *frames,
                                  const char *cache_dir, fv_error *err)
 {
     const fv_scenario *sc = info->sc;
+    const fv_bench_split *sp = info->opt->split;
+    const int rank = sp ? sp->rank : 0;
     fv_bench_ref_noise *rn = &info->ref_noise;
     if (!fv_bench_ref_noise_plan(sc, rn)) return FV_OK;
     const int last = sc->frames - 1;
@@ -264,39 +366,48 @@ static fv_status probe_reference(fv_bench_run_info *info, fv_scene *scene, const
     fv_driver *driver = NULL;
     float *rgb = fv_alloc_array(npix, 3 * sizeof(float));
     char v[32], key[2048 + 32], path[4096 + 64];
+    int need = 0; /* rank 0's: the probe is not in the cache */
     snprintf(v, sizeof v, "%d", rn->probe_spp);
     fv_status st = rgb ? fv_params_clone(sc->reference.params, &probe.params, err) : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if (st == FV_OK) st = fv_params_set(probe.params, rn->spp_key, v, err);
-    if (st != FV_OK) goto done;
-    reference_key(sc, &probe, &frames[last], last, key, sizeof key - 32);
-    strcat(key, "|stream=probe");
-    snprintf(path, sizeof path, "%s/probe-%016llx.pfm", cache_dir, (unsigned long long)fnv1a(FNV_BASIS, key));
-    fv_image img;
-    fv_error e2;
-    if (fv_file_exists(path) && fv_image_read(path, &img, &e2) == FV_OK) {
-        bool fits = img.width == sc->width && img.height == sc->height;
-        if (fits) memcpy(rgb, img.rgb, npix * 3 * sizeof(float));
-        fv_image_free(&img);
-        if (fits) goto compare;
+    if (st == FV_OK) {
+        reference_key(sc, &probe, &frames[last], last, key, sizeof key - 32);
+        strcat(key, "|stream=probe");
+        snprintf(path, sizeof path, "%s/probe-%016llx.pfm", cache_dir, (unsigned long long)fnv1a(FNV_BASIS, key));
+        fv_image img;
+        fv_error e2;
+        need = rank == 0;
+        if (rank == 0 && fv_file_exists(path) && fv_image_read(path, &img, &e2) == FV_OK) {
+            bool fits = img.width == sc->width && img.height == sc->height;
+            if (fits) memcpy(rgb, img.rgb, npix * 3 * sizeof(float));
+            fv_image_free(&img);
+            need = !fits;
+        }
     }
+    if ((st = share_plan(sp, st, &need, 1, err)) != FV_OK || !need) goto compare;
     say(info->opt, "reference noise: probing with %s=%d on its own stream", rn->spp_key, rn->probe_spp);
     fv_drive_opts o = *dopt;
     o.seed = fv_seed_reference_probe(sc->seed);
-    if ((st = fv_driver_create(scene, view, &o, &driver, err)) != FV_OK) goto done;
-    render_job j = {sc, scene, driver, &probe, info->opt->log, info->opt->split};
+    st = fv_driver_create(scene, view, &o, &driver, err);
+    render_job j = {sc, scene, driver, &probe, info->opt->log, sp};
+    bool split = false;
+    /* every rank has its driver before any splits the still; a failure there or in the split is
+     * already the job's */
+    if (sp && ((st = agree(sp, st, err)) != FV_OK || (st = split_still(&j, last, rgb, &split, err)) != FV_OK)) goto compare;
+    if (split && rank == 0) st = fv_image_write(path, rgb, sc->width, sc->height, 1.0f, err);
     probe_ctx c = {rgb, path};
-    if ((st = render_sequence(&j, last, last + 1, on_probe_frame, &c, err)) != FV_OK) {
-        fv_error_prefix(err, "the reference's noise probe: ");
-        goto done;
+    if (!split && rank == 0) st = render_sequence(&j, last, last + 1, on_probe_frame, &c, err);
+    if (st != FV_OK) fv_error_prefix(err, "the reference's noise probe: ");
+    st = agree(sp, st, err);
+compare:
+    if (st == FV_OK && rank == 0) {
+        fv_metric_opts mo;
+        fv_metric_opts_default(&mo);
+        mo.exposure = sc->exposure;
+        fv_metric_report rep;
+        if ((st = fv_metrics_compare(frames[last].ref[0], rgb, sc->width, sc->height, frames[last].labels, &mo, &rep, NULL, err)) == FV_OK)
+            fv_bench_ref_noise_estimate(rn, &rep);
     }
-compare:;
-    fv_metric_opts mo;
-    fv_metric_opts_default(&mo);
-    mo.exposure = sc->exposure;
-    fv_metric_report rep;
-    if ((st = fv_metrics_compare(frames[last].ref[0], rgb, sc->width, sc->height, frames[last].labels, &mo, &rep, NULL, err)) == FV_OK)
-        fv_bench_ref_noise_estimate(rn, &rep);
-done:
     fv_driver_destroy(driver);
     fv_params_destroy(probe.params);
     free(rgb);
@@ -566,19 +677,6 @@ static fv_status run_method(const fv_bench_run_info *info, fv_scene *scene, fram
     return st;
 }
 
-/* The scenario's methods, their repeats interleaved: round r renders every method's repeat r, so a
- * machine that slows down or speeds up (other processes, a shared host) does so for all of them
- * alike, and the speed-up is the median over rounds of the baseline's time over the method's, each
- * ratio taken within one round. */
-/* The job's status when the run is split over processes (fv_bench_split), else this one's. A
- * rank that failed says so first, so that the others stop rendering at their next frame. */
-static fv_status agree(const fv_bench_split *sp, fv_status s, fv_error *err)
-{
-    if (!sp) return s;
-    if (s != FV_OK && sp->failed) sp->failed(sp->user);
-    return sp->agree(sp->user, s, err);
-}
-
 /* Rank `rank` of a split run (fv_bench_split) times the rows i with i % size == rank. */
 static bool owns(const fv_bench_split *sp, int i) { return !sp || i % sp->size == sp->rank; }
 
@@ -620,6 +718,10 @@ static fv_status gather_row(const fv_bench_run_info *info, const frame_setup *fr
     return st;
 }
 
+/* The scenario's methods, their repeats interleaved: round r renders every method's repeat r, so a
+ * machine that slows down or speeds up (other processes, a shared host) does so for all of them
+ * alike, and the speed-up is the median over rounds of the baseline's time over the method's, each
+ * ratio taken within one round. */
 static fv_status run_methods(const fv_bench_run_info *info, fv_scene *scene, frame_setup *frames, fv_bench_result *res,
                              int total, fv_error *err)
 {
@@ -956,14 +1058,16 @@ static fv_status run_loaded(fv_scenario *sc, const char *path, const fv_bench_op
 setup_end:
     /* Split over processes: every rank has checked the same scenario; a problem is said once. */
     if ((st = agree(sp, st, err)) != FV_OK) goto done;
-    /* The references: rendered (or read from the cache) by rank 0, then handed to every rank. */
+    /* The references: read from rank 0's cache or rendered (split over the ranks where they can
+     * be), then handed to every rank. */
+    if ((st = load_references(&info, scene, frames, cache_dir, 0, &info.ref_cached, &info.ref_ms, err)) != FV_OK) goto done;
+    dopt.seed = sc->seed;
+    if ((st = probe_reference(&info, scene, view, &dopt, frames, cache_dir, err)) != FV_OK) goto done;
+    for (int k = 0; k < sc->nextra && st == FV_OK; k++)
+        st = load_references(&info, scene, frames, cache_dir, 1 + k, &info.extra_cached[k], &info.extra_ms[k], err);
+    /* (each of those ended with the job's status) */
+    if (st != FV_OK) goto done;
     if (rank == 0) {
-        if ((st = load_references(&info, scene, frames, cache_dir, 0, &info.ref_cached, &info.ref_ms, err)) != FV_OK) goto refs_end;
-        dopt.seed = sc->seed;
-        if ((st = probe_reference(&info, scene, view, &dopt, frames, cache_dir, err)) != FV_OK) goto refs_end;
-        for (int k = 0; k < sc->nextra && st == FV_OK; k++)
-            st = load_references(&info, scene, frames, cache_dir, 1 + k, &info.extra_cached[k], &info.extra_ms[k], err);
-        if (st != FV_OK) goto refs_end;
         snprintf(info.ref_img, sizeof info.ref_img, "%s/reference.png", sc->name);
         info.last_gaze = frames[sc->frames - 1].gaze;
         {

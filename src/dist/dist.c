@@ -9,7 +9,7 @@
 #include "fovea/stats.h"
 #include "dist/dist.h"
 
-enum { TAG_FAIL = 7001, TAG_DATA = 7002 };
+enum { TAG_FAIL = 7001, TAG_DATA = 7002, TAG_NOTE = 7003 };
 /* What a rank contributes to an agreement. */
 enum { AGREE_OK = 0, AGREE_STOPPED = 1, AGREE_FAILED = 2 };
 
@@ -20,6 +20,13 @@ struct fv_dist {
     bool peer_failed, told;
     int held_fd, saved_fd; /* fv_dist_hold: the file stderr goes to, and the real stderr */
     double comm_s, wait_s;
+    /* notes: the one in flight from here (its buffer must outlive it), the posted receive */
+    MPI_Request note_out, note_in;
+    double note_out_buf[FV_DIST_NOTE_MAX], note_in_buf[FV_DIST_NOTE_MAX];
+    bool note_out_busy, note_in_posted;
+    int bars; /* progress bars started (fv_dist_bar_next) */
+    void (*idle)(void *user);
+    void *idle_user;
 };
 
 bool fv_dist_launched(void)
@@ -91,6 +98,12 @@ void fv_dist_end(fv_dist *d)
 {
     if (!d) return;
     release_hold(d, d->rank == 0, false);
+    /* a note still in flight completes (or not) with MPI_Finalize; its buffer is d's */
+    if (d->note_out_busy) MPI_Request_free(&d->note_out);
+    if (d->note_in_posted) {
+        MPI_Cancel(&d->note_in);
+        MPI_Wait(&d->note_in, MPI_STATUS_IGNORE);
+    }
     if (!d->peer_failed) {
         MPI_Cancel(&d->fail_req);
         MPI_Wait(&d->fail_req, MPI_STATUS_IGNORE);
@@ -145,15 +158,18 @@ bool fv_dist_poll(fv_dist *d)
 
 /* Every rank's pair of ints. A rank that arrives early waits without spinning (MPI's blocking
  * collectives busy-poll, which takes a core from a rank still rendering on the same host): the
- * non-blocking gather is tested every millisecond. */
-static int wait_all(int mine[2], int *all)
+ * non-blocking gather is tested every millisecond (running the idle hook between tests). */
+static int wait_all(fv_dist *d, int mine[2], int *all)
 {
     MPI_Request q;
     int rc = MPI_Iallgather(mine, 2, MPI_INT, all, 2, MPI_INT, MPI_COMM_WORLD, &q);
     int done = 0;
     while (rc == MPI_SUCCESS && !done) {
         rc = MPI_Test(&q, &done, MPI_STATUS_IGNORE);
-        if (rc == MPI_SUCCESS && !done) nanosleep(&(struct timespec){0, 1000000}, NULL);
+        if (rc == MPI_SUCCESS && !done) {
+            if (d->idle) d->idle(d->idle_user);
+            nanosleep(&(struct timespec){0, 1000000}, NULL);
+        }
     }
     return rc;
 }
@@ -168,7 +184,7 @@ fv_status fv_dist_agree(fv_dist *d, fv_status s, bool *print_it, bool *name_rank
     }
     int *all = malloc(sizeof(int) * 2 * (size_t)d->size);
     double t0 = fv_time_ms();
-    int rc = all ? wait_all(mine, all) : MPI_ERR_NO_MEM;
+    int rc = all ? wait_all(d, mine, all) : MPI_ERR_NO_MEM;
     d->wait_s += (fv_time_ms() - t0) * 1e-3;
     if (rc != MPI_SUCCESS) {
         /* no agreement to be had: this rank speaks for itself */
@@ -238,3 +254,50 @@ fv_status fv_dist_sum(fv_dist *d, double *v, int n, fv_error *err)
     d->comm_s += (fv_time_ms() - t0) * 1e-3;
     return rc == MPI_SUCCESS ? FV_OK : mpi_fail(rc, "sum", err);
 }
+
+void fv_dist_set_idle(fv_dist *d, void (*fn)(void *user), void *user)
+{
+    d->idle = fn;
+    d->idle_user = user;
+}
+
+/* Whether the note in flight has left (its request then completed). */
+static bool note_gone(fv_dist *d)
+{
+    if (!d->note_out_busy) return true;
+    int flag = 0;
+    if (MPI_Test(&d->note_out, &flag, MPI_STATUS_IGNORE) != MPI_SUCCESS || flag) d->note_out_busy = false;
+    return !d->note_out_busy;
+}
+
+bool fv_dist_note_send(fv_dist *d, int peer, const double *v, int n)
+{
+    if (n > FV_DIST_NOTE_MAX || !note_gone(d)) return false;
+    memcpy(d->note_out_buf, v, (size_t)n * sizeof *v);
+    if (MPI_Isend(d->note_out_buf, n, MPI_DOUBLE, peer, TAG_NOTE, MPI_COMM_WORLD, &d->note_out) != MPI_SUCCESS) return false;
+    d->note_out_busy = true;
+    return true;
+}
+
+void fv_dist_note_flush(fv_dist *d)
+{
+    while (!note_gone(d) && !fv_dist_poll(d)) nanosleep(&(struct timespec){0, 1000000}, NULL);
+}
+
+bool fv_dist_note_take(fv_dist *d, double *v, int *from)
+{
+    if (!d->note_in_posted) {
+        if (MPI_Irecv(d->note_in_buf, FV_DIST_NOTE_MAX, MPI_DOUBLE, MPI_ANY_SOURCE, TAG_NOTE, MPI_COMM_WORLD, &d->note_in) != MPI_SUCCESS)
+            return false;
+        d->note_in_posted = true;
+    }
+    int flag = 0;
+    MPI_Status st;
+    if (MPI_Test(&d->note_in, &flag, &st) != MPI_SUCCESS || !flag) return false;
+    d->note_in_posted = false;
+    memcpy(v, d->note_in_buf, sizeof d->note_in_buf);
+    *from = st.MPI_SOURCE;
+    return true;
+}
+
+int fv_dist_bar_next(fv_dist *d) { return d->bars++; }

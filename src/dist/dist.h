@@ -57,6 +57,21 @@ fv_status fv_dist_recv_bytes(fv_dist *d, int peer, void *v, size_t n, fv_error *
 /* The sum over ranks of n doubles, the result on every rank. Used for counters only (order-free
  * values), never for pixels. */
 fv_status fv_dist_sum(fv_dist *d, double *v, int n, fv_error *err);
+/* Notes: a few doubles (at most FV_DIST_NOTE_MAX) sent without waiting, for what must never hold a
+ * rank up (progress). At most one note of this rank is in flight: fv_dist_note_send returns false
+ * and sends nothing while the previous one has not left. fv_dist_note_flush tests until it has
+ * left, or another rank failed (then it is left to MPI_Finalize: its buffer lives in d). */
+#define FV_DIST_NOTE_MAX 4
+bool fv_dist_note_send(fv_dist *d, int peer, const double *v, int n);
+void fv_dist_note_flush(fv_dist *d);
+/* One note from any rank, if one has arrived (v: FV_DIST_NOTE_MAX doubles): true and *from. */
+bool fv_dist_note_take(fv_dist *d, double *v, int *from);
+/* While this rank waits in fv_dist_agree, fn(user) runs about every millisecond (rank 0's bar
+ * goes on showing the others' progress); NULL stops it. */
+void fv_dist_set_idle(fv_dist *d, void (*fn)(void *user), void *user);
+/* 0, 1, 2, ...: the number of the job's next progress bar (progress.h), counted alike on every rank. */
+int fv_dist_bar_next(fv_dist *d);
+
 /* Seconds this rank spent moving data (sends, receives, sums): the communication share of the
  * figures; and waiting in agreements for the other ranks (load imbalance, not communication). */
 double fv_dist_comm_seconds(const fv_dist *d);

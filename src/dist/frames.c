@@ -19,6 +19,19 @@ void fv_dist_frames(int frames, int rank, int size, int warmup, int *start, int 
     *start = *first - warmup < 0 ? 0 : *first - warmup;
 }
 
+double fv_dist_frames_share(int frames, int rank, int size, int warmup, int still_warmup)
+{
+    double mine = 0.0, all = 0.0;
+    for (int r = 0; r < size; r++) {
+        int start, first, end;
+        fv_dist_frames(frames, r, size, warmup, &start, &first, &end);
+        const double n = (end > start ? end - start : 0) + (start == 0 ? still_warmup : 0);
+        all += n;
+        if (r == rank) mine = n;
+    }
+    return all > 0.0 ? mine / all : 0.0;
+}
+
 fv_status fv_dist_frames_manifest(const char *path, const char *method, int frames, int size, int warmup, fv_error *err)
 {
     cJSON *root = cJSON_CreateObject(), *blocks = cJSON_CreateArray();

@@ -24,8 +24,8 @@ static void share(int nb, int rank, int size, int *lo, int *hi)
     *hi = (int)(((long long)nb * (rank + 1) + size - 1) / size);
 }
 
-/* Progress of rank 0's own nodes as the job's (all ranks render equal shares at the same pace),
- * stopping when another rank failed. */
+/* Progress through this rank's own nodes (progress.h adds the ranks' shares up), stopping when
+ * another rank failed. */
 typedef struct node_progress {
     fv_dist *d;
     fv_progress_fn fn;
@@ -38,6 +38,26 @@ static bool on_progress(void *user, double f)
     node_progress *p = user;
     if (fv_dist_poll(p->d)) return false;
     return !p->fn || p->fn(p->user, p->base + p->span * f);
+}
+
+void fv_dist_still_job_init(fv_dist_still_job *job, const char *method, const fv_params *params, const fv_scene *scene, const fv_log *log,
+                            fv_driver *driver, int frame)
+{
+    *job = (fv_dist_still_job){.method = method, .params = params, .scene = scene, .log = log, .driver = driver, .frame = frame};
+    const char *spp_key = fv_technique_spp_param(fv_technique_index(method));
+    for (int i = 0; i < fv_params_count(params); i++) {
+        const char *k = fv_params_key(params, i), *v = fv_params_value(params, i);
+        if (spp_key && !strcmp(k, spp_key)) job->spp = atoi(v);
+        if (!strcmp(k, "device") && strcmp(v, "cpu")) job->other_device = true;
+    }
+}
+
+double fv_dist_still_share(const fv_dist_still_job *job, int rank, int size)
+{
+    const int nb = fv_blocks_count(job->spp);
+    int lo, hi;
+    share(nb, rank, size, &lo, &hi);
+    return nb > 0 ? (double)(hi - lo) / nb : 0.0;
 }
 
 bool fv_dist_still_splits(const fv_dist_still_job *job, int size)
@@ -57,7 +77,7 @@ static fv_status render_node(const fv_dist_still_job *job, int lo, int hi, fv_fi
     if (s == FV_OK) snprintf(v, sizeof v, "%d", lo), s = fv_params_set(p, "block_first", v, err);
     if (s == FV_OK) snprintf(v, sizeof v, "%d", hi - lo), s = fv_params_set(p, "block_count", v, err);
     if (s == FV_OK) s = fv_technique_create(job->method, job->scene, p, job->log, &t, err);
-    if (s == FV_OK) s = fv_driver_render(job->driver, t, 0, false, films, stats, on_progress, prog, err);
+    if (s == FV_OK) s = fv_driver_render(job->driver, t, job->frame, false, films, stats, on_progress, prog, err);
     fv_technique_destroy(t);
     fv_params_destroy(p);
     return s;
@@ -96,7 +116,7 @@ fv_status fv_dist_still(fv_dist *d, const fv_dist_still_job *job, fv_film *const
     /* This rank's nodes in block order (only block 0's range writes the auxiliary buffers). */
     int my_blocks = 0;
     for (int k = mine0; k < mine1; k++) my_blocks += nodes[k][1] - nodes[k][0];
-    node_progress prog = {d, rank == 0 ? job->progress : NULL, job->progress_user, 0.0, 0.0};
+    node_progress prog = {d, job->progress, job->progress_user, 0.0, 0.0};
     for (int i = 0; i < mine1 - mine0 && s == FV_OK; i++) {
         int k = mine0 + i;
         int n = nodes[k][1] - nodes[k][0];

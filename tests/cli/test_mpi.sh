@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # `mpirun -n N fovea render` (docs/distributed.md): a split still (pt's samples, ppm's passes) is
 # the one-process image bit for bit (shared memory and TCP), a split sequence writes the one-process frames (fipr after its
-# stated warm-up), a failed job says one line and leaves no output, a killed rank ends the job.
+# stated warm-up), pm's passes are not split and say so once, rank 0 alone draws one bar for the
+# whole job, a failed job says one line and leaves no output, a killed rank ends the job. The
+# bench's report, and the reference cache it splits over the ranks, equal a one-process run's.
 # Skipped (exit 77) where fovea was built without MPI or mpirun is missing.
 . "$(dirname "$0")/lib.sh"
 if [ "${FV_HAVE_MPI:-OFF}" != ON ] || ! command -v mpirun >/dev/null; then
@@ -54,6 +56,14 @@ $MPI -n 2 "$FOVEA" $P --out ppm2.exr || fail "2-rank ppm"
 same ppm1.exr ppm2.exr "ppm over 2 ranks"
 "$FOVEA" $P --param block_first=1 --out ppmpart.exr || fail "ppm's last two blocks"
 cmp -s ppm1.exr ppmpart.exr && fail "two of three blocks of passes gave the whole ppm image"
+# pm's passes (a filtered running mean) are not split: rank 0 renders them, the one-process image,
+# and says so once.
+M="render cornell --method pm --param passes=3 --param photons=2000 --size 24x24 --threads 1 --no-metadata"
+"$FOVEA" $M --quiet --out pm1.pfm || fail "one-process pm passes=3"
+$MPI -n 2 "$FOVEA" $M --out pm2.pfm 2>pm2.err || fail "2-rank pm passes=3: $(cat pm2.err)"
+same pm1.pfm pm2.pfm "pm passes=3 over 2 ranks"
+n=$(grep -c "mpi: the still is not split over 2 ranks (pm's 3 passes are averaged and filtered in one process" pm2.err)
+[ "$n" = 1 ] || fail "pm's passes: expected the note once, got $n: $(cat pm2.err)"
 
 # A sequence of a method without temporal state along a camera trace: every frame as one process.
 S="render cornell --size 32x24 --spp 4 --frames 5 --threads 1 --quiet --no-metadata --camera-trace $SRC/tests/data/camera.csv --fps 2"
@@ -62,6 +72,18 @@ $MPI -n 2 "$FOVEA" $S --out d.pfm || fail "2-rank sequence"
 for f in 0000 0001 0002 0003 0004; do same "s_$f.pfm" "d_$f.pfm" "sequence frame $f"; done
 [ "$(ls d_*.pfm | wc -l)" = 5 ] || fail "the 2-rank sequence wrote $(ls d_*.pfm | wc -l) frames, expected 5"
 grep -q '"warmup_frames":[[:space:]]*0' d_ranks.json || fail "the manifest lacks warmup_frames 0: $(cat d_ranks.json)"
+# One bar for the whole job, drawn by rank 0 alone (launchers give a rank's stdout a terminal, so
+# rank 0 draws it): 2 frames over 3 ranks leave rank 0 no frame, yet its bar follows ranks 1 and 2
+# to 100%, once, never going back (a second drawing rank would restart at its own few percent).
+$MPI -n 3 "$FOVEA" render cornell --size 32x32 --spp 64 --frames 2 --threads 1 --no-metadata --out pb.pfm >pb.out 2>pb.err ||
+  fail "3-rank sequence of 2 frames: $(cat pb.err)"
+python3 - pb.err <<'EOS' || fail "the job's bar: $(tr '\r' '\n' <pb.err | grep -o '[0-9]*%' | tr '\n' ' ')"
+import re, sys
+p = [int(x) for x in re.findall(r"\]\s*(\d+)%", open(sys.argv[1], errors="replace").read())]
+assert p, "no bar"
+assert all(a <= b for a, b in zip(p, p[1:])), "went back"
+assert p[-1] == 100 and p.count(100) == 1, "did not end at 100% once"
+EOS
 # fipr with refresh=4 keeps pixels for up to 3 frames: after its 3 warm-up frames rank 1's block is
 # the one-process sequence bit for bit; without them its first frame is not.
 printf 'time,x,y\n0,0.2,0.3\n0.3,0.8,0.6\n' >gaze.csv
@@ -116,6 +138,22 @@ for f in bone/pt-cornell/pt-spp=*[0-9].png; do
 done
 n=$(grep -c '^| pt-spp=4 ' btwo.out)
 [ "$n" = 1 ] || fail "the 2-rank bench printed its table $n times"
+# Its reference (pt, 256 spp: four sample blocks) was split over the ranks as `render` splits a
+# still, and cached bit for bit as one process caches it; so was its noise probe (64 spp, one
+# block: rank 0's).
+grep -q "reference: rendering 1 frame(s) with pt (0 cached), split over the ranks" btwo.err || fail "the 2-rank reference was not split: $(cat btwo.err)"
+[ "$(ls bone/cache | wc -l)" = 2 ] || fail "expected a reference and a probe in the cache: $(ls bone/cache)"
+for f in bone/cache/*; do same "$f" "btwo/cache/$(basename "$f")" "the 2-rank bench's cached $(basename "$f")"; done
+# A reference of 3 frames without state between them (8 spp: one block a frame) over 3 ranks, one
+# frame each: the cache of one process; again with one frame missing from the cache (rank 0 alone).
+C="bench --scene cornell --methods pt:spp=1,pt:spp=2 --reference pt:spp=8 --frames 3 --size 24x16 --threads 1 --quiet"
+"$FOVEA" $C --out cone >/dev/null 2>&1 || fail "one-process bench of 3 frames"
+$MPI -n 3 "$FOVEA" $C --out cthree >/dev/null 2>cthree.err || fail "3-rank bench of 3 frames: $(cat cthree.err)"
+[ "$(ls cone/cache | grep -c '^ref-')" = 3 ] || fail "expected 3 reference frames in the cache: $(ls cone/cache)"
+for f in cone/cache/*; do same "$f" "cthree/cache/$(basename "$f")" "the 3-rank bench's cached $(basename "$f")"; done
+rm "cthree/cache/$(ls cthree/cache | grep '^ref-' | head -1)"
+$MPI -n 3 "$FOVEA" $C --out cthree >/dev/null 2>cthree.err || fail "3-rank bench with 2 cached frames: $(cat cthree.err)"
+for f in cone/cache/*; do same "$f" "cthree/cache/$(basename "$f")" "the 3-rank bench's re-rendered $(basename "$f")"; done
 # Bad input every rank sees: one line, no folder.
 expect 2 "unknown scenario 'no-such'" -- $MPI -n 2 "$FOVEA" bench no-such --quick --out bbad
 expect 2 "spp=0: out of range" -- $MPI -n 2 "$FOVEA" bench --scene cornell --methods pt:spp=0 --out bbad

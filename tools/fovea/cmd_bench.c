@@ -182,9 +182,10 @@ static void on_status(void *user, const char *line)
 }
 
 #ifdef FOVEA_HAVE_MPI
-#include "dist/dist.h"
-/* `mpirun -n N fovea bench`: the library deals the rows to the ranks (fv_bench_split); here its
- * callbacks over src/dist, and the one line a failed job prints. */
+#include "dist/split.h"
+/* `mpirun -n N fovea bench`: the library deals the rows (and the references' frames) to the ranks
+ * (fv_bench_split); here its callbacks over src/dist, a reference still split by sample blocks as
+ * `fovea render` splits one, and the one line a failed job prints. */
 typedef struct bench_dist {
     fv_dist *d;
     bool agreed;             /* the library ran at least one agreement */
@@ -206,6 +207,28 @@ static fv_status split_agree(void *user, fv_status s, fv_error *err)
     fv_status js = fv_dist_agree(b->d, s, &b->print_it, &b->name_rank, &mpi);
     if (js != FV_OK) fv_cli_interrupt_mute(); /* the launcher may now signal this rank */
     if (js != FV_OK && s == FV_OK) *err = mpi.msg[0] ? mpi : (fv_error_set(err, js, "another rank failed"), *err);
+    return js;
+}
+
+/* The still over every rank when src/dist splits it (pt's sample blocks, ppm's blocks of passes):
+ * the same decision on every rank, from the method and its parameters alone. */
+static fv_status split_still(void *user, const fv_bench_still *still, fv_film *film, bool *split, fv_error *err)
+{
+    bench_dist *b = user;
+    fv_dist_still_job job;
+    fv_dist_still_job_init(&job, still->method, still->params, still->scene, still->log, still->driver, still->frame);
+    if (!(*split = fv_dist_still_splits(&job, fv_dist_size(b->d)))) return FV_OK;
+    fv_stats stats;
+    fv_stats_clear(&stats);
+    fv_error mine;
+    fv_error_clear(&mine);
+    b->agreed = true;
+    fv_status js = fv_dist_still(b->d, &job, &film, 1, &stats, &b->print_it, &b->name_rank, &mine);
+    if (js != FV_OK) {
+        fv_cli_interrupt_mute(); /* the launcher may now signal this rank */
+        if (mine.msg[0]) *err = mine;
+        else fv_error_set(err, js, "another rank failed");
+    }
     return js;
 }
 
@@ -393,7 +416,8 @@ int fv_cmd_bench(int argc, char **argv)
             fv_dist_end(bd.d);
             return fv_cli_fail("bench", s, err.msg);
         }
-        const fv_bench_split split = {fv_dist_rank(bd.d), fv_dist_size(bd.d), &bd, split_move, split_agree, split_stopped, split_failed};
+        const fv_bench_split split = {fv_dist_rank(bd.d), fv_dist_size(bd.d), &bd, split_move, split_agree, split_stopped, split_failed,
+                                     split_still};
         int rc = bench(argc, argv, &bd, &split);
         if (!bd.agreed) {
             /* Ended before the run split (bad options, --check, --list, --help): every rank agrees

@@ -15,6 +15,7 @@
 #include "gaze/overlay.h"
 #include "render_record.h"
 #ifdef FOVEA_HAVE_MPI
+#include "dist/progress.h"
 #include "dist/split.h"
 #endif
 
@@ -318,17 +319,52 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 #ifdef FOVEA_HAVE_MPI
 /* ---- over MPI ranks (docs/distributed.md; the split itself is src/dist's) ---- */
 
+/* Every rank's progress through its own work (base + span x the render's fraction) goes to the
+ * job's bar (src/dist/progress.h), which rank 0 alone draws. */
 typedef struct dist_progress {
     fv_dist *d;
-    fv_cli_progress *bar;
+    fv_dist_progress *job;
+    fv_cli_progress *bar; /* rank 0's: frames = the job's frames, so "frame k/N" counts the job's */
+    double base, span;
 } dist_progress;
 
-/* Rank 0's bar; every rank stops here once another failed. */
+/* Rank 0: the job's fraction on the bar. */
+static void show_job(void *user, double job)
+{
+    fv_cli_progress *bar = user;
+    const double at = job * bar->frames;
+    bar->frame = at >= bar->frames ? bar->frames - 1 : (int)at;
+    fv_cli_progress_frame(bar, at - bar->frame);
+}
+
+/* Every rank; it stops here once another failed or a signal came. */
 static bool on_dist_progress(void *user, double f)
 {
     dist_progress *p = user;
     if (fv_dist_poll(p->d)) return false;
-    return fv_cli_progress_frame(p->bar, f);
+    fv_dist_progress_update(p->job, p->base + p->span * f);
+    return !fv_cli_interrupted();
+}
+
+/* Why a still is not split over the ranks (docs/distributed.md, "What is split how"): one line,
+ * said by rank 0, which renders it alone. */
+static void unsplit_note(const char *method, const fv_params *params, int size, const fv_dist_still_job *job)
+{
+    char why[200];
+    int passes = 1;
+    for (int i = 0; i < fv_params_count(params); i++)
+        if (!strcmp(fv_params_key(params, i), "passes")) passes = atoi(fv_params_value(params, i));
+    if (!strcmp(method, "pm") && passes > 1)
+        /* pm's passes are a float running mean, then filtered (and a stereo right eye reuses the
+         * left eye's mean): not a sum of passes that ranks could each take a part of */
+        snprintf(why, sizeof why, "pm's %d passes are averaged and filtered in one process; ppm's passes are split", passes);
+    else if (strcmp(method, "pt") && strcmp(method, "ppm"))
+        snprintf(why, sizeof why, "only pt's samples and ppm's passes are split");
+    else if (job->other_device)
+        snprintf(why, sizeof why, "it runs on a device other than the cpu");
+    else
+        snprintf(why, sizeof why, "%s %s fit in one block of 64", job->spp > 0 ? "its" : "its default", !strcmp(method, "ppm") ? "passes" : "samples");
+    fprintf(stderr, "mpi: the still is not split over %d ranks (%s): rank 0 renders it alone\n", size, why);
 }
 
 /* The one line of a failed job, on the rank the agreement chose: "rank R: fovea render: ..." when
@@ -353,30 +389,35 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
     fv_status s = FV_OK;
     bool print_it = false, name_rank = false;
     fv_cli_progress bar;
-    fv_cli_progress_init(&bar, o->quiet || rank != 0, 1);
+    fv_cli_progress_init(&bar, o->quiet || rank != 0, o->frames);
     /* Launchers give a rank a terminal for stdout, not for stderr: rank 0 draws the bar when
      * the job's output is a terminal. */
     if (rank == 0 && !o->quiet) bar.enabled = isatty(STDOUT_FILENO);
-    dist_progress dp = {d, &bar};
+    dist_progress dp = {d, NULL, &bar, 0.0, 1.0};
     double t0 = fv_time_ms();
     fv_stats stats;
     fv_stats_clear(&stats);
     fv_cli_interrupt_defer(true);
     if (o->frames == 1) {
-        fv_dist_still_job job = {o->method, params, scene, log, driver, 0, false, on_dist_progress, &dp};
-        const char *spp_key = fv_technique_spp_param(fv_technique_index(o->method));
-        for (int i = 0; spp_key && i < fv_params_count(params); i++)
-            if (!strcmp(fv_params_key(params, i), spp_key)) job.spp = atoi(fv_params_value(params, i));
-        for (int i = 0; i < fv_params_count(params); i++)
-            if (!strcmp(fv_params_key(params, i), "device") && strcmp(fv_params_value(params, i), "cpu")) job.other_device = true;
-        if (fv_dist_still_splits(&job, size)) {
+        fv_dist_still_job job;
+        fv_dist_still_job_init(&job, o->method, params, scene, log, driver, 0);
+        job.progress = on_dist_progress;
+        job.progress_user = &dp;
+        const bool split = fv_dist_still_splits(&job, size);
+        s = fv_dist_progress_start(d, split ? fv_dist_still_share(&job, rank, size) : rank == 0, show_job, &bar, &dp.job, &err);
+        if (s == FV_OK && split) {
             s = fv_dist_still(d, &job, film, neyes, &stats, &print_it, &name_rank, &err);
         } else {
             /* Not split (docs/distributed.md says which stills are): rank 0 renders it alone. */
-            if (rank == 0) s = warm_up(o, rec, driver, tech, film, on_dist_progress, &dp, &bar, &err);
+            if (s == FV_OK && rank == 0 && !o->quiet) unsplit_note(o->method, params, size, &job);
+            const double wu = rec->warmup, all = wu + 1.0; /* the still's warm-up frames, then the still */
+            dp.span = wu / all;
+            if (s == FV_OK && rank == 0) s = warm_up(o, rec, driver, tech, film, on_dist_progress, &dp, &bar, &err);
+            dp.base = wu / all, dp.span = 1.0 / all;
             if (rank == 0 && s == FV_OK) s = fv_driver_render(driver, tech, 0, rec->warmup > 0, film, &stats, on_dist_progress, &dp, &err);
             s = fv_dist_agree(d, s, &print_it, &name_rank, &err);
         }
+        fv_dist_progress_end(dp.job, s == FV_OK);
         double ms = fv_time_ms() - t0;
         fv_cli_progress_done(&bar);
         if (s != FV_OK) return dist_fail(d, s, print_it, name_rank, err.msg);
@@ -394,12 +435,15 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
     const int mi = fv_technique_index(o->method), seq = fv_technique_warmup_frames(mi), still = fv_technique_still_warmup(mi);
     int warmup = o->warmup >= 0 ? o->warmup : seq > still ? seq : still, start, first, end;
     fv_dist_frames(o->frames, rank, size, warmup, &start, &first, &end);
+    /* this rank's work: the still's warm-up frames (the block at frame 0), then its frames */
+    const double wu = start == 0 ? rec->warmup : 0, all = wu + (end > start ? end - start : 0);
+    s = fv_dist_progress_start(d, fv_dist_frames_share(o->frames, rank, size, warmup, rec->warmup), show_job, &bar, &dp.job, &err);
+    dp.span = all > 0 ? wu / all : 0.0;
     /* the block that starts the sequence warms up as one process does, at frame 0's views */
-    if (start == 0) s = warm_up(o, rec, driver, tech, film, on_dist_progress, &dp, rank == 0 ? &bar : NULL, &err);
-    bar.frames = end - start > 0 ? end - start : 1;
+    if (s == FV_OK && start == 0) s = warm_up(o, rec, driver, tech, film, on_dist_progress, &dp, rank == 0 ? &bar : NULL, &err);
     for (int f = start; f < end && s == FV_OK && !fv_cli_interrupted(); f++) {
         fv_stats_clear(&stats);
-        bar.frame = f - start;
+        dp.base = (wu + (f - start)) / all, dp.span = 1.0 / all;
         double f0 = fv_time_ms();
         s = fv_driver_render(driver, tech, f, f > start || (start == 0 && rec->warmup > 0), film, &stats, on_dist_progress, &dp, &err);
         if (s == FV_OK && f >= first) s = write_frame(o, rec, driver, film, neyes, f, fv_time_ms() - f0, &err);
@@ -413,10 +457,12 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
         }
     }
     if (s == FV_OK && fv_cli_interrupted()) s = fv_error_set(&err, FV_ERR_CANCELLED, "interrupted");
-    fv_cli_progress_done(&bar);
     /* Signals stay deferred through the agreement: once a rank fails and exits, the launcher
      * signals the others, which must end with the job's one line, not one each. */
-    if ((s = fv_dist_agree(d, s, &print_it, &name_rank, &err)) != FV_OK) return dist_fail(d, s, print_it, name_rank, err.msg);
+    s = fv_dist_agree(d, s, &print_it, &name_rank, &err);
+    fv_dist_progress_end(dp.job, s == FV_OK);
+    fv_cli_progress_done(&bar);
+    if (s != FV_OK) return dist_fail(d, s, print_it, name_rank, err.msg);
     fv_cli_interrupt_defer(false);
     if (rank != 0) return FV_EXIT_OK;
     /* What was split how, beside the frames: OUT_ranks.json. */
