@@ -39,6 +39,14 @@ typedef struct fv_ksdf_counts {
     fv_sdf_shade_counts shade;
 } fv_ksdf_counts;
 
+/* What a pyramid's frame cost (ipr, fipr), as the CPU pipeline reports it: the sums, each level's
+ * camera rays and steps, and fipr's mask, edge and refreshed counts. Host code sums it. */
+typedef struct fv_ksdf_pyr_counts {
+    fv_ksdf_counts all;
+    uint64_t level_rays[FV_PYRAMID_MAX_LEVELS], level_steps[FV_PYRAMID_MAX_LEVELS];
+    uint64_t masked, edges, refreshed;
+} fv_ksdf_pyr_counts;
+
 /* The camera ray through target-grid position (sx, sy), its range clipped to the world's box (an
  * empty range when it misses the box). */
 FV_HD static inline void fv_ksdf_camera_ray(const fv_ksdf_world *w, const fv_ksdf_frame *f, float sx, float sy, fv_march_ray *r)
