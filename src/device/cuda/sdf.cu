@@ -362,7 +362,7 @@ static unsigned blocks_of(size_t n) { return (unsigned)((n + 255) / 256); }
 static fv_status pyramid_ensure(fv_cuda_sdf *c, const fv_kpyr *shape, bool fipr, bool vis, fv_error *err)
 {
     fv_kpyr *k = &c->k;
-    if (k->depth[0] && k->w == shape->w && k->h == shape->h && k->S == shape->S && k->L == shape->L && c->k_fipr == fipr && c->k_vis == vis) {
+    if (k->w > 0 && k->w == shape->w && k->h == shape->h && k->S == shape->S && k->L == shape->L && c->k_fipr == fipr && c->k_vis == vis) {
         k->min_filter = shape->min_filter;
         return FV_OK;
     }
@@ -379,7 +379,7 @@ static fv_status pyramid_ensure(fv_cuda_sdf *c, const fv_kpyr *shape, bool fipr,
         size_t n = (size_t)k->lv[i].w * k->lv[i].h;
         if ((e = cudaMalloc((void **)&k->depth[i], n * sizeof(float))) == cudaSuccess) e = cudaMalloc((void **)&k->steps[i], n * sizeof(uint16_t));
     }
-    const size_t nmid = (size_t)k->lv[L - 2].w * k->lv[L - 2].h;
+    const size_t nmid = L > 1 ? (size_t)k->lv[L - 2].w * k->lv[L - 2].h : 0;
     if (e == cudaSuccess && vis) e = cudaMalloc((void **)&k->vis, nmid * sizeof(uint32_t));
     if (e == cudaSuccess && fipr) e = cudaMalloc((void **)&k->need, nmid);
     if (e == cudaSuccess && fipr) e = cudaMalloc((void **)&k->edge, (size_t)k->lv[0].w * k->lv[0].h);
