@@ -91,7 +91,6 @@ typedef struct job {
     fv_sdf_world world;
     fv_camera_basis cam;
     fv_film_views out;
-    float foot;              /* a target sample's angular footprint per unit distance */
     int level;               /* the level of a level pass */
     fv_ksdf_frame kf;        /* what the kernel steps read of the frame (kernel/sdf_pixel.h) */
     fv_kit_counters *c;      /* RAYS (all rays), NAN, USER0 steps, USER1 shadow steps, USER2 normal evals, USER3 exhausted, USER4 shadow rays */
@@ -457,10 +456,10 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
     j->p = p;
     j->frame = frame;
     j->out = fv_film_views_of(film);
-    j->foot = 2.0f * j->cam.tan_half_x / (float)(j->cam.width * p->k.S);
     j->kf.cam = j->cam;
     j->kf.S = p->k.S;
-    j->kf.eps_k = p->o.hit * j->foot;
+    /* the hit distance per unit distance: `hit` x a target sample's angular footprint */
+    j->kf.eps_k = p->o.hit * (2.0f * j->cam.tan_half_x / (float)(j->cam.width * p->k.S));
     j->kf.march = p->o.march;
     j->kf.shade = p->o.shade;
 
