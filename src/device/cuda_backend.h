@@ -21,6 +21,9 @@ struct fv_kscene;
 struct fv_ksdf_world;
 struct fv_ksdf_frame;
 struct fv_ksdf_counts;
+struct fv_ksdf_pyr_counts;
+struct fv_kpyr;
+struct fv_kpyr_fovea;
 
 /* True when a CUDA device can run our kernels; else false with the reason in why. */
 bool fv_cuda_probe(char *why, size_t why_len);
@@ -45,6 +48,17 @@ fv_status fv_cuda_sdf_create(fv_cuda_sdf **out, fv_error *err);
  * buffers (host memory), and adds the costs to *counts; *kernel_ms the kernel's own time. */
 fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, const struct fv_ksdf_frame *f, const fv_film_views *out,
                              struct fv_ksdf_counts *counts, double *kernel_ms, fv_error *err);
+/* ipr and fipr (kernel/sdf_pyramid.h, kernel/sdf_pixel.h): shape gives the pyramid's sizes, levels
+ * and min filter (its pointers are not read); fov (NULL for ipr) fipr's mask and refresh, edge its
+ * Sobel threshold; shadow_reuse keeps level L-2's visibility. Every pass is a kernel launched on one
+ * stream with no host synchronisation between them, the pyramid's buffers and fipr's history (per
+ * eye) stay on the GPU between frames (reallocated only when the size changes), the world is copied
+ * only when it changed; the host receives the film's buffers that are set, the costs (added to
+ * *counts), and with mask_out (w x h, NULL: not asked) fipr's mask. *syncs: the host waits of the
+ * frame (1: the end). */
+fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, const struct fv_ksdf_frame *f, const struct fv_kpyr *shape,
+                                     const struct fv_kpyr_fovea *fov, float edge, bool shadow_reuse, const fv_film_views *out,
+                                     uint8_t *mask_out, struct fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err);
 void fv_cuda_sdf_destroy(fv_cuda_sdf *c);
 
 #ifdef __cplusplus

@@ -1,10 +1,11 @@
-/* fovea — one pixel of `sdf-gt` and `sdf-relaxed` as kernel code: every target sample of the pixel
- * sphere-traced from the camera (plain or over-relaxed, kernel/sdf_march.h) and shaded with
- * sphere-traced shadows (kernel/sdf_shade.h). The portable backend runs it a pixel at a time on the
- * CPU's threads (technique/sdf/device.c), CUDA one thread a pixel (device/cuda/sdf.cu).
+/* fovea — the rays of the sphere-tracing family as kernel code: a pixel of the target level (every
+ * target sample sphere-traced from the camera, plain or over-relaxed, kernel/sdf_march.h, and shaded
+ * with sphere-traced shadows, kernel/sdf_shade.h) for all four methods, and a ray of a pyramid level
+ * below it for ipr and fipr (kernel/sdf_pyramid.h holds the pyramid's image steps). The portable
+ * backend runs them a cell at a time on the CPU's threads (technique/sdf/device.c), CUDA one thread
+ * a cell (device/cuda/sdf.cu).
  *
- * It lays the samples out as the CPU pipeline's target level does (technique/sdf/pipeline.c, one
- * level): spp 1, 4 or 16 is a regular S x S grid of sub-pixel centres, sample (a, b) of pixel (x, y)
+ * The target level lays the samples out as the CPU pipeline's target level does (technique/sdf/pipeline.c): spp 1, 4 or 16 is a regular S x S grid of sub-pixel centres, sample (a, b) of pixel (x, y)
  * through target-grid position (x S + a + 1/2, y S + b + 1/2), rows first; the ray is clipped to the
  * world's box, its hit distance max(eps_abs, eps_k t). The samples' colours are summed in that
  * order through the same non-finite guard, and the first sample's hit fills the auxiliary buffers.
@@ -17,6 +18,7 @@
 #include "fovea/camera.h"
 #include "fovea/film.h"
 #include "kernel/path.h"
+#include "kernel/sdf_pyramid.h"
 #include "kernel/sdf_shade.h"
 
 /* What a frame's pixels share. */
@@ -37,6 +39,14 @@ typedef struct fv_ksdf_counts {
     fv_sdf_shade_counts shade;
 } fv_ksdf_counts;
 
+/* What a pyramid's frame cost (ipr, fipr), as the CPU pipeline reports it: the sums, each level's
+ * camera rays and steps, and fipr's mask, edge and refreshed counts. Host code sums it. */
+typedef struct fv_ksdf_pyr_counts {
+    fv_ksdf_counts all;
+    uint64_t level_rays[FV_PYRAMID_MAX_LEVELS], level_steps[FV_PYRAMID_MAX_LEVELS];
+    uint64_t masked, edges, refreshed;
+} fv_ksdf_pyr_counts;
+
 /* The camera ray through target-grid position (sx, sy), its range clipped to the world's box (an
  * empty range when it misses the box). */
 FV_HD static inline void fv_ksdf_camera_ray(const fv_ksdf_world *w, const fv_ksdf_frame *f, float sx, float sy, fv_march_ray *r)
@@ -48,25 +58,88 @@ FV_HD static inline void fv_ksdf_camera_ray(const fv_ksdf_world *w, const fv_ksd
     r->eps_k = f->eps_k;
 }
 
-/* Pixel (x, y): its colour into out's colour, the first sample's hit into its auxiliary buffers,
- * the costs added to *c. */
-FV_HD static inline void fv_ksdf_pixel(const fv_ksdf_world *w, const fv_ksdf_frame *f, int x, int y, const fv_film_views *out,
-                                       fv_ksdf_counts *c)
+/* Ray (x, y) of pyramid level k below the target (ipr, fipr; Polychronakis et al. 2023, Sec. 3.1):
+ * through the centre of its block, starting at the min-filtered depth of level k-1 (Sec. 3.2.4);
+ * its depth and steps into the level's buffers. On level L-2, the one the target starts from:
+ * fipr's rays that pass 4 does not need are skipped (kernel/sdf_pyramid.h, need), those due for a
+ * refresh are shaded into the eye's history (stamped with the frame's index), and with
+ * shadow_reuse every hit's visibility is kept for the target's samples. The costs are added to *c. */
+FV_HD static inline void fv_ksdf_level_cell(const fv_ksdf_world *w, const fv_ksdf_frame *f, const fv_kpyr *py, int k, int x, int y, int index,
+                                            fv_ksdf_counts *c)
+{
+    const fv_pyramid_level *lv = &py->lv[k];
+    const size_t i = (size_t)y * (size_t)lv->w + (size_t)x;
+    const bool below_target = k == py->L - 2;
+    if (py->need && below_target && !py->need[i]) {
+        py->depth[k][i] = 0.0f; /* not read: no mask pixel starts from it */
+        py->steps[k][i] = 0;
+        if (py->vis) py->vis[i] = FV_SDF_VIS_UNKNOWN;
+        return;
+    }
+    float sx, sy;
+    fv_kpyr_centre(lv, py->sw, py->sh, x, y, &sx, &sy);
+    fv_march_ray r;
+    fv_march_hit h;
+    fv_ksdf_camera_ray(w, f, sx, sy, &r);
+    if (k > 0) r.t0 = fmaxf(r.t0, fv_kpyr_start(py->depth[k - 1], &py->lv[k - 1], x >> 1, y >> 1, py->min_filter != 0));
+    fv_kmarch_one(w, f->march.max_steps, f->march.relax, &r, false, &h);
+    c->rays++;
+    c->steps += h.steps;
+    c->exhausted += h.exhausted;
+    py->depth[k][i] = h.hit ? h.t : INFINITY;
+    py->steps[k][i] = h.steps;
+    if (!below_target) return;
+    const bool colour = py->need && py->need[i] == 2;
+    if (!colour && !py->vis) return;
+    fv_vec3 nrm;
+    uint32_t vis;
+    fv_vec3 col = fv_ksdf_shade_vis(w, &f->march, &f->shade, &r, &h, FV_SDF_VIS_UNKNOWN, py->vis ? &vis : NULL, &c->shade, &nrm);
+    if (py->vis) py->vis[i] = vis;
+    if (!colour) return;
+    col = fv_path_guard(col, &c->nan);
+    py->hist_color[3 * i] = col.x;
+    py->hist_color[3 * i + 1] = col.y;
+    py->hist_color[3 * i + 2] = col.z;
+    py->hist_stamp[i] = index;
+}
+
+/* Pixel (x, y) of the target level: its colour into out's colour, the first sample's hit into its
+ * auxiliary buffers, the costs added to *c. py: NULL for sdf-gt and sdf-relaxed (every sample from
+ * the camera); ipr and fipr's pyramid otherwise: each sample starts at the min-filtered depth of
+ * level L-2, with shadow_reuse it takes the lights its parent's 3x3 agree on, and a pixel outside
+ * fipr's mask is reconstructed from the middle level's kept colours instead (no hit). */
+FV_HD static inline void fv_ksdf_target_pixel(const fv_ksdf_world *w, const fv_ksdf_frame *f, const fv_kpyr *py, int x, int y,
+                                              const fv_film_views *out, fv_ksdf_counts *c)
 {
     const int S = f->S;
     const size_t pix = (size_t)y * (size_t)f->cam.width + (size_t)x;
+    if (py && py->mask && !py->mask[pix]) {
+        fv_vec3 v = fv_kpyr_reconstruct(py, x, y);
+        fv_film_store_first_hit(out, pix, false, 0.0f, fv_v3s(0.0f), fv_v3s(0.0f), fv_v3s(0.0f), 0);
+        out->color[3 * pix] = v.x;
+        out->color[3 * pix + 1] = v.y;
+        out->color[3 * pix + 2] = v.z;
+        return;
+    }
+    const bool pyramid = py && py->L > 1;
     fv_vec3 sum = fv_v3s(0.0f);
     for (int b = 0; b < S; b++)
         for (int a = 0; a < S; a++) {
             fv_march_ray r;
             fv_march_hit h;
-            fv_ksdf_camera_ray(w, f, (float)(x * S + a) + 0.5f, (float)(y * S + b) + 0.5f, &r);
+            const int sx = x * S + a, sy = y * S + b;
+            fv_ksdf_camera_ray(w, f, (float)sx + 0.5f, (float)sy + 0.5f, &r);
+            uint32_t known = FV_SDF_VIS_UNKNOWN;
+            if (pyramid) {
+                r.t0 = fmaxf(r.t0, fv_kpyr_start(py->depth[py->L - 2], &py->lv[py->L - 2], sx >> 1, sy >> 1, py->min_filter != 0));
+                if (py->vis) known = fv_kpyr_agreed_vis(py, sx >> 1, sy >> 1);
+            }
             fv_kmarch_one(w, f->march.max_steps, f->march.relax, &r, false, &h);
             c->rays++;
             c->steps += h.steps;
             c->exhausted += h.exhausted;
             fv_vec3 nrm;
-            fv_vec3 col = fv_ksdf_shade_one(w, &f->march, &f->shade, &r, &h, &c->shade, &nrm);
+            fv_vec3 col = fv_ksdf_shade_vis(w, &f->march, &f->shade, &r, &h, known, NULL, &c->shade, &nrm);
             sum = fv_add(sum, fv_path_guard(col, &c->nan));
             if (a == 0 && b == 0) {
                 fv_vec3 hp = fv_madd(r.o, r.d, h.t);
@@ -78,6 +151,13 @@ FV_HD static inline void fv_ksdf_pixel(const fv_ksdf_world *w, const fv_ksdf_fra
     out->color[3 * pix] = v.x;
     out->color[3 * pix + 1] = v.y;
     out->color[3 * pix + 2] = v.z;
+}
+
+/* Pixel (x, y) of sdf-gt or sdf-relaxed: the target level without a pyramid. */
+FV_HD static inline void fv_ksdf_pixel(const fv_ksdf_world *w, const fv_ksdf_frame *f, int x, int y, const fv_film_views *out,
+                                       fv_ksdf_counts *c)
+{
+    fv_ksdf_target_pixel(w, f, NULL, x, y, out, c);
 }
 
 #endif

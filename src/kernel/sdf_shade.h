@@ -117,13 +117,24 @@ FV_HD static inline bool fv_ksdf_light_term(const fv_ksdf_light *L, const fv_ksd
     return true;
 }
 
+/* Which lights reach a shaded point: bit l for light l (scenes with up to 31 delta lights), or
+ * FV_SDF_VIS_UNKNOWN (also for a miss). ipr's shadow_reuse passes it from a level to the next. */
+#define FV_SDF_VIS_UNKNOWN 0xffffffffu
+
 /* Shades one marched camera ray: its radiance (black for a miss) and, in *normal, the unit normal
- * (zero for a miss); the costs are added to *c. */
-FV_HD static inline fv_vec3 fv_ksdf_shade_one(const fv_ksdf_world *w, const fv_march_opts *mo, const fv_sdf_shade_opts *so,
-                                              const fv_march_ray *r, const fv_march_hit *h, fv_sdf_shade_counts *c, fv_vec3 *normal)
+ * (zero for a miss); the costs are added to *c. known: the lights already known to reach the hit
+ * (shadow_reuse; FV_SDF_VIS_UNKNOWN: none known, trace the shadow rays); *vis_out (when not NULL)
+ * receives which lights reach it. The visibility is kept as bits only with at most 31 lights, as
+ * the CPU's batched shading keeps it (technique/sdf/shade.c). */
+FV_HD static inline fv_vec3 fv_ksdf_shade_vis(const fv_ksdf_world *w, const fv_march_opts *mo, const fv_sdf_shade_opts *so,
+                                              const fv_march_ray *r, const fv_march_hit *h, uint32_t known, uint32_t *vis_out,
+                                              fv_sdf_shade_counts *c, fv_vec3 *normal)
 {
     *normal = fv_v3s(0.0f);
+    if (vis_out) *vis_out = FV_SDF_VIS_UNKNOWN;
     if (!h->hit) return fv_v3s(0.0f);
+    const bool bits = w->nlights <= 31;
+    if (!bits) known = FV_SDF_VIS_UNKNOWN;
     const fv_vec3 pos = fv_madd(r->o, r->d, h->t);
     const float hd = fv_ksdf_hit_distance(r, h->t);
     float val[4];
@@ -137,21 +148,34 @@ FV_HD static inline fv_vec3 fv_ksdf_shade_one(const fv_ksdf_world *w, const fv_m
     const fv_material *m = fv_ksdf_material(w, h->mat);
     const fv_ksdf_lobe lb = fv_ksdf_lobe_of(m);
     fv_vec3 colour = fv_scale(m->albedo, so->ambient);
+    uint32_t vis = 0;
     for (int li = 0; li < w->nlights; li++) {
         const fv_ksdf_light *L = &w->lights[li];
         fv_march_ray s;
         if (!fv_ksdf_shadow_ray(w, L, pos, nrm, hd, &s)) continue;
-        if (so->shadows) {
+        if (known != FV_SDF_VIS_UNKNOWN || !so->shadows) {
+            /* the caller knows this point's visibility (shadow_reuse), or no shadows */
+            if (so->shadows && !(known >> li & 1u)) continue;
+        } else {
             fv_march_hit sh;
             fv_kmarch_one(w, mo->max_steps, FV_SDF_SHADOW_RELAX, &s, true, &sh);
             c->shadow_rays++;
             c->shadow_steps += sh.steps;
             if (sh.hit) continue;
         }
+        if (bits) vis |= 1u << li;
         fv_vec3 term;
         if (fv_ksdf_light_term(L, &lb, pos, nrm, hd, fv_neg(r->d), &term)) colour = fv_add(colour, term);
     }
+    if (vis_out && bits) *vis_out = vis;
     return colour;
+}
+
+/* Shades one marched camera ray, tracing every shadow ray (fv_ksdf_shade_vis knowing nothing). */
+FV_HD static inline fv_vec3 fv_ksdf_shade_one(const fv_ksdf_world *w, const fv_march_opts *mo, const fv_sdf_shade_opts *so,
+                                              const fv_march_ray *r, const fv_march_hit *h, fv_sdf_shade_counts *c, fv_vec3 *normal)
+{
+    return fv_ksdf_shade_vis(w, mo, so, r, h, FV_SDF_VIS_UNKNOWN, NULL, c, normal);
 }
 
 #endif

@@ -7,8 +7,8 @@ R="$FOVEA render"
 expect 2 "device 'gpu' is not one of cpu, portable, cuda, auto" -- $R cornell --device gpu --size 8x8 --out "$OUT"
 expect 2 "device '' is not one of" -- $R cornell --device "" --size 8x8 --out "$OUT"
 # A method without a CUDA version names the methods that have one.
-expect 2 "method 'vpolar' does not run on device cuda (methods that do: pt, sdf-gt, sdf-relaxed)" -- $R cornell --method vpolar --device cuda --size 8x8 --out "$OUT"
-expect 2 "method 'fpm' does not run on device portable (methods that do: pt, sdf-gt, sdf-relaxed)" -- $R cornell --method fpm --device portable --size 8x8 --out "$OUT"
+expect 2 "method 'vpolar' does not run on device cuda (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)" -- $R cornell --method vpolar --device cuda --size 8x8 --out "$OUT"
+expect 2 "method 'fpm' does not run on device portable (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)" -- $R cornell --method fpm --device portable --size 8x8 --out "$OUT"
 # The same refusals through --param.
 expect 2 "parameter device=nope: expected one of cpu, portable, cuda, auto" -- $R cornell --method pt --param device=nope --size 8x8 --out "$OUT"
 # pt on CUDA: this build has no CUDA, or this machine no GPU (CI has neither); either is one line.
@@ -31,12 +31,15 @@ expect 0 "" -- $R cornell --device portable --spp 2 --size 24x24 --out "$TMP/por
 [ -s "$TMP/portable.exr" ] || fail "--device portable wrote no image"
 expect 0 "" -- $R cornell --device portable --spp 2 --size 24x24 --frames 2 --stereo 0.1 --out "$TMP/portable-st.png"
 
-# sdf-gt and sdf-relaxed on the portable backend (test_device_sdf compares them with the CPU's bit
-# for bit), and on CUDA the same one line as pt where it cannot run.
-for m in sdf-gt sdf-relaxed; do
-  expect 0 "" -- $R sdf-primitives --method $m --device portable --param spp=4 --size 24x16 --out "$TMP/$m-portable.pfm" --no-metadata
-  expect 0 "" -- $R sdf-primitives --method $m --device cpu --param spp=4 --size 24x16 --out "$TMP/$m-cpu.pfm" --no-metadata
-  cmp -s "$TMP/$m-portable.pfm" "$TMP/$m-cpu.pfm" || fail "$m: --device portable and --device cpu wrote different images"
+# The sphere tracers on the portable backend (test_device_sdf compares them with the CPU's bit for
+# bit; fipr over three frames, so its kept history is read), and on CUDA the same one line as pt
+# where it cannot run.
+for m in sdf-gt sdf-relaxed ipr fipr; do
+  expect 0 "" -- $R sdf-primitives --method $m --device portable --param spp=4 --size 24x16 --frames 3 --out "$TMP/$m-portable.pfm" --no-metadata
+  expect 0 "" -- $R sdf-primitives --method $m --device cpu --param spp=4 --size 24x16 --frames 3 --out "$TMP/$m-cpu.pfm" --no-metadata
+  for i in 0000 0001 0002; do
+    cmp -s "$TMP/$m-portable_$i.pfm" "$TMP/$m-cpu_$i.pfm" || fail "$m: --device portable and --device cpu wrote different images (frame $i)"
+  done
   if "$FOVEA" render sdf-primitives --method $m --device cuda --size 8x8 --out "$TMP/$m-cuda.png" 2>"$TMP/$m-cuda.err"; then
     [ -s "$TMP/$m-cuda.png" ] || fail "$m --device cuda succeeded without writing its image"
   else
@@ -48,8 +51,8 @@ for m in sdf-gt sdf-relaxed; do
   fi
 done
 expect 2 "parameter show=steps: only the cpu device draws diagnostics (device portable renders the image)" -- $R sdf-primitives --method sdf-gt --device portable --param show=steps --size 8x8 --out "$TMP/steps.png"
-expect 2 "method 'ipr' does not run on device portable" -- $R sdf-primitives --method ipr --device portable --size 8x8 --out "$TMP/ipr.png"
-[ ! -e "$TMP/steps.png" ] && [ ! -e "$TMP/ipr.png" ] || fail "a refused sdf render left an image"
+expect 2 "parameter show=mask: only the cpu device draws diagnostics (device portable renders the image)" -- $R sdf-primitives --method fipr --device portable --param show=mask --size 8x8 --out "$TMP/mask.png"
+[ ! -e "$TMP/steps.png" ] && [ ! -e "$TMP/mask.png" ] || fail "a refused sdf render left an image"
 
 # bench --device: the measured methods that have the device run there, and the report says so.
 expect 2 "--device: device 'gpu' is not one of" -- $FOVEA bench pt-cornell --quick --device gpu --out "$TMP/bench-bad" --quiet

@@ -1,16 +1,23 @@
-/* GPU tests (ctest label `gpu`; scripts/gpu-check runs them on an NVIDIA machine): `sdf-gt` and
- * `sdf-relaxed` on CUDA against the portable backend, which runs the same kernel source
- * (kernel/sdf_pixel.h) on the CPU and equals the CPU pipeline bit for bit (test_device_sdf).
+/* GPU tests (ctest label `gpu`; scripts/gpu-check runs them on an NVIDIA machine): the sphere-tracing
+ * family on CUDA against the portable backend, which runs the same kernel source (kernel/sdf_pixel.h,
+ * kernel/sdf_pyramid.h) on the CPU and equals the CPU pipeline bit for bit (test_device_sdf):
+ * `sdf-gt` and `sdf-relaxed` one frame, `ipr` one frame, `fipr` over a stereo sequence with a moving
+ * gaze (its history stays on the GPU between frames, per eye), every frame compared.
  *
  * Bounds, not yet measured on a GPU (none was available when this was written), chosen from what
  * can differ: with --fmad=false the GPU rounds +, -, *, /, sqrtf as the CPU does, so the field and
  * every step are the same; only powf (the Blinn-Phong lobe) and cosf (a spot light's cone) differ
  * in the last bits. That changes a shaded colour by a few ulps and decides nothing in the march,
  * so 99.5% of the pixels must agree within 1e-4 relative (or 1e-6 absolute), the means within
- * 0.01%, and the counters (steps, shadow steps) exactly; two CUDA runs are bit-identical. If the GPU
+ * 0.01%, and the counters (steps, shadow steps; for ipr and fipr each level's, fipr's mask) exactly;
+ * two CUDA runs are bit-identical. (fipr's mask compares a float random number with a probability
+ * from double-precision exp and atan, whose last bits may differ on the GPU: a flip needs the number
+ * within an ulp of the probability, so the counts are still required to be equal.) A pyramid frame
+ * must report one host wait (host_syncs): its passes are launched without any between them. If the GPU
  * shows more, the first run's printout says where, and the bound is revised with that measurement.
  * Exits 77 (skipped) where CUDA cannot run: a build without CUDA, a machine without a GPU.
  */
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -76,6 +83,109 @@ static void compare(const char *scene, const char *method, int w, int h, int spp
     fv_scene_destroy(s);
 }
 
+static fv_technique *create(const char *method, const char *params, const fv_scene *s)
+{
+    fv_params *p = fv_test_params_str(params);
+    fv_technique *t = NULL;
+    fv_error err;
+    if (fv_technique_create(method, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s %s: %s", method, params, err.msg);
+    fv_params_destroy(p);
+    return t;
+}
+
+static void frame_into(fv_technique *t, const fv_frame *f, fv_film *film, fv_stats *stats)
+{
+    fv_film_clear(film);
+    float *col = fv_film_color(film);
+    for (size_t k = 0, m = (size_t)3 * fv_film_width(film) * fv_film_height(film); k < m; k++) col[k] = NAN;
+    fv_error err;
+    fv_stats_clear(stats);
+    if (fv_technique_render(t, f, film, stats, &err) != FV_OK) fail_msg("%s: frame %d: %s", fv_technique_name_of(t), f->index, err.msg);
+}
+
+/* ipr or fipr on portable and twice on CUDA over frames x eyes with a moving gaze. */
+static void compare_pyramid(const char *scene, const char *method, const char *params, int w, int h, int frames, int eyes)
+{
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load(scene, &s, &v) != 0) fail_msg("cannot load %s", scene);
+    fv_camera cam;
+    fv_view_camera(v, s, 0.0, w, h, &cam);
+    char pp[160], pc[160];
+    snprintf(pp, sizeof pp, "%s device=portable", params);
+    snprintf(pc, sizeof pc, "%s device=cuda", params);
+    fv_technique *tp = create(method, pp, s), *tc = create(method, pc, s), *tc2 = create(method, pc, s);
+    fv_film *p = NULL, *c1 = NULL, *c2 = NULL;
+    fv_error err;
+    const int aux = FV_AUX_DEPTH | FV_AUX_NORMAL | FV_AUX_ID;
+    if (fv_film_create(w, h, aux, &p, &err) != FV_OK || fv_film_create(w, h, aux, &c1, &err) != FV_OK || fv_film_create(w, h, aux, &c2, &err) != FV_OK)
+        fail_msg("%s", err.msg);
+    const size_t n = (size_t)w * h;
+    const bool fipr = strcmp(method, "fipr") == 0;
+    for (int i = 0; i < frames; i++)
+        for (int e = 0; e < eyes; e++) {
+            fv_frame f;
+            fv_frame_init(&f, &cam);
+            f.seed = 3;
+            f.index = i;
+            f.eye = e;
+            f.eye_count = eyes;
+            f.prev_camera = i > 0 ? &cam : NULL;
+            f.gaze.x = 0.3f + 0.1f * (float)i + 0.05f * (float)e;
+            f.gaze.y = 0.6f - 0.07f * (float)i;
+            fv_stats sp, sc, sc2;
+            frame_into(tp, &f, p, &sp);
+            frame_into(tc, &f, c1, &sc);
+            frame_into(tc2, &f, c2, &sc2);
+            fv_test_agreement r = fv_test_agree(p, c1, 1e-4);
+            const float *a = fv_film_color_const(p), *b = fv_film_color_const(c1);
+            double max_abs = 0.0;
+            for (size_t k = 0; k < 3 * n; k++)
+                if (fabs((double)a[k] - (double)b[k]) > max_abs) max_abs = fabs((double)a[k] - (double)b[k]);
+            char what[256];
+            snprintf(what, sizeof what, "%s %s [%s] %dx%d frame %d eye %d", method, scene, params, w, h, i, e);
+            printf("%s: %.3f%% of pixels within 1e-4, max |difference| %g, largest mean difference %.3g%%, steps portable %g cuda %g, "
+                   "mask pixels %g / %g, host syncs %g\n",
+                   what, 100.0 * r.equal_share, max_abs, 100.0 * r.max_mean_rel, fv_stats_get_count(&sp, "steps"), fv_stats_get_count(&sc, "steps"),
+                   fv_stats_get_count(&sp, "mask_pixels"), fv_stats_get_count(&sc, "mask_pixels"), fv_stats_get_count(&sc, "host_syncs"));
+            if (!(r.equal_share >= 0.995)) fail_msg("%s: only %.3f%% of pixels agree within 1e-4", what, 100.0 * r.equal_share);
+            if (!(r.max_mean_rel <= 1e-4)) fail_msg("%s: means differ by %.3g%%", what, 100.0 * r.max_mean_rel);
+            static const char *const keys[] = {"rays", "steps", "shadow_rays", "shadow_steps", "normal_evals", "exhausted_rays", "rays_level0",
+                                               "steps_level0", "rays_level1", "steps_level1", "rays_level2", "steps_level2", "mask_pixels",
+                                               "edge_pixels", "refreshed_pixels"};
+            for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
+                if (fv_stats_get_count(&sp, keys[k]) != fv_stats_get_count(&sc, keys[k]))
+                    fail_msg("%s: counter %s: portable %g, cuda %g", what, keys[k], fv_stats_get_count(&sp, keys[k]), fv_stats_get_count(&sc, keys[k]));
+            if (fv_stats_get_count(&sc, "host_syncs") != 1.0) fail_msg("%s: %g host waits in a frame", what, fv_stats_get_count(&sc, "host_syncs"));
+            if (memcmp(b, fv_film_color_const(c2), 3 * n * sizeof(float)) != 0) fail_msg("%s: two CUDA runs differ", what);
+            if (!fipr && memcmp(fv_film_depth(p), fv_film_depth(c1), n * sizeof(float)) != 0) fail_msg("%s: the first hit's depth differs", what);
+        }
+    fv_film_destroy(p);
+    fv_film_destroy(c1);
+    fv_film_destroy(c2);
+    fv_technique_destroy(tp);
+    fv_technique_destroy(tc);
+    fv_technique_destroy(tc2);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+static void test_ipr(void **st)
+{
+    (void)st;
+    compare_pyramid("sdf-primitives", "ipr", "spp=4", 160, 120, 1, 1);
+    compare_pyramid("sdf-columns", "ipr", "spp=1 shadow_reuse=true", 160, 120, 1, 1);
+    compare_pyramid("sdf-temple", "ipr", "spp=16", 96, 72, 1, 1);
+}
+
+static void test_fipr(void **st)
+{
+    (void)st;
+    compare_pyramid("sdf-primitives", "fipr", "spp=4 refresh=2", 160, 120, 3, 2);
+    compare_pyramid("sdf-columns", "fipr", "spp=1 refresh=4 shadow_reuse=true", 160, 120, 5, 1);
+    compare_pyramid("sdf-temple", "fipr", "spp=16 refresh=4 blur=true", 96, 72, 5, 2);
+}
+
 static void test_primitives(void **st)
 {
     (void)st;
@@ -104,6 +214,7 @@ int main(void)
         printf("skipped: %s\n", why);
         return 77;
     }
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_primitives), cmocka_unit_test(test_columns), cmocka_unit_test(test_temple)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_primitives), cmocka_unit_test(test_columns), cmocka_unit_test(test_temple),
+                                       cmocka_unit_test(test_ipr), cmocka_unit_test(test_fipr)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,6 +1,10 @@
-/* `sdf-gt` and `sdf-relaxed` on the portable backend (kernel/sdf_pixel.h run a pixel at a time on
- * the CPU's threads, the code CUDA runs) against the CPU pipeline (technique/sdf/pipeline.c: eight
- * rays at a time through the 8-wide field, shading in batches), on the three sphere-tracing scenes.
+/* The sphere-tracing family on the portable backend (kernel/sdf_pixel.h and kernel/sdf_pyramid.h
+ * run a cell at a time on the CPU's threads, the code CUDA runs) against the CPU pipeline
+ * (technique/sdf/pipeline.c: eight rays at a time through the 8-wide field, shading in batches), on
+ * the three sphere-tracing scenes: `sdf-gt` and `sdf-relaxed` one frame each; `ipr` one frame with
+ * and without shadow_reuse and the min filter, at 3 and 4 levels; `fipr` over a stereo sequence
+ * whose gaze moves, so the mask changes and the history kept per eye is refreshed every 1, 2 or 4
+ * frames and read in between, with shadow_reuse and pass 5's blur in one of them.
  *
  * The bound is equality, bit for bit, in the colour, in every auxiliary buffer and in every
  * counter. Measured, not assumed: the first renders of the two backends agreed exactly on all six
@@ -10,7 +14,10 @@
  * same order (kernel/sdf_shade.h), and evaluate the world's field with the scalar build of
  * sdf/kernel.h, whose result the CPU's 8-wide lanes equal bit for bit (test_sdf_many checks that
  * with moving objects too); nothing is compiled with FMA contraction. So any difference here is a
- * divergence of the two paths, not rounding, and the test allows none. (CUDA against portable,
+ * divergence of the two paths, not rounding, and the test allows none. The same holds for ipr and
+ * fipr, whose per-cell steps (start, Sobel, mask, refresh, reconstruction, agreed visibility) the
+ * CPU pipeline calls too, and whose counters (each level's rays and steps, fipr's mask, edge and
+ * refreshed counts) must match as well. (CUDA against portable,
  * tests/gpu/test_gpu_sdf.c, needs a tolerance: the GPU's powf differs in the last bits.)
  */
 #include <setjmp.h>
@@ -20,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
+#include <math.h>
 #include "fovea/fovea.h"
 #include "testkit.h"
 
@@ -92,6 +100,141 @@ static void compare(const char *scene, const char *method, int w, int h, int spp
     fv_scene_destroy(s);
 }
 
+/* The counters both backends report for a pyramid method. */
+static void compare_counters(const char *what, const fv_stats *sc, const fv_stats *sp, int levels, bool fipr)
+{
+    char keys[32][32];
+    int n = 0;
+    static const char *const base[] = {"rays", "steps", "shadow_rays", "shadow_steps", "normal_evals", "exhausted_rays", "samples", "nan_samples"};
+    for (size_t k = 0; k < sizeof base / sizeof base[0]; k++) snprintf(keys[n++], sizeof keys[0], "%s", base[k]);
+    for (int k = 0; k < levels; k++) {
+        snprintf(keys[n++], sizeof keys[0], "rays_level%d", k);
+        snprintf(keys[n++], sizeof keys[0], "steps_level%d", k);
+    }
+    if (fipr) {
+        snprintf(keys[n++], sizeof keys[0], "mask_pixels");
+        snprintf(keys[n++], sizeof keys[0], "edge_pixels");
+        snprintf(keys[n++], sizeof keys[0], "refreshed_pixels");
+    }
+    for (int k = 0; k < n; k++) {
+        if (fv_stats_get_count(sc, keys[k]) != fv_stats_get_count(sp, keys[k]))
+            fail_msg("%s: counter %s: cpu %g, portable %g", what, keys[k], fv_stats_get_count(sc, keys[k]), fv_stats_get_count(sp, keys[k]));
+    }
+}
+
+static fv_technique *create(const char *method, const char *params, const fv_scene *s)
+{
+    fv_params *p = fv_test_params_str(params);
+    fv_technique *t = NULL;
+    fv_error err;
+    if (fv_technique_create(method, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s %s: %s", method, params, err.msg);
+    fv_params_destroy(p);
+    return t;
+}
+
+/* One frame of t into film (cleared, colour NaN first, so an unwritten pixel cannot pass). */
+static void render_frame(fv_technique *t, const fv_frame *f, fv_film *film, fv_stats *stats)
+{
+    fv_film_clear(film);
+    float *col = fv_film_color(film);
+    for (size_t k = 0, m = (size_t)3 * fv_film_width(film) * fv_film_height(film); k < m; k++) col[k] = NAN;
+    fv_error err;
+    fv_stats_clear(stats);
+    if (fv_technique_render(t, f, film, stats, &err) != FV_OK) fail_msg("%s: frame %d: %s", fv_technique_name_of(t), f->index, err.msg);
+}
+
+/* ipr or fipr (params besides the device) on both backends over `frames` frames of `eyes` eyes
+ * (1 or 2), the gaze moving from frame to frame; every frame's film and counters must be equal.
+ * Returns the last frame's portable stats in *last. */
+static void compare_pyramid(const char *scene, const char *method, const char *params, int w, int h, int frames, int eyes, fv_stats *last)
+{
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load(scene, &s, &v) != 0) fail_msg("cannot load %s", scene);
+    fv_camera cam;
+    fv_view_camera(v, s, 0.0, w, h, &cam);
+    char pc[160], pp[160];
+    snprintf(pc, sizeof pc, "%s device=cpu", params);
+    snprintf(pp, sizeof pp, "%s device=portable", params);
+    fv_technique *tc = create(method, pc, s), *tp = create(method, pp, s);
+    fv_film *a = NULL, *b = NULL;
+    fv_error err;
+    if (fv_film_create(w, h, AUX, &a, &err) != FV_OK || fv_film_create(w, h, AUX, &b, &err) != FV_OK) fail_msg("%s", err.msg);
+    const size_t n = (size_t)w * h;
+    const bool fipr = strcmp(method, "fipr") == 0;
+    int levels = 3;
+    const char *lv = strstr(params, "levels=");
+    if (lv) levels = atoi(lv + 7);
+    for (int i = 0; i < frames; i++)
+        for (int e = 0; e < eyes; e++) {
+            fv_frame f;
+            fv_frame_init(&f, &cam);
+            f.seed = 3;
+            f.index = i;
+            f.eye = e;
+            f.eye_count = eyes;
+            f.prev_camera = i > 0 ? &cam : NULL;
+            /* a gaze that wanders, so the mask and the pixels it reconstructs change */
+            f.gaze.x = 0.3f + 0.1f * (float)i + 0.05f * (float)e;
+            f.gaze.y = 0.6f - 0.07f * (float)i;
+            fv_stats sc, sp;
+            render_frame(tc, &f, a, &sc);
+            render_frame(tp, &f, b, &sp);
+            double max_abs = 0.0, sum = 0.0;
+            const float *ca = fv_film_color_const(a);
+            for (size_t k = 0; k < 3 * n; k++) sum += ca[k];
+            size_t dc = differing(ca, fv_film_color_const(b), 3 * n, &max_abs);
+            size_t dd = differing(fv_film_depth(a), fv_film_depth(b), n, &max_abs);
+            size_t dn = differing(fv_film_normal(a), fv_film_normal(b), 3 * n, &max_abs);
+            size_t da = differing(fv_film_albedo(a), fv_film_albedo(b), 3 * n, &max_abs);
+            size_t dp = differing(fv_film_position(a), fv_film_position(b), 3 * n, &max_abs);
+            size_t di = memcmp(fv_film_id(a), fv_film_id(b), n * sizeof(uint32_t)) != 0;
+            char what[256];
+            snprintf(what, sizeof what, "%s %s [%s] %dx%d frame %d eye %d", method, scene, params, w, h, i, e);
+            if (i == frames - 1 || dc || dd || dn || da || dp || di)
+                printf("%s: mean %.5f, %zu colour values differ (max |difference| %g), aux %zu/%zu/%zu/%zu/%zu, steps %g / %g%s%g\n", what,
+                       sum / (3.0 * (double)n), dc, max_abs, dd, dn, da, dp, di, fv_stats_get_count(&sc, "steps"),
+                       fv_stats_get_count(&sp, "steps"), fipr ? ", mask pixels " : ", level-0 rays ",
+                       fv_stats_get_count(&sp, fipr ? "mask_pixels" : "rays_level0"));
+            if (!(sum > 0.0)) fail_msg("%s rendered black on the CPU", what);
+            if (dc || dd || dn || da || dp || di) fail_msg("%s: the portable backend's image differs from the CPU's", what);
+            compare_counters(what, &sc, &sp, levels, fipr);
+            if (!(fv_stats_get_count(&sp, "rays_level0") > 0)) fail_msg("%s: the tip traced nothing", what);
+            if (last) *last = sp;
+        }
+    fv_film_destroy(a);
+    fv_film_destroy(b);
+    fv_technique_destroy(tc);
+    fv_technique_destroy(tp);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+static void test_ipr(void **st)
+{
+    (void)st;
+    compare_pyramid("sdf-primitives", "ipr", "spp=4", 64, 48, 1, 1, NULL);
+    compare_pyramid("sdf-columns", "ipr", "spp=1 levels=4 shadow_reuse=true", 56, 40, 1, 1, NULL);
+    compare_pyramid("sdf-temple", "ipr", "spp=16 shadow_reuse=true", 32, 24, 1, 1, NULL);
+    compare_pyramid("sdf-temple", "ipr", "spp=4 min_filter=false relax=1.5", 40, 30, 1, 1, NULL);
+}
+
+/* fipr over sequences: the history is refreshed every frame, every other frame or every fourth,
+ * per eye; in between the pixels outside the mask read colours shaded in earlier frames. */
+static void test_fipr(void **st)
+{
+    (void)st;
+    fv_stats last;
+    compare_pyramid("sdf-primitives", "fipr", "spp=4 refresh=1", 64, 48, 3, 1, &last);
+    compare_pyramid("sdf-columns", "fipr", "spp=1 refresh=2 levels=4", 64, 48, 4, 2, &last);
+    /* refresh 4: the last frame shades only a quarter of the middle level, so most of the
+     * reconstructed pixels read colours kept from earlier frames */
+    compare_pyramid("sdf-temple", "fipr", "spp=4 refresh=4 shadow_reuse=true blur=true", 48, 36, 5, 2, &last);
+    const double mid = (double)(48 * 2 / 2) * (36 * 2 / 2);
+    if (!(fv_stats_get_count(&last, "refreshed_pixels") < 0.3 * mid)) fail_msg("refresh=4 refreshed %g of %g middle rays", fv_stats_get_count(&last, "refreshed_pixels"), mid);
+    if (!(fv_stats_get_count(&last, "mask_pixels") < 0.9 * 48 * 36)) fail_msg("the mask covers %g of %d pixels: nothing reconstructed", fv_stats_get_count(&last, "mask_pixels"), 48 * 36);
+}
+
 static void test_primitives(void **st)
 {
     (void)st;
@@ -143,7 +286,7 @@ static void test_options(void **st)
     fv_scene_destroy(s);
 }
 
-/* What the device backends refuse: diagnostics, and the pyramid methods (not ported yet). */
+/* What the device backends refuse: diagnostics, and methods without a device form. */
 static void test_refusals(void **st)
 {
     (void)st;
@@ -154,8 +297,9 @@ static void test_refusals(void **st)
         const char *method, *params, *needle;
     } cases[] = {
         {"sdf-gt", "device=portable show=steps", "parameter show=steps: only the cpu device draws diagnostics (device portable renders the image)"},
-        {"ipr", "device=portable", "method 'ipr' does not run on device portable (methods that do: pt, sdf-gt, sdf-relaxed)"},
-        {"fipr", "device=cuda", "method 'fipr' does not run on device cuda"},
+        {"fipr", "device=portable show=mask", "parameter show=mask: only the cpu device draws diagnostics (device portable renders the image)"},
+        {"ipr", "device=portable show=level", "parameter show=level: only the cpu device draws diagnostics (device portable renders the image)"},
+        {"vpolar", "device=portable", "method 'vpolar' does not run on device portable (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         fv_params *p = fv_test_params_str(cases[i].params);
@@ -186,6 +330,7 @@ static void test_refusals(void **st)
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_primitives), cmocka_unit_test(test_columns), cmocka_unit_test(test_temple),
-                                       cmocka_unit_test(test_options), cmocka_unit_test(test_refusals)};
+                                       cmocka_unit_test(test_options), cmocka_unit_test(test_ipr),
+                                       cmocka_unit_test(test_fipr), cmocka_unit_test(test_refusals)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,15 +1,23 @@
-/* fovea — the CUDA backend of `sdf-gt` and `sdf-relaxed` (see device/cuda_backend.h): the world's
- * flat form copied to the GPU each frame, and the pixel kernel of kernel/sdf_pixel.h launched one
- * thread a pixel, the very function the portable backend runs on the CPU (docs/gpu.md).
+/* fovea — the CUDA backend of the sphere-tracing family (see device/cuda_backend.h): the world's
+ * flat form on the GPU, `sdf-gt` and `sdf-relaxed` as the pixel kernel of kernel/sdf_pixel.h (one
+ * thread a pixel), and `ipr` and `fipr` as one kernel per pass of the pyramid (a thread a cell):
+ * the levels (fv_ksdf_level_cell), fipr's sky reduction, Sobel edges, mask and refresh
+ * (kernel/sdf_pyramid.h), its middle level, then the target (fv_ksdf_target_pixel): the very
+ * functions the portable backend runs on the CPU (docs/gpu.md).
  *
- * Memory: the world's arrays (programs, moving objects, lights, materials) and the film keep
- * their GPU buffers between frames, grown only when a frame needs more; a frame copies the
- * world in (a few kilobytes: the programs do not change with time, the transforms and lights may)
- * and the displayed buffers out. The costs are summed per block in shared memory, then once per
+ * Memory: the world's arrays (programs, moving objects, lights, materials), the film, the pyramid's
+ * levels, edges, mask and visibility, and fipr's history per eye keep their GPU buffers between
+ * frames, reallocated only when a frame needs another size. The world is copied in only when its
+ * bytes changed since the last copy (a host mirror is compared: a moving object or light changes
+ * it, a still scene is copied once). A pyramid frame's passes are launched on one stream with no
+ * host wait between them; the host waits once, for the displayed buffers (and fipr's mask when the
+ * host blurs it) and the counters. The costs are summed per block in shared memory, then once per
  * block into the global counters.
  */
 #include <cuda_runtime.h>
+#include <limits.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "device/cuda/common.h"
 #include "device/cuda_backend.h"
@@ -20,44 +28,106 @@
 /* The counters, in this order: rays, steps, exhausted, nan, shadow rays, shadow steps, normal evaluations. */
 #define FV_CUDA_SDF_COUNTS 7
 
-/* A device array that grows and is refilled from the host. */
+/* A pyramid frame's counters: the first FV_CUDA_SDF_COUNTS as above, then fipr's mask pixels, edge
+ * pixels and refreshed rays, then each level's rays and each level's steps. */
+#define FV_CUDA_PYR_MASKED 7
+#define FV_CUDA_PYR_EDGES 8
+#define FV_CUDA_PYR_REFRESHED 9
+#define FV_CUDA_PYR_LEVEL_RAYS 10
+#define FV_CUDA_PYR_LEVEL_STEPS (FV_CUDA_PYR_LEVEL_RAYS + FV_PYRAMID_MAX_LEVELS)
+#define FV_CUDA_PYR_COUNTS (FV_CUDA_PYR_LEVEL_STEPS + FV_PYRAMID_MAX_LEVELS)
+
+/* A device array that grows and is refilled from the host when what it holds changed. */
 typedef struct dev_array {
     void *p;
-    size_t cap; /* bytes */
+    size_t cap;   /* bytes */
+    void *mirror; /* host copy of what p holds, bytes long */
+    size_t bytes;
 } dev_array;
+
+/* fipr's middle level of one eye on the GPU (pyramid.h's fv_pyramid_history). */
+typedef struct dev_history {
+    int sw, sh;
+    float *color;
+    int *stamp;
+} dev_history;
 
 struct fv_cuda_sdf {
     dev_array ops, objs, lights, mats;
     fv_cuda_film film;
-    unsigned long long *counts;
+    unsigned long long *counts; /* FV_CUDA_PYR_COUNTS */
     cudaEvent_t start, stop;
+    cudaStream_t stream;        /* the pyramid's passes */
+    /* ipr and fipr: the buffers' shape and the buffers */
+    fv_kpyr k;                  /* device pointers; hist_* point at the frame's eye */
+    bool k_fipr, k_vis;
+    unsigned *far;              /* pass 2's farthest tip depth, as float bits */
+    dev_history hist[2];
 };
 
 static fv_status fill(dev_array *a, const void *src, size_t bytes, fv_error *err)
 {
     if (bytes == 0) return FV_OK;
+    if (a->p && bytes == a->bytes && memcmp(a->mirror, src, bytes) == 0) return FV_OK; /* unchanged since the last copy */
     cudaError_t e;
     if (bytes > a->cap) {
         cudaFree(a->p);
-        a->p = NULL;
-        a->cap = 0;
+        free(a->mirror);
+        a->p = a->mirror = NULL;
+        a->cap = a->bytes = 0;
+        if (!(a->mirror = malloc(bytes))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
         if ((e = cudaMalloc(&a->p, bytes)) != cudaSuccess)
             return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for the world")
                                                   : fv_cuda_fail(e, "allocating the world", err);
         a->cap = bytes;
     }
+    a->bytes = 0; /* stale until the copy succeeds */
     if ((e = cudaMemcpy(a->p, src, bytes, cudaMemcpyHostToDevice)) != cudaSuccess) return fv_cuda_fail(e, "copying the world", err);
+    memcpy(a->mirror, src, bytes);
+    a->bytes = bytes;
     return FV_OK;
+}
+
+static void dev_array_free(dev_array *a)
+{
+    cudaFree(a->p);
+    free(a->mirror);
+    memset(a, 0, sizeof *a);
+}
+
+static void pyramid_free(fv_cuda_sdf *c)
+{
+    for (int i = 0; i < FV_PYRAMID_MAX_LEVELS; i++) {
+        cudaFree(c->k.depth[i]);
+        cudaFree(c->k.steps[i]);
+    }
+    cudaFree(c->k.need);
+    cudaFree(c->k.edge);
+    cudaFree(c->k.mask);
+    cudaFree(c->k.vis);
+    memset(&c->k, 0, sizeof c->k);
+}
+
+static void history_free(dev_history *h)
+{
+    cudaFree(h->color);
+    cudaFree(h->stamp);
+    memset(h, 0, sizeof *h);
 }
 
 extern "C" void fv_cuda_sdf_destroy(fv_cuda_sdf *c)
 {
     if (!c) return;
-    cudaFree(c->ops.p);
-    cudaFree(c->objs.p);
-    cudaFree(c->lights.p);
-    cudaFree(c->mats.p);
+    dev_array_free(&c->ops);
+    dev_array_free(&c->objs);
+    dev_array_free(&c->lights);
+    dev_array_free(&c->mats);
     fv_cuda_film_free(&c->film);
+    pyramid_free(c);
+    history_free(&c->hist[0]);
+    history_free(&c->hist[1]);
+    cudaFree(c->far);
+    if (c->stream) cudaStreamDestroy(c->stream);
     cudaFree(c->counts);
     if (c->start) cudaEventDestroy(c->start);
     if (c->stop) cudaEventDestroy(c->stop);
@@ -71,8 +141,10 @@ extern "C" fv_status fv_cuda_sdf_create(fv_cuda_sdf **out, fv_error *err)
     if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     cudaError_t e;
     fv_status s = FV_OK;
-    if ((e = cudaMalloc((void **)&c->counts, FV_CUDA_SDF_COUNTS * sizeof(unsigned long long))) != cudaSuccess)
+    if ((e = cudaMalloc((void **)&c->counts, FV_CUDA_PYR_COUNTS * sizeof(unsigned long long))) != cudaSuccess ||
+        (e = cudaMalloc((void **)&c->far, sizeof(unsigned))) != cudaSuccess)
         s = fv_cuda_fail(e, "allocating counters", err);
+    if (s == FV_OK && (e = cudaStreamCreate(&c->stream)) != cudaSuccess) s = fv_cuda_fail(e, "creating a stream", err);
     if (s == FV_OK && ((e = cudaEventCreate(&c->start)) != cudaSuccess || (e = cudaEventCreate(&c->stop)) != cudaSuccess))
         s = fv_cuda_fail(e, "creating events", err);
     if (s != FV_OK) {
@@ -106,21 +178,29 @@ __global__ void fv_cuda_sdf_kernel(fv_ksdf_world w, fv_ksdf_frame f, fv_film_vie
     if (tid < FV_CUDA_SDF_COUNTS && sum[tid]) atomicAdd(&counts[tid], sum[tid]);
 }
 
-extern "C" fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const fv_ksdf_world *w, const fv_ksdf_frame *f, const fv_film_views *out,
-                                        fv_ksdf_counts *counts, double *kernel_ms, fv_error *err)
+/* The world on the GPU (copied only where it changed) as *dw, with device pointers. */
+static fv_status upload_world(fv_cuda_sdf *c, const fv_ksdf_world *w, fv_ksdf_world *dw, fv_error *err)
 {
-    /* the world with device pointers */
-    fv_ksdf_world dw = *w;
+    *dw = *w;
     fv_status s;
     if ((s = fill(&c->ops, w->ops, (size_t)w->nops * sizeof(fv_sdf_op), err)) != FV_OK ||
         (s = fill(&c->objs, w->objs, (size_t)w->count * sizeof(fv_ksdf_object), err)) != FV_OK ||
         (s = fill(&c->lights, w->lights, (size_t)w->nlights * sizeof(fv_ksdf_light), err)) != FV_OK ||
         (s = fill(&c->mats, w->mats, (size_t)w->nmat * sizeof(fv_material), err)) != FV_OK)
         return s;
-    dw.ops = (const fv_sdf_op *)c->ops.p;
-    dw.objs = (const fv_ksdf_object *)c->objs.p;
-    dw.lights = (const fv_ksdf_light *)c->lights.p;
-    dw.mats = (const fv_material *)c->mats.p;
+    dw->ops = (const fv_sdf_op *)c->ops.p;
+    dw->objs = (const fv_ksdf_object *)c->objs.p;
+    dw->lights = (const fv_ksdf_light *)c->lights.p;
+    dw->mats = (const fv_material *)c->mats.p;
+    return FV_OK;
+}
+
+extern "C" fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const fv_ksdf_world *w, const fv_ksdf_frame *f, const fv_film_views *out,
+                                        fv_ksdf_counts *counts, double *kernel_ms, fv_error *err)
+{
+    fv_ksdf_world dw;
+    fv_status s = upload_world(c, w, &dw, err);
+    if (s != FV_OK) return s;
     const size_t n = (size_t)f->cam.width * (size_t)f->cam.height;
     fv_film_views dv;
     if ((s = fv_cuda_film_prepare(&c->film, out, n, &dv, err)) != FV_OK) return s;
@@ -148,4 +228,276 @@ extern "C" fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const fv_ksdf_world *w, 
     counts->shade.shadow_steps += k[5];
     counts->shade.normal_evals += k[6];
     return fv_cuda_film_read(&c->film, out, n, err);
+}
+
+/* ---- ipr and fipr: a kernel per pass ---- */
+
+/* A block's sums of the pyramid counters: zeroed by sum_begin, added to by every thread, flushed
+ * into the global counters by sum_end; every thread of the block calls begin and end. */
+__device__ static inline void sum_begin(unsigned long long *sum)
+{
+    const int tid = (int)(threadIdx.y * blockDim.x + threadIdx.x);
+    if (tid < FV_CUDA_PYR_COUNTS) sum[tid] = 0;
+    __syncthreads();
+}
+
+__device__ static inline void sum_add(unsigned long long *sum, int i, unsigned long long v)
+{
+    if (v) atomicAdd(&sum[i], v);
+}
+
+/* A cell's marching and shading costs, its camera rays and steps also as level `level`'s. */
+__device__ static inline void sum_counts(unsigned long long *sum, const fv_ksdf_counts *c, int level)
+{
+    sum_add(sum, 0, c->rays);
+    sum_add(sum, 1, c->steps);
+    sum_add(sum, 2, c->exhausted);
+    sum_add(sum, 3, c->nan);
+    sum_add(sum, 4, c->shade.shadow_rays);
+    sum_add(sum, 5, c->shade.shadow_steps);
+    sum_add(sum, 6, c->shade.normal_evals);
+    sum_add(sum, FV_CUDA_PYR_LEVEL_RAYS + level, c->rays);
+    sum_add(sum, FV_CUDA_PYR_LEVEL_STEPS + level, c->steps);
+}
+
+__device__ static inline void sum_end(unsigned long long *sum, unsigned long long *counts)
+{
+    __syncthreads();
+    const int tid = (int)(threadIdx.y * blockDim.x + threadIdx.x);
+    if (tid < FV_CUDA_PYR_COUNTS && sum[tid]) atomicAdd(&counts[tid], sum[tid]);
+}
+
+#define CELL_XY                                                      \
+    const int x = (int)(blockIdx.x * blockDim.x + threadIdx.x);      \
+    const int y = (int)(blockIdx.y * blockDim.y + threadIdx.y)
+
+/* Pass 1 (and each level below the target): ray (x, y) of level k. */
+__global__ void fv_cuda_pyr_level(fv_ksdf_world w, fv_ksdf_frame f, fv_kpyr k, int level, int index, unsigned long long *counts)
+{
+    __shared__ unsigned long long sum[FV_CUDA_PYR_COUNTS];
+    sum_begin(sum);
+    CELL_XY;
+    if (x < k.lv[level].w && y < k.lv[level].h) {
+        fv_ksdf_counts c;
+        memset(&c, 0, sizeof c);
+        fv_ksdf_level_cell(&w, &f, &k, level, x, y, index, &c);
+        sum_counts(sum, &c, level);
+    }
+    sum_end(sum, counts);
+}
+
+/* Pass 2's sky: the farthest finite depth of the tip (depths are >= 0, so their bits order as
+ * unsigned integers do). */
+__global__ void fv_cuda_pyr_far(const float *depth, int n, unsigned *far)
+{
+    const int i = (int)(blockIdx.x * blockDim.x + threadIdx.x);
+    if (i < n && isfinite(depth[i]) && depth[i] > 0.0f) atomicMax(far, __float_as_uint(depth[i]));
+}
+
+__global__ void fv_cuda_pyr_sobel(fv_kpyr k, const unsigned *far, float threshold)
+{
+    CELL_XY;
+    const fv_pyramid_level *low = &k.lv[0];
+    if (x >= low->w || y >= low->h) return;
+    k.edge[(size_t)y * low->w + x] = fv_kpyr_sobel_cell(k.depth[0], low->w, low->h, fv_kpyr_sky(__uint_as_float(*far)), threshold, x, y);
+}
+
+__global__ void fv_cuda_pyr_mask(fv_kpyr k, fv_kpyr_fovea fov, unsigned long long *counts)
+{
+    __shared__ unsigned long long sum[FV_CUDA_PYR_COUNTS];
+    sum_begin(sum);
+    CELL_XY;
+    if (x < k.w && y < k.h) {
+        uint8_t m = fv_kpyr_mask_pixel(&k, &fov, x, y);
+        k.mask[(size_t)y * k.w + x] = m;
+        sum_add(sum, FV_CUDA_PYR_MASKED, m);
+        sum_add(sum, FV_CUDA_PYR_EDGES, fv_kpyr_edge_of_pixel(&k, x, y) != 0);
+    }
+    sum_end(sum, counts);
+}
+
+__global__ void fv_cuda_pyr_need(fv_kpyr k, fv_kpyr_fovea fov, unsigned long long *counts)
+{
+    __shared__ unsigned long long sum[FV_CUDA_PYR_COUNTS];
+    sum_begin(sum);
+    CELL_XY;
+    const fv_pyramid_level *mid = &k.lv[k.L - 2];
+    if (x < mid->w && y < mid->h) {
+        uint8_t need = fv_kpyr_need_cell(&k, &fov, x, y);
+        k.need[(size_t)y * mid->w + x] = need;
+        sum_add(sum, FV_CUDA_PYR_REFRESHED, need == 2);
+    }
+    sum_end(sum, counts);
+}
+
+__global__ void fv_cuda_pyr_target(fv_ksdf_world w, fv_ksdf_frame f, fv_kpyr k, fv_film_views out, unsigned long long *counts)
+{
+    __shared__ unsigned long long sum[FV_CUDA_PYR_COUNTS];
+    sum_begin(sum);
+    CELL_XY;
+    if (x < k.w && y < k.h) {
+        fv_ksdf_counts c;
+        memset(&c, 0, sizeof c);
+        fv_ksdf_target_pixel(&w, &f, &k, x, y, &out, &c);
+        sum_counts(sum, &c, k.L - 1);
+    }
+    sum_end(sum, counts);
+}
+
+/* A sequence's first frame, or a new size: no middle-level ray has been shaded. */
+__global__ void fv_cuda_pyr_forget(int *stamp, int n)
+{
+    const int i = (int)(blockIdx.x * blockDim.x + threadIdx.x);
+    if (i < n) stamp[i] = INT_MIN;
+}
+
+static dim3 grid_of(int w, int h)
+{
+    return dim3((unsigned)((w + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK), (unsigned)((h + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK));
+}
+
+static unsigned blocks_of(size_t n) { return (unsigned)((n + 255) / 256); }
+
+/* The pyramid's buffers for shape (kept when they fit). */
+static fv_status pyramid_ensure(fv_cuda_sdf *c, const fv_kpyr *shape, bool fipr, bool vis, fv_error *err)
+{
+    fv_kpyr *k = &c->k;
+    if (k->w > 0 && k->w == shape->w && k->h == shape->h && k->S == shape->S && k->L == shape->L && c->k_fipr == fipr && c->k_vis == vis) {
+        k->min_filter = shape->min_filter;
+        return FV_OK;
+    }
+    pyramid_free(c);
+    *k = *shape;
+    for (int i = 0; i < FV_PYRAMID_MAX_LEVELS; i++) k->depth[i] = NULL, k->steps[i] = NULL;
+    k->need = k->edge = k->mask = NULL;
+    k->vis = NULL;
+    k->hist_color = NULL;
+    k->hist_stamp = NULL;
+    const int L = k->L;
+    cudaError_t e = cudaSuccess;
+    for (int i = 0; i + 1 < L && e == cudaSuccess; i++) {
+        size_t n = (size_t)k->lv[i].w * k->lv[i].h;
+        if ((e = cudaMalloc((void **)&k->depth[i], n * sizeof(float))) == cudaSuccess) e = cudaMalloc((void **)&k->steps[i], n * sizeof(uint16_t));
+    }
+    const size_t nmid = L > 1 ? (size_t)k->lv[L - 2].w * k->lv[L - 2].h : 0;
+    if (e == cudaSuccess && vis) e = cudaMalloc((void **)&k->vis, nmid * sizeof(uint32_t));
+    if (e == cudaSuccess && fipr) e = cudaMalloc((void **)&k->need, nmid);
+    if (e == cudaSuccess && fipr) e = cudaMalloc((void **)&k->edge, (size_t)k->lv[0].w * k->lv[0].h);
+    if (e == cudaSuccess && fipr) e = cudaMalloc((void **)&k->mask, (size_t)k->w * k->h);
+    if (e != cudaSuccess) {
+        pyramid_free(c);
+        return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for a %dx%d pyramid", shape->w, shape->h)
+                                              : fv_cuda_fail(e, "allocating the pyramid", err);
+    }
+    c->k_fipr = fipr;
+    c->k_vis = vis;
+    return FV_OK;
+}
+
+/* fipr's history of eye `eye` sized for the pyramid (new: every stamp forgotten, as at index 0). */
+static fv_status history_ensure(fv_cuda_sdf *c, int eye, int index, fv_error *err)
+{
+    dev_history *h = &c->hist[eye];
+    fv_kpyr *k = &c->k;
+    const size_t n = (size_t)k->lv[k->L - 2].w * k->lv[k->L - 2].h;
+    if (h->sw != k->sw || h->sh != k->sh || !h->color) {
+        history_free(h);
+        cudaError_t e;
+        if ((e = cudaMalloc((void **)&h->color, 3 * n * sizeof(float))) != cudaSuccess ||
+            (e = cudaMalloc((void **)&h->stamp, n * sizeof(int))) != cudaSuccess ||
+            (e = cudaMemsetAsync(h->color, 0, 3 * n * sizeof(float), c->stream)) != cudaSuccess) {
+            history_free(h);
+            return fv_cuda_fail(e, "allocating fipr's history", err);
+        }
+        h->sw = k->sw;
+        h->sh = k->sh;
+        index = 0;
+    }
+    if (index == 0) fv_cuda_pyr_forget<<<blocks_of(n), 256, 0, c->stream>>>(h->stamp, (int)n);
+    k->hist_color = h->color;
+    k->hist_stamp = h->stamp;
+    return FV_OK;
+}
+
+/* Copies the device film's n pixels into host's buffers that are set, on the stream. */
+static cudaError_t film_read_async(const fv_cuda_film *f, const fv_film_views *host, size_t n, cudaStream_t st)
+{
+    struct {
+        void *host;
+        const void *dev;
+        size_t bytes;
+    } back[6] = {{host->color, f->color, 3 * n * sizeof(float)},       {host->depth, f->depth, n * sizeof(float)},
+                 {host->normal, f->normal, 3 * n * sizeof(float)},     {host->albedo, f->albedo, 3 * n * sizeof(float)},
+                 {host->position, f->position, 3 * n * sizeof(float)}, {host->id, f->id, n * sizeof(uint32_t)}};
+    cudaError_t e = cudaSuccess;
+    for (int i = 0; i < 6 && e == cudaSuccess; i++)
+        if (back[i].host) e = cudaMemcpyAsync(back[i].host, back[i].dev, back[i].bytes, cudaMemcpyDeviceToHost, st);
+    return e;
+}
+
+extern "C" fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const fv_ksdf_world *w, const fv_ksdf_frame *f, const fv_kpyr *shape,
+                                                const fv_kpyr_fovea *fov, float edge, bool shadow_reuse, const fv_film_views *out,
+                                                uint8_t *mask_out, fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err)
+{
+    *syncs = 0;
+    fv_ksdf_world dw;
+    fv_status s = upload_world(c, w, &dw, err);
+    if (s != FV_OK) return s;
+    const bool fipr = fov != NULL;
+    const int L = shape->L;
+    if ((s = pyramid_ensure(c, shape, fipr, shadow_reuse && L > 1, err)) != FV_OK) return s;
+    const size_t n = (size_t)shape->w * (size_t)shape->h;
+    fv_film_views dv;
+    if ((s = fv_cuda_film_prepare(&c->film, out, n, &dv, err)) != FV_OK) return s;
+    cudaStream_t st = c->stream;
+    cudaError_t e;
+    if ((e = cudaMemsetAsync(c->counts, 0, FV_CUDA_PYR_COUNTS * sizeof(unsigned long long), st)) != cudaSuccess)
+        return fv_cuda_fail(e, "clearing counters", err);
+    if (fipr && (s = history_ensure(c, fov->eye_index, fov->index, err)) != FV_OK) return s;
+    fv_kpyr *k = &c->k;
+    const dim3 block(FV_CUDA_SDF_BLOCK, FV_CUDA_SDF_BLOCK);
+    const int index = fipr ? fov->index : 0;
+    cudaEventRecord(c->start, st);
+    /* the levels traced whole (fipr: all but the middle, which the mask decides) */
+    const int full_below = fipr ? L - 2 : L - 1;
+    for (int i = 0; i < full_below; i++)
+        fv_cuda_pyr_level<<<grid_of(k->lv[i].w, k->lv[i].h), block, 0, st>>>(dw, *f, *k, i, index, c->counts);
+    if (fipr) {
+        const size_t ntip = (size_t)k->lv[0].w * k->lv[0].h;
+        cudaMemsetAsync(c->far, 0, sizeof(unsigned), st);
+        fv_cuda_pyr_far<<<blocks_of(ntip), 256, 0, st>>>(k->depth[0], (int)ntip, c->far);
+        fv_cuda_pyr_sobel<<<grid_of(k->lv[0].w, k->lv[0].h), block, 0, st>>>(*k, c->far, edge);
+        fv_cuda_pyr_mask<<<grid_of(k->w, k->h), block, 0, st>>>(*k, *fov, c->counts);
+        fv_cuda_pyr_need<<<grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, 0, st>>>(*k, *fov, c->counts);
+        fv_cuda_pyr_level<<<grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, 0, st>>>(dw, *f, *k, L - 2, index, c->counts);
+    }
+    fv_cuda_pyr_target<<<grid_of(k->w, k->h), block, 0, st>>>(dw, *f, *k, dv, c->counts);
+    cudaEventRecord(c->stop, st);
+    if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the pyramid's kernels", err);
+    /* what the host receives, then its one wait */
+    unsigned long long kc[FV_CUDA_PYR_COUNTS];
+    e = film_read_async(&c->film, out, n, st);
+    if (e == cudaSuccess && mask_out && fipr) e = cudaMemcpyAsync(mask_out, k->mask, n, cudaMemcpyDeviceToHost, st);
+    if (e == cudaSuccess) e = cudaMemcpyAsync(kc, c->counts, sizeof kc, cudaMemcpyDeviceToHost, st);
+    if (e == cudaSuccess) e = cudaStreamSynchronize(st);
+    *syncs = 1;
+    if (e != cudaSuccess) return fv_cuda_fail(e, "running the pyramid's kernels", err);
+    float ms = 0.0f;
+    cudaEventElapsedTime(&ms, c->start, c->stop);
+    *kernel_ms = ms;
+    counts->all.rays += kc[0];
+    counts->all.steps += kc[1];
+    counts->all.exhausted += kc[2];
+    counts->all.nan += kc[3];
+    counts->all.shade.shadow_rays += kc[4];
+    counts->all.shade.shadow_steps += kc[5];
+    counts->all.shade.normal_evals += kc[6];
+    counts->masked += kc[FV_CUDA_PYR_MASKED];
+    counts->edges += kc[FV_CUDA_PYR_EDGES];
+    counts->refreshed += kc[FV_CUDA_PYR_REFRESHED];
+    for (int i = 0; i < L; i++) {
+        counts->level_rays[i] += kc[FV_CUDA_PYR_LEVEL_RAYS + i];
+        counts->level_steps[i] += kc[FV_CUDA_PYR_LEVEL_STEPS + i];
+    }
+    return FV_OK;
 }

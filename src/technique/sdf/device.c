@@ -1,6 +1,9 @@
-/* fovea — `sdf-gt` and `sdf-relaxed` on the portable and CUDA backends (device.h). */
+/* fovea — the sphere-tracing family on the portable and CUDA backends (device.h). */
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/alloc.h"
 #include "core/parallel.h"
 #include "device/cuda_backend.h"
 #include "kernel/sdf_pixel.h"
@@ -11,7 +14,13 @@
 struct fv_sdf_device {
     const fv_scene *scene;
     fv_sdf_opts o;
-    fv_cuda_sdf *cuda; /* NULL: the portable backend */
+    fv_cuda_sdf *cuda;          /* NULL: the portable backend */
+    /* ipr and fipr */
+    fv_kpyr k;                  /* portable: the pyramid's host buffers */
+    fv_pyramid_history hist[2]; /* portable, fipr: the middle level kept per eye */
+    uint8_t *mask;              /* cuda, fipr with blur: the mask read back */
+    float *sigma;               /* fipr with blur: pass 5's sigma */
+    size_t blur_pixels;         /* the size mask and sigma have */
 };
 
 fv_status fv_sdf_device_create(const fv_scene *scene, const fv_sdf_opts *o, fv_device device, fv_sdf_device **out, fv_error *err)
@@ -36,38 +45,163 @@ void fv_sdf_device_destroy(fv_sdf_device *d)
 {
     if (!d) return;
     fv_cuda_sdf_destroy(d->cuda);
+    fv_pyramid_free(&d->k);
+    fv_pyramid_history_free(&d->hist[0]);
+    fv_pyramid_history_free(&d->hist[1]);
+    free(d->mask);
+    free(d->sigma);
     free(d);
 }
 
-/* The counters a pixel adds, in the kit's per-thread slots. */
-enum { C_STEPS = FV_KIT_USER0, C_SHADOW = FV_KIT_USER1, C_NORMAL = FV_KIT_USER2, C_EXHAUSTED = FV_KIT_USER3, C_SHADOW_RAYS = FV_KIT_USER4 };
+/* ---- the portable backend: each pass's kernel steps over tiles of its grid on the CPU's threads ---- */
+
+typedef enum pass { PASS_LEVEL, PASS_SOBEL, PASS_MASK, PASS_NEED, PASS_TARGET } pass;
 
 typedef struct tile_job {
     const fv_ksdf_world *world;
     fv_ksdf_frame f;
     fv_film_views out;
-    fv_kit_counters *c;
+    const fv_kpyr *k;         /* NULL: sdf-gt, sdf-relaxed */
+    const fv_kpyr_fovea *fov; /* fipr */
+    pass what;
+    int level;                /* PASS_LEVEL */
+    float sky, edge;          /* PASS_SOBEL */
+    fv_ksdf_counts *c;        /* per thread: the pass's costs */
+    uint64_t *n;              /* per thread: mask pixels (PASS_MASK), edge pixels (PASS_MASK), refreshed rays (PASS_NEED) */
 } tile_job;
 
-static void pixel_tile(void *ctx, const fv_tile *tile)
+static void pass_tile(void *ctx, const fv_tile *tile)
 {
     tile_job *j = ctx;
-    fv_ksdf_counts c;
-    memset(&c, 0, sizeof c);
+    const fv_kpyr *k = j->k;
+    fv_ksdf_counts *c = &j->c[tile->thread];
+    uint64_t *n = &j->n[2 * tile->thread];
     for (int y = tile->y0; y < tile->y1; y++)
-        for (int x = tile->x0; x < tile->x1; x++) fv_ksdf_pixel(j->world, &j->f, x, y, &j->out, &c);
-    fv_kit_count(j->c, tile->thread, FV_KIT_RAYS, c.rays);
-    fv_kit_count(j->c, tile->thread, FV_KIT_NAN, c.nan);
-    fv_kit_count(j->c, tile->thread, C_STEPS, c.steps);
-    fv_kit_count(j->c, tile->thread, C_EXHAUSTED, c.exhausted);
-    fv_kit_count(j->c, tile->thread, C_SHADOW, c.shade.shadow_steps);
-    fv_kit_count(j->c, tile->thread, C_NORMAL, c.shade.normal_evals);
-    fv_kit_count(j->c, tile->thread, C_SHADOW_RAYS, c.shade.shadow_rays);
+        for (int x = tile->x0; x < tile->x1; x++) switch (j->what) {
+            case PASS_LEVEL: fv_ksdf_level_cell(j->world, &j->f, k, j->level, x, y, j->fov ? j->fov->index : 0, c); break;
+            case PASS_SOBEL:
+                k->edge[(size_t)y * k->lv[0].w + x] = fv_kpyr_sobel_cell(k->depth[0], k->lv[0].w, k->lv[0].h, j->sky, j->edge, x, y);
+                break;
+            case PASS_MASK: {
+                uint8_t m = fv_kpyr_mask_pixel(k, j->fov, x, y);
+                k->mask[(size_t)y * k->w + x] = m;
+                n[0] += m;
+                n[1] += fv_kpyr_edge_of_pixel(k, x, y) != 0;
+                break;
+            }
+            case PASS_NEED: {
+                uint8_t need = fv_kpyr_need_cell(k, j->fov, x, y);
+                k->need[(size_t)y * k->lv[k->L - 2].w + x] = need;
+                n[0] += need == 2;
+                break;
+            }
+            case PASS_TARGET: fv_ksdf_target_pixel(j->world, &j->f, k, x, y, &j->out, c); break;
+            }
 }
 
-/* The counters as the CPU pipeline names them (one level: the target). */
-static void report(const fv_ksdf_counts *c, double samples, fv_stats *stats)
+static void add_counts(fv_ksdf_counts *to, const fv_ksdf_counts *c)
 {
+    to->rays += c->rays;
+    to->steps += c->steps;
+    to->exhausted += c->exhausted;
+    to->nan += c->nan;
+    to->shade.shadow_rays += c->shade.shadow_rays;
+    to->shade.shadow_steps += c->shade.shadow_steps;
+    to->shade.normal_evals += c->shade.normal_evals;
+}
+
+/* One pass over a gw x gh grid; its costs into *sum (and, for a level, the level's share), its
+ * counts into n[0], n[1]. */
+static fv_status run_pass(tile_job *j, pass what, int level, int gw, int gh, const fv_frame *frame, fv_kit_progress *prog, double base,
+                          double span, fv_ksdf_pyr_counts *sum, uint64_t n[2], fv_error *err)
+{
+    const int nt = fv_thread_count(frame->threads);
+    memset(j->c, 0, (size_t)nt * sizeof *j->c);
+    memset(j->n, 0, (size_t)nt * 2 * sizeof *j->n);
+    j->what = what;
+    j->level = level;
+    fv_kit_phase(prog, frame, base, span);
+    fv_parallel_tiles(gw, gh, frame->threads, pass_tile, j, fv_kit_progress_fn, prog);
+    fv_ksdf_counts c;
+    memset(&c, 0, sizeof c);
+    for (int t = 0; t < nt; t++) {
+        add_counts(&c, &j->c[t]);
+        if (n) n[0] += j->n[2 * t], n[1] += j->n[2 * t + 1];
+    }
+    add_counts(&sum->all, &c);
+    if (level >= 0) {
+        sum->level_rays[level] += c.rays;
+        sum->level_steps[level] += c.steps;
+    }
+    return fv_kit_phase_end(prog, err);
+}
+
+/* ipr and fipr on the portable backend: the CPU pipeline's passes in its order (pipeline.c). */
+static fv_status portable_pyramid(fv_sdf_device *d, tile_job *j, const fv_frame *frame, fv_ksdf_pyr_counts *sum, fv_error *err)
+{
+    const fv_sdf_opts *o = &d->o;
+    const bool fipr = o->method == FV_SDF_FIPR;
+    const int L = o->levels, w = j->f.cam.width, h = j->f.cam.height;
+    fv_kpyr *k = &d->k;
+    fv_status s = fv_pyramid_alloc(k, w, h, j->f.S, L, fipr, o->shadow_reuse, err);
+    if (s != FV_OK) return s;
+    k->min_filter = o->min_filter;
+    fv_kpyr_fovea fov;
+    if (fipr) {
+        if ((s = fv_pyramid_history_attach(&d->hist[frame->eye], k, frame->index, err)) != FV_OK) return s;
+        fv_sdf_fovea_of(frame, o, w, h, &fov);
+        j->fov = &fov;
+    }
+    j->k = k;
+    const int nt = fv_thread_count(frame->threads);
+    j->c = fv_calloc_array((size_t)nt, sizeof *j->c);
+    j->n = fv_calloc_array((size_t)nt * 2, sizeof *j->n);
+    if (!j->c || !j->n) {
+        s = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    double total = 0.0, base = 0.0;
+    for (int i = 0; i < L; i++) total += (double)k->lv[i].w * k->lv[i].h;
+    fv_kit_progress prog = {0};
+    const int full_below = fipr ? L - 2 : L - 1;
+    for (int i = 0; i < full_below && s == FV_OK; i++) {
+        double span = (double)k->lv[i].w * k->lv[i].h / total;
+        s = run_pass(j, PASS_LEVEL, i, k->lv[i].w, k->lv[i].h, frame, &prog, base, span, sum, NULL, err);
+        base += span;
+    }
+    if (s == FV_OK && fipr) {
+        const fv_pyramid_level *low = &k->lv[0], *mid = &k->lv[L - 2];
+        /* pass 2's sky: a maximum, the same in any order */
+        float far = 0.0f;
+        for (size_t i = 0; i < (size_t)low->w * low->h; i++)
+            if (isfinite(k->depth[0][i]) && k->depth[0][i] > far) far = k->depth[0][i];
+        j->sky = fv_kpyr_sky(far);
+        j->edge = o->edge;
+        uint64_t mask_n[2] = {0, 0}, need_n[2] = {0, 0};
+        s = run_pass(j, PASS_SOBEL, -1, low->w, low->h, frame, &prog, base, 0.0, sum, NULL, err);
+        if (s == FV_OK) s = run_pass(j, PASS_MASK, -1, w, h, frame, &prog, base, 0.0, sum, mask_n, err);
+        if (s == FV_OK) s = run_pass(j, PASS_NEED, -1, mid->w, mid->h, frame, &prog, base, 0.0, sum, need_n, err);
+        sum->masked = mask_n[0];
+        sum->edges = mask_n[1];
+        sum->refreshed = need_n[0];
+        double span = (double)mid->w * mid->h / total;
+        if (s == FV_OK) s = run_pass(j, PASS_LEVEL, L - 2, mid->w, mid->h, frame, &prog, base, span, sum, NULL, err);
+        base += span;
+    }
+    if (s == FV_OK) s = run_pass(j, PASS_TARGET, L - 1, w, h, frame, &prog, base, 1.0 - base, sum, NULL, err);
+done:
+    free(j->c);
+    free(j->n);
+    j->c = NULL;
+    j->n = NULL;
+    return s;
+}
+
+/* The counters as the CPU pipeline names them. */
+static void report(const fv_sdf_opts *o, const fv_ksdf_pyr_counts *pc, double samples, fv_stats *stats)
+{
+    const fv_ksdf_counts *c = &pc->all;
+    char key[32];
     fv_stats_add_count(stats, "rays", (double)c->rays);
     fv_stats_add_count(stats, "nan_samples", (double)c->nan);
     fv_stats_add_count(stats, "samples", samples);
@@ -76,8 +210,23 @@ static void report(const fv_ksdf_counts *c, double samples, fv_stats *stats)
     fv_stats_add_count(stats, "normal_evals", (double)c->shade.normal_evals);
     fv_stats_add_count(stats, "exhausted_rays", (double)c->exhausted);
     fv_stats_add_count(stats, "shadow_rays", (double)c->shade.shadow_rays);
-    fv_stats_add_count(stats, "rays_level0", (double)c->rays);
-    fv_stats_add_count(stats, "steps_level0", (double)c->steps);
+    for (int k = 0; k < o->levels; k++) {
+        snprintf(key, sizeof key, "rays_level%d", k);
+        fv_stats_add_count(stats, key, (double)pc->level_rays[k]);
+        snprintf(key, sizeof key, "steps_level%d", k);
+        fv_stats_add_count(stats, key, (double)pc->level_steps[k]);
+    }
+    if (o->method == FV_SDF_FIPR) {
+        fv_stats_add_count(stats, "mask_pixels", (double)pc->masked);
+        fv_stats_add_count(stats, "edge_pixels", (double)pc->edges);
+        fv_stats_add_count(stats, "refreshed_pixels", (double)pc->refreshed);
+    }
+}
+
+/* fipr's pass 5 on the host, after either backend (filter/blur.h; not yet a kernel). */
+static fv_status blur(fv_sdf_device *d, const uint8_t *mask, const fv_film_views *out, int w, int h, int threads, fv_error *err)
+{
+    return fv_sdf_blur_transitions(out->color, mask, d->sigma, w, h, d->o.blur_sigma, threads, err);
 }
 
 fv_status fv_sdf_device_render(fv_sdf_device *d, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
@@ -86,50 +235,83 @@ fv_status fv_sdf_device_render(fv_sdf_device *d, const fv_frame *frame, fv_film 
     memset(&j, 0, sizeof j);
     fv_status s = fv_frame_camera(frame->camera, film, &j.f.cam, err);
     if (s != FV_OK) return s;
+    const fv_sdf_opts *o = &d->o;
+    const bool pyramid = o->method == FV_SDF_IPR || o->method == FV_SDF_FIPR;
+    const bool blurred = o->method == FV_SDF_FIPR && o->blur;
+    const int w = j.f.cam.width, h = j.f.cam.height;
+    const size_t np = (size_t)w * h;
+    if (blurred && d->blur_pixels != np) {
+        free(d->mask);
+        free(d->sigma);
+        d->mask = fv_alloc_array(np, 1);
+        d->sigma = fv_alloc_array(np, sizeof(float));
+        d->blur_pixels = d->mask && d->sigma ? np : 0;
+        if (!d->blur_pixels) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for fipr's blur");
+    }
     fv_sdf_world world;
     double t0 = fv_time_ms();
     if ((s = fv_sdf_world_build(&world, d->scene, err)) != FV_OK) return s;
     fv_stats_add_ms(stats, "scene", fv_time_ms() - t0);
-    const int S = d->o.spp >= 16 ? 4 : d->o.spp >= 4 ? 2 : 1;
+    const int S = fv_sdf_samples_per_axis(o->spp);
     j.world = &world.k;
     j.f.S = S;
     /* a target sample's angular footprint per unit distance, as the CPU pipeline's */
-    j.f.eps_k = d->o.hit * (2.0f * j.f.cam.tan_half_x / (float)(j.f.cam.width * S));
-    j.f.march = d->o.march;
-    j.f.shade = d->o.shade;
+    j.f.eps_k = o->hit * (2.0f * j.f.cam.tan_half_x / (float)(w * S));
+    j.f.march = o->march;
+    j.f.shade = o->shade;
     j.out = fv_film_views_of(film);
-    const double samples = (double)j.f.cam.width * j.f.cam.height * d->o.spp;
-    fv_ksdf_counts c;
+    const double samples = (double)w * h * o->spp;
+    fv_ksdf_pyr_counts c;
     memset(&c, 0, sizeof c);
+    const uint8_t *mask = NULL;
+    t0 = fv_time_ms();
     if (d->cuda) {
         double kernel_ms = 0.0;
-        t0 = fv_time_ms();
-        s = fv_cuda_sdf_render(d->cuda, &world.k, &j.f, &j.out, &c, &kernel_ms, err);
-        fv_stats_add_ms(stats, "target", fv_time_ms() - t0);
+        int syncs = 0;
+        if (!pyramid) {
+            s = fv_cuda_sdf_render(d->cuda, &world.k, &j.f, &j.out, &c.all, &kernel_ms, err);
+            c.level_rays[0] = c.all.rays;
+            c.level_steps[0] = c.all.steps;
+            syncs = 1;
+        } else {
+            fv_kpyr shape;
+            memset(&shape, 0, sizeof shape);
+            shape.L = o->levels;
+            shape.S = S;
+            shape.w = w;
+            shape.h = h;
+            shape.sw = w * S;
+            shape.sh = h * S;
+            shape.min_filter = o->min_filter;
+            fv_kpyr_levels(shape.sw, shape.sh, shape.L, shape.lv);
+            fv_kpyr_fovea fov;
+            if (o->method == FV_SDF_FIPR) fv_sdf_fovea_of(frame, o, w, h, &fov);
+            s = fv_cuda_sdf_pyramid_render(d->cuda, &world.k, &j.f, &shape, o->method == FV_SDF_FIPR ? &fov : NULL, o->edge, o->shadow_reuse,
+                                           &j.out, blurred ? d->mask : NULL, &c, &kernel_ms, &syncs, err);
+            mask = d->mask;
+        }
         fv_stats_add_ms(stats, "kernel", kernel_ms);
-        fv_sdf_world_free(&world);
-        if (s == FV_OK) report(&c, samples, stats);
-        return s;
+        fv_stats_add_count(stats, "host_syncs", (double)syncs);
+    } else if (!pyramid) {
+        const int nt = fv_thread_count(frame->threads);
+        j.c = fv_calloc_array((size_t)nt, sizeof *j.c);
+        j.n = fv_calloc_array((size_t)nt * 2, sizeof *j.n);
+        fv_kit_progress prog = {0};
+        s = j.c && j.n ? run_pass(&j, PASS_TARGET, 0, w, h, frame, &prog, 0.0, 1.0, &c, NULL, err) : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        free(j.c);
+        free(j.n);
+    } else {
+        s = portable_pyramid(d, &j, frame, &c, err);
+        mask = d->k.mask;
     }
-    if (!(j.c = fv_kit_counters_create())) {
-        fv_sdf_world_free(&world);
-        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    }
-    fv_kit_progress prog = {0};
-    fv_kit_phase(&prog, frame, 0.0, 1.0);
-    t0 = fv_time_ms();
-    fv_parallel_tiles(j.f.cam.width, j.f.cam.height, frame->threads, pixel_tile, &j, fv_kit_progress_fn, &prog);
     fv_stats_add_ms(stats, "target", fv_time_ms() - t0);
-    c.rays = fv_kit_sum(j.c, FV_KIT_RAYS);
-    c.nan = fv_kit_sum(j.c, FV_KIT_NAN);
-    c.steps = fv_kit_sum(j.c, C_STEPS);
-    c.exhausted = fv_kit_sum(j.c, C_EXHAUSTED);
-    c.shade.shadow_steps = fv_kit_sum(j.c, C_SHADOW);
-    c.shade.normal_evals = fv_kit_sum(j.c, C_NORMAL);
-    c.shade.shadow_rays = fv_kit_sum(j.c, C_SHADOW_RAYS);
-    fv_kit_counters_destroy(j.c);
     fv_sdf_world_free(&world);
-    if ((s = fv_kit_phase_end(&prog, err)) != FV_OK) return s;
-    report(&c, samples, stats);
+    if (s == FV_OK && blurred) {
+        t0 = fv_time_ms();
+        s = blur(d, mask, &j.out, w, h, frame->threads, err);
+        fv_stats_add_ms(stats, "blur", fv_time_ms() - t0);
+    }
+    if (s != FV_OK) return s;
+    report(o, &c, samples, stats);
     return FV_OK;
 }

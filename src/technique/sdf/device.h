@@ -1,7 +1,11 @@
-/* fovea — `sdf-gt` and `sdf-relaxed` on the device backends (docs/gpu.md): the pixel kernel of
- * kernel/sdf_pixel.h run by the portable backend (the CPU's threads over film tiles, what CI
- * tests) or by CUDA (device/cuda/sdf.cu). The world is built on the host each frame, as the CPU
- * pipeline builds it (technique/sdf/world.h), and read in its flat form.
+/* fovea — the sphere-tracing family on the device backends (docs/gpu.md): `sdf-gt` and
+ * `sdf-relaxed` (the target pixel of kernel/sdf_pixel.h), `ipr` and `fipr` (its pyramid passes:
+ * the level rays of kernel/sdf_pixel.h, the Sobel edges, mask and refresh of kernel/sdf_pyramid.h,
+ * then the target pixel), run by the portable backend (each pass over tiles of its grid on the
+ * CPU's threads, what CI tests against the CPU pipeline) or by CUDA (device/cuda/sdf.cu, a kernel
+ * per pass). The world is built on the host each frame, as the CPU pipeline builds it
+ * (technique/sdf/world.h), and read in its flat form. fipr's pass 5 (blur=true) runs on the host
+ * after either backend, with the CPU's filter (filter/blur.h).
  */
 #ifndef FV_SDF_DEVICE_H
 #define FV_SDF_DEVICE_H
@@ -14,7 +18,7 @@
 
 typedef struct fv_sdf_device fv_sdf_device;
 
-/* o: the method's options (sdf-gt or sdf-relaxed, show=image); device portable or cuda. */
+/* o: the method's options (show=image); device portable or cuda. */
 fv_status fv_sdf_device_create(const fv_scene *scene, const fv_sdf_opts *o, fv_device device, fv_sdf_device **out, fv_error *err);
 /* Renders one eye of one frame, reporting the CPU pipeline's counters. */
 fv_status fv_sdf_device_render(fv_sdf_device *d, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);

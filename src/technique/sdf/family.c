@@ -10,7 +10,7 @@
 
 typedef struct family_state {
     fv_sdf_pipeline *pipe; /* the cpu device */
-    fv_sdf_device *dev;    /* sdf-gt and sdf-relaxed on portable and cuda (device.h) */
+    fv_sdf_device *dev;    /* portable and cuda (device.h) */
 } family_state;
 
 /* The show modes each method has, in fv_sdf_show's order: the baselines one level, ipr the level
@@ -94,7 +94,7 @@ static fv_status create_method(fv_sdf_method m, const fv_scene *scene, fv_params
     if (s != FV_OK) return s;
     if (device != FV_DEVICE_CPU && o.show != FV_SDF_SHOW_IMAGE)
         return fv_error_set(err, FV_ERR_INVALID, "parameter show=%s: only the cpu device draws diagnostics (device %s renders the image)",
-                            k_show_traced[o.show], fv_device_name(device));
+                            k_show_fipr[o.show], fv_device_name(device));
     int meshes = fv_scene_object_count(scene) - fv_scene_sdf_object_count(scene);
     if (meshes > 0)
         fv_log_warn(log, "%d mesh object%s not sphere-traced: this method sees only the signed distance fields (pt renders both)",
@@ -128,8 +128,7 @@ static void destroy(void *state)
     free(st);
 }
 
-/* sdf-gt and sdf-relaxed also run on the device backends (device.h), so the registry hands them
- * the device; ipr and fipr are CPU-only. */
+/* All four also run on the device backends (device.h), so the registry hands them the device. */
 static fv_status create_gt(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
 {
     return create_method(FV_SDF_GT, s, p, d, l, st, e);
@@ -138,13 +137,13 @@ static fv_status create_relaxed(const fv_scene *s, fv_params *p, fv_device d, co
 {
     return create_method(FV_SDF_RELAXED, s, p, d, l, st, e);
 }
-static fv_status create_ipr(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
+static fv_status create_ipr(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
 {
-    return create_method(FV_SDF_IPR, s, p, FV_DEVICE_CPU, l, st, e);
+    return create_method(FV_SDF_IPR, s, p, d, l, st, e);
 }
-static fv_status create_fipr(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
+static fv_status create_fipr(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
 {
-    return create_method(FV_SDF_FIPR, s, p, FV_DEVICE_CPU, l, st, e);
+    return create_method(FV_SDF_FIPR, s, p, d, l, st, e);
 }
 
 #define COMMON_PARAMS                                                                                                    \
@@ -208,7 +207,7 @@ static const fv_param_info k_fipr_params[] = {
  * one-process frames bit for bit (tests/cli/test_mpi.sh). */
 #define FIPR_WARMUP 3
 
-/* The devices beyond the CPU of sdf-gt and sdf-relaxed. */
+/* The devices beyond the CPU of the family. */
 #define SDF_DEVICES ((1u << FV_DEVICE_PORTABLE) | (1u << FV_DEVICE_CUDA))
 
 #define SDF_CLASS(id, nm, sum, base, table, fn, fn_on, devs, fov, warmup)                                             \
@@ -225,6 +224,6 @@ SDF_CLASS(fv_technique_sdf_gt, "sdf-gt", "sphere tracing of every target sample 
 SDF_CLASS(fv_technique_sdf_relaxed, "sdf-relaxed", "over-relaxed sphere tracing (Keinert et al. 2014) of every target sample", "sdf-gt",
           k_relaxed_params, NULL, create_relaxed, SDF_DEVICES, false, 0);
 SDF_CLASS(fv_technique_ipr, "ipr", "inverted-pyramid sphere tracing: each level starts at the min-filtered depth of the one below", "sdf-gt",
-          k_ipr_params, create_ipr, NULL, 0, false, 0);
+          k_ipr_params, NULL, create_ipr, SDF_DEVICES, false, 0);
 SDF_CLASS(fv_technique_fipr, "fipr", "foveated inverted-pyramid sphere tracing: the five passes of Polychronakis et al. 2023", "sdf-gt",
-          k_fipr_params, create_fipr, NULL, 0, true, FIPR_WARMUP);
+          k_fipr_params, NULL, create_fipr, SDF_DEVICES, true, FIPR_WARMUP);

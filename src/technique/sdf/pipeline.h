@@ -60,4 +60,13 @@ fv_status fv_sdf_pipeline_create(const fv_scene *scene, const fv_sdf_opts *o, fv
 fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);
 void fv_sdf_pipeline_destroy(fv_sdf_pipeline *p);
 
+/* What the CPU pipeline and the device backends (device.h) share of a frame: */
+/* samples per pixel along each axis for spp 1, 4, 16; */
+int fv_sdf_samples_per_axis(int spp);
+/* what fipr's mask and refresh read of the frame (kernel/sdf_pyramid.h) for a w x h film; */
+void fv_sdf_fovea_of(const fv_frame *f, const fv_sdf_opts *o, int w, int h, fv_kpyr_fovea *out);
+/* pass 5: the transitions of mask (w x h) blurred in rgb with sigma blur_sigma (sigma: w x h
+ * scratch), by filter/blur.h. */
+fv_status fv_sdf_blur_transitions(float *rgb, const uint8_t *mask, float *sigma, int w, int h, float blur_sigma, int threads, fv_error *err);
+
 #endif

@@ -3,12 +3,9 @@
  * probability of pass 3, and the colours of the diagnostic outputs. Pure functions on buffers,
  * tested by hand (tests/unit/test_sdf_family.c).
  *
- * Levels are counted from the tip: level 0 is the coarsest, level L-1 the target. They are built on
- * the sample grid (the film's pixels times the samples per pixel along each axis, so at 16 spp the
- * tip has one ray per pixel, which is where the paper's speed-up with super-sampling comes from).
- * Level k has one ray per f = 2^(L-1-k) x f block of target samples: ceil(W / f) x ceil(H / f)
- * rays, the last row and column covering what is left of an odd size; each ray passes through the
- * centre of the part of its block inside the grid.
+ * Levels are counted from the tip (level 0) to the target (L-1) on the sample grid; how they are
+ * laid out: kernel/sdf_pyramid.h. The host buffers below are the CPU pipeline's and the portable
+ * backend's (CUDA keeps its own on the GPU, device/cuda/sdf.cu).
  */
 #ifndef FV_SDF_PYRAMID_H
 #define FV_SDF_PYRAMID_H
@@ -16,13 +13,11 @@
 #include <stdbool.h>
 #include <stdint.h>
 #include "fovea/math.h"
+#include "fovea/status.h"
+#include "kernel/sdf_pyramid.h"
 
-#define FV_PYRAMID_MAX_LEVELS 6
-
-typedef struct fv_pyramid_level {
-    int w, h;  /* rays */
-    int f;     /* target samples per ray along each axis */
-} fv_pyramid_level;
+/* fv_pyramid_level, fv_kpyr (a pyramid's shape and buffers) and the per-cell steps:
+ * kernel/sdf_pyramid.h. These are their whole-buffer forms and the host buffers. */
 
 /* Fills level[0 .. levels-1] for a target grid of sw x sh samples. */
 void fv_pyramid_levels(int sw, int sh, int levels, fv_pyramid_level *level);
@@ -51,5 +46,24 @@ double fv_pyramid_probability(double ecc_deg, double fovea_deg, double outer_deg
  * (the target). */
 fv_vec3 fv_pyramid_heat(float steps);
 fv_vec3 fv_pyramid_level_colour(int level, int levels);
+
+/* fipr's middle level kept between frames, per eye: the colours the pixels outside the mask are
+ * reconstructed from, and the frame each was last shaded in (refreshed every 1, 2 or 4 frames). */
+typedef struct fv_pyramid_history {
+    int sw, sh;   /* the target grid it belongs to; another size starts afresh */
+    float *color; /* 3 per middle-level ray */
+    int *stamp;   /* frame index of the last shading, INT_MIN: never */
+} fv_pyramid_history;
+
+/* Makes k's host buffers fit a w x h film at S samples per pixel along each axis and L levels
+ * (kept when they already do): depth and steps of levels 0 .. L-2, with fipr need, edge and mask,
+ * with vis the shadow_reuse visibility of level L-2. FV_ERR_NOMEM (k emptied) when memory runs out. */
+fv_status fv_pyramid_alloc(fv_kpyr *k, int w, int h, int S, int L, bool fipr, bool vis, fv_error *err);
+void fv_pyramid_free(fv_kpyr *k);
+
+/* Points k's history at hs, sized for k's middle level; a new size, or index 0 (a sequence's first
+ * frame), starts without history (every stamp INT_MIN). */
+fv_status fv_pyramid_history_attach(fv_pyramid_history *hs, fv_kpyr *k, int index, fv_error *err);
+void fv_pyramid_history_free(fv_pyramid_history *hs);
 
 #endif

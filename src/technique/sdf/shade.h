@@ -20,9 +20,7 @@
 
 /* fv_sdf_shade_opts, fv_sdf_shade_counts and the per-hit steps: kernel/sdf_shade.h. */
 
-/* Which lights reach a shaded point: bit l for light l (scenes with up to 31 delta lights), or
- * FV_SDF_VIS_UNKNOWN (also for a miss). */
-#define FV_SDF_VIS_UNKNOWN 0xffffffffu
+/* Which lights reach a shaded point: FV_SDF_VIS_UNKNOWN and the bits, kernel/sdf_shade.h. */
 
 /* Shades the n marched camera rays: radiance per ray in color (black for a miss; color NULL:
  * visibility only), when normal is not NULL the unit normal (zero for a miss), when vis_out is
