@@ -185,15 +185,28 @@ static fv_status read_params(fir_state *st, fv_params *p, fv_error *err)
 }
 
 /* The occupied level-0 cells of each density cell: the area a density cell's VPLs share. */
-static void count_density_voxels(fir_state *st)
+/* The occupied voxels per density-grid cell. A step of the team (or one thread outside a region):
+ * the cells shared out, each count an atomic increment (the same integers in any order). */
+static void count_range(void *ctx, int64_t b, int64_t e, int thread)
 {
-    memset(st->dens_vox, 0, (size_t)fv_density_grid_cells(st->grid) * sizeof *st->dens_vox);
-    for (size_t c = 0; c < st->ncells; c++) {
+    (void)thread;
+    fir_state *st = ctx;
+    for (int64_t c = b; c < e; c++) {
         fv_voxel vx;
         fv_voxels_cell(st->vox, (int)c, &vx);
         if (!vx.occupied) continue;
-        st->dens_vox[fv_density_grid_cell(st->grid, fv_voxels_centre(st->vox, (int)c))]++;
+        int *slot = &st->dens_vox[fv_density_grid_cell(st->grid, fv_voxels_centre(st->vox, (int)c))];
+#pragma omp atomic
+        (*slot)++;
     }
+}
+
+static void count_density_voxels(fir_state *st)
+{
+#pragma omp master
+    memset(st->dens_vox, 0, (size_t)fv_density_grid_cells(st->grid) * sizeof *st->dens_vox);
+#pragma omp barrier
+    fv_team_for((int64_t)st->ncells, 4096, count_range, st);
 }
 
 static fv_status fir_create(const fv_scene *scene, fv_params *params, const fv_log *log, void **state, fv_error *err)
@@ -639,17 +652,12 @@ static fv_status manage(fir_state *st, const fv_frame *frame, const fv_camera_ba
     fv_region_begin();
 #pragma omp parallel num_threads(fv_thread_count(threads))
     {
-#pragma omp master
-        {
-            const double ts = fv_time_ms();
-            if (st->has_dynamic && moved) {
-                fv_voxels_update_dynamic(st->vox);
-                count_density_voxels(st);
-            }
-            fv_region_serial(fv_time_ms() - ts);
-            c1 = fv_stage_clock_now();
+        if (st->has_dynamic && moved) {
+            fv_voxels_update_dynamic(st->vox);
+            count_density_voxels(st);
         }
-#pragma omp barrier
+#pragma omp master
+        c1 = fv_stage_clock_now();
         if (inject) fv_vpl_inject_team(st->vox, s, frame->seed, (uint64_t)frame->index, st->area_samples, st->scratch, &inject_rays);
 #pragma omp master
         c2 = fv_stage_clock_now();

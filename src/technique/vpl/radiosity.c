@@ -8,7 +8,7 @@
 #include "technique/vpl/radiosity.h"
 
 typedef struct inject_job {
-    const fv_voxels *v;
+    fv_voxels *v;
     const fv_scene *s;
     uint64_t seed, frame;
     int area_samples;
@@ -47,6 +47,13 @@ static void inject_range(void *ctx, int64_t b, int64_t e, int thread)
     *j->rays += rays;
 }
 
+static void set_range(void *ctx, int64_t b, int64_t e, int thread)
+{
+    (void)thread;
+    const inject_job *j = ctx;
+    for (int64_t c = b; c < e; c++) fv_voxels_set_radiance(j->v, (int)c, fv_v3(j->out[3 * c], j->out[3 * c + 1], j->out[3 * c + 2]));
+}
+
 void fv_vpl_inject_team(fv_voxels *v, const fv_scene *s, uint64_t seed, uint64_t frame, int area_samples, float *scratch,
                         uint64_t *rays)
 {
@@ -61,17 +68,9 @@ void fv_vpl_inject_team(fv_voxels *v, const fv_scene *s, uint64_t seed, uint64_t
     fv_voxels_dims(v, 0, j.dims);
     const int64_t n = (int64_t)j.dims[0] * j.dims[1] * j.dims[2];
     fv_team_for(n, 1024, inject_range, &j);
-    /* the setters are not thread-safe (voxels.h): one pass after the parallel work, by the thread
-     * that opened the region (its serial time is reported), the others waiting at the barrier */
-#pragma omp master
-    {
-        const double t0 = fv_time_ms();
-        for (int64_t c = 0; c < n; c++)
-            fv_voxels_set_radiance(v, (int)c, fv_v3(scratch[3 * c], scratch[3 * c + 1], scratch[3 * c + 2]));
-        fv_voxels_build_radiance(v);
-        fv_region_serial(fv_time_ms() - t0);
-    }
-#pragma omp barrier
+    /* then into the slots (a cell each, so shared out too) and up the pyramid */
+    fv_team_for(n, 4096, set_range, &j);
+    fv_voxels_build_radiance(v);
 }
 
 fv_vec3 fv_vpl_cone_irradiance(const fv_voxels *v, fv_vec3 p, fv_vec3 n)

@@ -33,8 +33,8 @@
 /* Injects direct light into every occupied cell (scratch: 3 floats per level-0 cell) and rebuilds
  * the pyramid's radiance. Area lights use `area_samples` samples from stream (seed, FV_STREAM_VPL,
  * FV_VPL_RNG_INJECT + cell, 0, frame). Runs inside a region the caller opened, called by every
- * thread of its team: adds the shadow rays cast to *rays (shared); the pyramid is rebuilt by the
- * region's master; ends with the team's barrier. */
+ * thread of its team: adds the shadow rays cast to *rays (shared); the slots are set and the
+ * pyramid rebuilt by the team too; ends with the team's barrier. */
 void fv_vpl_inject_team(fv_voxels *v, const fv_scene *s, uint64_t seed, uint64_t frame, int area_samples, float *scratch,
                         uint64_t *rays);
 

@@ -1,7 +1,7 @@
 /* fovea — the voxel grid of Foveated Instant Radiosity: voxelization (Alg. 1), the mip pyramid and
  * cone tracing (Sec. 3.4, Eq. 3), ray casting (Alg. 3). See voxels.h for the representation.
  *
- * Limits: one thread; a surface voxelization (no solid fill); the pyramid is rebuilt over the box of
+ * Limits: the voxelization is one thread's (the pyramid is the team's); a surface voxelization (no solid fill); the pyramid is rebuilt over the box of
  * cells that changed, which for a fast object crossing the scene is most of the grid.
  */
 #include "technique/vpl/voxels.h"
@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "core/parallel.h"
+#include "fovea/stats.h"
 #include "core/ray_box.h"
 
 #define FV_VOX_MAX_LEVELS 12   /* 1024 -> 1 takes 11 halvings */
@@ -35,6 +37,7 @@ struct fv_voxels {
     float *rad0;                          /* 3 per level-0 cell */
     uint32_t *touched;                    /* cells with a dynamic write, each once */
     size_t ntouched;
+    int dirty_lo[3], dirty_hi[3];         /* the level-0 box the last update changed (the team's) */
     fv_voxel_mip *mip[FV_VOX_MAX_LEVELS]; /* levels >= 1 (mip[0] unused: level 0 is resolved on read) */
 };
 
@@ -225,38 +228,65 @@ void fv_voxels_mip_cell(const fv_voxels *v, int level, int i, int j, int k, fv_v
 
 /* ---- the pyramid ---- */
 
-/* Rebuilds levels 1.. over the parents of level-0 cells lo..hi (inclusive): geometry and radiance,
- * or radiance alone. Each parent averages its 8 children, those outside the grid counting empty. */
+/* One parent of level l (l >= 1): the mean of its 8 children, those outside the grid counting
+ * empty; geometry and radiance, or radiance alone. */
+static void build_parent(fv_voxels *v, int l, int i, int j, int k, bool geometry)
+{
+    fv_voxel_mip sum;
+    memset(&sum, 0, sizeof sum);
+    for (int q = 0; q < 8; q++) {
+        fv_voxel_mip ch;
+        fv_voxels_mip_cell(v, l - 1, 2 * i + (q & 1), 2 * j + (q >> 1 & 1), 2 * k + (q >> 2), &ch);
+        /* Already premultiplied (level 0: an occupied cell's values times 1). */
+        sum.occupancy += ch.occupancy;
+        sum.albedo = fv_add(sum.albedo, ch.albedo);
+        sum.normal = fv_add(sum.normal, ch.normal);
+        sum.radiance = fv_add(sum.radiance, ch.radiance);
+    }
+    fv_voxel_mip *m = mip_at(v, l, i, j, k);
+    m->radiance = fv_scale(sum.radiance, 0.125f);
+    if (!geometry) return;
+    m->occupancy = sum.occupancy * 0.125f;
+    m->albedo = fv_scale(sum.albedo, 0.125f);
+    m->normal = fv_scale(sum.normal, 0.125f);
+}
+
+/* The parents of one level's box, shared out by rows (j, k). */
+typedef struct mip_level_job {
+    fv_voxels *v;
+    int l, lo[3], hi[3];
+    bool geometry;
+} mip_level_job;
+
+static void mip_rows(void *ctx, int64_t b, int64_t e, int thread)
+{
+    (void)thread;
+    const mip_level_job *m = ctx;
+    const int64_t ny = m->hi[1] - m->lo[1] + 1;
+    for (int64_t r = b; r < e; r++) {
+        const int j = m->lo[1] + (int)(r % ny), k = m->lo[2] + (int)(r / ny);
+        for (int i = m->lo[0]; i <= m->hi[0]; i++) build_parent(m->v, m->l, i, j, k, m->geometry);
+    }
+}
+
+/* Rebuilds levels 1.. over the parents of level-0 cells lo..hi (inclusive). A step of the calling
+ * team (fv_team_for; a team of one outside a region): every parent of a level is independent of the
+ * others, and the loop's barrier finishes a level before the next reads it, so any thread count
+ * gives the same bits. */
 static void build_mips(fv_voxels *v, const int lo0[3], const int hi0[3], bool geometry)
 {
-    int lo[3] = {lo0[0], lo0[1], lo0[2]}, hi[3] = {hi0[0], hi0[1], hi0[2]};
+    mip_level_job m = {v, 0, {lo0[0], lo0[1], lo0[2]}, {hi0[0], hi0[1], hi0[2]}, geometry};
     for (int l = 1; l < v->nlevels; l++) {
+        bool empty = false;
         for (int a = 0; a < 3; a++) {
-            lo[a] >>= 1;
-            hi[a] >>= 1;
-            if (hi[a] > v->dims[l][a] - 1) hi[a] = v->dims[l][a] - 1;
+            m.lo[a] >>= 1;
+            m.hi[a] >>= 1;
+            if (m.hi[a] > v->dims[l][a] - 1) m.hi[a] = v->dims[l][a] - 1;
+            empty = empty || m.hi[a] < m.lo[a];
         }
-        for (int k = lo[2]; k <= hi[2]; k++)
-            for (int j = lo[1]; j <= hi[1]; j++)
-                for (int i = lo[0]; i <= hi[0]; i++) {
-                    fv_voxel_mip sum;
-                    memset(&sum, 0, sizeof sum);
-                    for (int q = 0; q < 8; q++) {
-                        fv_voxel_mip ch;
-                        fv_voxels_mip_cell(v, l - 1, 2 * i + (q & 1), 2 * j + (q >> 1 & 1), 2 * k + (q >> 2), &ch);
-                        /* Already premultiplied (level 0: an occupied cell's values times 1). */
-                        sum.occupancy += ch.occupancy;
-                        sum.albedo = fv_add(sum.albedo, ch.albedo);
-                        sum.normal = fv_add(sum.normal, ch.normal);
-                        sum.radiance = fv_add(sum.radiance, ch.radiance);
-                    }
-                    fv_voxel_mip *m = mip_at(v, l, i, j, k);
-                    m->radiance = fv_scale(sum.radiance, 0.125f);
-                    if (!geometry) continue;
-                    m->occupancy = sum.occupancy * 0.125f;
-                    m->albedo = fv_scale(sum.albedo, 0.125f);
-                    m->normal = fv_scale(sum.normal, 0.125f);
-                }
+        m.l = l;
+        const int64_t rows = empty ? 0 : (int64_t)(m.hi[1] - m.lo[1] + 1) * (m.hi[2] - m.lo[2] + 1);
+        fv_team_for(rows, 4, mip_rows, &m);
     }
 }
 
@@ -282,16 +312,27 @@ static void extend_box(const fv_voxels *v, size_t c, int lo[3], int hi[3])
 
 void fv_voxels_update_dynamic(fv_voxels *v)
 {
-    int lo[3] = {INT_MAX, INT_MAX, INT_MAX}, hi[3] = {-1, -1, -1};
-    for (size_t q = 0; q < v->ntouched; q++) {
-        extend_box(v, v->touched[q], lo, hi);
-        memset(&v->dyn[v->touched[q]], 0, sizeof v->dyn[0]);
+    /* The voxelization by one thread (a cell's writes add up in the objects' triangle order, which
+     * keeps it bit for bit), its time reported as the region's serial part; the box of changed
+     * cells is the team's, published by the barrier. */
+#pragma omp master
+    {
+        const double t0 = fv_time_ms();
+        int lo[3] = {INT_MAX, INT_MAX, INT_MAX}, hi[3] = {-1, -1, -1};
+        for (size_t q = 0; q < v->ntouched; q++) {
+            extend_box(v, v->touched[q], lo, hi);
+            memset(&v->dyn[v->touched[q]], 0, sizeof v->dyn[0]);
+        }
+        v->ntouched = 0;
+        for (int o = 0, n = fv_scene_object_count(v->scene); o < n; o++)
+            if (fv_scene_object_dynamic(v->scene, o)) voxelize_object(v, o, v->dyn, true);
+        for (size_t q = 0; q < v->ntouched; q++) extend_box(v, v->touched[q], lo, hi);
+        memcpy(v->dirty_lo, lo, sizeof lo);
+        memcpy(v->dirty_hi, hi, sizeof hi);
+        fv_region_serial(fv_time_ms() - t0);
     }
-    v->ntouched = 0;
-    for (int o = 0, n = fv_scene_object_count(v->scene); o < n; o++)
-        if (fv_scene_object_dynamic(v->scene, o)) voxelize_object(v, o, v->dyn, true);
-    for (size_t q = 0; q < v->ntouched; q++) extend_box(v, v->touched[q], lo, hi);
-    if (hi[0] >= 0) build_mips(v, lo, hi, true);
+#pragma omp barrier
+    if (v->dirty_hi[0] >= 0) build_mips(v, v->dirty_lo, v->dirty_hi, true);
 }
 
 int fv_voxels_dynamic_cells(const fv_voxels *v) { return (int)v->ntouched; }

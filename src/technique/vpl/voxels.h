@@ -70,7 +70,9 @@ void fv_voxels_destroy(fv_voxels *v);
 
 /* Alg. 1 line 4: clears the cells the dynamic objects wrote last time, voxelizes them at the
  * scene's current time and rebuilds the pyramid over the cells that changed. Radiance slots keep
- * their values (re-inject after). */
+ * their values (re-inject after). A step of a merged region: every thread of the team calls it (or
+ * one thread outside any region); the voxelization is the opening thread's (reported as serial
+ * time), the pyramid the team's, with the same bits at any thread count. */
 void fv_voxels_update_dynamic(fv_voxels *v);
 /* How many level-0 cells the dynamic objects occupy now. */
 int fv_voxels_dynamic_cells(const fv_voxels *v);
@@ -94,9 +96,11 @@ void fv_voxels_mip_cell(const fv_voxels *v, int level, int i, int j, int k, fv_v
 
 /* ---- radiance ---- */
 
+/* Sets one cell's slot: threads may set different cells at once (nothing else is written). */
 void fv_voxels_set_radiance(fv_voxels *v, int cell, fv_vec3 radiance);
 fv_vec3 fv_voxels_radiance(const fv_voxels *v, int cell);
-/* Rebuilds every level's radiance from level 0 (after the slots were set). */
+/* Rebuilds every level's radiance from level 0 (after the slots were set); a step of the team as
+ * fv_voxels_update_dynamic is. */
 void fv_voxels_build_radiance(fv_voxels *v);
 
 /* ---- queries ---- */
