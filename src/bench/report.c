@@ -81,6 +81,7 @@ static void run_settings(const fv_bench_run_info *info, text *t)
             fv_threads_used(info->threads), sc->reference.method);
     for (int i = 0; i < fv_params_count(sc->reference.params); i++)
         tprintf(t, " %s=%s", fv_params_key(sc->reference.params, i), fv_params_value(sc->reference.params, i));
+    if (sc->stereo > 0.0f) tprintf(t, "; stereo, eyes %g apart: a frame is both eyes (both timed), errors and images the left eye's", sc->stereo);
     tprintf(t, "; methods");
     for (int i = 0; i < sc->nmethods; i++) {
         const fv_bench_method *m = &sc->methods[i];
@@ -207,6 +208,8 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     cJSON_AddStringToObject(root, "scene", sc->scene);
     /* The scene edits, only when asked for (reports of other scenarios stay as they were). */
     if (sc->diffuse) cJSON_AddBoolToObject(root, "diffuse", true);
+    /* Only when set: a stereo run's frame is both eyes (its times), its errors the left eye's. */
+    if (sc->stereo > 0.0f) cJSON_AddNumberToObject(root, "stereo", sc->stereo);
     if (sc->nanimate) {
         cJSON *an = cJSON_AddArrayToObject(root, "animate");
         for (int i = 0; an && i < sc->nanimate; i++) {

@@ -124,18 +124,23 @@ static bool keep_going(void *user, double fraction)
 static fv_status render_sequence(const render_job *j, int first, int nframes, frame_fn on_frame, void *user, fv_error *err)
 {
     fv_technique *t = NULL;
-    fv_film *film = NULL;
+    /* A stereo scenario renders both eyes per frame (both timed); the left eye is the one
+     * measured and shown. */
+    fv_film *films[2] = {NULL, NULL};
     fv_status st = fv_technique_create(j->m->method, j->scene, j->m->params, j->log, &t, err);
     if (st != FV_OK) fv_error_prefix(err, "%s: ", j->m->label);
-    if (st == FV_OK) st = fv_film_create(j->sc->width, j->sc->height, 0, &film, err);
+    for (int e = 0; e < fv_driver_eye_count(j->driver) && st == FV_OK; e++)
+        st = fv_film_create(j->sc->width, j->sc->height, 0, &films[e], err);
+    fv_film *film = films[0];
     for (int i = first; i < nframes && st == FV_OK; i++) {
         fv_stats stats;
         fv_stats_clear(&stats);
         fv_film_clear(film);
+        if (films[1]) fv_film_clear(films[1]);
         double t0 = fv_time_ms();
         /* split over processes: a frame stops early once another rank has failed */
         const bool poll = j->split && j->split->stopped;
-        st = fv_driver_render(j->driver, t, i, i > first, &film, &stats, poll ? keep_going : NULL, poll ? (void *)j->split : NULL, err);
+        st = fv_driver_render(j->driver, t, i, i > first, films, &stats, poll ? keep_going : NULL, poll ? (void *)j->split : NULL, err);
         double ms = fv_time_ms() - t0;
         if (st != FV_OK) {
             fv_error_prefix(err, "%s, frame %d: ", j->m->label, i);
@@ -143,7 +148,8 @@ static fv_status render_sequence(const render_job *j, int first, int nframes, fr
         }
         st = on_frame(user, i, film, ms, &stats, err);
     }
-    fv_film_destroy(film);
+    fv_film_destroy(films[0]);
+    fv_film_destroy(films[1]);
     fv_technique_destroy(t);
     return st;
 }
@@ -195,7 +201,8 @@ static fv_status split_still(const render_job *j, int index, float *rgb, bool *s
 {
     *split = false;
     const fv_bench_split *sp = j->split;
-    if (!sp || !sp->still) return FV_OK;
+    /* a split still is one film: a stereo pair renders on one rank */
+    if (!sp || !sp->still || fv_driver_eye_count(j->driver) > 1) return FV_OK;
     fv_film *film = NULL;
     fv_status st = fv_film_create(j->sc->width, j->sc->height, 0, &film, err);
     /* a film that cannot be made here fails the job before any rank splits */
@@ -873,6 +880,7 @@ static void scenario_drive_opts(const fv_scenario *sc, fv_camera_path *cpath, fv
     o->camera_path = sc->ncam_keys ? cpath : NULL;
     o->gaze_path = sc->gaze;
     o->eye_model = sc->has_eye ? &sc->eye : NULL;
+    o->eye_separation = sc->stereo;
 }
 
 /* Everything a run would refuse, found before anything is rendered or written: the scenario
