@@ -18,6 +18,9 @@ typedef struct fv_bench_result {
     const fv_bench_method *m;
     double *ms;                 /* per repeat: mean ms per frame */
     double ms_median, ms_min, ms_max;
+    /* Frame pacing over every timed frame of every repeat (docs/bench.md): nearest-rank p50 and
+     * p99 (core/order_stats.h) and the worst frame, in ms. */
+    double frame_p50, frame_p99, frame_max;
     double speedup;             /* median over rounds of baseline / this (run.c) */
     fv_stats stages;            /* per stage: median over repeats of the mean per frame */
     fv_stats stages_min, stages_max; /* the same stages (same order): least and most over repeats */

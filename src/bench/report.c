@@ -81,6 +81,7 @@ static void run_settings(const fv_bench_run_info *info, text *t)
             fv_threads_used(info->threads), sc->reference.method);
     for (int i = 0; i < fv_params_count(sc->reference.params); i++)
         tprintf(t, " %s=%s", fv_params_key(sc->reference.params, i), fv_params_value(sc->reference.params, i));
+    if (sc->stereo > 0.0f) tprintf(t, "; stereo, eyes %g apart: a frame is both eyes (both timed), errors and images the left eye's", sc->stereo);
     tprintf(t, "; methods");
     for (int i = 0; i < sc->nmethods; i++) {
         const fv_bench_method *m = &sc->methods[i];
@@ -117,6 +118,13 @@ static cJSON *result_json(const fv_bench_run_info *info, const fv_bench_result *
     int reps = info->opt->repeats > 0 ? info->opt->repeats : info->sc->repeats;
     cJSON *all = cJSON_AddArrayToObject(ms, "repeats");
     for (int i = 0; i < reps; i++) cJSON_AddItemToArray(all, num(r->ms[i]));
+    /* Frame pacing (docs/bench.md): nearest-rank percentiles over every timed frame of every
+     * repeat, and the worst of them. */
+    cJSON *fm = cJSON_AddObjectToObject(o, "frame_ms");
+    cJSON_AddItemToObject(fm, "p50", num(r->frame_p50));
+    cJSON_AddItemToObject(fm, "p99", num(r->frame_p99));
+    cJSON_AddItemToObject(fm, "max", num(r->frame_max));
+    cJSON_AddNumberToObject(fm, "frames", reps * info->sc->frames);
     cJSON *st = cJSON_AddObjectToObject(o, "stages_ms");
     for (int i = 0; i < r->stages.n_stages; i++) cJSON_AddItemToObject(st, r->stages.stage[i].name, num(r->stages.stage[i].value));
     /* Each stage's serial share in [0, 1]: the part of its time outside parallel regions, or inside
@@ -200,6 +208,8 @@ static fv_status write_json(const fv_bench_run_info *info, const fv_bench_result
     cJSON_AddStringToObject(root, "scene", sc->scene);
     /* The scene edits, only when asked for (reports of other scenarios stay as they were). */
     if (sc->diffuse) cJSON_AddBoolToObject(root, "diffuse", true);
+    /* Only when set: a stereo run's frame is both eyes (its times), its errors the left eye's. */
+    if (sc->stereo > 0.0f) cJSON_AddNumberToObject(root, "stereo", sc->stereo);
     if (sc->nanimate) {
         cJSON *an = cJSON_AddArrayToObject(root, "animate");
         for (int i = 0; an && i < sc->nanimate; i++) {
@@ -343,20 +353,23 @@ static fv_status write_markdown(const fv_bench_run_info *info, const fv_bench_re
                     "thread(s) while the others ran theirs: a row's time includes that sharing",
                 info->opt->split->size, fv_threads_used(info->threads));
     int reps = info->opt->repeats > 0 ? info->opt->repeats : sc->repeats;
-    tprintf(&t, ". Times are medians of %d repeat(s) (ms per frame, render call only); speed-up is relative to `%s`. "
+    tprintf(&t, ". Times are medians of %d repeat(s) (ms per frame, render call only); frame p50 / p99 / worst are the nearest-rank "
+                "percentiles and the slowest of all %d timed frames; speed-up is relative to `%s`. "
                 "Errors are means over frames on display values (exposure %g, sRGB); MSE' is the temporal error "
                 "(Foveated Photon Mapping Eq. 9).\n\n",
-            reps, sc->baseline, sc->exposure);
+            reps, reps * sc->frames, sc->baseline, sc->exposure);
     size_t table_at = t.len;
-    tprintf(&t, "| method | params | ms/frame | ms min–max | speed-up | MSE fovea | MSE transition | MSE periphery | SSIM fovea | FLIP fovea | "
-                "FLIP all | MSE' fovea | MSE' periphery |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    tprintf(&t, "| method | params | ms/frame | ms min–max | frame p50 / p99 / worst | speed-up | MSE fovea | MSE transition | MSE periphery | "
+                "SSIM fovea | FLIP fovea | FLIP all | MSE' fovea | MSE' periphery |\n"
+                "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int i = 0; i < n; i++) {
         const fv_bench_result *r = &res[i];
         tprintf(&t, "| %s%s | ", r->m->label, r->m->match > 0 && !r->m->match_reached ? " (target not reached)" : "");
         for (int k = 0; k < fv_params_count(r->m->params); k++)
             tprintf(&t, "%s%s=%s", k ? " " : "", fv_params_key(r->m->params, k), fv_params_value(r->m->params, k));
         const fv_metric_values *v = r->error.region;
-        tprintf(&t, " | %.1f | %.1f–%.1f | %.2f | %s | %s | %s | %s | %s | %s | %s | %s |\n", r->ms_median, r->ms_min, r->ms_max, r->speedup,
+        tprintf(&t, " | %.1f | %.1f–%.1f | %.1f / %.1f / %.1f | %.2f | %s | %s | %s | %s | %s | %s | %s | %s |\n", r->ms_median, r->ms_min,
+                r->ms_max, r->frame_p50, r->frame_p99, r->frame_max, r->speedup,
                 sci(a, v[FV_REGION_FOVEA].mse), sci(b, v[FV_REGION_TRANSITION].mse), sci(c, v[FV_REGION_PERIPHERY].mse),
                 sci(d, v[FV_REGION_FOVEA].ssim), sci(e, v[FV_REGION_FOVEA].flip), sci(f, v[FV_REGION_ALL].flip),
                 sci(g, r->has_temporal ? r->temporal_mse[FV_REGION_FOVEA] : NAN),

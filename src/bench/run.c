@@ -16,6 +16,7 @@
 #include "bench/bench_impl.h"
 #include "core/alloc.h"
 #include "core/fileio.h"
+#include "core/order_stats.h"
 #include "core/params_read.h"
 #include "fovea/device.h"
 #include "core/rng.h"
@@ -40,23 +41,6 @@ static void say(const fv_bench_options *opt, const char *fmt, ...)
     vsnprintf(line, sizeof line, fmt, ap);
     va_end(ap);
     opt->status(opt->status_user, line);
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(const double *v, int n)
-{
-    double *c = malloc((size_t)n * sizeof *c);
-    if (!c) return v[0];
-    memcpy(c, v, (size_t)n * sizeof *c);
-    qsort(c, (size_t)n, sizeof *c, cmp_double);
-    double m = n % 2 ? c[n / 2] : 0.5 * (c[n / 2 - 1] + c[n / 2]);
-    free(c);
-    return m;
 }
 
 #define FNV_BASIS 1469598103934665603ULL
@@ -140,18 +124,23 @@ static bool keep_going(void *user, double fraction)
 static fv_status render_sequence(const render_job *j, int first, int nframes, frame_fn on_frame, void *user, fv_error *err)
 {
     fv_technique *t = NULL;
-    fv_film *film = NULL;
+    /* A stereo scenario renders both eyes per frame (both timed); the left eye is the one
+     * measured and shown. */
+    fv_film *films[2] = {NULL, NULL};
     fv_status st = fv_technique_create(j->m->method, j->scene, j->m->params, j->log, &t, err);
     if (st != FV_OK) fv_error_prefix(err, "%s: ", j->m->label);
-    if (st == FV_OK) st = fv_film_create(j->sc->width, j->sc->height, 0, &film, err);
+    for (int e = 0; e < fv_driver_eye_count(j->driver) && st == FV_OK; e++)
+        st = fv_film_create(j->sc->width, j->sc->height, 0, &films[e], err);
+    fv_film *film = films[0];
     for (int i = first; i < nframes && st == FV_OK; i++) {
         fv_stats stats;
         fv_stats_clear(&stats);
         fv_film_clear(film);
+        if (films[1]) fv_film_clear(films[1]);
         double t0 = fv_time_ms();
         /* split over processes: a frame stops early once another rank has failed */
         const bool poll = j->split && j->split->stopped;
-        st = fv_driver_render(j->driver, t, i, i > first, &film, &stats, poll ? keep_going : NULL, poll ? (void *)j->split : NULL, err);
+        st = fv_driver_render(j->driver, t, i, i > first, films, &stats, poll ? keep_going : NULL, poll ? (void *)j->split : NULL, err);
         double ms = fv_time_ms() - t0;
         if (st != FV_OK) {
             fv_error_prefix(err, "%s, frame %d: ", j->m->label, i);
@@ -159,7 +148,8 @@ static fv_status render_sequence(const render_job *j, int first, int nframes, fr
         }
         st = on_frame(user, i, film, ms, &stats, err);
     }
-    fv_film_destroy(film);
+    fv_film_destroy(films[0]);
+    fv_film_destroy(films[1]);
     fv_technique_destroy(t);
     return st;
 }
@@ -211,7 +201,8 @@ static fv_status split_still(const render_job *j, int index, float *rgb, bool *s
 {
     *split = false;
     const fv_bench_split *sp = j->split;
-    if (!sp || !sp->still) return FV_OK;
+    /* a split still is one film: a stereo pair renders on one rank */
+    if (!sp || !sp->still || fv_driver_eye_count(j->driver) > 1) return FV_OK;
     fv_film *film = NULL;
     fv_status st = fv_film_create(j->sc->width, j->sc->height, 0, &film, err);
     /* a film that cannot be made here fails the job before any rank splits */
@@ -422,6 +413,7 @@ typedef struct method_ctx {
     fv_bench_result *res;
     bool measure;              /* last repeat: compute errors and keep images */
     double ms_sum;
+    double *frame_ms;          /* this repeat's row of method_run.frame_ms */
     fv_stats stage_sum, counter_sum;
     fv_temporal *temporal;
     fv_metric_opts mopts;
@@ -442,6 +434,7 @@ static fv_status on_method_frame(void *user, int i, fv_film *film, double ms, co
     method_ctx *c = user;
     const fv_scenario *sc = c->info->sc;
     c->ms_sum += ms;
+    c->frame_ms[i] = ms;
     stats_accumulate(&c->stage_sum, stats);
     stats_accumulate(&c->counter_sum, stats);
     if (!c->measure || i < sc->measure_from) return FV_OK;
@@ -509,6 +502,7 @@ typedef struct method_run {
     render_job j;
     int reps;
     double *stage_per_rep;     /* per stage name (stage_names' order), per repeat */
+    double *frame_ms;          /* every repeat's frame times, reps x frames (the row's pacing) */
     fv_stats stage_names;
 } method_run;
 
@@ -516,6 +510,7 @@ static void method_free(method_run *mr)
 {
     fv_temporal_destroy(mr->c.temporal);
     free(mr->stage_per_rep);
+    free(mr->frame_ms);
     free(mr->c.flip_map);
     free(mr->c.last);
     memset(mr, 0, sizeof *mr);
@@ -539,9 +534,10 @@ static fv_status method_begin(const fv_bench_run_info *info, fv_scene *scene, fr
     res->ms = calloc((size_t)mr->reps, sizeof(double));
     res->speedup = 0.0;
     mr->stage_per_rep = calloc((size_t)mr->reps * FV_STATS_MAX, sizeof(double));
+    mr->frame_ms = fv_calloc_array((size_t)mr->reps * sc->frames, sizeof(double));
     c->flip_map = fv_alloc_array(npix, sizeof(float));
     c->last = fv_alloc_array(npix, 3 * sizeof(float));
-    if (!res->ms || !mr->stage_per_rep || !c->flip_map || !c->last) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (!res->ms || !mr->stage_per_rep || !mr->frame_ms || !c->flip_map || !c->last) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_stats_clear(&mr->stage_names);
     mr->j = (render_job){sc, scene, info->driver, res->m, info->opt->log, info->opt->split};
     return render_sequence(&mr->j, 0, 1, on_warmup_frame, NULL, err);
@@ -557,6 +553,7 @@ static fv_status method_repeat(method_run *mr, int index, int total, int r, fv_e
     say(c->info->opt, "[%d/%d] %s: repeat %d/%d, %d frame(s)", index + 1, total, res->m->label, r + 1, reps, sc->frames);
     c->measure = r == reps - 1;
     c->ms_sum = 0.0;
+    c->frame_ms = mr->frame_ms + (size_t)r * sc->frames;
     fv_stats_clear(&c->stage_sum);
     fv_stats_clear(&c->counter_sum);
     fv_status st = FV_OK;
@@ -586,12 +583,19 @@ static void method_figures(method_run *mr)
     const fv_scenario *sc = info->sc;
     fv_bench_result *res = c->res;
     const int reps = mr->reps;
-    res->ms_median = median(res->ms, reps);
+    res->ms_median = fv_median(res->ms, reps);
     res->ms_min = res->ms_max = res->ms[0];
     for (int r = 1; r < reps; r++) {
         res->ms_min = fmin(res->ms_min, res->ms[r]);
         res->ms_max = fmax(res->ms_max, res->ms[r]);
     }
+    /* Frame pacing: every timed frame of every repeat, warm-up frames (before measure_from)
+     * included, since a headset shows them too; nearest-rank percentiles (core/order_stats.h).
+     * The last use of frame_ms: sorting it in place is fine. */
+    const int nf = reps * sc->frames;
+    res->frame_p50 = fv_percentile(mr->frame_ms, nf, 50.0);
+    res->frame_p99 = fv_percentile(mr->frame_ms, nf, 99.0);
+    res->frame_max = mr->frame_ms[nf - 1];
     fv_stats_clear(&res->stages);
     fv_stats_clear(&res->stages_min);
     fv_stats_clear(&res->stages_max);
@@ -599,14 +603,14 @@ static void method_figures(method_run *mr)
         const double *v = mr->stage_per_rep + (size_t)q * reps;
         double lo = v[0], hi = v[0];
         for (int r = 1; r < reps; r++) lo = fmin(lo, v[r]), hi = fmax(hi, v[r]);
-        fv_stats_add_ms(&res->stages, mr->stage_names.stage[q].name, median(v, reps));
+        fv_stats_add_ms(&res->stages, mr->stage_names.stage[q].name, fv_median(v, reps));
         fv_stats_add_ms(&res->stages_min, mr->stage_names.stage[q].name, lo);
         fv_stats_add_ms(&res->stages_max, mr->stage_names.stage[q].name, hi);
         /* The serial share of the measured (last) repeat's frames, as --stats-json gives it, kept as
          * that share of the median: the report divides it back out. */
         const char *name = mr->stage_names.stage[q].name;
         const double tot = fv_stats_get_ms(&c->stage_sum, name), ser = fv_stats_get_serial_ms(&c->stage_sum, name);
-        if (ser >= 0.0 && tot > 0.0) fv_stats_add_serial_ms(&res->stages, name, median(v, reps) * fmin(1.0, ser / tot));
+        if (ser >= 0.0 && tot > 0.0) fv_stats_add_serial_ms(&res->stages, name, fv_median(v, reps) * fmin(1.0, ser / tot));
     }
     fv_stats_clear(&res->counters);
     for (int k = 0; k < c->counter_sum.n_counters; k++)
@@ -762,7 +766,7 @@ static fv_status run_methods(const fv_bench_run_info *info, fv_scene *scene, fra
         if (!ratio) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
         for (int i = 0; i < sc->nmethods && ratio && b >= 0; i++) {
             for (int r = 0; r < reps; r++) ratio[r] = res[i].ms[r] > 0.0 ? res[b].ms[r] / res[i].ms[r] : 0.0;
-            res[i].speedup = median(ratio, reps);
+            res[i].speedup = fv_median(ratio, reps);
         }
         free(ratio);
     }
@@ -876,6 +880,7 @@ static void scenario_drive_opts(const fv_scenario *sc, fv_camera_path *cpath, fv
     o->camera_path = sc->ncam_keys ? cpath : NULL;
     o->gaze_path = sc->gaze;
     o->eye_model = sc->has_eye ? &sc->eye : NULL;
+    o->eye_separation = sc->stereo;
 }
 
 /* Everything a run would refuse, found before anything is rendered or written: the scenario

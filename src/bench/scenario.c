@@ -341,11 +341,11 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
 {
     static const char *const keys[] = {"name", "description", "scene", "size", "frames", "measure_from", "fps", "start_time", "repeats",
                                        "exposure", "seed", "eye", "gaze", "camera_path", "reference", "baseline", "methods",
-                                       "sweep", "match", "extra_references", "diffuse", "animate", "quick", "full", NULL};
+                                       "sweep", "match", "extra_references", "diffuse", "animate", "stereo", "quick", "full", NULL};
     fv_status st = fv_json_check_keys(root, keys, file, "", err);
     if (st != FV_OK) return st;
     const char *name = NULL, *desc = NULL, *scene = NULL, *baseline = NULL;
-    double size[2] = {256, 256}, exposure = 1.0, seed = 1;
+    double size[2] = {256, 256}, exposure = 1.0, seed = 1, stereo = 0.0;
     if ((st = fv_json_require(root, "scene", file, "", err)) || (st = fv_json_require(root, "reference", file, "", err)) ||
         (st = fv_json_string(root, "name", file, "", &name, err)) || (st = fv_json_string(root, "description", file, "", &desc, err)) ||
         (st = fv_json_string(root, "scene", file, "", &scene, err)) || (st = fv_json_string(root, "baseline", file, "", &baseline, err)) ||
@@ -357,8 +357,10 @@ static fv_status parse_root(cJSON *root, const char *file, const char *dir, fv_s
         (st = fv_json_int(root, "repeats", 1, 1000, file, "", &s->repeats, err)) ||
         (st = fv_json_number(root, "exposure", 0, 1e9, file, "", &exposure, err)) ||
         (st = fv_json_number(root, "seed", 0, 9007199254740992.0, file, "", &seed, err)) ||
-        (st = fv_json_bool(root, "diffuse", file, "", &s->diffuse, err)))
+        (st = fv_json_bool(root, "diffuse", file, "", &s->diffuse, err)) ||
+        (st = fv_json_number(root, "stereo", 0, FV_COORD_MAX, file, "", &stereo, err)))
         return st;
+    s->stereo = (float)stereo;
     const cJSON *an = cJSON_GetObjectItemCaseSensitive(root, "animate");
     if (an && (st = parse_animate(an, file, s, err)) != FV_OK) return st;
     if (s->measure_from >= s->frames)

@@ -72,6 +72,7 @@ typedef struct fv_scenario {
     fv_eye_model eye;        /* the scenario's "eye" block (has_eye), then the one the driver used */
     bool has_eye;
     fv_gaze_path *gaze;      /* NULL: the scene's gaze path, else the centre */
+    float stereo;            /* > 0: stereo pairs, eyes this far apart (scene units); 0: mono */
     fv_camera_key *cam_keys; /* optional camera path overriding the scene's */
     int ncam_keys;
     fv_bench_method reference;

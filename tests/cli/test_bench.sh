@@ -13,6 +13,12 @@ for r in rows:
     for k in ("method", "params", "ms_per_frame", "stages_ms", "speedup", "error", "temporal", "counters", "images"):
         assert k in r, k
     assert r["ms_per_frame"]["min"] <= r["ms_per_frame"]["median"] <= r["ms_per_frame"]["max"]
+    # frame pacing over every timed frame of every repeat: ordered, and the worst frame is at least
+    # the slowest repeat's mean frame (a mean never exceeds its largest term)
+    fm = r["frame_ms"]
+    assert fm["frames"] == d["repeats"] * d["frames"], (fm, d["repeats"], d["frames"])
+    assert 0.0 < fm["p50"] <= fm["p99"] <= fm["max"], fm
+    assert fm["max"] >= r["ms_per_frame"]["max"] * (1 - 1e-12), (fm, r["ms_per_frame"])
     for g in ("fovea", "transition", "periphery", "all"):
         for m in ("mse", "ssim", "flip"):
             assert r["error"][g][m] is not None, (g, m)
@@ -54,6 +60,35 @@ for r in d["results"]:
     w, h, text = png(f"{out}/{r['images']['flip']}")
     assert text.get("fovea:heatmap") == "FLIP" and text.get("fovea:heatmap_max") == "1", (r["images"]["flip"], text)
     assert w >= d["size"][0] and h > d["size"][1], (w, h, d["size"])
+PY
+# The Markdown table's pacing column says the JSON's p50 / p99 / worst, rounded to 0.1 ms.
+python3 - "$OUT" <<'PY' || fail "pt-cornell.md's frame p50 / p99 / worst column disagrees with the JSON"
+import json, sys
+out = sys.argv[1]
+d = json.load(open(f"{out}/pt-cornell.json"))
+lines = open(f"{out}/pt-cornell.md").read().splitlines()
+head = [l for l in lines if l.startswith("| method | params | ms/frame |")][0].split("|")
+col = [c.strip() for c in head].index("frame p50 / p99 / worst")
+for r in d["results"]:
+    row = [l for l in lines if l.startswith(f"| {r['method']} |")][0].split("|")
+    got = [float(x) for x in row[col].split("/")]
+    fm = r["frame_ms"]
+    assert all(abs(g - fm[k]) <= 0.05 + 1e-9 for g, k in zip(got, ("p50", "p99", "max"))), (got, fm)
+PY
+# Pacing over several frames and repeats: 5 frames x 3 repeats = 15 timed frames per row; with
+# nearest rank, p50 is the 8th of them and p99 the 15th, the worst (fewer than 100 frames).
+expect 0 "" -- $B --scene cornell --methods pt:spp=1,pt:spp=2 --reference pt:spp=4 --frames 5 --size 24x24 --repeats 3 \
+  --out "$TMP/pace" --quiet
+python3 - "$TMP/pace" <<'PY' || fail "the 15-frame bench's frame pacing is wrong"
+import glob, json, sys
+d = json.load(open(glob.glob(f"{sys.argv[1]}/*.json")[0]))
+assert d["frames"] == 5 and d["repeats"] == 3, (d["frames"], d["repeats"])
+for r in d["results"]:
+    fm, ms = r["frame_ms"], r["ms_per_frame"]
+    assert fm["frames"] == 15, fm
+    assert 0.0 < fm["p50"] <= fm["p99"] == fm["max"], fm
+    # the worst frame is at least the slowest repeat's mean (a mean never exceeds its largest term)
+    assert fm["max"] >= ms["max"] * (1 - 1e-12), (fm, ms)
 PY
 grep -q "on one scale, shared by every method: 0 (no error) to 1" "$OUT/pt-cornell.md" || fail "pt-cornell.md does not state the heat maps' scale"
 ls "$OUT"/cache/ref-*.pfm >/dev/null 2>&1 || fail "no cached reference"

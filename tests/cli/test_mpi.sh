@@ -123,7 +123,7 @@ $MPI -n 2 "$FOVEA" $B --out btwo >btwo.out 2>btwo.err || fail "2-rank bench: $(c
 python3 - bone/pt-cornell.json btwo/pt-cornell.json <<'EOS' || fail "the 2-rank bench report differs from one process's beyond timings"
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:3])
-timing = {"ms_per_frame", "stages_ms", "stages_ms_range", "stages_serial_share", "speedup", "date", "command", "ranks", "timed_on_rank"}
+timing = {"ms_per_frame", "frame_ms", "stages_ms", "stages_ms_range", "stages_serial_share", "speedup", "date", "command", "ranks", "timed_on_rank"}
 def strip(x):
     if isinstance(x, dict):
         return {k: strip(v) for k, v in x.items() if k not in timing}

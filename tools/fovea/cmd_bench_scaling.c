@@ -21,6 +21,7 @@
 #include "cli.h"
 #include "core/alloc.h"
 #include "core/fileio.h"
+#include "core/order_stats.h"
 #include "fovea/fovea.h"
 
 #define MAX_COUNTS 16
@@ -40,20 +41,6 @@ static const char *scene_for(const char *m)
     if (!strncmp(m, "sdf-", 4) || !strcmp(m, "ipr") || !strcmp(m, "fipr")) return "sdf-temple";
     if (!strcmp(m, "ir") || !strcmp(m, "ir-low") || !strcmp(m, "fir")) return "cornell-fir";
     return "cornell";
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* The nearest-rank percentile q (0..100) of n values (sorted in place). */
-static double percentile(double *v, int n, double q)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    int k = (int)ceil(q / 100.0 * n) - 1;
-    return v[k < 0 ? 0 : k >= n ? n - 1 : k];
 }
 
 static double karp_flatt(double t1, double tp, int p)
@@ -124,9 +111,9 @@ static int run_one(const char *cmd, const char *method, fv_scene *scene, const f
         frame_sum += t;
     }
     if (s == FV_OK) {
-        for (int i = 0; i < r->n_stages; i++) r->stage_ms[i] = percentile(&st[(size_t)i * o->frames], o->frames, 50.0);
-        r->p99 = percentile(ms, o->frames, 99.0);
-        r->p50 = percentile(ms, o->frames, 50.0);
+        for (int i = 0; i < r->n_stages; i++) r->stage_ms[i] = fv_percentile(&st[(size_t)i * o->frames], o->frames, 50.0);
+        r->p99 = fv_percentile(ms, o->frames, 99.0);
+        r->p50 = fv_percentile(ms, o->frames, 50.0);
         r->serial = frame_sum > 0.0 ? fmin(1.0, ser_frame / frame_sum) : 0.0;
         for (int i = 0; i < r->n_stages; i++)
             r->stage_serial[i] = !has_ser[i] ? -1.0 : stage_sum[i] > 0.0 ? fmin(1.0, ser_stage[i] / stage_sum[i]) : 0.0;
