@@ -1,6 +1,7 @@
 /* A frame allocates nothing once warmed up (issue 29, docs/threads.md "No allocation in a frame"):
- * fpm-guided's frames, with its lattice filter, its A-Trous workspace and its kept photon paths,
- * counted call by call. This executable is linked with `-Wl,--wrap` for malloc, calloc, realloc
+ * every registered method's frames (the registry, src/technique/registry.c, with each class's own
+ * test_params, at 1 and 2 threads, the gaze moving every frame), and fpm-guided's with its lattice
+ * filter, its A-Trous workspace and its kept photon paths, counted call by call. This executable is linked with `-Wl,--wrap` for malloc, calloc, realloc
  * and aligned_alloc (tests/CMakeLists.txt), so every call fovea's own code makes goes through the
  * counters below first; the libraries it calls (Embree, the OpenMP runtime) are not counted. */
 #include <setjmp.h>
@@ -8,9 +9,11 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 #include <cmocka.h>
 #include "fovea/fovea.h"
 #include "testkit.h"
+#include "technique/class.h"
 
 /* The test's own count (this executable's, not the library's): calls by any thread. */
 static uint64_t g_allocs;
@@ -82,6 +85,105 @@ static uint64_t frame_allocs(const char *scene, const char *method, const char *
     return n;
 }
 
+/* Renders `frames` frames of a registered class at W x H in its conformance scene (cornell, or
+ * sdf-primitives for a method that only sphere-traces fields) with its test_params; the gaze moves
+ * every frame (foveation-dependent buffers see a new fovea each time); returns the allocations of
+ * the frames after the first `warm`. */
+static uint64_t class_frame_allocs(const fv_technique_class *c, int threads, int warm, int frames)
+{
+    enum { W = 32, H = 24 };
+    fv_scene *s;
+    fv_view *v;
+    fv_error err;
+    assert_int_equal(fv_scene_load(c->sdf_only ? "sdf-primitives" : "cornell", NULL, &s, &v, &err), FV_OK);
+    fv_params *p = fv_test_params_str(c->test_params);
+    fv_technique *t = NULL;
+    if (fv_technique_create(c->name, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s: %s", c->name, err.msg);
+    fv_params_destroy(p);
+    fv_film *f;
+    assert_int_equal(fv_film_create(W, H, 0, &f, &err), FV_OK);
+    fv_camera cam;
+    fv_view_camera(v, s, 0.0, W, H, &cam);
+    fv_stats stats;
+    uint64_t before = 0;
+    for (int i = 0; i < frames; i++) {
+        if (i == warm) before = allocs();
+        fv_frame fr;
+        fv_frame_init(&fr, NULL);
+        fr.camera = &cam;
+        fr.prev_camera = i ? &cam : NULL;
+        fr.index = i;
+        fr.seed = 7;
+        fr.threads = threads;
+        /* a saccade-like path across the screen: no two frames share a gaze */
+        fr.gaze = (fv_gaze){0.2f + 0.6f * (float)(i % 5) / 4.0f, 0.75f - 0.5f * (float)(i % 3) / 2.0f};
+        fv_stats_clear(&stats);
+        if (fv_technique_render(t, &fr, f, &stats, &err) != FV_OK) fail_msg("%s: %s", c->name, err.msg);
+    }
+    const uint64_t n = allocs() - before;
+    fv_technique_destroy(t);
+    fv_film_destroy(f);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+    return n;
+}
+
+/* The methods whose warmed-up frames still allocate (docs/threads.md, "No allocation in a frame"),
+ * each with where and a bound on its calls per frame in this test (32 x 24, the class's
+ * test_params): the bound catches a regression, the entry's presence a fix (a listed method that
+ * reaches zero fails the test until it is taken off the list). */
+typedef struct known_alloc {
+    const char *method, *why;
+    uint64_t per_frame;
+} known_alloc;
+
+static const known_alloc k_known[] = {
+    {"pm", "photon/photon_trace.c deposit: each frame's photons into blocks of its own", 400},
+    {"fpm", "the foveated photons' map blocks (foveated.c, photon_map.c) and its path manager", 10},
+    {"ppm", "each pass's photon blocks and the pass tree's node images", 800},
+    {"fpm-guided", "photon/path_store.c walk and keep: a path's blocks at this photon count and moving gaze", 250},
+    {"vpolar", "filter/blur.c: fv_blur_variable's per-call scratch", 2},
+    {"linear-falloff", "filter/blur.c: fv_blur_variable's per-call scratch", 2},
+    {"sdf-gt", "sdf/shade.c's per-tile scratch, sdf/world.c's per-frame world, the frame's job", 160},
+    {"sdf-relaxed", "sdf/shade.c's per-tile scratch, sdf/world.c's per-frame world, the frame's job", 160},
+    {"ipr", "sdf/shade.c's per-tile scratch, sdf/world.c's per-frame world, the frame's job", 180},
+    {"fipr", "sdf/shade.c's per-tile scratch, sdf/world.c's per-frame world, the frame's job", 180},
+    {"fir", "vpl/manage.c: fv_vpl_resample's CDF and fv_vpl_select's ranking", 4},
+};
+
+static const known_alloc *known(const char *method)
+{
+    for (size_t i = 0; i < sizeof k_known / sizeof k_known[0]; i++)
+        if (strcmp(k_known[i].method, method) == 0) return &k_known[i];
+    return NULL;
+}
+
+/* Every registered method, at 1 and 2 threads: frames 5 to 8, after four warm-up frames, make no
+ * allocation, but for the methods listed above, which stay within their bound. Each method's
+ * count is printed. */
+static void test_registry_steady(void **st)
+{
+    (void)st;
+    int bad = 0;
+    for (int i = 0; i < fv_technique_count(); i++) {
+        const fv_technique_class *c = fv_technique_class_at(i);
+        const known_alloc *k = known(c->name);
+        for (int threads = 1; threads <= 2; threads++) {
+            const uint64_t n = class_frame_allocs(c, threads, 4, 8);
+            print_message("%-16s threads=%d  allocations in frames 5-8: %llu%s\n", c->name, threads, (unsigned long long)n,
+                          k ? " (listed)" : "");
+            if (k ? n == 0 || n > 4 * k->per_frame : n != 0) {
+                print_error("%s, %d threads: %llu allocations in 4 warmed-up frames (%s)\n", c->name, threads, (unsigned long long)n,
+                            k ? "listed as allocating: fixed? then take it off the list; else over its bound" : "expected none");
+                bad++;
+            }
+        }
+    }
+    /* every entry names a registered method */
+    for (size_t i = 0; i < sizeof k_known / sizeof k_known[0]; i++) assert_non_null(fv_technique_class_find(k_known[i].method));
+    assert_int_equal(bad, 0);
+}
+
 /* The wrap is in place: a film fovea makes is counted (its struct and its buffers). */
 static void test_counter_counts(void **st)
 {
@@ -111,6 +213,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_counter_counts),
         cmocka_unit_test(test_fpm_guided_steady),
+        cmocka_unit_test(test_registry_steady),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -22,6 +22,8 @@ struct fv_sdf_pipeline {
     uint8_t *level_of; /* pixels */
     float *sigma;      /* fipr pass 5, pixels */
     int pw, ph;        /* the size heat, level_of and sigma have */
+    /* every frame's counters, kept (fv_kit_counters_reuse): steps and rays, and per level */
+    fv_kit_counters *c, *lsteps, *lrays;
 };
 
 static void free_scratch(fv_sdf_pipeline *p)
@@ -51,6 +53,9 @@ void fv_sdf_pipeline_destroy(fv_sdf_pipeline *p)
     free_scratch(p);
     fv_pyramid_history_free(&p->hist[0]);
     fv_pyramid_history_free(&p->hist[1]);
+    fv_kit_counters_destroy(p->c);
+    fv_kit_counters_destroy(p->lsteps);
+    fv_kit_counters_destroy(p->lrays);
     free(p);
 }
 
@@ -448,9 +453,9 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
     const fv_sdf_method m = p->o.method;
     const int L = p->o.levels;
     if (s == FV_OK && m == FV_SDF_FIPR) s = fv_pyramid_history_attach(&p->hist[frame->eye], &p->k, frame->index, err);
-    j->c = fv_kit_counters_create();
-    j->lsteps = fv_kit_counters_create();
-    j->lrays = fv_kit_counters_create();
+    j->c = fv_kit_counters_reuse(&p->c);
+    j->lsteps = fv_kit_counters_reuse(&p->lsteps);
+    j->lrays = fv_kit_counters_reuse(&p->lrays);
     if (s == FV_OK && (!j->c || !j->lsteps || !j->lrays)) s = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if (s != FV_OK) goto done;
     j->p = p;
@@ -515,9 +520,6 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
     }
 done:
     fv_sdf_world_free(&j->world);
-    fv_kit_counters_destroy(j->c);
-    fv_kit_counters_destroy(j->lsteps);
-    fv_kit_counters_destroy(j->lrays);
     free(j);
     return s;
 }

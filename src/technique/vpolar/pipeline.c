@@ -46,6 +46,7 @@ struct fv_vp_pipeline {
     int coords_state;       /* COORDS_NONE, _STORE (this frame writes them), _READ */
     uint32_t *perm;
     long nperm;
+    fv_kit_counters *counters; /* the trace's, kept from frame to frame (fv_kit_counters_reuse) */
     bool have_prev;
     fv_camera_basis prev_cam;
     fv_space_view prev_view;
@@ -87,6 +88,7 @@ void fv_vp_pipeline_destroy(fv_vp_pipeline *p)
 {
     if (!p) return;
     free_buffers(p);
+    fv_kit_counters_destroy(p->counters);
     free(p);
 }
 
@@ -381,6 +383,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     fv_kit_progress prog = {0};
     fv_kit_phase(&prog, frame, 0.0, 0.8);
     job.progress = &prog;
+    job.counters = fv_kit_counters_reuse(&p->counters);
     fv_vp_trace_result tr;
     fv_stage_clock t0 = fv_stage_clock_now();
     bool traced = fv_vp_trace(&job, &p->g, &tr);
