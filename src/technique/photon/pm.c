@@ -75,6 +75,7 @@ typedef struct pm_state {
      * stereo) */
     float *nbuf, *pbuf, *rbuf;
     fv_atrous *atrous; /* the filter's scratch, kept from frame to frame */
+    fv_photon_room *room; /* the light tracer's blocks, kept from frame to frame */
     int32_t *obuf;
     /* fpm: the left eye's gathered sums per pixel and Eq. 1's luminances and mask (finish_fpm) */
     struct px_sums *sums;
@@ -139,9 +140,11 @@ static fv_status pm_create_mode(pm_mode mode, const fv_scene *scene, fv_params *
     fv_status s = read_opts(mode, params, &st->o, err);
     if (s == FV_OK && mode != MODE_PM) s = fv_pmt_maps_init(&st->tm, scene, err);
     if (s == FV_OK) s = fv_atrous_create(&st->atrous, err);
+    if (s == FV_OK && !(st->room = fv_photon_room_create())) s = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if (s != FV_OK) {
         fv_pmt_maps_free(&st->tm);
         fv_atrous_destroy(st->atrous);
+        fv_photon_room_destroy(st->room);
         free(st);
         return s;
     }
@@ -161,6 +164,7 @@ static void pm_destroy(void *state)
     fv_pmt_maps_free(&st->tm);
     fv_foveated_destroy(st->fov);
     fv_atrous_destroy(st->atrous);
+    fv_photon_room_destroy(st->room);
     free(st->nbuf);
     free(st->pbuf);
     free(st->rbuf);
@@ -365,7 +369,7 @@ static fv_status light_tracing(pm_state *st, const fv_frame *frame, float cell, 
     const fv_scene *s = st->scene;
     uint64_t rays = 0;
     fv_status rc = FV_OK;
-    fv_photon_job job = {s, 0, frame->seed, frame->index, st->o.max_depth, frame->threads, 0, prog, NULL, NULL};
+    fv_photon_job job = {s, 0, frame->seed, frame->index, st->o.max_depth, frame->threads, 0, prog, NULL, NULL, st->room};
     if (st->mode == MODE_PM) {
         fv_photon_map_clear(&st->all);
         job.count = (int64_t)n_light;

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "core/scratch.h"
 #include "core/parallel.h"
 #include "core/stage_time.h"
 #include "core/rng.h"
@@ -24,6 +25,10 @@ struct fv_sdf_pipeline {
     int pw, ph;        /* the size heat, level_of and sigma have */
     /* every frame's counters, kept (fv_kit_counters_reuse): steps and rays, and per level */
     fv_kit_counters *c, *lsteps, *lrays;
+    /* each thread's tile temporaries (rays, hits, shading's), kept from frame to frame */
+    fv_scratch room[FV_MAX_THREADS];
+    fv_sdf_world world; /* the scene's fields and lights, refreshed every frame (fv_sdf_world_refresh) */
+    struct job *jb;     /* the frame's shared context, made by the first frame, zeroed every frame */
 };
 
 static void free_scratch(fv_sdf_pipeline *p)
@@ -56,6 +61,9 @@ void fv_sdf_pipeline_destroy(fv_sdf_pipeline *p)
     fv_kit_counters_destroy(p->c);
     fv_kit_counters_destroy(p->lsteps);
     fv_kit_counters_destroy(p->lrays);
+    for (int t = 0; t < FV_MAX_THREADS; t++) fv_scratch_free(&p->room[t]);
+    fv_sdf_world_free(&p->world);
+    free(p->jb);
     free(p);
 }
 
@@ -133,7 +141,7 @@ static void trace(job *j, int thread, int level, fv_march_ray *rays, fv_march_hi
     if (!colour) return;
     fv_sdf_shade_counts sc = {0, 0, 0};
     fv_error e;
-    fv_status s = fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, vis_in, NULL, colour, normal, &sc, &e);
+    fv_status s = fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, vis_in, NULL, colour, normal, &sc, &p->room[thread], &e);
     if (s != FV_OK) j->status[thread] = s;
     count_shading(j, thread, &sc);
 }
@@ -148,13 +156,15 @@ static void shade_level(job *j, int thread, fv_march_ray *rays, fv_march_hit *hi
     if (n == 0) return;
     fv_sdf_shade_counts sc = {0, 0, 0};
     fv_error e;
-    uint32_t *bits = p->k.vis ? malloc((size_t)n * sizeof *bits) : NULL;
+    fv_scratch *room = &p->room[thread];
+    const size_t mark = fv_scratch_mark(room);
+    uint32_t *bits = p->k.vis ? fv_scratch_take(room, (size_t)n, sizeof *bits) : NULL;
     fv_status s = p->k.vis && !bits ? FV_ERR_NOMEM
-                                   : fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, NULL, bits, colour, NULL, &sc, &e);
+                                   : fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, NULL, bits, colour, NULL, &sc, room, &e);
     if (s != FV_OK) j->status[thread] = s;
     if (bits && s == FV_OK)
         for (int r = 0; r < n; r++) p->k.vis[at[r]] = bits[r];
-    free(bits);
+    fv_scratch_release(room, mark);
     count_shading(j, thread, &sc);
 }
 
@@ -166,10 +176,12 @@ static void level_tile(void *ctx, const fv_tile *tile)
     const fv_pyramid_level *lv = &p->k.lv[k];
     const bool below_target = k == p->o.levels - 2;
     const int cap = (tile->x1 - tile->x0) * (tile->y1 - tile->y0);
-    fv_march_ray *rays = malloc((size_t)cap * sizeof *rays), *vrays = malloc((size_t)cap * sizeof *vrays);
-    fv_march_hit *hits = malloc((size_t)cap * sizeof *hits), *vhits = malloc((size_t)cap * sizeof *vhits);
-    int *at = malloc((size_t)cap * sizeof *at), *vat = calloc((size_t)cap, sizeof *vat);
-    fv_vec3 *colour = p->k.need ? malloc((size_t)cap * sizeof *colour) : NULL;
+    fv_scratch *room = &p->room[tile->thread];
+    fv_scratch_begin(room);
+    fv_march_ray *rays = fv_scratch_take(room, (size_t)cap, sizeof *rays), *vrays = fv_scratch_take(room, (size_t)cap, sizeof *vrays);
+    fv_march_hit *hits = fv_scratch_take(room, (size_t)cap, sizeof *hits), *vhits = fv_scratch_take(room, (size_t)cap, sizeof *vhits);
+    int *at = fv_scratch_take(room, (size_t)cap, sizeof *at), *vat = fv_scratch_take_zero(room, (size_t)cap, sizeof *vat);
+    fv_vec3 *colour = p->k.need ? fv_scratch_take(room, (size_t)cap, sizeof *colour) : NULL;
     if (!rays || !vrays || !hits || !vhits || !at || !vat || (p->k.need && !colour)) {
         j->status[tile->thread] = FV_ERR_NOMEM;
         goto done;
@@ -218,14 +230,7 @@ static void level_tile(void *ctx, const fv_tile *tile)
         p->k.hist_stamp[at[r]] = j->frame->index;
     }
     fv_kit_count(j->c, tile->thread, FV_KIT_NAN, bad);
-done:
-    free(rays);
-    free(vrays);
-    free(hits);
-    free(vhits);
-    free(at);
-    free(vat);
-    free(colour);
+done:; /* the temporaries stay in the thread's room until its next tile */
 }
 
 /* ---- the target level, per film tile ---- */
@@ -255,11 +260,13 @@ static void target_tile(void *ctx, const fv_tile *tile)
     fv_sdf_pipeline *p = j->p;
     const int S = p->k.S, L = p->o.levels, w = p->k.w;
     const int npix = (tile->x1 - tile->x0) * (tile->y1 - tile->y0), cap = npix * S * S;
-    fv_march_ray *rays = malloc((size_t)cap * sizeof *rays);
-    fv_march_hit *hits = malloc((size_t)cap * sizeof *hits);
-    fv_vec3 *colour = malloc((size_t)cap * sizeof *colour), *normal = malloc((size_t)cap * sizeof *normal);
-    int *first = malloc((size_t)npix * sizeof *first);
-    uint32_t *known = p->k.vis ? malloc((size_t)cap * sizeof *known) : NULL;
+    fv_scratch *room = &p->room[tile->thread];
+    fv_scratch_begin(room);
+    fv_march_ray *rays = fv_scratch_take(room, (size_t)cap, sizeof *rays);
+    fv_march_hit *hits = fv_scratch_take(room, (size_t)cap, sizeof *hits);
+    fv_vec3 *colour = fv_scratch_take(room, (size_t)cap, sizeof *colour), *normal = fv_scratch_take(room, (size_t)cap, sizeof *normal);
+    int *first = fv_scratch_take(room, (size_t)npix, sizeof *first);
+    uint32_t *known = p->k.vis ? fv_scratch_take(room, (size_t)cap, sizeof *known) : NULL;
     if (!rays || !hits || !colour || !normal || !first || (p->k.vis && !known)) {
         j->status[tile->thread] = FV_ERR_NOMEM;
         goto done;
@@ -321,13 +328,7 @@ static void target_tile(void *ctx, const fv_tile *tile)
             j->out.color[3 * pix + 2] = c.z;
         }
     fv_kit_count(j->c, tile->thread, FV_KIT_NAN, bad);
-done:
-    free(known);
-    free(rays);
-    free(hits);
-    free(colour);
-    free(normal);
-    free(first);
+done:; /* the temporaries stay in the thread's room until its next tile */
 }
 
 /* ---- fipr's passes 2 and 3, and what pass 4 must trace of the middle level ---- */
@@ -445,10 +446,12 @@ static fv_status run_pass(job *j, int gw, int gh, fv_tile_fn fn, fv_kit_progress
 
 fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
-    job *j = calloc(1, sizeof *j);
-    if (!j) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (!p->jb && !(p->jb = malloc(sizeof *p->jb))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    job *j = p->jb;
+    memset(j, 0, sizeof *j);
     fv_status s = fv_frame_camera(frame->camera, film, &j->cam, err);
-    if (s == FV_OK) s = fv_sdf_world_build(&j->world, p->scene, err);
+    if (s == FV_OK) s = fv_sdf_world_refresh(&p->world, p->scene, err);
+    j->world = p->world; /* a view of the pipeline's world: its arrays stay the pipeline's */
     if (s == FV_OK) s = ensure_size(p, j->cam.width, j->cam.height, err);
     const fv_sdf_method m = p->o.method;
     const int L = p->o.levels;
@@ -519,7 +522,5 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
         fv_stats_add_count(stats, "refreshed_pixels", (double)refreshed);
     }
 done:
-    fv_sdf_world_free(&j->world);
-    free(j);
     return s;
 }
