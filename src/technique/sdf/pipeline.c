@@ -27,6 +27,7 @@ struct fv_sdf_pipeline {
     fv_kit_counters *c, *lsteps, *lrays;
     /* each thread's tile temporaries (rays, hits, shading's), kept from frame to frame */
     fv_scratch room[FV_MAX_THREADS];
+    fv_scratch blur_room; /* fipr's pass 5 */
     fv_sdf_world world; /* the scene's fields and lights, refreshed every frame (fv_sdf_world_refresh) */
     struct job *jb;     /* the frame's shared context, made by the first frame, zeroed every frame */
 };
@@ -62,6 +63,7 @@ void fv_sdf_pipeline_destroy(fv_sdf_pipeline *p)
     fv_kit_counters_destroy(p->lsteps);
     fv_kit_counters_destroy(p->lrays);
     for (int t = 0; t < FV_MAX_THREADS; t++) fv_scratch_free(&p->room[t]);
+    fv_scratch_free(&p->blur_room);
     fv_sdf_world_free(&p->world);
     free(p->jb);
     free(p);
@@ -392,11 +394,12 @@ static uint64_t build_mask(job *j, uint64_t *edge_pixels, uint64_t *refreshed)
 
 /* Pass 5: sigma = blur_sigma on the transitions, 0 elsewhere, which fv_blur_variable leaves
  * untouched. */
-fv_status fv_sdf_blur_transitions(float *rgb, const uint8_t *mask, float *sigma, int w, int h, float blur_sigma, int threads, fv_error *err)
+fv_status fv_sdf_blur_transitions(float *rgb, const uint8_t *mask, float *sigma, int w, int h, float blur_sigma, int threads, fv_scratch *room,
+                                  fv_error *err)
 {
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) sigma[(size_t)y * w + x] = fv_kpyr_blur_sigma(mask, w, h, x, y, blur_sigma);
-    return fv_blur_variable(rgb, w, h, sigma, threads, err);
+    return room ? fv_blur_variable_in(rgb, w, h, sigma, threads, room, err) : fv_blur_variable(rgb, w, h, sigma, threads, err);
 }
 
 static void show(job *j)
@@ -497,7 +500,7 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
     if (s == FV_OK) s = run_pass(j, p->k.w, p->k.h, target_tile, &prog, base, 1.0 - base, stats, "target", err);
     if (s == FV_OK && m == FV_SDF_FIPR && p->o.blur) {
         fv_stage_clock t0 = fv_stage_clock_now();
-        s = fv_sdf_blur_transitions(j->out.color, p->k.mask, p->sigma, p->k.w, p->k.h, p->o.blur_sigma, frame->threads, err);
+        s = fv_sdf_blur_transitions(j->out.color, p->k.mask, p->sigma, p->k.w, p->k.h, p->o.blur_sigma, frame->threads, &p->blur_room, err);
         fv_stage_stop(stats, "blur", t0);
     }
     if (s != FV_OK) goto done;
