@@ -33,11 +33,22 @@ void fv_scratch_begin(fv_scratch *s)
     s->peak = 0;
 }
 
+size_t fv_scratch_bytes(size_t count, size_t size)
+{
+    if (size != 0 && count > SIZE_MAX / size) return 0;
+    const size_t want = count * size;
+    return round_up(want ? want : 1);
+}
+
+void fv_scratch_reserve(fv_scratch *s, size_t bytes)
+{
+    if (bytes > s->peak) s->peak = bytes;
+    fv_scratch_begin(s);
+}
+
 void *fv_scratch_take(fv_scratch *s, size_t count, size_t size)
 {
-    if (size != 0 && count > SIZE_MAX / size) return NULL;
-    const size_t want = count * size;
-    const size_t bytes = round_up(want ? want : 1);
+    const size_t bytes = fv_scratch_bytes(count, size);
     if (bytes == 0) return NULL;
     void *p;
     if (bytes <= s->cap - s->used) {

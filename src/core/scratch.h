@@ -37,5 +37,12 @@ void *fv_scratch_take_zero(fv_scratch *s, size_t count, size_t size);
 static inline size_t fv_scratch_mark(const fv_scratch *s) { return s->used; }
 static inline void fv_scratch_release(fv_scratch *s, size_t mark) { s->used = mark; }
 void fv_scratch_free(fv_scratch *s);
+/* The bytes fv_scratch_take(s, count, size) uses of the block (0 when that overflows), to add up
+ * a bound; and the block grown to at least `bytes` now (to be called between pieces, before a
+ * begin). Where the pieces' needs depend on which thread runs which piece (dynamic schedules),
+ * reserving a bound on the largest is what makes a warmed-up run allocate nothing: each arena
+ * would otherwise grow only once its own thread meets a larger piece. */
+size_t fv_scratch_bytes(size_t count, size_t size);
+void fv_scratch_reserve(fv_scratch *s, size_t bytes);
 
 #endif

@@ -436,6 +436,21 @@ static fv_status first_error(const job *j, int threads, fv_error *err)
 }
 
 /* One pass over a grid, as a phase of the frame's progress. */
+/* The most a tile takes from its thread's room: a level tile's arrays (level_tile, shade_level) or
+ * a target tile's (target_tile), with the shading of every ray. Reserved in every thread's room
+ * before the passes, since which thread meets the largest tile depends on the schedule. */
+static size_t tile_room_bound(const fv_sdf_pipeline *p)
+{
+    const size_t lc = (size_t)FV_TILE_SIZE * FV_TILE_SIZE, tc = lc * (size_t)p->k.S * (size_t)p->k.S;
+    const size_t level = 2 * fv_scratch_bytes(lc, sizeof(fv_march_ray)) + 2 * fv_scratch_bytes(lc, sizeof(fv_march_hit)) +
+                         2 * fv_scratch_bytes(lc, sizeof(int)) + fv_scratch_bytes(lc, sizeof(fv_vec3)) + fv_scratch_bytes(lc, sizeof(uint32_t)) +
+                         fv_sdf_shade_room_bound((int)lc);
+    const size_t target = fv_scratch_bytes(tc, sizeof(fv_march_ray)) + fv_scratch_bytes(tc, sizeof(fv_march_hit)) +
+                          2 * fv_scratch_bytes(tc, sizeof(fv_vec3)) + fv_scratch_bytes(lc, sizeof(int)) + fv_scratch_bytes(tc, sizeof(uint32_t)) +
+                          fv_sdf_shade_room_bound((int)tc);
+    return level > target ? level : target;
+}
+
 static fv_status run_pass(job *j, int gw, int gh, fv_tile_fn fn, fv_kit_progress *prog, double base, double span, fv_stats *stats,
                           const char *stage, fv_error *err)
 {
@@ -456,6 +471,8 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
     if (s == FV_OK) s = fv_sdf_world_refresh(&p->world, p->scene, err);
     j->world = p->world; /* a view of the pipeline's world: its arrays stay the pipeline's */
     if (s == FV_OK) s = ensure_size(p, j->cam.width, j->cam.height, err);
+    if (s == FV_OK)
+        for (int t = 0, nt = fv_thread_count(frame->threads); t < nt; t++) fv_scratch_reserve(&p->room[t], tile_room_bound(p));
     const fv_sdf_method m = p->o.method;
     const int L = p->o.levels;
     if (s == FV_OK && m == FV_SDF_FIPR) s = fv_pyramid_history_attach(&p->hist[frame->eye], &p->k, frame->index, err);

@@ -3,6 +3,16 @@
 #include <stdlib.h>
 #include "technique/sdf/shade.h"
 
+size_t fv_sdf_shade_room_bound(int n)
+{
+    /* the takes of fv_sdf_shade below, at n hits */
+    const size_t h = (size_t)n;
+    return fv_scratch_bytes(h, sizeof(int)) + fv_scratch_bytes(h * 4, sizeof(fv_vec3)) + fv_scratch_bytes(h * 4, sizeof(float)) +
+           2 * fv_scratch_bytes(h, sizeof(fv_vec3)) + fv_scratch_bytes(h, sizeof(float)) + fv_scratch_bytes(h, sizeof(fv_march_ray)) +
+           fv_scratch_bytes(h, sizeof(fv_march_hit)) + 2 * fv_scratch_bytes(h, sizeof(int)) + fv_scratch_bytes(h, sizeof(uint32_t)) +
+           fv_scratch_bytes(h, sizeof(fv_ksdf_lobe));
+}
+
 fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_sdf_shade_opts *so, const fv_march_ray *rays,
                        const fv_march_hit *hits, int n, const uint32_t *vis_in, uint32_t *vis_out, fv_vec3 *color, fv_vec3 *normal,
                        fv_sdf_shade_counts *counts, fv_scratch *room, fv_error *err)

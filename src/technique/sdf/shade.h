@@ -32,5 +32,7 @@
 fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_sdf_shade_opts *so, const fv_march_ray *rays,
                        const fv_march_hit *hits, int n, const uint32_t *vis_in, uint32_t *vis_out, fv_vec3 *color, fv_vec3 *normal,
                        fv_sdf_shade_counts *counts, fv_scratch *room, fv_error *err);
+/* The most fv_sdf_shade takes from its room for n rays (fv_scratch_reserve). */
+size_t fv_sdf_shade_room_bound(int n);
 
 #endif
