@@ -1,9 +1,11 @@
 /* A frame allocates nothing once warmed up (issue 29, docs/threads.md "No allocation in a frame"):
  * every registered method's frames (the registry, src/technique/registry.c, with each class's own
  * test_params, at 1 and 2 threads, the gaze moving every frame), and fpm-guided's with its lattice
- * filter, its A-Trous workspace and its kept photon paths, counted call by call. This executable is linked with `-Wl,--wrap` for malloc, calloc, realloc
- * and aligned_alloc (tests/CMakeLists.txt), so every call fovea's own code makes goes through the
- * counters below first; the libraries it calls (Embree, the OpenMP runtime) are not counted. */
+ * filter, its A-Trous workspace and its kept photon paths, counted call by call; and the scratch
+ * arena (core/scratch.h) that per-thread temporaries come from. This executable is linked with
+ * `-Wl,--wrap` for malloc, calloc, realloc and aligned_alloc (tests/CMakeLists.txt), so every call
+ * fovea's own code makes goes through the counters below first; the libraries it calls (Embree,
+ * the OpenMP runtime) are not counted. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

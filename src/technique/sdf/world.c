@@ -96,7 +96,8 @@ fv_status fv_sdf_world_refresh(fv_sdf_world *w, const fv_scene *s, fv_error *err
         w->nlights = nl;
     }
     const fv_sdf **statics = w->static_list;
-    memset(w->objs, 0, (size_t)n * sizeof *w->objs);
+    memset(w->objs, 0, (size_t)n * sizeof *w->objs); /* as a fresh build has them */
+    memset(w->sdfs, 0, (size_t)n * sizeof *w->sdfs);
     memset(&w->k, 0, sizeof w->k);
     fv_ksdf_world *k = &w->k;
     k->lo = fv_v3s(INFINITY);
