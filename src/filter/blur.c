@@ -30,7 +30,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include "core/alloc.h"
+#include "core/scratch.h"
 #include "core/parallel.h"
 #include "filter/blur.h"
 
@@ -110,18 +110,18 @@ typedef struct kernel_set {
     float *k;
 } kernel_set;
 
-static int kernel_set_init(kernel_set *ks, int qmax, int rcap)
+static int kernel_set_init(kernel_set *ks, int qmax, int rcap, fv_scratch *room)
 {
     ks->rcap = rcap;
     ks->nq = (qmax < Q_TABLE ? qmax : Q_TABLE) + 1;
-    ks->off = fv_alloc_array((size_t)ks->nq, sizeof(int));
+    ks->off = fv_scratch_take(room, (size_t)ks->nq, sizeof(int));
     if (!ks->off) return -1;
     size_t total = 0;
     for (int q = 0; q < ks->nq; q++) {
         ks->off[q] = (int)total;
         total += (size_t)radius_of(q, rcap) + 1;
     }
-    ks->k = fv_alloc_array(total, sizeof(float));
+    ks->k = fv_scratch_take(room, total, sizeof(float));
     if (!ks->k) return -1;
     for (int q = 0; q < ks->nq; q++) make_kernel(q, radius_of(q, rcap), ks->k + ks->off[q]);
     return 0;
@@ -441,12 +441,7 @@ static void slab_run(const blur_job *j, slab *s)
     }
 }
 
-static void slab_free(slab *s)
-{
-    free(s->ring), free(s->srow), free(s->hrows), free(s->vrows), free(s->kscratch);
-}
-
-static int slab_alloc(const blur_job *j, slab *s, bool wide_kernels)
+static int slab_alloc(const blur_job *j, slab *s, bool wide_kernels, fv_scratch *room)
 {
     const int R = j->R;
     const int above = R < s->y0 ? R : s->y0;
@@ -459,11 +454,11 @@ static int slab_alloc(const blur_job *j, slab *s, bool wide_kernels)
     s->kq = -1;
     /* Zeroed: the last block of a run reads up to PAD floats beyond it (the next row, an unused
      * part of the last strip, the padding), which must be defined memory. */
-    s->ring = fv_calloc_array((size_t)j->nstrips * s->region + PAD, sizeof(float));
-    s->srow = fv_calloc_array(j->w3 + 6 * (size_t)R + PAD, sizeof(float));
-    s->hrows = fv_alloc_array(2 * (size_t)R + 1, sizeof(float *));
-    s->vrows = fv_alloc_array(BATCH + 2 * (size_t)R, sizeof(float *));
-    s->kscratch = wide_kernels ? fv_alloc_array((size_t)j->ks.rcap + 1, sizeof(float)) : NULL;
+    s->ring = fv_scratch_take_zero(room, (size_t)j->nstrips * s->region + PAD, sizeof(float));
+    s->srow = fv_scratch_take_zero(room, j->w3 + 6 * (size_t)R + PAD, sizeof(float));
+    s->hrows = fv_scratch_take(room, 2 * (size_t)R + 1, sizeof(float *));
+    s->vrows = fv_scratch_take(room, BATCH + 2 * (size_t)R, sizeof(float *));
+    s->kscratch = wide_kernels ? fv_scratch_take(room, (size_t)j->ks.rcap + 1, sizeof(float)) : NULL;
     if (!s->ring || !s->srow || !s->hrows || !s->vrows || (wide_kernels && !s->kscratch)) return -1;
     for (int d = -R; d <= R; d++) s->hrows[d + R] = s->srow + 3 * (size_t)(R + d);
     return 0;
@@ -471,12 +466,21 @@ static int slab_alloc(const blur_job *j, slab *s, bool wide_kernels)
 
 fv_status fv_blur_variable(float *rgb, int w, int h, const float *sigma, int threads, fv_error *err)
 {
+    fv_scratch room = FV_SCRATCH_INIT;
+    fv_status s = fv_blur_variable_in(rgb, w, h, sigma, threads, &room, err);
+    fv_scratch_free(&room);
+    return s;
+}
+
+fv_status fv_blur_variable_in(float *rgb, int w, int h, const float *sigma, int threads, fv_scratch *room, fv_error *err)
+{
+    fv_scratch_begin(room); /* every temporary of the call below comes from room */
     if (!rgb || !sigma) return fv_error_set(err, FV_ERR_INVALID, "blur: no %s", rgb ? "sigma buffer" : "image");
     if (w < 1 || h < 1) return fv_error_set(err, FV_ERR_INVALID, "blur: image size %dx%d", w, h);
     const int nt = fv_thread_count(threads);
 
     /* Validate before touching rgb; find the widest kernel and each row's share of the work. */
-    float *cost = fv_alloc_array((size_t)h + 1, sizeof(float));
+    float *cost = fv_scratch_take(room, (size_t)h + 1, sizeof(float));
     if (!cost) return fv_error_set(err, FV_ERR_NOMEM, "out of memory blurring a %dx%d image", w, h);
     float smax = 0.0f;
     int bad = 0;
@@ -500,7 +504,6 @@ fv_region_begin();
     }
 fv_region_end();
     if (bad) {
-        free(cost);
         for (size_t i = 0; i < (size_t)w * h; i++)
             if (!(sigma[i] >= 0.0f && sigma[i] <= FLT_MAX))
                 return fv_error_set(err, FV_ERR_INVALID, "blur: sigma %g at pixel (%d, %d) is not a finite value >= 0",
@@ -511,16 +514,13 @@ fv_region_end();
                   .taps = pick_taps()};
     const int rcap = (w > h ? w : h) - 1, qmax = quantise(smax);
     j.R = radius_of(qmax, rcap);
-    if (j.R == 0) { /* no pixel has a tap besides its centre */
-        free(cost);
-        return FV_OK;
-    }
+    if (j.R == 0) return FV_OK; /* no pixel has a tap besides its centre */
 
     /* One slab per thread, split so that each gets the same estimated work (the fovea is cheap). */
     int nslab = nt < h ? nt : h;
-    slab *slabs = fv_calloc_array((size_t)nslab, sizeof(slab));
-    float *zero = fv_calloc_array(STRIP_FLOATS + PAD, sizeof(float));
-    int fail = !slabs || !zero || kernel_set_init(&j.ks, qmax, rcap) != 0;
+    slab *slabs = fv_scratch_take_zero(room, (size_t)nslab, sizeof(slab));
+    float *zero = fv_scratch_take_zero(room, STRIP_FLOATS + PAD, sizeof(float));
+    int fail = !slabs || !zero || kernel_set_init(&j.ks, qmax, rcap, room) != 0;
     if (!fail) {
         double total = 0.0, acc = 0.0;
         for (int y = 0; y < h; y++) total += cost[y];
@@ -537,12 +537,9 @@ fv_region_end();
             slabs[i].y1 = y;
         }
         j.zero = zero;
-        for (int i = 0; i < nslab && !fail; i++) fail = slab_alloc(&j, &slabs[i], qmax >= Q_TABLE) != 0;
+        for (int i = 0; i < nslab && !fail; i++) fail = slab_alloc(&j, &slabs[i], qmax >= Q_TABLE, room) != 0;
     }
-    free(cost);
     if (fail) {
-        for (int i = 0; slabs && i < nslab; i++) slab_free(&slabs[i]);
-        free(slabs), free(zero), free(j.ks.off), free(j.ks.k);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory blurring a %dx%d image", w, h);
     }
 
@@ -556,7 +553,5 @@ fv_region_begin();
         for (int i = 0; i < nslab; i++) slab_run(&j, &slabs[i]);
     }
 fv_region_end();
-    for (int i = 0; i < nslab; i++) slab_free(&slabs[i]);
-    free(slabs), free(zero), free(j.ks.off), free(j.ks.k);
     return FV_OK;
 }

@@ -13,6 +13,7 @@
 #ifndef FV_FILTER_BLUR_H
 #define FV_FILTER_BLUR_H
 
+#include "core/scratch.h"
 #include "fovea/status.h"
 
 /* Sigma profile of Sec. 3.5: 0 up to fovea_deg, rising linearly to sigma_max at ramp_deg, held at
@@ -24,5 +25,9 @@ double fv_blur_sigma_at(double e_deg, double fovea_deg, double ramp_deg, double 
  * threads 0 = all; the result does not depend on it. Bad sizes, a NULL buffer or a negative or
  * non-finite sigma -> FV_ERR_INVALID (rgb unchanged); no scratch memory -> FV_ERR_NOMEM. */
 fv_status fv_blur_variable(float *rgb, int w, int h, const float *sigma, int threads, fv_error *err);
+/* The same with its temporaries (the row costs, the kernels, each slab's rows) from room, a
+ * scratch arena its caller keeps (core/scratch.h): once room has grown to what a call needs, a
+ * call allocates nothing (docs/threads.md, "No allocation in a frame"). The same bytes. */
+fv_status fv_blur_variable_in(float *rgb, int w, int h, const float *sigma, int threads, fv_scratch *room, fv_error *err);
 
 #endif

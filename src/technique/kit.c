@@ -13,6 +13,13 @@ fv_kit_counters *fv_kit_counters_create(void)
 
 void fv_kit_counters_destroy(fv_kit_counters *k) { free(k); }
 
+fv_kit_counters *fv_kit_counters_reuse(fv_kit_counters **keep)
+{
+    if (*keep) memset(*keep, 0, sizeof **keep);
+    else *keep = fv_kit_counters_create();
+    return *keep;
+}
+
 uint64_t fv_kit_sum(const fv_kit_counters *k, int slot)
 {
     uint64_t s = 0;

@@ -68,6 +68,10 @@ typedef struct fv_kit_counters {
 /* Counters live on the heap (they are 16 KiB): create zeroed, destroy. */
 fv_kit_counters *fv_kit_counters_create(void);
 void fv_kit_counters_destroy(fv_kit_counters *k);
+/* A frame's counters from a block its technique keeps (*keep, created on first use, zeroed on every
+ * later one), so that a warmed-up frame allocates nothing (docs/threads.md, "No allocation in a
+ * frame"); NULL when out of memory. The technique destroys *keep with its state. */
+fv_kit_counters *fv_kit_counters_reuse(fv_kit_counters **keep);
 static inline void fv_kit_count(fv_kit_counters *k, int thread, int slot, uint64_t v) { k->t[thread].c[slot] += v; }
 uint64_t fv_kit_sum(const fv_kit_counters *k, int slot);
 /* Adds "rays" and "nan_samples" to stats (the latter even when zero, so it is always reported). */

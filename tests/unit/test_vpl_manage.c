@@ -301,7 +301,7 @@ static sel_result run_select(const fv_vpl_select_in *in, int total, int limit, f
     /* Poison the flags: the call must write every one. */
     memset(r.keep, 0x5a, sizeof r.keep);
     memset(r.take, 0x5a, sizeof r.take);
-    fv_vpl_select_opts o = {total, limit, c};
+    fv_vpl_select_opts o = {total, limit, c, NULL};
     fv_density_grid_clear(g);
     r.n = fv_vpl_select(in, &o, g, r.keep, r.take, &r.reused, &r.left);
     for (int i = 0; i < in->n_old; i++) assert_true(r.keep[i] == true || r.keep[i] == false);
@@ -537,7 +537,7 @@ static void test_select_random(void **state)
             ci[i] = fv_rng_next(&r) * 3.0f;
         }
         fv_vpl_select_in in = {n_old, op, prev, now, u, n_cand, cp, ci};
-        fv_vpl_select_opts o = {total, limit, 0.5f};
+        fv_vpl_select_opts o = {total, limit, 0.5f, NULL};
         fv_density_grid_clear(g);
         int reused = -1, left = -1;
         int n = fv_vpl_select(&in, &o, g, keep, take, &reused, &left);

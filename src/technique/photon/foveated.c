@@ -19,6 +19,13 @@ struct fv_foveated {
     int cap, *free_ids, nfree, live;
     fv_photon_map fs, fd;
     bool has_prev;
+    /* Scratch kept from frame to frame, so that a warmed-up frame allocates nothing
+     * (docs/threads.md): manage's source pixels (w * h), and trace's tasks and their paths
+     * (task_cap of each, grown, never shrunk). */
+    int *src;
+    int *task_px;
+    struct path_out *res;
+    long task_cap;
 };
 
 fv_status fv_foveated_create(int w, int h, int n, int max_depth, fv_foveated **out, fv_error *err)
@@ -40,9 +47,10 @@ fv_status fv_foveated_create(int w, int h, int n, int max_depth, fv_foveated **o
     f->fbm_prev = calloc(np, sizeof(int));
     f->fbp = fv_alloc_array(np * (size_t)n, sizeof(int32_t));
     f->fbp_prev = fv_alloc_array(np * (size_t)n, sizeof(int32_t));
+    f->src = fv_alloc_array(np, sizeof(int));
     fv_photon_map_init(&f->fs);
     fv_photon_map_init(&f->fd);
-    if (!f->focus || !f->focus_prev || !f->claimed || !f->fbm || !f->fbm_prev || !f->fbp || !f->fbp_prev) {
+    if (!f->focus || !f->focus_prev || !f->claimed || !f->fbm || !f->fbm_prev || !f->fbp || !f->fbp_prev || !f->src) {
         fv_foveated_destroy(f);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the foveated photon buffers of %dx%d", w, h);
     }
@@ -65,6 +73,9 @@ void fv_foveated_destroy(fv_foveated *f)
     free(f->pool);
     free(f->len);
     free(f->free_ids);
+    free(f->src);
+    free(f->task_px);
+    free(f->res);
     fv_photon_map_free(&f->fs);
     fv_photon_map_free(&f->fd);
     free(f);
@@ -140,8 +151,7 @@ fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera 
     if (rc != FV_OK) return rc;
     bool have_prev = f->has_prev && prev && fv_camera_basis_make(prev, &pb, err) == FV_OK;
     /* Lines 5-7, one row per task: back-project each focus pixel with V, project with V'. */
-    int *src = fv_alloc_array(np, sizeof(int));
-    if (!src) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    int *src = f->src;
     int nthreads = fv_thread_count(threads);
     fv_region_begin();
     #pragma omp parallel for schedule(dynamic, 4) num_threads(nthreads)
@@ -184,7 +194,6 @@ fv_status fv_foveated_manage(fv_foveated *f, const fv_scene *s, const fv_camera 
             }
         }
     }
-    free(src);
     /* Paths of previous pixels no current pixel took over have left the focus region (or are
      * hidden now): delete them so the maps do not grow. */
     for (size_t q = 0; q < np; q++) {
@@ -341,13 +350,22 @@ fv_status fv_foveated_trace(fv_foveated *f, const fv_scene *s, const fv_camera *
     /* The tasks: (pixel, attempt) for every path a pixel still needs. */
     long ntasks = 0;
     for (size_t i = 0; i < np; i++) ntasks += f->fbm[i] > 0 ? f->fbm[i] : 0;
-    int *task_px = fv_alloc_array((size_t)ntasks, sizeof(int));
-    path_out *res = fv_alloc_array((size_t)ntasks, sizeof *res);
-    if (!task_px || !res) {
-        free(task_px);
-        free(res);
-        return fv_error_set(err, FV_ERR_NOMEM, "out of memory tracing %ld foveated photon paths", ntasks);
+    if (ntasks > f->task_cap) {
+        int *tp = fv_alloc_array((size_t)ntasks, sizeof(int));
+        path_out *r = fv_alloc_array((size_t)ntasks, sizeof *r);
+        if (!tp || !r) {
+            free(tp);
+            free(r);
+            return fv_error_set(err, FV_ERR_NOMEM, "out of memory tracing %ld foveated photon paths", ntasks);
+        }
+        free(f->task_px);
+        free(f->res);
+        f->task_px = tp;
+        f->res = r;
+        f->task_cap = ntasks;
     }
+    int *task_px = f->task_px;
+    path_out *res = f->res;
     long t = 0;
     for (size_t i = 0; i < np; i++)
         for (int k = 0; k < f->fbm[i]; k++) task_px[t++] = (int)i;
@@ -393,8 +411,6 @@ fv_status fv_foveated_trace(fv_foveated *f, const fv_scene *s, const fv_camera *
             }
         if (st) st->paths_stored_static++;
     }
-    free(task_px);
-    free(res);
     if (rc != FV_OK) return rc;
     /* What each pixel still lacks: paths that turned out dynamic or failed are traced again next
      * frame. */

@@ -136,6 +136,7 @@ struct fv_photon_guide {
     int lbins, ncells;
     double cdf[LIGHT_BINS * DIR_BINS * DIR_BINS + 1];
     float q[LIGHT_BINS * DIR_BINS * DIR_BINS]; /* density relative to uniform numbers */
+    uint64_t w[LIGHT_BINS * DIR_BINS * DIR_BINS]; /* learn's pilot sums per cell: the guide's, so learning allocates nothing */
     double focus_share;
 };
 
@@ -233,8 +234,9 @@ fv_status fv_photon_guide_learn(fv_photon_guide *g, const fv_photon_job *job, fv
 {
     fv_photon_guide_reset(g, job->scene);
     if (job->count <= 0 || fv_scene_light_count(job->scene) == 0 || fv_focus_cells_count(focus) == 0) return FV_OK;
-    uint64_t *w = fv_calloc_array((size_t)g->ncells, sizeof *w);
-    if (!w) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    (void)err;
+    uint64_t *w = g->w;
+    memset(w, 0, (size_t)g->ncells * sizeof *w);
     uint64_t in = 0, all = 0, nrays = 0;
     /* Integer sums: the same q whatever the thread count or schedule. */
     fv_region_begin();
@@ -258,7 +260,6 @@ fv_status fv_photon_guide_learn(fv_photon_guide *g, const fv_photon_job *job, fv
     fv_region_end();
     build(g, w);
     g->focus_share = all > 0 ? (double)in / (double)all : 0.0;
-    free(w);
     if (rays) *rays += nrays;
     return FV_OK;
 }

@@ -375,7 +375,7 @@ static fv_status update_maps(gd_ctx *c, fv_stats *stats, fv_error *err)
     double n_guided = st->o.photons * st->o.guided_fraction, n_light = st->o.photons - n_guided;
     /* Paths kept for every frame use frame 0's random numbers, unless the lights move. */
     const int path_frame = st->lights_move ? f->index : 0;
-    fv_photon_job job = {st->scene, (int64_t)n_light, f->seed, path_frame, st->o.max_depth, f->threads, 1, &c->prog, NULL, NULL};
+    fv_photon_job job = {st->scene, (int64_t)n_light, f->seed, path_frame, st->o.max_depth, f->threads, 1, &c->prog, NULL, NULL, NULL};
     uint64_t rays = 0;
     int64_t again = 0, again_g = 0;
     fv_kit_phase(&c->prog, f, 0.0, 0.2);

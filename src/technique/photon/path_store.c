@@ -24,7 +24,11 @@ struct fv_path_store {
     seg *sg;
     int64_t *sstart;     /* count + 1 offsets into sg */
     float (*u)[5];       /* each path's emission numbers (what a flux scale may depend on) */
-    struct blk *fb;      /* fv_path_store_frame's blocks, kept with their buffers (grown, never shrunk) */
+    /* The room the arrays above have (paths, photons, segments): grown, never shrunk, so that
+     * tracing the paths again (fpm-guided's M_g, when the focus region moves) allocates nothing
+     * once it has grown to what a trace needs (docs/threads.md). */
+    int64_t cap_count, cap_ph, cap_sg;
+    struct blk *fb;      /* the blocks of a trace or a frame, kept with their buffers (grown, never shrunk) */
     int64_t fb_cap;
 };
 
@@ -80,10 +84,9 @@ fv_status fv_path_store_create(fv_path_store **out, fv_error *err)
     return *out ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
 }
 
+/* No paths (the room is kept). */
 static void clear(fv_path_store *p)
 {
-    free(p->ph), free(p->pstart), free(p->sg), free(p->sstart), free(p->u);
-    p->ph = NULL, p->pstart = NULL, p->sg = NULL, p->sstart = NULL, p->u = NULL;
     p->count = 0;
     p->ready = false;
 }
@@ -91,13 +94,29 @@ static void clear(fv_path_store *p)
 void fv_path_store_destroy(fv_path_store *p)
 {
     if (!p) return;
-    clear(p);
+    free(p->ph), free(p->pstart), free(p->sg), free(p->sstart), free(p->u);
     for (int64_t k = 0; k < p->fb_cap; k++) free(p->fb[k].p), free(p->fb[k].s);
     free(p->fb);
     free(p);
 }
 
 bool fv_path_store_ready(const fv_path_store *p) { return p->ready; }
+
+/* *ptr with room for need elements of size bytes (*cap of them now): replaced by a larger block
+ * when short, its contents not kept. 0 on success. */
+static int room_for(void **ptr, int64_t *cap, int64_t need, size_t size)
+{
+    if (need <= *cap) return 0;
+    void *q = fv_alloc_array((size_t)need, size);
+    if (!q) return -1;
+    free(*ptr);
+    *ptr = q;
+    *cap = need;
+    return 0;
+}
+
+/* The store's n blocks, emptied (their buffers kept), or NULL when out of memory. */
+static struct blk *blocks(fv_path_store *p, int64_t n);
 
 typedef struct trace_job {
     fv_path_store *p;
@@ -130,15 +149,20 @@ fv_status fv_path_store_trace(fv_path_store *p, const fv_photon_job *job, uint64
         return FV_OK;
     }
     int64_t nblocks = (job->count + BLOCK - 1) / BLOCK;
-    blk *b = fv_calloc_array((size_t)nblocks, sizeof *b);
-    p->pstart = fv_alloc_array((size_t)job->count + 1, sizeof *p->pstart);
-    p->sstart = fv_alloc_array((size_t)job->count + 1, sizeof *p->sstart);
-    p->u = fv_calloc_array((size_t)job->count, sizeof *p->u);
-    if (!b || !p->pstart || !p->sstart || !p->u) {
-        free(b);
+    blk *b = blocks(p, nblocks);
+    const int64_t need = job->count + 1;
+    if (b && p->cap_count < need) {
+        /* grown together: cap_count is the room all three have */
+        int64_t cp = p->cap_count, cs = p->cap_count, cu = p->cap_count;
+        if (room_for((void **)&p->pstart, &cp, need, sizeof *p->pstart) == 0 && room_for((void **)&p->sstart, &cs, need, sizeof *p->sstart) == 0 &&
+            room_for((void **)&p->u, &cu, need, sizeof *p->u) == 0)
+            p->cap_count = need;
+    }
+    if (!b || p->cap_count < need) {
         clear(p);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory keeping %lld photon paths", (long long)job->count);
     }
+    memset(p->u, 0, (size_t)job->count * sizeof *p->u); /* a path that emits nothing keeps zeros */
     trace_job tj = {p, job, b};
     bool stop = !fv_photon_blocks(job, nblocks, trace_block, &tj);
     /* Concatenated in block order: the store does not depend on the thread count. */
@@ -148,7 +172,7 @@ fv_status fv_path_store_trace(fv_path_store *p, const fv_photon_job *job, uint64
         if (b[k].oom && st == FV_OK) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory keeping photon paths");
         tp += b[k].np, ts += b[k].ns;
     }
-    if (st == FV_OK && (!(p->ph = fv_alloc_array((size_t)tp + 1, sizeof *p->ph)) || !(p->sg = fv_alloc_array((size_t)ts + 1, sizeof *p->sg))))
+    if (st == FV_OK && (room_for((void **)&p->ph, &p->cap_ph, tp + 1, sizeof *p->ph) || room_for((void **)&p->sg, &p->cap_sg, ts + 1, sizeof *p->sg)))
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory keeping photon paths");
     int64_t op = 0, os = 0;
     for (int64_t k = 0; k < nblocks; k++) {
@@ -162,9 +186,7 @@ fv_status fv_path_store_trace(fv_path_store *p, const fv_photon_job *job, uint64
             }
         }
         if (rays) *rays += b[k].rays;
-        free(b[k].p), free(b[k].s);
     }
-    free(b);
     if (st != FV_OK) {
         clear(p);
         return st;
@@ -187,6 +209,21 @@ static bool meets(const seg *s, fv_vec3 c, float r)
     return fv_dot(q, q) <= r * r;
 }
 
+/* The blocks and their photon and segment buffers are the store's, kept from frame to frame: once
+ * they have grown to what a frame (or a trace) needs, it allocates nothing (docs/threads.md). */
+static blk *blocks(fv_path_store *p, int64_t n)
+{
+    if (n > p->fb_cap) {
+        blk *nb = realloc(p->fb, (size_t)n * sizeof *nb);
+        if (!nb) return NULL;
+        memset(nb + p->fb_cap, 0, ((size_t)(n - p->fb_cap)) * sizeof *nb);
+        p->fb = nb;
+        p->fb_cap = n;
+    }
+    for (int64_t k = 0; k < n; k++) p->fb[k].np = p->fb[k].ns = 0, p->fb[k].rays = 0, p->fb[k].oom = p->fb[k].record = false;
+    return p->fb;
+}
+
 fv_status fv_path_store_frame(fv_path_store *p, const fv_dyn_dirs *dirs, fv_path_scale_fn scale, const void *scale_ctx,
                               int threads, fv_photon_map *out, int64_t *retraced, uint64_t *rays, fv_error *err)
 {
@@ -199,17 +236,8 @@ fv_status fv_path_store_frame(fv_path_store *p, const fv_dyn_dirs *dirs, fv_path
     const int n = nsph < MAXS ? nsph : MAXS;
     for (int k = 0; k < n; k++) fv_dyn_dirs_sphere(dirs, k, &c[k], &r[k]);
     int64_t nblocks = (p->count + BLOCK - 1) / BLOCK;
-    /* The blocks and their photon buffers are the store's, kept from frame to frame: once they have
-     * grown to what a frame needs, a frame allocates nothing (docs/threads.md). */
-    if (nblocks + 1 > p->fb_cap) {
-        blk *nb = realloc(p->fb, ((size_t)nblocks + 1) * sizeof *nb);
-        if (!nb) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-        memset(nb + p->fb_cap, 0, ((size_t)(nblocks + 1 - p->fb_cap)) * sizeof *nb);
-        p->fb = nb;
-        p->fb_cap = nblocks + 1;
-    }
-    blk *b = p->fb;
-    for (int64_t k = 0; k <= nblocks; k++) b[k].np = b[k].ns = 0, b[k].rays = 0, b[k].oom = b[k].record = false;
+    blk *b = blocks(p, nblocks + 1);
+    if (!b) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     int64_t again = 0;
     fv_region_begin();
     #pragma omp parallel for schedule(dynamic, 1) reduction(+ : again) num_threads(fv_thread_count(threads))

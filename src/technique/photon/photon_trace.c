@@ -21,6 +21,40 @@ typedef struct block_out {
     bool oom;
 } block_out;
 
+struct fv_photon_room {
+    block_out *blocks;
+    int64_t cap; /* blocks held, each with its photon buffer */
+};
+
+fv_photon_room *fv_photon_room_create(void) { return calloc(1, sizeof(fv_photon_room)); }
+
+void fv_photon_room_destroy(fv_photon_room *r)
+{
+    if (!r) return;
+    for (int64_t b = 0; b < r->cap; b++) free(r->blocks[b].p);
+    free(r->blocks);
+    free(r);
+}
+
+/* nblocks empty blocks from the room (grown to hold them; each block keeps its buffer), or NULL
+ * when out of memory. */
+static block_out *room_blocks(fv_photon_room *r, int64_t nblocks)
+{
+    if (nblocks > r->cap) {
+        block_out *nb = realloc(r->blocks, (size_t)nblocks * sizeof *nb);
+        if (!nb) return NULL;
+        memset(nb + r->cap, 0, (size_t)(nblocks - r->cap) * sizeof *nb);
+        r->blocks = nb;
+        r->cap = nblocks;
+    }
+    for (int64_t b = 0; b < nblocks; b++) {
+        r->blocks[b].n = 0;
+        r->blocks[b].rays = 0;
+        r->blocks[b].oom = false;
+    }
+    return r->blocks;
+}
+
 /* The light path's visit: a photon is stored at every diffuse or glossy vertex. */
 static void deposit(void *ctx, const fv_hit *h, const fv_material *m, fv_vec3 dir, fv_vec3 flux)
 {
@@ -87,7 +121,7 @@ static fv_status run_blocks(run_ctx *c, photon_fn fn, fv_photon_map *out, uint64
 {
     const fv_photon_job *job = c->job;
     int64_t nblocks = (job->count + BLOCK - 1) / BLOCK;
-    c->blocks = fv_calloc_array((size_t)nblocks, sizeof *c->blocks);
+    c->blocks = job->room ? room_blocks(job->room, nblocks) : fv_calloc_array((size_t)nblocks, sizeof *c->blocks);
     if (!c->blocks) return fv_error_set(err, FV_ERR_NOMEM, "out of memory tracing %lld photons", (long long)job->count);
     block_job bj = {c, fn};
     bool stop = !fv_photon_blocks(job, nblocks, run_block, &bj);
@@ -96,9 +130,9 @@ static fv_status run_blocks(run_ctx *c, photon_fn fn, fv_photon_map *out, uint64
         if (c->blocks[b].oom && st == FV_OK) st = fv_error_set(err, FV_ERR_NOMEM, "out of memory storing photons");
         if (st == FV_OK) st = fv_photon_map_append(out, c->blocks[b].p, c->blocks[b].n, err);
         if (rays) *rays += c->blocks[b].rays;
-        free(c->blocks[b].p);
+        if (!job->room) free(c->blocks[b].p);
     }
-    free(c->blocks);
+    if (!job->room) free(c->blocks);
     c->blocks = NULL;
     return st;
 }

@@ -40,6 +40,14 @@ void fv_dyn_dirs_sphere(const fv_dyn_dirs *d, int k, fv_vec3 *c, float *r);
  * the photon's flux is divided so the map stays unbiased; a density <= 0 drops the photon. */
 typedef float (*fv_photon_warp_fn)(const void *ctx, fv_rng *rng, float u[5]);
 
+/* Room the tracers below keep from call to call: the blocks' photon buffers, grown, never shrunk,
+ * so that a warmed-up frame traces its photons without allocating (docs/threads.md, "No
+ * allocation in a frame"). One room serves one call at a time; a technique that traces several
+ * maps a frame, one after the other, keeps one. */
+typedef struct fv_photon_room fv_photon_room;
+fv_photon_room *fv_photon_room_create(void); /* NULL when out of memory */
+void fv_photon_room_destroy(fv_photon_room *r);
+
 typedef struct fv_photon_job {
     const fv_scene *scene;
     int64_t count;         /* photons emitted */
@@ -52,6 +60,7 @@ typedef struct fv_photon_job {
                                   the tracing with FV_ERR_CANCELLED */
     fv_photon_warp_fn warp;     /* fv_photon_trace_lights: NULL for uniform emission */
     const void *warp_ctx;
+    fv_photon_room *room;       /* optional: kept room for the blocks (NULL: room for the call only) */
 } fv_photon_job;
 
 /* The start of photon i of a job: its random stream (left where the walk goes on), the five numbers

@@ -75,8 +75,14 @@ typedef struct pm_state {
      * stereo) */
     float *nbuf, *pbuf, *rbuf;
     fv_atrous *atrous; /* the filter's scratch, kept from frame to frame */
+    fv_photon_room *room; /* the light tracer's blocks, kept from frame to frame */
     int32_t *obuf;
+    /* fpm: the left eye's gathered sums per pixel and Eq. 1's luminances and mask (finish_fpm) */
+    struct px_sums *sums;
+    float *eta_l, *eta_f;
+    uint8_t *eta_mask;
     size_t bufn;
+    fv_kit_counters *counters; /* every frame's, kept (fv_kit_counters_reuse) */
     /* the left eye of a stereo frame, for the right eye (Sec. 3.3) */
     float *left_color;
     bool left_valid;
@@ -134,9 +140,11 @@ static fv_status pm_create_mode(pm_mode mode, const fv_scene *scene, fv_params *
     fv_status s = read_opts(mode, params, &st->o, err);
     if (s == FV_OK && mode != MODE_PM) s = fv_pmt_maps_init(&st->tm, scene, err);
     if (s == FV_OK) s = fv_atrous_create(&st->atrous, err);
+    if (s == FV_OK && !(st->room = fv_photon_room_create())) s = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if (s != FV_OK) {
         fv_pmt_maps_free(&st->tm);
         fv_atrous_destroy(st->atrous);
+        fv_photon_room_destroy(st->room);
         free(st);
         return s;
     }
@@ -156,10 +164,16 @@ static void pm_destroy(void *state)
     fv_pmt_maps_free(&st->tm);
     fv_foveated_destroy(st->fov);
     fv_atrous_destroy(st->atrous);
+    fv_photon_room_destroy(st->room);
     free(st->nbuf);
     free(st->pbuf);
     free(st->rbuf);
     free(st->obuf);
+    free(st->sums);
+    free(st->eta_l);
+    free(st->eta_f);
+    free(st->eta_mask);
+    fv_kit_counters_destroy(st->counters);
     free(st->left_color);
     free(st);
 }
@@ -324,11 +338,26 @@ static fv_status ensure_buffers(pm_state *st, int w, int h, fv_error *err)
     free(st->pbuf);
     free(st->rbuf);
     free(st->obuf);
+    free(st->sums);
+    free(st->eta_l);
+    free(st->eta_f);
+    free(st->eta_mask);
+    st->sums = NULL;
+    st->eta_l = st->eta_f = NULL;
+    st->eta_mask = NULL;
     st->nbuf = fv_alloc_array(n, 3 * sizeof(float));
     st->pbuf = fv_alloc_array(n, 3 * sizeof(float));
     st->rbuf = fv_alloc_array(n, 3 * sizeof(float));
     st->obuf = fv_alloc_array(n, sizeof(int32_t));
-    st->bufn = st->nbuf && st->pbuf && st->rbuf && st->obuf ? n : 0;
+    bool ok = st->nbuf && st->pbuf && st->rbuf && st->obuf;
+    if (st->mode == MODE_FPM) {
+        st->sums = fv_alloc_array(n, sizeof *st->sums);
+        st->eta_l = fv_alloc_array(n, sizeof(float));
+        st->eta_f = fv_alloc_array(n, sizeof(float));
+        st->eta_mask = fv_alloc_array(n, 1);
+        ok = ok && st->sums && st->eta_l && st->eta_f && st->eta_mask;
+    }
+    st->bufn = ok ? n : 0;
     return st->bufn ? FV_OK : fv_error_set(err, FV_ERR_NOMEM, "out of memory for %dx%d photon mapping buffers", w, h);
 }
 
@@ -340,7 +369,7 @@ static fv_status light_tracing(pm_state *st, const fv_frame *frame, float cell, 
     const fv_scene *s = st->scene;
     uint64_t rays = 0;
     fv_status rc = FV_OK;
-    fv_photon_job job = {s, 0, frame->seed, frame->index, st->o.max_depth, frame->threads, 0, prog, NULL, NULL};
+    fv_photon_job job = {s, 0, frame->seed, frame->index, st->o.max_depth, frame->threads, 0, prog, NULL, NULL, st->room};
     if (st->mode == MODE_PM) {
         fv_photon_map_clear(&st->all);
         job.count = (int64_t)n_light;
@@ -390,14 +419,11 @@ static fv_status render_eye_pass(render_ctx *c, fv_film *film, bool right, fv_st
  * (=focus), then every fpm pixel's colour. */
 static fv_status finish_fpm(render_ctx *c, fv_film *film, fv_stats *stats, fv_error *err)
 {
+    (void)err;
     int w = fv_film_width(film), h = fv_film_height(film);
     size_t n = (size_t)w * h;
-    float *l = fv_alloc_array(n, sizeof(float)), *f = fv_alloc_array(n, sizeof(float));
-    uint8_t *mask = fv_alloc_array(n, 1);
-    if (!l || !f || !mask) {
-        free(l), free(f), free(mask);
-        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    }
+    float *l = c->st->eta_l, *f = c->st->eta_f; /* the state's, sized with the film (ensure_buffers) */
+    uint8_t *mask = c->st->eta_mask;
     bool fovea_only = c->st->o.eta_region == 0;
     for (size_t i = 0; i < n; i++) {
         const px_sums *o = &c->sums[i];
@@ -406,7 +432,6 @@ static fv_status finish_fpm(render_ctx *c, fv_film *film, fv_stats *stats, fv_er
         mask[i] = o->hit && (fovea_only ? o->b <= 0.0f : o->b < 1.0f);
     }
     c->eta = fv_foveated_eta(l, f, mask, n);
-    free(l), free(f), free(mask);
     float *col = fv_film_color(film);
     uint64_t bad = 0;
     fv_region_begin();
@@ -521,8 +546,7 @@ static fv_status render_left(pm_state *st, render_ctx *c, fv_film *film, fv_stat
         fv_stage_stop(stats, "light_tracing", t0);
         if (rc == FV_OK && st->mode == MODE_FPM) rc = foveated_photons(st, c, w, h, cell, stats, err);
         c->pass = pass;
-        if (rc == FV_OK && st->mode == MODE_FPM && !(c->sums = fv_alloc_array((size_t)w * h, sizeof *c->sums)))
-            rc = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        if (rc == FV_OK && st->mode == MODE_FPM) c->sums = st->sums;
         fv_kit_phase(&c->prog, frame, base + 0.4 * span, 0.6 * span);
         if (rc == FV_OK) rc = render_eye_pass(c, film, false, stats, err);
         if (rc == FV_OK && c->sums) {
@@ -531,7 +555,6 @@ static fv_status render_left(pm_state *st, render_ctx *c, fv_film *film, fv_stat
             fv_stage_stop(stats, "render", t1);
             fv_stats_add_count(stats, "eta", c->eta);
         }
-        free(c->sums);
         c->sums = NULL;
     }
     if (rc == FV_OK) rc = filter_film(st, film, c->gamma, frame->threads, stats, err);
@@ -543,10 +566,10 @@ static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv
     pm_state *st = state;
     int w = fv_film_width(film), h = fv_film_height(film);
     fv_eye_model def;
-    render_ctx *c = calloc(1, sizeof *c);
-    if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    render_ctx ctx, *c = &ctx; /* on the stack: a frame allocates nothing once warmed up */
+    memset(c, 0, sizeof *c);
     fv_status rc = ensure_buffers(st, w, h, err);
-    if (rc == FV_OK && !(c->counters = fv_kit_counters_create())) rc = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (rc == FV_OK && !(c->counters = fv_kit_counters_reuse(&st->counters))) rc = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     c->st = st;
     c->frame = frame;
     c->eye = fv_frame_eye_model(frame, w, h, &def);
@@ -570,8 +593,6 @@ static fv_status pm_render(void *state, const fv_frame *frame, fv_film *film, fv
             st->left_eta = c->eta;
         }
     }
-    fv_kit_counters_destroy(c->counters);
-    free(c);
     return rc;
 }
 

@@ -53,7 +53,41 @@ typedef struct ppm_state {
     const fv_scene *scene;
     ppm_opts o;
     fv_photon_map map;
+    /* Kept from frame to frame, so that a warmed-up frame allocates nothing (docs/threads.md, "No
+     * allocation in a frame"): the light tracer's blocks, the counters, and the images of sums
+     * (img_n pixels, 3 doubles each): the running one and the block counter's nodes, at most one
+     * per bit (img_take, img_give). */
+    fv_photon_room *room;
+    fv_kit_counters *counters;
+    double *img[FV_BLOCKS_MAX_DEPTH + 1];
+    bool img_used[FV_BLOCKS_MAX_DEPTH + 1];
+    size_t img_n;
 } ppm_state;
+
+/* A zeroed image of n pixels' sums from the state's (allocated on first use), NULL when out of
+ * memory. Images are resized only while none is taken (at a frame's start). */
+static double *img_take(ppm_state *st, size_t n)
+{
+    if (n != st->img_n) {
+        for (int k = 0; k <= FV_BLOCKS_MAX_DEPTH; k++) free(st->img[k]), st->img[k] = NULL, st->img_used[k] = false;
+        st->img_n = n;
+    }
+    for (int k = 0; k <= FV_BLOCKS_MAX_DEPTH; k++) {
+        if (st->img_used[k]) continue;
+        if (!st->img[k] && !(st->img[k] = fv_alloc_array(n * 3, sizeof(double)))) return NULL;
+        memset(st->img[k], 0, n * 3 * sizeof(double));
+        st->img_used[k] = true;
+        return st->img[k];
+    }
+    return NULL;
+}
+
+/* Gives back an image img_take returned (NULL: nothing). */
+static void img_give(ppm_state *st, const double *img)
+{
+    for (int k = 0; img && k <= FV_BLOCKS_MAX_DEPTH; k++)
+        if (st->img[k] == img) st->img_used[k] = false;
+}
 
 static fv_status read_opts(fv_params *p, ppm_opts *o, fv_error *err)
 {
@@ -84,7 +118,9 @@ static fv_status ppm_create(const fv_scene *scene, fv_params *params, const fv_l
     st->scene = scene;
     fv_photon_map_init(&st->map);
     fv_status s = read_opts(params, &st->o, err);
+    if (s == FV_OK && !(st->room = fv_photon_room_create())) s = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if (s != FV_OK) {
+        fv_photon_room_destroy(st->room);
         free(st);
         return s;
     }
@@ -97,6 +133,9 @@ static void ppm_destroy(void *state)
     ppm_state *st = state;
     if (!st) return;
     fv_photon_map_free(&st->map);
+    fv_photon_room_destroy(st->room);
+    fv_kit_counters_destroy(st->counters);
+    for (int k = 0; k <= FV_BLOCKS_MAX_DEPTH; k++) free(st->img[k]);
     free(st);
 }
 
@@ -150,14 +189,14 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
     c.st = st;
     c.frame = frame;
     c.out = fv_film_views_of(film);
-    c.sum = fv_calloc_array(n * 3, sizeof *c.sum);
-    c.counters = fv_kit_counters_create();
+    for (int k = 0; k <= FV_BLOCKS_MAX_DEPTH; k++) st->img_used[k] = false;
+    c.sum = img_take(st, n);
+    c.counters = fv_kit_counters_reuse(&st->counters);
     /* Finished blocks as a binary counter of node images (core/blocks.h): at most one per bit. */
     double *node[FV_BLOCKS_MAX_DEPTH] = {0};
     int node_size[FV_BLOCKS_MAX_DEPTH], nodes = 0;
     if (!c.sum || !c.counters) {
-        free(c.sum);
-        fv_kit_counters_destroy(c.counters);
+        img_give(st, c.sum);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for %dx%d progressive photon mapping", w, h);
     }
     fv_vec3 lo, hi;
@@ -182,7 +221,7 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
         fv_photon_map_clear(&st->map);
         fv_photon_job job = {.scene = st->scene, .count = st->o.photons, .seed = frame->seed, .frame = frame->index,
                              .max_depth = st->o.max_depth, .threads = frame->threads, .stream = PPM_STREAM_BASE + (uint64_t)pass,
-                             .progress = &prog};
+                             .progress = &prog, .room = st->room};
         rc = fv_photon_trace_lights(&job, FV_TRACE_ALL, &st->map, &rays, err);
         if (rc == FV_OK) rc = fv_photon_map_build_mt(&st->map, c.r, frame->threads, err);
         photons += st->map.n;
@@ -201,11 +240,11 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
             while (nodes >= 2 && node_size[nodes - 1] == node_size[nodes - 2]) {
                 double *l = node[nodes - 2], *r = node[nodes - 1];
                 for (size_t i = 0; i < 3 * n; i++) l[i] += r[i];
-                free(r);
+                img_give(st, r);
                 node_size[nodes - 2] *= 2;
                 nodes--;
             }
-            c.sum = pass + 1 < p1 ? fv_calloc_array(n * 3, sizeof *c.sum) : NULL;
+            c.sum = pass + 1 < p1 ? img_take(st, n) : NULL;
             if (pass + 1 < p1 && !c.sum) rc = fv_error_set(err, FV_ERR_NOMEM, "out of memory for %dx%d progressive photon mapping", w, h);
         }
     }
@@ -213,9 +252,9 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
         /* the counter's nodes folded right to left: the tree's order */
         for (int k = nodes - 2; k >= 0; k--) {
             for (size_t i = 0; i < 3 * n; i++) node[k][i] = node[k][i] + node[k + 1][i];
-            free(node[k + 1]);
+            img_give(st, node[k + 1]);
         }
-        free(c.sum);
+        img_give(st, c.sum);
         c.sum = node[0];
         nodes = 0;
     }
@@ -242,9 +281,8 @@ static fv_status ppm_render(void *state, const fv_frame *frame, fv_film *film, f
     fv_stats_add_count(stats, "light_photons", photons);
     fv_stats_add_count(stats, "radius_first", r1);
     fv_stats_add_count(stats, "radius_last", c.r);
-    fv_kit_counters_destroy(c.counters);
-    for (int k = 0; k < nodes; k++) free(node[k]);
-    free(c.sum);
+    for (int k = 0; k < nodes; k++) img_give(st, node[k]);
+    img_give(st, c.sum);
     return rc;
 }
 

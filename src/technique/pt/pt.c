@@ -30,6 +30,7 @@ typedef struct pt_state {
     int block_first, block_count; /* the blocks rendered: [first, first + count) of the spp's */
     fv_scene_export *flat; /* portable and cuda: the flat scene at the frame's time */
     fv_cuda_pt *cuda;      /* cuda: the GPU's copy of it */
+    fv_kit_counters *counters; /* every frame's, kept (fv_kit_counters_reuse) */
 } pt_state;
 
 static void pt_destroy(void *state)
@@ -38,6 +39,7 @@ static void pt_destroy(void *state)
     if (!st) return;
     fv_cuda_pt_destroy(st->cuda);
     fv_scene_export_destroy(st->flat);
+    fv_kit_counters_destroy(st->counters);
     free(st);
 }
 
@@ -189,14 +191,13 @@ static fv_status pt_render_flat(pt_state *st, const fv_frame *frame, fv_film *fi
         fv_stats_add_count(stats, "nan_samples", (double)bad);
         return FV_OK;
     }
-    if (!(j.counters = fv_kit_counters_create())) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (!(j.counters = fv_kit_counters_reuse(&st->counters))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_kit_progress prog = {0};
     fv_kit_phase(&prog, frame, 0.0, 1.0);
     t0 = fv_stage_clock_now();
     bool done = fv_parallel_tiles(cam->width, cam->height, frame->threads, pt_flat_tile, &j, fv_kit_progress_fn, &prog);
     fv_stage_stop(stats, "trace", t0);
     fv_kit_report(j.counters, stats);
-    fv_kit_counters_destroy(j.counters);
     return done ? FV_OK : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
 }
 
@@ -209,7 +210,7 @@ static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv
     memset(&j, 0, sizeof j);
     fv_status s = fv_frame_camera(cam, film, &j.cam, err);
     if (s != FV_OK) return s;
-    if (!(j.counters = fv_kit_counters_create())) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (!(j.counters = fv_kit_counters_reuse(&st->counters))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     j.st = st;
     j.frame = frame;
     j.out = fv_film_views_of(film);
@@ -223,7 +224,6 @@ static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv
     int range_spp = 0;
     for (int b = st->block_first; b < st->block_first + st->block_count; b++) range_spp += fv_blocks_samples(st->opt.spp, b);
     fv_stats_add_count(stats, "samples", (double)cam->width * cam->height * range_spp);
-    fv_kit_counters_destroy(j.counters);
     return done ? FV_OK : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
 }
 

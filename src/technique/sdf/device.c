@@ -226,7 +226,7 @@ static void report(const fv_sdf_opts *o, const fv_ksdf_pyr_counts *pc, double sa
 /* fipr's pass 5 on the host, after either backend (filter/blur.h; not yet a kernel). */
 static fv_status blur(fv_sdf_device *d, const uint8_t *mask, const fv_film_views *out, int w, int h, int threads, fv_error *err)
 {
-    return fv_sdf_blur_transitions(out->color, mask, d->sigma, w, h, d->o.blur_sigma, threads, err);
+    return fv_sdf_blur_transitions(out->color, mask, d->sigma, w, h, d->o.blur_sigma, threads, NULL, err);
 }
 
 fv_status fv_sdf_device_render(fv_sdf_device *d, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "core/scratch.h"
 #include "core/parallel.h"
 #include "core/stage_time.h"
 #include "core/rng.h"
@@ -22,6 +23,13 @@ struct fv_sdf_pipeline {
     uint8_t *level_of; /* pixels */
     float *sigma;      /* fipr pass 5, pixels */
     int pw, ph;        /* the size heat, level_of and sigma have */
+    /* every frame's counters, kept (fv_kit_counters_reuse): steps and rays, and per level */
+    fv_kit_counters *c, *lsteps, *lrays;
+    /* each thread's tile temporaries (rays, hits, shading's), kept from frame to frame */
+    fv_scratch room[FV_MAX_THREADS];
+    fv_scratch blur_room; /* fipr's pass 5 */
+    fv_sdf_world world; /* the scene's fields and lights, refreshed every frame (fv_sdf_world_refresh) */
+    struct job *jb;     /* the frame's shared context, made by the first frame, zeroed every frame */
 };
 
 static void free_scratch(fv_sdf_pipeline *p)
@@ -51,6 +59,13 @@ void fv_sdf_pipeline_destroy(fv_sdf_pipeline *p)
     free_scratch(p);
     fv_pyramid_history_free(&p->hist[0]);
     fv_pyramid_history_free(&p->hist[1]);
+    fv_kit_counters_destroy(p->c);
+    fv_kit_counters_destroy(p->lsteps);
+    fv_kit_counters_destroy(p->lrays);
+    for (int t = 0; t < FV_MAX_THREADS; t++) fv_scratch_free(&p->room[t]);
+    fv_scratch_free(&p->blur_room);
+    fv_sdf_world_free(&p->world);
+    free(p->jb);
     free(p);
 }
 
@@ -128,7 +143,7 @@ static void trace(job *j, int thread, int level, fv_march_ray *rays, fv_march_hi
     if (!colour) return;
     fv_sdf_shade_counts sc = {0, 0, 0};
     fv_error e;
-    fv_status s = fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, vis_in, NULL, colour, normal, &sc, &e);
+    fv_status s = fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, vis_in, NULL, colour, normal, &sc, &p->room[thread], &e);
     if (s != FV_OK) j->status[thread] = s;
     count_shading(j, thread, &sc);
 }
@@ -143,13 +158,15 @@ static void shade_level(job *j, int thread, fv_march_ray *rays, fv_march_hit *hi
     if (n == 0) return;
     fv_sdf_shade_counts sc = {0, 0, 0};
     fv_error e;
-    uint32_t *bits = p->k.vis ? malloc((size_t)n * sizeof *bits) : NULL;
+    fv_scratch *room = &p->room[thread];
+    const size_t mark = fv_scratch_mark(room);
+    uint32_t *bits = p->k.vis ? fv_scratch_take(room, (size_t)n, sizeof *bits) : NULL;
     fv_status s = p->k.vis && !bits ? FV_ERR_NOMEM
-                                   : fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, NULL, bits, colour, NULL, &sc, &e);
+                                   : fv_sdf_shade(&j->world, &p->o.march, &p->o.shade, rays, hits, n, NULL, bits, colour, NULL, &sc, room, &e);
     if (s != FV_OK) j->status[thread] = s;
     if (bits && s == FV_OK)
         for (int r = 0; r < n; r++) p->k.vis[at[r]] = bits[r];
-    free(bits);
+    fv_scratch_release(room, mark);
     count_shading(j, thread, &sc);
 }
 
@@ -161,10 +178,12 @@ static void level_tile(void *ctx, const fv_tile *tile)
     const fv_pyramid_level *lv = &p->k.lv[k];
     const bool below_target = k == p->o.levels - 2;
     const int cap = (tile->x1 - tile->x0) * (tile->y1 - tile->y0);
-    fv_march_ray *rays = malloc((size_t)cap * sizeof *rays), *vrays = malloc((size_t)cap * sizeof *vrays);
-    fv_march_hit *hits = malloc((size_t)cap * sizeof *hits), *vhits = malloc((size_t)cap * sizeof *vhits);
-    int *at = malloc((size_t)cap * sizeof *at), *vat = calloc((size_t)cap, sizeof *vat);
-    fv_vec3 *colour = p->k.need ? malloc((size_t)cap * sizeof *colour) : NULL;
+    fv_scratch *room = &p->room[tile->thread];
+    fv_scratch_begin(room);
+    fv_march_ray *rays = fv_scratch_take(room, (size_t)cap, sizeof *rays), *vrays = fv_scratch_take(room, (size_t)cap, sizeof *vrays);
+    fv_march_hit *hits = fv_scratch_take(room, (size_t)cap, sizeof *hits), *vhits = fv_scratch_take(room, (size_t)cap, sizeof *vhits);
+    int *at = fv_scratch_take(room, (size_t)cap, sizeof *at), *vat = fv_scratch_take_zero(room, (size_t)cap, sizeof *vat);
+    fv_vec3 *colour = p->k.need ? fv_scratch_take(room, (size_t)cap, sizeof *colour) : NULL;
     if (!rays || !vrays || !hits || !vhits || !at || !vat || (p->k.need && !colour)) {
         j->status[tile->thread] = FV_ERR_NOMEM;
         goto done;
@@ -213,14 +232,7 @@ static void level_tile(void *ctx, const fv_tile *tile)
         p->k.hist_stamp[at[r]] = j->frame->index;
     }
     fv_kit_count(j->c, tile->thread, FV_KIT_NAN, bad);
-done:
-    free(rays);
-    free(vrays);
-    free(hits);
-    free(vhits);
-    free(at);
-    free(vat);
-    free(colour);
+done:; /* the temporaries stay in the thread's room until its next tile */
 }
 
 /* ---- the target level, per film tile ---- */
@@ -250,11 +262,13 @@ static void target_tile(void *ctx, const fv_tile *tile)
     fv_sdf_pipeline *p = j->p;
     const int S = p->k.S, L = p->o.levels, w = p->k.w;
     const int npix = (tile->x1 - tile->x0) * (tile->y1 - tile->y0), cap = npix * S * S;
-    fv_march_ray *rays = malloc((size_t)cap * sizeof *rays);
-    fv_march_hit *hits = malloc((size_t)cap * sizeof *hits);
-    fv_vec3 *colour = malloc((size_t)cap * sizeof *colour), *normal = malloc((size_t)cap * sizeof *normal);
-    int *first = malloc((size_t)npix * sizeof *first);
-    uint32_t *known = p->k.vis ? malloc((size_t)cap * sizeof *known) : NULL;
+    fv_scratch *room = &p->room[tile->thread];
+    fv_scratch_begin(room);
+    fv_march_ray *rays = fv_scratch_take(room, (size_t)cap, sizeof *rays);
+    fv_march_hit *hits = fv_scratch_take(room, (size_t)cap, sizeof *hits);
+    fv_vec3 *colour = fv_scratch_take(room, (size_t)cap, sizeof *colour), *normal = fv_scratch_take(room, (size_t)cap, sizeof *normal);
+    int *first = fv_scratch_take(room, (size_t)npix, sizeof *first);
+    uint32_t *known = p->k.vis ? fv_scratch_take(room, (size_t)cap, sizeof *known) : NULL;
     if (!rays || !hits || !colour || !normal || !first || (p->k.vis && !known)) {
         j->status[tile->thread] = FV_ERR_NOMEM;
         goto done;
@@ -316,13 +330,7 @@ static void target_tile(void *ctx, const fv_tile *tile)
             j->out.color[3 * pix + 2] = c.z;
         }
     fv_kit_count(j->c, tile->thread, FV_KIT_NAN, bad);
-done:
-    free(known);
-    free(rays);
-    free(hits);
-    free(colour);
-    free(normal);
-    free(first);
+done:; /* the temporaries stay in the thread's room until its next tile */
 }
 
 /* ---- fipr's passes 2 and 3, and what pass 4 must trace of the middle level ---- */
@@ -386,11 +394,12 @@ static uint64_t build_mask(job *j, uint64_t *edge_pixels, uint64_t *refreshed)
 
 /* Pass 5: sigma = blur_sigma on the transitions, 0 elsewhere, which fv_blur_variable leaves
  * untouched. */
-fv_status fv_sdf_blur_transitions(float *rgb, const uint8_t *mask, float *sigma, int w, int h, float blur_sigma, int threads, fv_error *err)
+fv_status fv_sdf_blur_transitions(float *rgb, const uint8_t *mask, float *sigma, int w, int h, float blur_sigma, int threads, fv_scratch *room,
+                                  fv_error *err)
 {
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) sigma[(size_t)y * w + x] = fv_kpyr_blur_sigma(mask, w, h, x, y, blur_sigma);
-    return fv_blur_variable(rgb, w, h, sigma, threads, err);
+    return room ? fv_blur_variable_in(rgb, w, h, sigma, threads, room, err) : fv_blur_variable(rgb, w, h, sigma, threads, err);
 }
 
 static void show(job *j)
@@ -427,6 +436,21 @@ static fv_status first_error(const job *j, int threads, fv_error *err)
 }
 
 /* One pass over a grid, as a phase of the frame's progress. */
+/* The most a tile takes from its thread's room: a level tile's arrays (level_tile, shade_level) or
+ * a target tile's (target_tile), with the shading of every ray. Reserved in every thread's room
+ * before the passes, since which thread meets the largest tile depends on the schedule. */
+static size_t tile_room_bound(const fv_sdf_pipeline *p)
+{
+    const size_t lc = (size_t)FV_TILE_SIZE * FV_TILE_SIZE, tc = lc * (size_t)p->k.S * (size_t)p->k.S;
+    const size_t level = 2 * fv_scratch_bytes(lc, sizeof(fv_march_ray)) + 2 * fv_scratch_bytes(lc, sizeof(fv_march_hit)) +
+                         2 * fv_scratch_bytes(lc, sizeof(int)) + fv_scratch_bytes(lc, sizeof(fv_vec3)) + fv_scratch_bytes(lc, sizeof(uint32_t)) +
+                         fv_sdf_shade_room_bound((int)lc);
+    const size_t target = fv_scratch_bytes(tc, sizeof(fv_march_ray)) + fv_scratch_bytes(tc, sizeof(fv_march_hit)) +
+                          2 * fv_scratch_bytes(tc, sizeof(fv_vec3)) + fv_scratch_bytes(lc, sizeof(int)) + fv_scratch_bytes(tc, sizeof(uint32_t)) +
+                          fv_sdf_shade_room_bound((int)tc);
+    return level > target ? level : target;
+}
+
 static fv_status run_pass(job *j, int gw, int gh, fv_tile_fn fn, fv_kit_progress *prog, double base, double span, fv_stats *stats,
                           const char *stage, fv_error *err)
 {
@@ -440,17 +464,21 @@ static fv_status run_pass(job *j, int gw, int gh, fv_tile_fn fn, fv_kit_progress
 
 fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
-    job *j = calloc(1, sizeof *j);
-    if (!j) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (!p->jb && !(p->jb = malloc(sizeof *p->jb))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    job *j = p->jb;
+    memset(j, 0, sizeof *j);
     fv_status s = fv_frame_camera(frame->camera, film, &j->cam, err);
-    if (s == FV_OK) s = fv_sdf_world_build(&j->world, p->scene, err);
+    if (s == FV_OK) s = fv_sdf_world_refresh(&p->world, p->scene, err);
+    j->world = p->world; /* a view of the pipeline's world: its arrays stay the pipeline's */
     if (s == FV_OK) s = ensure_size(p, j->cam.width, j->cam.height, err);
+    if (s == FV_OK)
+        for (int t = 0, nt = fv_thread_count(frame->threads); t < nt; t++) fv_scratch_reserve(&p->room[t], tile_room_bound(p));
     const fv_sdf_method m = p->o.method;
     const int L = p->o.levels;
     if (s == FV_OK && m == FV_SDF_FIPR) s = fv_pyramid_history_attach(&p->hist[frame->eye], &p->k, frame->index, err);
-    j->c = fv_kit_counters_create();
-    j->lsteps = fv_kit_counters_create();
-    j->lrays = fv_kit_counters_create();
+    j->c = fv_kit_counters_reuse(&p->c);
+    j->lsteps = fv_kit_counters_reuse(&p->lsteps);
+    j->lrays = fv_kit_counters_reuse(&p->lrays);
     if (s == FV_OK && (!j->c || !j->lsteps || !j->lrays)) s = fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     if (s != FV_OK) goto done;
     j->p = p;
@@ -489,7 +517,7 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
     if (s == FV_OK) s = run_pass(j, p->k.w, p->k.h, target_tile, &prog, base, 1.0 - base, stats, "target", err);
     if (s == FV_OK && m == FV_SDF_FIPR && p->o.blur) {
         fv_stage_clock t0 = fv_stage_clock_now();
-        s = fv_sdf_blur_transitions(j->out.color, p->k.mask, p->sigma, p->k.w, p->k.h, p->o.blur_sigma, frame->threads, err);
+        s = fv_sdf_blur_transitions(j->out.color, p->k.mask, p->sigma, p->k.w, p->k.h, p->o.blur_sigma, frame->threads, &p->blur_room, err);
         fv_stage_stop(stats, "blur", t0);
     }
     if (s != FV_OK) goto done;
@@ -514,10 +542,5 @@ fv_status fv_sdf_pipeline_render(fv_sdf_pipeline *p, const fv_frame *frame, fv_f
         fv_stats_add_count(stats, "refreshed_pixels", (double)refreshed);
     }
 done:
-    fv_sdf_world_free(&j->world);
-    fv_kit_counters_destroy(j->c);
-    fv_kit_counters_destroy(j->lsteps);
-    fv_kit_counters_destroy(j->lrays);
-    free(j);
     return s;
 }

@@ -66,7 +66,8 @@ int fv_sdf_samples_per_axis(int spp);
 /* what fipr's mask and refresh read of the frame (kernel/sdf_pyramid.h) for a w x h film; */
 void fv_sdf_fovea_of(const fv_frame *f, const fv_sdf_opts *o, int w, int h, fv_kpyr_fovea *out);
 /* pass 5: the transitions of mask (w x h) blurred in rgb with sigma blur_sigma (sigma: w x h
- * scratch), by filter/blur.h. */
-fv_status fv_sdf_blur_transitions(float *rgb, const uint8_t *mask, float *sigma, int w, int h, float blur_sigma, int threads, fv_error *err);
+ * scratch), by filter/blur.h, its temporaries from room (a kept arena; NULL: for the call). */
+fv_status fv_sdf_blur_transitions(float *rgb, const uint8_t *mask, float *sigma, int w, int h, float blur_sigma, int threads, fv_scratch *room,
+                                  fv_error *err);
 
 #endif

@@ -1,12 +1,21 @@
 /* fovea — the SDF family's shading (shade.h): many hits at once, each step kernel/sdf_shade.h's. */
 #include <math.h>
 #include <stdlib.h>
-#include "core/alloc.h"
 #include "technique/sdf/shade.h"
+
+size_t fv_sdf_shade_room_bound(int n)
+{
+    /* the takes of fv_sdf_shade below, at n hits */
+    const size_t h = (size_t)n;
+    return fv_scratch_bytes(h, sizeof(int)) + fv_scratch_bytes(h * 4, sizeof(fv_vec3)) + fv_scratch_bytes(h * 4, sizeof(float)) +
+           2 * fv_scratch_bytes(h, sizeof(fv_vec3)) + fv_scratch_bytes(h, sizeof(float)) + fv_scratch_bytes(h, sizeof(fv_march_ray)) +
+           fv_scratch_bytes(h, sizeof(fv_march_hit)) + 2 * fv_scratch_bytes(h, sizeof(int)) + fv_scratch_bytes(h, sizeof(uint32_t)) +
+           fv_scratch_bytes(h, sizeof(fv_ksdf_lobe));
+}
 
 fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_sdf_shade_opts *so, const fv_march_ray *rays,
                        const fv_march_hit *hits, int n, const uint32_t *vis_in, uint32_t *vis_out, fv_vec3 *color, fv_vec3 *normal,
-                       fv_sdf_shade_counts *counts, fv_error *err)
+                       fv_sdf_shade_counts *counts, fv_scratch *room, fv_error *err)
 {
     int nh = 0;
     for (int i = 0; i < n; i++) nh += hits[i].hit;
@@ -18,16 +27,18 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
     /* visibility is known per light as one bit, for the first 31 lights */
     const bool bits = w->k.nlights <= 31;
     if (nh == 0) return FV_OK;
-    int *idx = fv_alloc_array((size_t)nh, sizeof *idx);
-    fv_vec3 *pt = fv_alloc_array((size_t)nh * 4, sizeof *pt);
-    float *val = fv_alloc_array((size_t)nh * 4, sizeof *val);
-    fv_vec3 *nrm = fv_alloc_array((size_t)nh, sizeof *nrm), *pos = fv_alloc_array((size_t)nh, sizeof *pos);
-    float *hd = fv_alloc_array((size_t)nh, sizeof *hd);
-    fv_march_ray *sray = fv_alloc_array((size_t)nh, sizeof *sray);
-    fv_march_hit *shit = fv_alloc_array((size_t)nh, sizeof *shit);
-    int *sidx = fv_alloc_array((size_t)nh, sizeof *sidx), *lit = fv_alloc_array((size_t)nh, sizeof *lit);
-    uint32_t *vis = fv_calloc_array((size_t)nh, sizeof *vis);
-    fv_ksdf_lobe *lobes = color ? fv_alloc_array((size_t)nh, sizeof *lobes) : NULL;
+    /* the temporaries, from the caller's room, given back at the end */
+    const size_t mark = fv_scratch_mark(room);
+    int *idx = fv_scratch_take(room, (size_t)nh, sizeof *idx);
+    fv_vec3 *pt = fv_scratch_take(room, (size_t)nh * 4, sizeof *pt);
+    float *val = fv_scratch_take(room, (size_t)nh * 4, sizeof *val);
+    fv_vec3 *nrm = fv_scratch_take(room, (size_t)nh, sizeof *nrm), *pos = fv_scratch_take(room, (size_t)nh, sizeof *pos);
+    float *hd = fv_scratch_take(room, (size_t)nh, sizeof *hd);
+    fv_march_ray *sray = fv_scratch_take(room, (size_t)nh, sizeof *sray);
+    fv_march_hit *shit = fv_scratch_take(room, (size_t)nh, sizeof *shit);
+    int *sidx = fv_scratch_take(room, (size_t)nh, sizeof *sidx), *lit = fv_scratch_take(room, (size_t)nh, sizeof *lit);
+    uint32_t *vis = fv_scratch_take_zero(room, (size_t)nh, sizeof *vis);
+    fv_ksdf_lobe *lobes = color ? fv_scratch_take(room, (size_t)nh, sizeof *lobes) : NULL;
     fv_status st = FV_OK;
     if (!idx || !pt || !val || !nrm || !pos || !hd || !sray || !shit || !sidx || !lit || !vis || (color && !lobes)) {
         st = fv_error_set(err, FV_ERR_NOMEM, "out of memory shading %d hits", nh);
@@ -90,17 +101,6 @@ fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_
     if (vis_out && bits)
         for (int k = 0; k < nh; k++) vis_out[idx[k]] = vis[k];
 done:
-    free(lit);
-    free(vis);
-    free(lobes);
-    free(idx);
-    free(pt);
-    free(val);
-    free(nrm);
-    free(pos);
-    free(hd);
-    free(sray);
-    free(shit);
-    free(sidx);
+    fv_scratch_release(room, mark);
     return st;
 }

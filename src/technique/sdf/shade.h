@@ -15,6 +15,7 @@
 #ifndef FV_SDF_SHADE_H
 #define FV_SDF_SHADE_H
 
+#include "core/scratch.h"
 #include "kernel/sdf_shade.h"
 #include "technique/sdf/march.h"
 
@@ -25,9 +26,13 @@
 /* Shades the n marched camera rays: radiance per ray in color (black for a miss; color NULL:
  * visibility only), when normal is not NULL the unit normal (zero for a miss), when vis_out is
  * not NULL which lights reach each hit. vis_in (NULL: none) gives, per ray, visibility already
- * known (ipr's shadow_reuse): those rays trace no shadow ray. FV_ERR_NOMEM without scratch. */
+ * known (ipr's shadow_reuse): those rays trace no shadow ray. The temporaries come from room (the
+ * calling thread's, core/scratch.h) and are given back before returning. FV_ERR_NOMEM without
+ * scratch. */
 fv_status fv_sdf_shade(const fv_sdf_world *w, const fv_march_opts *mo, const fv_sdf_shade_opts *so, const fv_march_ray *rays,
                        const fv_march_hit *hits, int n, const uint32_t *vis_in, uint32_t *vis_out, fv_vec3 *color, fv_vec3 *normal,
-                       fv_sdf_shade_counts *counts, fv_error *err);
+                       fv_sdf_shade_counts *counts, fv_scratch *room, fv_error *err);
+/* The most fv_sdf_shade takes from its room for n rays (fv_scratch_reserve). */
+size_t fv_sdf_shade_room_bound(int n);
 
 #endif

@@ -43,8 +43,13 @@ static fv_status flatten(fv_sdf_world *w, int nmoving, fv_error *err)
 {
     int n = w->statics ? w->statics->count : 0;
     for (int i = 0; i < nmoving; i++) n += w->sdfs[i]->count;
-    w->ops = fv_alloc_array((size_t)(n > 0 ? n : 1), sizeof *w->ops);
-    if (!w->ops) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (!w->ops || n > w->ops_cap) {
+        free(w->ops);
+        w->ops_cap = 0;
+        w->ops = fv_alloc_array((size_t)(n > 0 ? n : 1), sizeof *w->ops);
+        if (!w->ops) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        w->ops_cap = n > 0 ? n : 1;
+    }
     int at = 0;
     if (w->statics) {
         memcpy(w->ops, w->statics->ops, (size_t)w->statics->count * sizeof *w->ops);
@@ -65,19 +70,35 @@ static fv_status flatten(fv_sdf_world *w, int nmoving, fv_error *err)
 fv_status fv_sdf_world_build(fv_sdf_world *w, const fv_scene *s, fv_error *err)
 {
     memset(w, 0, sizeof *w);
-    w->scene = s;
+    return fv_sdf_world_refresh(w, s, err);
+}
+
+fv_status fv_sdf_world_refresh(fv_sdf_world *w, const fv_scene *s, fv_error *err)
+{
     int n = fv_scene_sdf_object_count(s);
-    if (n == 0) return fv_error_set(err, FV_ERR_INVALID, "the scene has no signed distance field object");
     int nl = fv_light_delta_count(s);
-    w->objs = fv_calloc_array((size_t)n, sizeof *w->objs);
-    w->sdfs = fv_calloc_array((size_t)n, sizeof *w->sdfs);
-    w->lights = fv_calloc_array((size_t)(nl > 0 ? nl : 1), sizeof *w->lights);
-    const fv_sdf **statics = fv_calloc_array((size_t)n, sizeof *statics);
-    if (!w->objs || !w->sdfs || !w->lights || !statics) {
-        free(statics);
+    /* Kept: built for this scene, with its objects and lights (a committed scene's counts and
+     * static objects do not change, so neither does the static union). */
+    const bool keep = w->objs && w->scene == s && w->nsdf == n && w->nlights == nl;
+    if (!keep) {
         fv_sdf_world_free(w);
-        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        w->scene = s;
+        if (n == 0) return fv_error_set(err, FV_ERR_INVALID, "the scene has no signed distance field object");
+        w->objs = fv_calloc_array((size_t)n, sizeof *w->objs);
+        w->sdfs = fv_calloc_array((size_t)n, sizeof *w->sdfs);
+        w->lights = fv_calloc_array((size_t)(nl > 0 ? nl : 1), sizeof *w->lights);
+        w->static_list = fv_calloc_array((size_t)n, sizeof *w->static_list);
+        if (!w->objs || !w->sdfs || !w->lights || !w->static_list) {
+            fv_sdf_world_free(w);
+            return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        }
+        w->nsdf = n;
+        w->nlights = nl;
     }
+    const fv_sdf **statics = w->static_list;
+    memset(w->objs, 0, (size_t)n * sizeof *w->objs); /* as a fresh build has them */
+    memset(w->sdfs, 0, (size_t)n * sizeof *w->sdfs);
+    memset(&w->k, 0, sizeof w->k);
     fv_ksdf_world *k = &w->k;
     k->lo = fv_v3s(INFINITY);
     k->hi = fv_v3s(-INFINITY);
@@ -108,8 +129,9 @@ fv_status fv_sdf_world_build(fv_sdf_world *w, const fv_scene *s, fv_error *err)
     }
     fv_status status = FV_OK;
     if (ns == 1) w->statics = statics[0];
+    else if (ns > 1 && w->merged) w->statics = w->merged; /* kept: the same static objects */
     else if (ns > 1 && (status = fv_sdf_union_create(statics, ns, &w->merged, err)) == FV_OK) w->statics = w->merged;
-    free(statics);
+    else w->statics = NULL;
     if (status == FV_OK) status = flatten(w, count, err);
     if (status != FV_OK) {
         fv_sdf_world_free(w);
@@ -149,6 +171,7 @@ void fv_sdf_world_free(fv_sdf_world *w)
     free(w->sdfs);
     free(w->lights);
     free(w->ops);
+    free(w->static_list);
     memset(w, 0, sizeof *w);
 }
 

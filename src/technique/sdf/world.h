@@ -37,11 +37,21 @@ typedef struct fv_sdf_world {
     fv_ksdf_object *objs;
     fv_ksdf_light *lights;
     float eps_abs;             /* = k.eps_abs */
+    /* what fv_sdf_world_refresh keeps: the SDF objects and delta lights it was built for, the
+     * room of ops, and the static fields' list (n entries) */
+    int nsdf, nlights, ops_cap;
+    const fv_sdf **static_list;
 } fv_sdf_world;
 
 /* The scene's SDF objects and delta lights at its current time. FV_ERR_INVALID when the scene has
  * no SDF object; FV_ERR_NOMEM. fv_sdf_world_free releases it (safe on a zeroed world). */
 fv_status fv_sdf_world_build(fv_sdf_world *w, const fv_scene *s, fv_error *err);
+/* The same for a world kept from frame to frame (zeroed before its first call): a world already
+ * built for s is brought to s's current time in place (the moving objects, the lights), its
+ * arrays and its static union kept, so that a warmed-up frame allocates nothing (docs/threads.md,
+ * "No allocation in a frame"); otherwise it is built afresh. The same world as
+ * fv_sdf_world_build's. */
+fv_status fv_sdf_world_refresh(fv_sdf_world *w, const fv_scene *s, fv_error *err);
 void fv_sdf_world_free(fv_sdf_world *w);
 
 /* The field at eight points (x, y, z need no alignment), with the nearest leaf's material. */

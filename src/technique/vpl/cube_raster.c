@@ -16,21 +16,24 @@ typedef struct soup_tri {
 
 struct fv_tri_soup {
     int count;
+    size_t cap; /* triangles tri holds room for: grown, never shrunk (fv_tri_soup_update) */
     soup_tri *tri;
 };
 
-fv_status fv_tri_soup_create(const fv_scene *s, fv_tri_soup **out, fv_error *err)
+fv_status fv_tri_soup_update(fv_tri_soup **io, const fv_scene *s, fv_error *err)
 {
-    *out = NULL;
-    fv_tri_soup *t = calloc(1, sizeof *t);
-    if (!t) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the cube maps' triangles");
+    fv_tri_soup *t = *io;
+    if (!t && !(t = *io = calloc(1, sizeof *t))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the cube maps' triangles");
     size_t total = 0;
     const int nobj = fv_scene_object_count(s);
     for (int o = 0; o < nobj; o++) total += (size_t)fv_scene_object_triangle_count(s, o);
-    t->tri = total ? fv_alloc_array(total, sizeof *t->tri) : NULL;
-    if (total && !t->tri) {
-        free(t);
-        return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the cube maps' %zu triangles", total);
+    t->count = 0;
+    if (total > t->cap) {
+        soup_tri *tri = fv_alloc_array(total, sizeof *tri);
+        if (!tri) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the cube maps' %zu triangles", total);
+        free(t->tri);
+        t->tri = tri;
+        t->cap = total;
     }
     for (int o = 0; o < nobj; o++)
         for (int p = 0, nt = fv_scene_object_triangle_count(s, o); p < nt; p++) {
@@ -38,7 +41,6 @@ fv_status fv_tri_soup_create(const fv_scene *s, fv_tri_soup **out, fv_error *err
             fv_scene_triangle(s, o, p, &q->a, &q->b, &q->c);
             q->nrm = fv_cross(fv_sub(q->b, q->a), fv_sub(q->c, q->a));
         }
-    *out = t;
     return FV_OK;
 }
 

@@ -33,9 +33,12 @@
 
 typedef struct fv_tri_soup fv_tri_soup;
 
-/* All triangles of the committed scene s at its current time, in world space. Fails with
- * FV_ERR_NOMEM only. */
-fv_status fv_tri_soup_create(const fv_scene *s, fv_tri_soup **out, fv_error *err);
+/* All triangles of the committed scene s at its current time, in world space, into *io (NULL:
+ * created; fv_tri_soup_destroy after): its triangles replaced by s's, its room
+ * grown, never shrunk, so that a frame that refreshes a kept soup allocates nothing once warmed up
+ * (docs/threads.md, "No allocation in a frame"). Fails with FV_ERR_NOMEM only; *io then keeps its
+ * room, and its count is 0. */
+fv_status fv_tri_soup_update(fv_tri_soup **io, const fv_scene *s, fv_error *err);
 void fv_tri_soup_destroy(fv_tri_soup *t);
 int fv_tri_soup_count(const fv_tri_soup *t);
 

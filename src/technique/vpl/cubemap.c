@@ -26,6 +26,7 @@ struct fv_cubemaps {
     size_t texels;      /* per map: 6 n^2 */
     float *depth;       /* count x texels */
     fv_cube_meta *meta; /* count */
+    fv_tri_soup *soup;  /* rasterised builds: the frame's triangles, kept and refreshed (soup_for) */
 };
 
 fv_status fv_cubemaps_create(int count, int face_size, fv_cubemaps **out, fv_error *err)
@@ -68,6 +69,7 @@ void fv_cubemaps_destroy(fv_cubemaps *m)
     if (!m) return;
     free(m->depth);
     free(m->meta);
+    fv_tri_soup_destroy(m->soup);
     free(m);
 }
 
@@ -203,11 +205,15 @@ static void build_one(fv_cubemaps *m, const fv_scene *s, const fv_tri_soup *soup
     }
 }
 
-/* The triangles to rasterise when this pool rasterises in scene s, else NULL (*soup). */
-static fv_status soup_for(const fv_cubemaps *m, const fv_scene *s, fv_tri_soup **soup, fv_error *err)
+/* The triangles to rasterise when this pool rasterises in scene s, else NULL (*soup): the pool's
+ * own soup, refreshed to the scene's current time (its room grown, never shrunk). */
+static fv_status soup_for(fv_cubemaps *m, const fv_scene *s, fv_tri_soup **soup, fv_error *err)
 {
     *soup = NULL;
-    return fv_cube_build_rasterises(m->how, s) ? fv_tri_soup_create(s, soup, err) : FV_OK;
+    if (!fv_cube_build_rasterises(m->how, s)) return FV_OK;
+    fv_status st = fv_tri_soup_update(&m->soup, s, err);
+    if (st == FV_OK) *soup = m->soup;
+    return st;
 }
 
 fv_status fv_cubemaps_build(fv_cubemaps *m, const fv_scene *s, int i, fv_vec3 p, const fv_vec3 *n, fv_error *err)
@@ -220,7 +226,6 @@ fv_status fv_cubemaps_build(fv_cubemaps *m, const fv_scene *s, int i, fv_vec3 p,
     fv_status st = soup_for(m, s, &soup, err);
     if (st != FV_OK) return st;
     build_one(m, s, soup, i, p, n);
-    fv_tri_soup_destroy(soup);
     return FV_OK;
 }
 
@@ -251,12 +256,10 @@ fv_status fv_cubemaps_check(const fv_cubemaps *m, const int *indices, const fv_v
     return FV_OK;
 }
 
-fv_status fv_cubemaps_prepare(const fv_cubemaps *m, const fv_scene *s, fv_tri_soup **soup, fv_error *err)
+fv_status fv_cubemaps_prepare(fv_cubemaps *m, const fv_scene *s, fv_tri_soup **soup, fv_error *err)
 {
     return soup_for(m, s, soup, err);
 }
-
-void fv_cubemaps_release(fv_tri_soup *soup) { fv_tri_soup_destroy(soup); }
 
 void fv_cubemaps_build_team(fv_cubemaps *m, const fv_scene *s, const fv_tri_soup *soup, const int *indices,
                             const fv_vec3 *positions, const fv_vec3 *normals, int count)
@@ -275,7 +278,6 @@ fv_status fv_cubemaps_build_many(fv_cubemaps *m, const fv_scene *s, const int *i
     if ((st = soup_for(m, s, &soup, err)) != FV_OK) return st;
     build_job j = {m, s, soup, indices, positions, normals};
     fv_parallel_for(count, 1, threads, build_range, &j);
-    fv_tri_soup_destroy(soup);
     return FV_OK;
 }
 

@@ -159,15 +159,15 @@ fv_status fv_cubemaps_build_many(fv_cubemaps *maps, const fv_scene *s, const int
  * and uses each in turn (ir-low, docs/threads.md): fv_cubemaps_prepare once before the region (the
  * triangles to rasterise in the frame's scene, *soup; NULL when maps are traced), then per batch
  * fv_cubemaps_check (one thread; its error is fv_cubemaps_build_many's) and fv_cubemaps_build_team
- * (every thread of the region, same arguments: each map on one thread, the team's barrier after),
- * and fv_cubemaps_release(soup) after the region. Same depths as fv_cubemaps_build_many. */
+ * (every thread of the region, same arguments: each map on one thread, the team's barrier after).
+ * The soup is the pool's own, kept from frame to frame and refreshed by prepare (its room grown,
+ * never shrunk): valid until the next prepare or build. Same depths as fv_cubemaps_build_many. */
 typedef struct fv_tri_soup fv_tri_soup; /* cube_raster.h */
-fv_status fv_cubemaps_prepare(const fv_cubemaps *maps, const fv_scene *s, fv_tri_soup **soup, fv_error *err);
+fv_status fv_cubemaps_prepare(fv_cubemaps *maps, const fv_scene *s, fv_tri_soup **soup, fv_error *err);
 fv_status fv_cubemaps_check(const fv_cubemaps *maps, const int *indices, const fv_vec3 *positions, const fv_vec3 *normals,
                             int count, fv_error *err);
 void fv_cubemaps_build_team(fv_cubemaps *maps, const fv_scene *s, const fv_tri_soup *soup, const int *indices,
                             const fv_vec3 *positions, const fv_vec3 *normals, int count);
-void fv_cubemaps_release(fv_tri_soup *soup);
 
 /* Visibility of point q from VPL i (its map's centre), by the bias rule above: the nearest
  * texel's test. A non-finite q reads as not visible; q within 2 eps of the centre as visible. */

@@ -110,6 +110,7 @@ typedef struct fir_state {
     fv_vec3 *tmp;       /* the box filter's horizontal pass */
     float *fbuf;        /* atrous: rgb, normal, position */
     fv_atrous *atrous;  /* atrous: the filter's scratch, kept from frame to frame */
+    fv_scratch room;    /* resampling's CDF and the selection's ranking, kept from frame to frame */
     size_t ntmp;
     /* last management's counts, reported by both eyes */
     int moved_count[FV_MAX_THREADS];
@@ -126,6 +127,7 @@ static void fir_destroy(void *state)
     fv_density_grid_destroy(st->grid);
     fv_cubemaps_destroy(st->maps);
     fv_atrous_destroy(st->atrous);
+    fv_scratch_free(&st->room);
     fv_vpl_frame_free(&st->vf);
     void *bufs[] = {st->reached, st->owner, st->queue, st->cell_area, st->weight,   st->scratch,   st->dens_vox,    st->vpl,       st->next,         st->cand,
                     st->cand_ok,  st->cand_imp,  st->picked,      st->old_pos,   st->cand_pos,     st->sel_cand_pos,
@@ -559,7 +561,7 @@ static int manage_select(fir_state *st, const fv_frame *frame, int made, int n_o
     for (int j = 0; j < made; j++)
         if (st->cand_imp[j] < st->drop_importance) st->cand_imp[j] = 0.0f;
     fv_rng rr = fv_rng_stream(frame->seed, FV_STREAM_VPL, FIR_RNG_RESAMPLE, 0, (uint64_t)frame->index);
-    const int npick = fv_vpl_resample(st->cand_imp, made, need, &rr, st->picked);
+    const int npick = fv_vpl_resample_in(st->cand_imp, made, need, &rr, st->picked, &st->room);
     for (int k = 0; k < npick; k++) {
         st->sel_cand_pos[k] = st->cand[st->picked[k]].p;
         st->sel_cand_imp[k] = st->cand_imp[st->picked[k]];
@@ -572,7 +574,7 @@ static int manage_select(fir_state *st, const fv_frame *frame, int made, int n_o
         st->old_u[i] = fv_rng_next(&ra);
     }
     fv_vpl_select_in in = {n_old, st->old_pos, st->old_prev, st->old_new, st->old_u, npick, st->sel_cand_pos, st->sel_cand_imp};
-    fv_vpl_select_opts opt = {st->total, st->density_limit, st->density_c};
+    fv_vpl_select_opts opt = {st->total, st->density_limit, st->density_c, &st->room};
     fv_density_grid_clear(st->grid);
     int kept_reused = 0, kept_left = 0;
     fv_vpl_select(&in, &opt, st->grid, st->keep_old, st->take_cand, &kept_reused, &kept_left);

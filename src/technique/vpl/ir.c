@@ -161,7 +161,7 @@ static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv
         g.filter = (fv_cube_filter)st->cube_filter;
         fv_stats cube = {0}, shade = {0}; /* the batches' sums, stage by stage */
         int built = 0;
-        fv_tri_soup *soup = NULL; /* the frame's triangles, rasterised into every batch's maps */
+        fv_tri_soup *soup = NULL; /* the frame's triangles (the pool's, refreshed), rasterised into every batch's maps */
         status = n > 0 ? fv_cubemaps_prepare(st->maps, s, &soup, err) : FV_OK;
         fv_team_progress tp;
         fv_team_progress_init(&tp, fv_kit_progress_fn, &vf->prog);
@@ -213,7 +213,6 @@ static fv_status ir_render(void *state, const fv_frame *frame, fv_film *film, fv
             }
             fv_region_end();
         }
-        fv_cubemaps_release(soup);
         add_batches(stats, &cube, "cube_maps");
         add_batches(stats, &shade, "shading");
         fv_stats_add_count(stats, "cube_maps_built", built);

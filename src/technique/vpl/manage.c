@@ -67,6 +67,11 @@ static int linear_search(const float *weights, int count, double x)
 
 int fv_vpl_resample(const float *weights, int count, int draws, fv_rng *rng, int *out)
 {
+    return fv_vpl_resample_in(weights, count, draws, rng, out, NULL);
+}
+
+int fv_vpl_resample_in(const float *weights, int count, int draws, fv_rng *rng, int *out, fv_scratch *room)
+{
     if (count <= 0 || draws <= 0) return 0;
     double total = 0.0;
     for (int i = 0; i < count; i++) total += clean_weight(weights[i]);
@@ -77,7 +82,8 @@ int fv_vpl_resample(const float *weights, int count, int draws, fv_rng *rng, int
     double *cdf = NULL;
     uint64_t *seen = NULL;
     if ((size_t)count < SIZE_MAX / sizeof(double) - words) {
-        cdf = fv_alloc_array((size_t)count + words, sizeof(double));
+        if (room) fv_scratch_begin(room);
+        cdf = room ? fv_scratch_take(room, (size_t)count + words, sizeof(double)) : fv_alloc_array((size_t)count + words, sizeof(double));
         if (cdf) {
             double acc = 0.0;
             for (int i = 0; i < count; i++) {
@@ -106,7 +112,7 @@ int fv_vpl_resample(const float *weights, int count, int draws, fv_rng *rng, int
          * counted twice, so repeats are dropped and only the first draw keeps its place. */
         if (!dup) out[n++] = i;
     }
-    free(cdf);
+    if (!room) free(cdf);
     return n;
 }
 
@@ -283,7 +289,9 @@ int fv_vpl_select(const fv_vpl_select_in *in, const fv_vpl_select_opts *opt, fv_
      * current importance, the one measured for this frame's fovea like the candidates'. */
     fv_ranked *rank = NULL;
     if (n_left + n_cand > 0 && selected < total) {
-        rank = fv_alloc_array((size_t)n_left + (size_t)n_cand, sizeof *rank);
+        if (opt->room) fv_scratch_begin(opt->room);
+        rank = opt->room ? fv_scratch_take(opt->room, (size_t)n_left + (size_t)n_cand, sizeof *rank)
+                         : fv_alloc_array((size_t)n_left + (size_t)n_cand, sizeof *rank);
         if (rank) {
             for (int i = 0, m = 0; i < n_old; i++) {
                 if (keep_old[i]) continue;
@@ -340,7 +348,7 @@ int fv_vpl_select(const fv_vpl_select_in *in, const fv_vpl_select_opts *opt, fv_
         fv_density_grid_add(grid, in->cand_pos[k], 1);
         selected++;
     }
-    free(rank);
+    if (!opt->room) free(rank);
     if (kept_reused) *kept_reused = reused;
     if (kept_left) *kept_left = left_kept;
     return selected;

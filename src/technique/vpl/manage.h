@@ -12,6 +12,7 @@
 
 #include <stdbool.h>
 #include "core/rng.h"
+#include "core/scratch.h"
 #include "fovea/math.h"
 #include "fovea/status.h"
 
@@ -29,6 +30,9 @@ void fv_vpl_polar_sample(float u, float v, float *dx, float *dy);
  * min(draws, count)). Returns how many were written: 0 when every weight is 0 or count/draws <= 0,
  * and then the rng is not advanced (otherwise it is advanced exactly `draws` times). */
 int fv_vpl_resample(const float *weights, int count, int draws, fv_rng *rng, int *out);
+/* The same with its CDF from room, a scratch arena the caller keeps (core/scratch.h), so that a
+ * warmed-up frame allocates nothing (docs/threads.md, "No allocation in a frame"). */
+int fv_vpl_resample_in(const float *weights, int count, int draws, fv_rng *rng, int *out, fv_scratch *room);
 
 /* ---- Eq. 2: may an old VPL stay? ---- */
 
@@ -64,6 +68,7 @@ typedef struct fv_vpl_select_opts {
     int total;         /* TOTALNUMBER: at most this many valid VPLs in all */
     int density_limit; /* DENSITYLIMIT: a candidate is taken only while its cell holds fewer VPLs */
     float density_c;   /* C of the score Imp + 1 / (vd + C); > 0 keeps the term finite */
+    fv_scratch *room;  /* the ranking's scratch, kept by the caller (core/scratch.h); NULL: allocated for the call */
 } fv_vpl_select_opts;
 
 typedef struct fv_vpl_select_in {

@@ -194,7 +194,7 @@ fv_status fv_vpl_frame_begin(fv_vpl_frame *vf, const fv_scene *s, const fv_frame
         vf->npix = vf->direct && vf->indirect ? n : 0;
         if (!vf->npix) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d frame", w, h);
     }
-    if (!(vf->counters = fv_kit_counters_create())) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    if (!fv_kit_counters_reuse(&vf->counters)) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     vf->out = fv_film_views_of(film);
     memset(&vf->prog, 0, sizeof vf->prog);
     vf->rays = 0;
@@ -220,8 +220,6 @@ fv_status fv_vpl_frame_end(fv_vpl_frame *vf, fv_vpl_show show, bool ok, fv_statu
         fv_stats_add_count(stats, "cube_lookups", (double)fv_kit_sum(vf->counters, FV_VPL_SLOT_LOOKUPS));
         fv_stats_add_count(stats, "direct_rays", (double)fv_kit_sum(vf->counters, FV_VPL_SLOT_DIRECT_RAYS));
     }
-    fv_kit_counters_destroy(vf->counters);
-    vf->counters = NULL;
     if (status != FV_OK) return status;
     return ok ? fv_kit_phase_end(&vf->prog, err) : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
 }

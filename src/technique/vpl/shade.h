@@ -70,7 +70,7 @@ typedef struct fv_vpl_frame {
     size_t npix;
     fv_camera_basis cam;
     fv_film_views out;
-    fv_kit_counters *counters;
+    fv_kit_counters *counters; /* kept from frame to frame (fv_kit_counters_reuse), zeroed by begin */
     fv_kit_progress prog;
     uint64_t rays; /* rays cast outside the passes (first hits, VPLs, cube maps) */
 } fv_vpl_frame;
@@ -80,7 +80,7 @@ typedef struct fv_vpl_frame {
 fv_status fv_vpl_frame_begin(fv_vpl_frame *vf, const fv_scene *s, const fv_frame *frame, fv_film *film, fv_stats *stats,
                              fv_error *err);
 /* The last: compose what `show` asks into the film (stage "compose"), report the counters (rays,
- * nan_samples, vpl_shadow_rays, cube_lookups, direct_rays) and release them. ok false (a pass was
+ * nan_samples, vpl_shadow_rays, cube_lookups, direct_rays). ok false (a pass was
  * cancelled) or status != FV_OK: nothing is composed or reported; the status to return. */
 fv_status fv_vpl_frame_end(fv_vpl_frame *vf, fv_vpl_show show, bool ok, fv_status status, fv_stats *stats, fv_error *err);
 void fv_vpl_frame_free(fv_vpl_frame *vf);

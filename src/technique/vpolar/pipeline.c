@@ -46,6 +46,8 @@ struct fv_vp_pipeline {
     int coords_state;       /* COORDS_NONE, _STORE (this frame writes them), _READ */
     uint32_t *perm;
     long nperm;
+    fv_kit_counters *counters; /* the trace's, kept from frame to frame (fv_kit_counters_reuse) */
+    fv_scratch blur_room;      /* the foveated blur's temporaries, kept from frame to frame */
     bool have_prev;
     fv_camera_basis prev_cam;
     fv_space_view prev_view;
@@ -87,6 +89,8 @@ void fv_vp_pipeline_destroy(fv_vp_pipeline *p)
 {
     if (!p) return;
     free_buffers(p);
+    fv_kit_counters_destroy(p->counters);
+    fv_scratch_free(&p->blur_room);
     free(p);
 }
 
@@ -381,6 +385,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     fv_kit_progress prog = {0};
     fv_kit_phase(&prog, frame, 0.0, 0.8);
     job.progress = &prog;
+    job.counters = fv_kit_counters_reuse(&p->counters);
     fv_vp_trace_result tr;
     fv_stage_clock t0 = fv_stage_clock_now();
     bool traced = fv_vp_trace(&job, &p->g, &tr);
@@ -454,7 +459,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
 
     /* 5. foveated blur (Sec. 3.5) */
     t0 = fv_stage_clock_now();
-    if (p->o.blur && (s = fv_blur_variable(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, err)) != FV_OK) return s;
+    if (p->o.blur && (s = fv_blur_variable_in(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, &p->blur_room, err)) != FV_OK) return s;
     fv_stage_stop(stats, "blur", t0);
     fv_kit_phase(&prog, frame, 0.8, 0.2);
     return fv_kit_phase_end(&prog, err);

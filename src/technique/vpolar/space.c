@@ -36,6 +36,7 @@ struct fv_space {
     int sw, sh;            /* screen */
     fv_grid grid;
     int *col_h;
+    float *row_cs;         /* polar grids: cos and sin of each full-height row's angle (onscreen mask) */
     long count;
     /* Visual-Polar profile */
     double ppd, rho_ref, e_ref, a_f, a_e;
@@ -251,6 +252,13 @@ fv_status fv_space_create(const fv_space_opts *o, int screen_w, int screen_h, do
         return st;
     }
     s->grid.col_h = s->col_h;
+    /* The onscreen mask's angle table, made once here so that a frame that moves the gaze
+     * allocates nothing (docs/threads.md, "No allocation in a frame"). */
+    if (o->kind != FV_SPACE_CARTESIAN && (s->row_cs = fv_alloc_array((size_t)s->grid.h, 2 * sizeof(float))))
+        for (int y = 0; y < s->grid.h; y++) {
+            float phi = 2.0f * FV_PI * ((float)y + 0.5f) / (float)s->grid.h;
+            s->row_cs[2 * y] = cosf(phi), s->row_cs[2 * y + 1] = sinf(phi);
+        }
     s->count = 0;
     for (int x = 0; x < s->grid.w; x++) s->count += fv_grid_col_h(&s->grid, x);
     *out = s;
@@ -261,6 +269,7 @@ void fv_space_destroy(fv_space *s)
 {
     if (!s) return;
     free(s->col_h);
+    free(s->row_cs);
     free(s);
 }
 
@@ -322,14 +331,9 @@ long fv_space_onscreen_mask(const fv_space_view *v, float reach_px, uint8_t *mas
      * so every point of it is within (r1 - r0) / 2 + pi r1 / n of its centre (radial half-width
      * plus the arc, which is longer than the chord). That bound, doubled for the neighbouring cells a
      * bilinear tap reaches, is how far the centre may be off the screen widened by reach_px. */
-    float *cs = fv_alloc_array((size_t)h, 2 * sizeof(float));
+    const float *cs = s->row_cs; /* NULL (out of memory at create): the angles are computed per cell */
     const float lo_x = -reach_px, lo_y = -reach_px, hi_x = (float)s->sw + reach_px, hi_y = (float)s->sh + reach_px;
     long on = 0;
-    if (cs)
-        for (int y = 0; y < h; y++) {
-            float phi = 2.0f * FV_PI * ((float)y + 0.5f) / (float)h;
-            cs[2 * y] = cosf(phi), cs[2 * y + 1] = sinf(phi);
-        }
     float r0 = fv_space_radius(v, 0.0f);
     for (int x = 0; x < w; x++) {
         const float r1 = fv_space_radius(v, (float)x + 1.0f), rm = fv_space_radius(v, (float)x + 0.5f);
@@ -363,7 +367,6 @@ long fv_space_onscreen_mask(const fv_space_view *v, float reach_px, uint8_t *mas
         }
         r0 = r1;
     }
-    free(cs);
     return on;
 }
 

@@ -131,7 +131,7 @@ bool fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_re
     trace_ctx ctx, *c = &ctx;
     memset(res, 0, sizeof *res);
     memset(c, 0, sizeof *c);
-    if (!(c->counters = fv_kit_counters_create())) return true; /* the caller checks res->paths against the grid */
+    if (!(c->counters = job->counters)) return true; /* the caller checks res->paths against the grid */
     c->job = job;
     c->g = g;
     c->grid = fv_space_grid(job->view.space);
@@ -144,7 +144,6 @@ bool fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_re
     res->rays = fv_kit_sum(c->counters, FV_KIT_RAYS);
     res->paths = fv_kit_sum(c->counters, FV_KIT_USER0);
     res->nan_paths = fv_kit_sum(c->counters, FV_KIT_NAN);
-    fv_kit_counters_destroy(c->counters);
     return done;
 }
 

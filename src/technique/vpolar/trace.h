@@ -47,6 +47,7 @@ typedef struct fv_vp_trace_job {
     double kill_e0, kill_e1, kill_p, px_per_deg;
     const fv_frame *frame;     /* seed, index, eye, threads */
     fv_kit_progress *progress; /* the trace's phase of the frame */
+    fv_kit_counters *counters; /* the caller's block, zeroed (fv_kit_counters_reuse); NULL: none */
 } fv_vp_trace_job;
 
 typedef struct fv_vp_trace_result {
