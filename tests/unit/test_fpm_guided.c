@@ -136,7 +136,7 @@ static void test_guide_unbiased(void **st)
         for (int guided = 0; guided < 2; guided++) {
             fv_photon_map m;
             fv_photon_map_init(&m);
-            fv_photon_job job = {s, n, (uint64_t)(seed + 1), 0, 8, 0, 7, NULL, NULL, NULL};
+            fv_photon_job job = {s, n, (uint64_t)(seed + 1), 0, 8, 0, 7, NULL, NULL, NULL, NULL};
             if (guided) {
                 fv_photon_job pilot = job;
                 pilot.count = n / 8;
@@ -211,7 +211,7 @@ static void test_path_store_refresh(void **st)
     fv_dyn_dirs *dirs;
     assert_int_equal(fv_path_store_create(&store, &err), FV_OK);
     assert_int_equal(fv_dyn_dirs_create(&dirs, &err), FV_OK);
-    fv_photon_job job = {s, 20000, 5, 0, 6, 0, 1, NULL, NULL, NULL};
+    fv_photon_job job = {s, 20000, 5, 0, 6, 0, 1, NULL, NULL, NULL, NULL};
     assert_int_equal(fv_path_store_trace(store, &job, NULL, &err), FV_OK);
     for (int t = 0; t < 2; t++) {
         assert_int_equal(fv_scene_set_time(s, (double)t, &err), FV_OK);

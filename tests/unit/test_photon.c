@@ -134,7 +134,7 @@ static void test_negative_photons(void **st)
     fv_photon_map_init(&all);
     fv_photon_map_init(&ls);
     fv_photon_map_init(&ld);
-    fv_photon_job job = {s, 400000, 7, 0, 1, 0, 0, NULL, NULL, NULL};
+    fv_photon_job job = {s, 400000, 7, 0, 1, 0, 0, NULL, NULL, NULL, NULL};
     assert_int_equal(fv_photon_trace_lights(&job, FV_TRACE_ALL, &all, NULL, &err), FV_OK);
     job.stream = 1;
     assert_int_equal(fv_photon_trace_lights(&job, FV_TRACE_STATIC, &ls, NULL, &err), FV_OK);
