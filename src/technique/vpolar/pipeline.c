@@ -196,8 +196,8 @@ static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
         }
         #pragma omp simd
         for (int k = 0; k < n; k++) {
-            const float dx = px[k] - gx, dy = py[k] - gy;
-            const float X = fv_space_table_x(p->lut, 3, p->nlut, inv_step, sqrtf(dx * dx + dy * dy)), V = fv_space_turns(dx, dy);
+            float X, V;
+            fv_kvp_table_coords(p->lut, p->nlut, inv_step, px[k] - gx, py[k] - gy, &X, &V, NULL, NULL);
             pc[2 * k] = ok[k] ? X : NAN;
             pc[2 * k + 1] = ok[k] ? V : NAN;
         }
@@ -261,13 +261,7 @@ static void map_coords(const map_ctx *c, int64_t y, int x0, int n, float *X, flo
     const float dy = (float)y + 0.5f - gy;
     /* The table's three entries (column, mip level, blur sigma) read the same way. */
     #pragma omp simd
-    for (int k = 0; k < n; k++) {
-        const float dx = (float)(x0 + k) + 0.5f - gx, r = sqrtf(dx * dx + dy * dy);
-        X[k] = fv_space_table_x(lut, 3, p->nlut, inv_step, r);
-        level[k] = fv_space_table_x(lut + 1, 3, p->nlut, inv_step, r);
-        V[k] = fv_space_turns(dx, dy);
-        sigma[k] = fv_space_table_x(lut + 2, 3, p->nlut, inv_step, r);
-    }
+    for (int k = 0; k < n; k++) fv_kvp_table_coords(lut, p->nlut, inv_step, (float)(x0 + k) + 0.5f - gx, dy, &X[k], &V[k], &level[k], &sigma[k]);
     if (p->o.blur) memcpy(&p->sigma[(size_t)y * p->sw + x0], sigma, (size_t)n * sizeof(float));
     if (p->coords_state == COORDS_STORE)
         for (int k = 0; k < n; k++) kept[3 * k] = X[k], kept[3 * k + 1] = V[k], kept[3 * k + 2] = level[k];
@@ -324,12 +318,7 @@ static void map_rows(void *ctx, int64_t b, int64_t e, int thread)
                 }
                 fv_phi_mips_sample(p->mips, X[k], V[k], level[k], &c->out.color[3 * pix]);
                 if (!aux) continue;
-                int gx = (int)X[k];
-                gx = gx < 0 ? 0 : (gx >= g->w ? g->w - 1 : gx);
-                int nr = fv_grid_col_h(g, gx);
-                int gy = (int)(V[k] * (float)nr);
-                gy = gy < 0 ? 0 : (gy >= nr ? nr - 1 : gy);
-                store_aux(c, pix, (long)gy * g->w + gx);
+                store_aux(c, pix, fv_kvp_nearest_cell(g->col_h, g->w, g->h, X[k], V[k]));
             }
         }
 }
