@@ -57,3 +57,11 @@ __global__ void fv_check_vp(fv_kvp_space s, fv_kvp_view v, const float *table, i
     fv_kphi_sample(&m, X, V, level, out);
     out[3] = sigma + (float)fv_kvp_nearest_cell(m.rows[0], m.w, 4, X, V);
 }
+
+/* Visual-Polar's trace (kernel/vp_trace.h): one grid sample's path on the flat scene. */
+#include "kernel/vp_trace.h"
+
+__global__ void fv_check_vp_trace(fv_kscene s, fv_kvp_trace_frame f, fv_kvp_gbuf g, fv_kvp_trace_counts *c)
+{
+    fv_kvp_trace_sample(&s, &f, &g, (long)blockIdx.x * blockDim.x + threadIdx.x, c);
+}
