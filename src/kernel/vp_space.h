@@ -30,6 +30,15 @@ typedef struct fv_kvp_space {
     double lp_alpha;       /* log-polar */
 } fv_kvp_space;
 
+/* Buffers on the grid's storage (w * h cells; host memory on the CPU and the portable backend,
+ * device memory on CUDA). */
+typedef struct fv_kvp_gbuf {
+    float *color, *albedo, *normal, *depth, *position;
+    float *reflectance; /* what SVGF demodulates by (fv_bsdf_demod_reflectance); albedo is the film's */
+    uint32_t *id;       /* object + 1, 0: no surface */
+    uint8_t *sampled;   /* 1 where a path was traced */
+} fv_kvp_gbuf;
+
 /* A space placed for one gaze (fv_space_view without its pointer). */
 typedef struct fv_kvp_view {
     float gx, gy, rho_max, log_rho_max;

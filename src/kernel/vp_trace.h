@@ -21,15 +21,6 @@
 #include "kernel/pt.h"
 #include "kernel/vp_space.h"
 
-/* Buffers on the grid's storage (w * h cells; host memory on the CPU and the portable backend,
- * device memory on CUDA). */
-typedef struct fv_kvp_gbuf {
-    float *color, *albedo, *normal, *depth, *position;
-    float *reflectance; /* what SVGF demodulates by (fv_bsdf_demod_reflectance); albedo is the film's */
-    uint32_t *id;       /* object + 1, 0: no surface */
-    uint8_t *sampled;   /* 1 where a path was traced */
-} fv_kvp_gbuf;
-
 /* One eye of one frame of the trace stage. */
 typedef struct fv_kvp_trace_frame {
     fv_kvp_space space;
