@@ -13,6 +13,7 @@
 #ifndef FV_FILTER_BLUR_H
 #define FV_FILTER_BLUR_H
 
+#include <stddef.h>
 #include "fovea/status.h"
 
 /* Sigma profile of Sec. 3.5: 0 up to fovea_deg, rising linearly to sigma_max at ramp_deg, held at
@@ -24,5 +25,11 @@ double fv_blur_sigma_at(double e_deg, double fovea_deg, double ramp_deg, double 
  * threads 0 = all; the result does not depend on it. Bad sizes, a NULL buffer or a negative or
  * non-finite sigma -> FV_ERR_INVALID (rgb unchanged); no scratch memory -> FV_ERR_NOMEM. */
 fv_status fv_blur_variable(float *rgb, int w, int h, const float *sigma, int threads, fv_error *err);
+
+/* The kernels fv_blur_variable uses, for the kernels' passes (kernel/vp_blur.h, fv_kblur_table):
+ * on a w x h image whose largest sigma is smax, *nq kernels of *nk floats in all; fill writes
+ * kernel q at k + off[q] (off: nq ints, k: nk floats). */
+void fv_blur_table_size(float smax, int w, int h, int *nq, size_t *nk);
+void fv_blur_table_fill(int w, int h, int nq, int *off, float *k);
 
 #endif

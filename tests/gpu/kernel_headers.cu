@@ -65,3 +65,12 @@ __global__ void fv_check_vp_trace(fv_kscene s, fv_kvp_trace_frame f, fv_kvp_gbuf
 {
     fv_kvp_trace_sample(&s, &f, &g, (long)blockIdx.x * blockDim.x + threadIdx.x, c);
 }
+
+/* Visual-Polar's foveated blur (kernel/vp_blur.h): a pixel of each pass. */
+#include "kernel/vp_blur.h"
+
+__global__ void fv_check_vp_blur(fv_kblur_table t, const float *sigma, float *rgb, float *tmp)
+{
+    fv_kblur_h_pixel(&t, sigma, rgb, tmp, threadIdx.x, blockIdx.x);
+    fv_kblur_v_pixel(&t, sigma, tmp, rgb, threadIdx.x, blockIdx.x);
+}

@@ -1,10 +1,11 @@
 /* fovea — the Visual-Polar family's stages on a device backend (docs/gpu.md): the trace (a grid
  * sample at a time, kernel/vp_trace.h, on the flat scene and its BVH), the φ-mipmaps (a cell of a
- * level at a time) and the map to the screen (a pixel at a time, kernel/vp_map.h). The portable
+ * level at a time), the map to the screen (a pixel at a time, kernel/vp_map.h) and the foveated
+ * blur (a pixel of each pass at a time, kernel/vp_blur.h). The portable
  * backend runs each stage over tiles of its grid on the CPU's threads, which is what CI tests
  * against the CPU pipeline. The pipeline (pipeline.c) keeps the buffers and the temporal state
- * either way; the denoiser (filter/svgf.h, its reprojection through the radial table) and the
- * foveated blur (filter/blur.h) run on the host between and after these stages.
+ * either way; the denoiser (filter/svgf.h, its reprojection through the radial table) runs on the
+ * host between the trace and the mipmaps.
  */
 #ifndef FV_TECHNIQUE_VPOLAR_DEVICE_H
 #define FV_TECHNIQUE_VPOLAR_DEVICE_H
@@ -29,5 +30,8 @@ fv_status fv_vp_device_trace(fv_vp_device *d, const fv_vp_trace_job *job, const 
 void fv_vp_device_mips(fv_vp_device *d, fv_phi_mips *m, const float *rgb, int threads);
 /* The map stage: every pixel of the screen. */
 void fv_vp_device_map(fv_vp_device *d, const fv_kvp_map_frame *mf, const fv_film_views *out, int threads);
+/* The foveated blur (kernel/vp_blur.h): rgb (w x h) in place with the per-pixel sigma, as
+ * fv_blur_variable, bit for bit; its scratch image is kept between frames. */
+fv_status fv_vp_device_blur(fv_vp_device *d, float *rgb, int w, int h, const float *sigma, int threads, fv_error *err);
 
 #endif

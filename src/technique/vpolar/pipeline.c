@@ -446,7 +446,11 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
 
     /* 5. foveated blur (Sec. 3.5) */
     t0 = fv_stage_clock_now();
-    if (p->o.blur && (s = fv_blur_variable(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, err)) != FV_OK) return s;
+    if (p->o.blur) {
+        s = p->dev ? fv_vp_device_blur(p->dev, fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, err)
+                   : fv_blur_variable(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, err);
+        if (s != FV_OK) return s;
+    }
     fv_stage_stop(stats, "blur", t0);
     fv_kit_phase(&prog, frame, 0.8, 0.2);
     return fv_kit_phase_end(&prog, err);
