@@ -74,3 +74,12 @@ __global__ void fv_check_vp_blur(fv_kblur_table t, const float *sigma, float *rg
     fv_kblur_h_pixel(&t, sigma, rgb, tmp, threadIdx.x, blockIdx.x);
     fv_kblur_v_pixel(&t, sigma, tmp, rgb, threadIdx.x, blockIdx.x);
 }
+
+/* Visual-Polar's history reprojection (kernel/vp_reproject.h): one grid sample. */
+#include "kernel/vp_reproject.h"
+
+__global__ void fv_check_vp_reproject(fv_kvp_reproject_frame f, float *prev_coord)
+{
+    const long i = (long)blockIdx.x * blockDim.x + threadIdx.x;
+    fv_kvp_reproject_sample(&f, i, &prev_coord[2 * i]);
+}

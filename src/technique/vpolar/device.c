@@ -7,6 +7,7 @@
 #include "core/parallel.h"
 #include "filter/blur.h"
 #include "kernel/vp_blur.h"
+#include "kernel/vp_reproject.h"
 #include "scene/export.h"
 #include "technique/vpolar/device.h"
 
@@ -177,4 +178,23 @@ fv_status fv_vp_device_blur(fv_vp_device *d, float *rgb, int w, int h, const flo
     for (j.vertical = 0; j.vertical < 2; j.vertical++) fv_parallel_tiles(w, h, threads, blur_tile, &j, NULL, NULL);
     free(off), free(k);
     return FV_OK;
+}
+
+typedef struct reproject_job {
+    const fv_kvp_reproject_frame *f;
+    float *prev_coord;
+} reproject_job;
+
+static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
+{
+    (void)thread;
+    const reproject_job *j = ctx;
+    for (int64_t i = b; i < e; i++) fv_kvp_reproject_sample(j->f, (long)i, &j->prev_coord[2 * i]);
+}
+
+void fv_vp_device_reproject(fv_vp_device *d, const fv_kvp_reproject_frame *f, float *prev_coord, int threads)
+{
+    (void)d;
+    reproject_job j = {f, prev_coord};
+    fv_parallel_for((int64_t)f->space.gw * f->space.gh, 4096, threads, reproject_range, &j);
 }

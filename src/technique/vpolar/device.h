@@ -4,8 +4,8 @@
  * blur (a pixel of each pass at a time, kernel/vp_blur.h). The portable
  * backend runs each stage over tiles of its grid on the CPU's threads, which is what CI tests
  * against the CPU pipeline. The pipeline (pipeline.c) keeps the buffers and the temporal state
- * either way; the denoiser (filter/svgf.h, its reprojection through the radial table) runs on the
- * host between the trace and the mipmaps.
+ * either way. The reprojection of the denoiser's history is a kernel too (kernel/vp_reproject.h);
+ * the denoiser itself (filter/svgf.h) runs on the host between the trace and the mipmaps.
  */
 #ifndef FV_TECHNIQUE_VPOLAR_DEVICE_H
 #define FV_TECHNIQUE_VPOLAR_DEVICE_H
@@ -14,6 +14,7 @@
 #include "fovea/device.h"
 #include "fovea/film.h"
 #include "kernel/vp_map.h"
+#include "kernel/vp_reproject.h"
 #include "technique/vpolar/trace.h"
 
 typedef struct fv_vp_device fv_vp_device;
@@ -26,6 +27,9 @@ void fv_vp_device_destroy(fv_vp_device *d);
  * changes nothing: each sample has its own random stream). *done false: cancelled. */
 fv_status fv_vp_device_trace(fv_vp_device *d, const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_result *res, bool *done,
                              fv_error *err);
+/* The denoiser's history coordinates (kernel/vp_reproject.h): every cell of the grid into
+ * prev_coord (2 floats a cell). */
+void fv_vp_device_reproject(fv_vp_device *d, const fv_kvp_reproject_frame *f, float *prev_coord, int threads);
 /* Every level of m from rgb (level 0 a copy), as fv_phi_mips_build. */
 void fv_vp_device_mips(fv_vp_device *d, fv_phi_mips *m, const float *rgb, int threads);
 /* The map stage: every pixel of the screen. */

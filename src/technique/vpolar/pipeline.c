@@ -14,6 +14,7 @@
 #include "core/parallel.h"
 #include "filter/blur.h"
 #include "filter/phi_mips.h"
+#include "kernel/vp_reproject.h"
 #include "technique/vpolar/device.h"
 #include "technique/vpolar/pipeline.h"
 
@@ -184,13 +185,9 @@ static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
     for (int64_t i0 = b; i0 < e; i0 += REPROJECT_SPAN) {
         const int n = e - i0 < REPROJECT_SPAN ? (int)(e - i0) : REPROJECT_SPAN;
         for (int k = 0; k < n; k++) {
-            const int64_t i = i0 + k;
-            ok[k] = 0, px[k] = gx, py[k] = gy;
-            if (!p->g.sampled[i] || p->g.id[i] == 0 || (p->onscreen && !p->onscreen[i])) continue;
-            fv_vec3 x = fv_v3(p->g.position[3 * i], p->g.position[3 * i + 1], p->g.position[3 * i + 2]);
             float qx, qy;
-            if (!fv_camera_project(&p->prev_cam, x, &qx, &qy)) continue;
-            if (qx < 0.0f || qy < 0.0f || qx > (float)p->sw || qy > (float)p->sh) continue;
+            ok[k] = 0, px[k] = gx, py[k] = gy;
+            if (!fv_kvp_reproject_screen(&p->g, p->onscreen, &p->prev_cam, p->sw, p->sh, (long)(i0 + k), &qx, &qy)) continue;
             ok[k] = 1, px[k] = qx, py[k] = qy;
         }
         float *pc = &p->prev_coord[2 * i0];
@@ -387,7 +384,21 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
              * stayed kept it). */
             reproject_ctx rc = {p, fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN && p->prev_view.gx == p->lut_gx &&
                                        p->prev_view.gy == p->lut_gy};
-            fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
+            if (p->dev && (rc.lut || fv_space_kind_of(p->space) == FV_SPACE_CARTESIAN)) {
+                fv_kvp_reproject_frame rf;
+                memset(&rf, 0, sizeof rf);
+                rf.space = *fv_space_kernel(p->space);
+                rf.g = p->g;
+                rf.onscreen = p->onscreen;
+                rf.prev_cam = p->prev_cam;
+                rf.prev_view = fv_space_kview(&p->prev_view);
+                rf.prev_lut = p->lut;
+                rf.nlut = p->nlut;
+                rf.inv_step = 1.0f / LUT_STEP;
+                fv_vp_device_reproject(p->dev, &rf, p->prev_coord, frame->threads);
+            } else {
+                fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
+            }
         }
         fv_svgf_frame fr = {p->g.color, p->g.reflectance, p->g.normal, p->g.depth, p->g.position, p->g.id,
                             hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
