@@ -31,6 +31,15 @@ expect 0 "" -- $R cornell --device portable --spp 2 --size 24x24 --out "$TMP/por
 [ -s "$TMP/portable.exr" ] || fail "--device portable wrote no image"
 expect 0 "" -- $R cornell --device portable --spp 2 --size 24x24 --frames 2 --stereo 0.1 --out "$TMP/portable-st.png"
 
+# The Visual-Polar family on the portable backend, over a sequence (its denoiser's history carried
+# from frame to frame; test_device_vpolar compares the images with the CPU's), show=space included
+# (the pipeline's sample-space image is on the host either way).
+for m in vpolar cartesian cartesian-full linear-falloff log-polar; do
+  expect 0 "" -- $R cornell --method $m --device portable --size 32x24 --frames 2 --warmup 1 --out "$TMP/$m-portable.png"
+  [ -s "$TMP/$m-portable_0001.png" ] || fail "$m --device portable wrote no second frame"
+done
+expect 0 "" -- $R cornell --method vpolar --device portable --param show=space --size 32x24 --out "$TMP/vp-space.png"
+
 # The sphere tracers on the portable backend (test_device_sdf compares them with the CPU's bit for
 # bit; fipr over three frames, so its kept history is read), and on CUDA the same one line as pt
 # where it cannot run.
