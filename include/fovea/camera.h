@@ -47,6 +47,18 @@ FV_HD static inline fv_vec3 fv_camera_dir(const fv_camera_basis *b, float px, fl
 /* Projects a world point to film coordinates in pixels; false when behind the camera.
  * Inverse of fv_camera_dir: used by reprojection between two cameras. */
 FV_API bool fv_camera_project(const fv_camera_basis *b, fv_vec3 p, float *px, float *py);
+/* The same inline, for the device kernels (fv_camera_project calls it). */
+FV_HD static inline bool fv_camera_project_point(const fv_camera_basis *b, fv_vec3 p, float *px, float *py)
+{
+    fv_vec3 d = fv_sub(p, b->pos);
+    float z = fv_dot(d, b->forward);
+    if (z <= 1e-8f) return false;
+    float sx = fv_dot(d, b->right) / (z * b->tan_half_x);
+    float sy = fv_dot(d, b->up) / (z * b->tan_half_y);
+    *px = (sx + 1.0f) * 0.5f * (float)b->width;
+    *py = (1.0f - sy) * 0.5f * (float)b->height;
+    return true;
+}
 
 /* Left and right eye cameras of a stereo pair: each offset by half of eye_sep along the camera's
  * right vector, looking in parallel (look point offset by the same amount). */

@@ -33,9 +33,10 @@
 #include "core/scratch.h"
 #include "core/parallel.h"
 #include "filter/blur.h"
+#include "kernel/vp_blur.h"
 
-#define Q_BITS 5                     /* sigma grid: 2^Q_BITS values per octave (see quantise) */
-#define Q_STEPS (1 << Q_BITS)
+#define Q_BITS FV_KBLUR_Q_BITS       /* sigma grid: 2^Q_BITS values per octave (see quantise) */
+#define Q_STEPS FV_KBLUR_Q_STEPS
 #define Q_TABLE (6 * Q_STEPS)        /* kernels up to sigma 32 px are built up front */
 #define BATCH 64                     /* output rows per batch of a slab */
 #define STRIP 32                     /* columns per strip of the vertical pass: its 2 r + 1 rows
@@ -57,17 +58,9 @@ double fv_blur_sigma_at(double e_deg, double fovea_deg, double ramp_deg, double 
  * pixel or 1/64 of itself, far below what anyone can see. Relative steps keep runs of equal kernels
  * a few pixels long even where the paper's profile ramps up (uniform steps of 1/32 would cut the
  * ramp into runs of one or two pixels). q indexes the grid: q / 32 pixels below 64, above it octave
- * q / 32 - 1, step q % 32. Integer arithmetic on the float's bits keeps the rounding exact and cheap:
- * it runs for every pixel of the ramp. */
-static int quantise(float s)
-{
-    if (s < 1.0f) return (int)(s * (float)Q_STEPS + 0.5f);
-    uint32_t b;
-    memcpy(&b, &s, sizeof b);
-    int octave = (int)(b >> 23) - 127;                                           /* s >= 1: normal */
-    int step = (int)(((b & 0x7FFFFFu) + (1u << (22 - Q_BITS))) >> (23 - Q_BITS)); /* 0..Q_STEPS */
-    return Q_STEPS * (1 + octave) + step;
-}
+ * q / 32 - 1, step q % 32 (fv_kblur_quantise, kernel/vp_blur.h: it runs for every pixel of the
+ * ramp, and on the device backends). */
+#define quantise fv_kblur_quantise
 
 static double sigma_of(int q)
 {
@@ -76,19 +69,8 @@ static double sigma_of(int q)
 }
 
 /* Taps reach 3 sigma (floor), but never further than the image: beyond rcap every tap is outside it
- * and carries no weight after the border renormalisation anyway. */
-static int radius_of(int q, int rcap)
-{
-    long long r;
-    if (q < 2 * Q_STEPS) {
-        r = 3LL * q / Q_STEPS;
-    } else {
-        int octave = q / Q_STEPS - 1;
-        if (octave > 40) return rcap;
-        r = (3LL * (Q_STEPS + q % Q_STEPS) << octave) >> Q_BITS;
-    }
-    return r < rcap ? (int)r : rcap;
-}
+ * and carries no weight after the border renormalisation anyway (fv_kblur_radius). */
+#define radius_of fv_kblur_radius
 
 /* k[d] for d = 0..r: exp(-d^2 / 2 sigma^2), normalised so that k[0] + 2 sum k[d] = 1 (double
  * precision, so the normalisation is exact to float rounding even for thousands of taps). */
@@ -127,13 +109,26 @@ static int kernel_set_init(kernel_set *ks, int qmax, int rcap, fv_scratch *room)
     return 0;
 }
 
-/* The weight of the taps of a radius-r kernel centred at pos that fall inside [0, n). */
-static float inside_weight(const float *k, int r, int pos, int n)
+void fv_blur_table_size(float smax, int w, int h, int *nq, size_t *nk)
 {
-    float wsum = k[0];
-    for (int d = 1; d <= r; d++) wsum += k[d] * (float)((pos - d >= 0) + (pos + d < n));
-    return wsum;
+    const int rcap = (w > h ? w : h) - 1;
+    *nq = quantise(smax) + 1;
+    *nk = 0;
+    for (int q = 0; q < *nq; q++) *nk += (size_t)radius_of(q, rcap) + 1;
 }
+
+void fv_blur_table_fill(int w, int h, int nq, int *off, float *k)
+{
+    const int rcap = (w > h ? w : h) - 1;
+    size_t total = 0;
+    for (int q = 0; q < nq; q++) {
+        off[q] = (int)total;
+        make_kernel(q, radius_of(q, rcap), k + total);
+        total += (size_t)radius_of(q, rcap) + 1;
+    }
+}
+
+#define inside_weight fv_kblur_inside_weight
 
 /* The kernels below compute, for the run of n pixels starting at float offset off of the rows,
  *   o[i] = k[0] rows[0][off + i] + sum_{d=1..r} k[d] (rows[-d][off + i] + rows[d][off + i]),

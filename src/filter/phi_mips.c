@@ -24,7 +24,7 @@
 #include "core/parallel.h"
 #include "filter/phi_mips.h"
 
-#define MAX_LEVELS 32 /* a column of up to INT_MAX rows needs at most 32 levels */
+#define MAX_LEVELS FV_KPHI_MAX_LEVELS
 
 struct fv_phi_mips {
     int levels;
@@ -107,33 +107,23 @@ const fv_grid *fv_phi_mips_grid(const fv_phi_mips *m, int k)
     return m && k >= 0 && k < m->levels ? &m->grid[k] : NULL;
 }
 
-/* Row j of level k from level k - 1 (see the top of the file for the weights). */
-static void halve_row(const fv_phi_mips *m, int k, int j)
+/* Row j of level k from level k - 1, a cell at a time with the kernel's step (kernel/vp_map.h). */
+static void halve_row(const fv_kphi_mips *km, int k, int j)
 {
-    const int w = m->w;
-    const size_t stride = 3 * (size_t)w;
-    const int *hs = m->rows[k - 1], *hd = m->rows[k];
-    const float *inv = m->inv_src[k];
-    const float *src = m->img[k - 1] + 2 * (size_t)j * stride; /* row 2j of the source */
-    float *dst = m->img[k] + (size_t)j * stride;
-    for (int x = 0; x < w; x++) {
-        const int md = hd[x];
-        if (j >= md) continue;
-        const float *s = src + 3 * (size_t)x;
-        float *o = dst + 3 * (size_t)x;
-        if (hs[x] == 2 * md) {
-            for (int c = 0; c < 3; c++) o[c] = 0.5f * (s[c] + s[stride + c]);
-        } else {
-            /* Zero weights are skipped, not multiplied: the rows they name may not exist, and a
-             * non-finite neighbour must not leak in through 0 * inf. */
-            const float wa = (float)j, wb = (float)md, wc = (float)(md - 1 - j), u = inv[x];
-            for (int c = 0; c < 3; c++) {
-                float sum = wb * s[c];
-                if (j > 0) sum += wa * s[c - stride];
-                if (j < md - 1) sum += wc * s[c + stride];
-                o[c] = sum * u;
-            }
-        }
+    for (int x = 0; x < km->w; x++) fv_kphi_halve_cell(km, k, x, j);
+}
+
+void fv_phi_mips_kernel(const fv_phi_mips *m, fv_kphi_mips *out)
+{
+    memset(out, 0, sizeof *out);
+    out->levels = m->levels;
+    out->w = m->w;
+    out->wrap = m->wrap;
+    for (int k = 0; k < m->levels; k++) {
+        out->rows[k] = m->rows[k];
+        out->rowsf[k] = m->rowsf[k];
+        out->inv_src[k] = m->inv_src[k];
+        out->img[k] = m->img[k];
     }
 }
 
@@ -142,6 +132,8 @@ void fv_phi_mips_build(fv_phi_mips *m, const float *rgb, int threads)
     if (!m || !rgb) return;
     const size_t stride = 3 * (size_t)m->w;
     const int h0 = m->grid[0].h;
+    fv_kphi_mips km;
+    fv_phi_mips_kernel(m, &km);
 fv_region_begin();
 #pragma omp parallel num_threads(fv_thread_count(threads))
     {
@@ -151,7 +143,7 @@ fv_region_begin();
          * near the top hold more columns (a triangular grid), hence dynamic chunks. */
         for (int k = 1; k < m->levels; k++) {
 #pragma omp for schedule(dynamic, 8)
-            for (int j = 0; j < m->grid[k].h; j++) halve_row(m, k, j);
+            for (int j = 0; j < m->grid[k].h; j++) halve_row(&km, k, j);
         }
     }
 fv_region_end();

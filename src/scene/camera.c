@@ -33,17 +33,7 @@ fv_status fv_camera_basis_make(const fv_camera *c, fv_camera_basis *b, fv_error 
     return FV_OK;
 }
 
-bool fv_camera_project(const fv_camera_basis *b, fv_vec3 p, float *px, float *py)
-{
-    fv_vec3 d = fv_sub(p, b->pos);
-    float z = fv_dot(d, b->forward);
-    if (z <= 1e-8f) return false;
-    float sx = fv_dot(d, b->right) / (z * b->tan_half_x);
-    float sy = fv_dot(d, b->up) / (z * b->tan_half_y);
-    *px = (sx + 1.0f) * 0.5f * (float)b->width;
-    *py = (1.0f - sy) * 0.5f * (float)b->height;
-    return true;
-}
+bool fv_camera_project(const fv_camera_basis *b, fv_vec3 p, float *px, float *py) { return fv_camera_project_point(b, p, px, py); }
 
 void fv_camera_stereo(const fv_camera *center, float eye_sep, fv_camera *left, fv_camera *right)
 {

@@ -8,7 +8,7 @@ expect 2 "device 'gpu' is not one of cpu, portable, cuda, auto" -- $R cornell --
 expect 2 "device '' is not one of" -- $R cornell --device "" --size 8x8 --out "$OUT"
 # A method without a CUDA version names the methods that have one.
 expect 2 "method 'vpolar' does not run on device cuda (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)" -- $R cornell --method vpolar --device cuda --size 8x8 --out "$OUT"
-expect 2 "method 'fpm' does not run on device portable (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)" -- $R cornell --method fpm --device portable --size 8x8 --out "$OUT"
+expect 2 "method 'fpm' does not run on device portable (methods that do: pt, vpolar, cartesian, cartesian-full, linear-falloff, log-polar, sdf-gt, sdf-relaxed, ipr, fipr)" -- $R cornell --method fpm --device portable --size 8x8 --out "$OUT"
 # The same refusals through --param.
 expect 2 "parameter device=nope: expected one of cpu, portable, cuda, auto" -- $R cornell --method pt --param device=nope --size 8x8 --out "$OUT"
 # pt on CUDA: this build has no CUDA, or this machine no GPU (CI has neither); either is one line.
@@ -30,6 +30,15 @@ expect 0 "" -- $R cornell --device auto --spp 1 --size 16x16 --out "$TMP/auto.pn
 expect 0 "" -- $R cornell --device portable --spp 2 --size 24x24 --out "$TMP/portable.exr"
 [ -s "$TMP/portable.exr" ] || fail "--device portable wrote no image"
 expect 0 "" -- $R cornell --device portable --spp 2 --size 24x24 --frames 2 --stereo 0.1 --out "$TMP/portable-st.png"
+
+# The Visual-Polar family on the portable backend, over a sequence (its denoiser's history carried
+# from frame to frame; test_device_vpolar compares the images with the CPU's), show=space included
+# (the pipeline's sample-space image is on the host either way).
+for m in vpolar cartesian cartesian-full linear-falloff log-polar; do
+  expect 0 "" -- $R cornell --method $m --device portable --size 32x24 --frames 2 --warmup 1 --out "$TMP/$m-portable.png"
+  [ -s "$TMP/$m-portable_0001.png" ] || fail "$m --device portable wrote no second frame"
+done
+expect 0 "" -- $R cornell --method vpolar --device portable --param show=space --size 32x24 --out "$TMP/vp-space.png"
 
 # The sphere tracers on the portable backend (test_device_sdf compares them with the CPU's bit for
 # bit; fipr over three frames, so its kept history is read), and on CUDA the same one line as pt

@@ -42,3 +42,44 @@ __global__ void fv_check_sdf(fv_ksdf_world w, fv_ksdf_frame f, fv_film_views out
     fv_ksdf_pixel(&w, &f, 0, 0, &out, &pc);
     res[0] = c.x + n.y + fv_ksdf_world_eval1(&w, 0.0f, 1.0f, 2.0f, 0) + (float)pc.steps + fv_ksdf_lobe_of(&w.mats[0]).norm;
 }
+
+/* Visual-Polar's kernels (kernel/vp_space.h, kernel/vp_map.h): a sample's screen position, a
+ * pixel's coordinates through the radial table, a φ-mip cell and lookup. */
+#include "kernel/vp_map.h"
+#include "kernel/vp_space.h"
+
+__global__ void fv_check_vp(fv_kvp_space s, fv_kvp_view v, const float *table, int n, fv_kphi_mips m, float *out)
+{
+    float px, py, X, V, level, sigma;
+    fv_kvp_to_screen(&s, &v, threadIdx.x + 0.5f, 0.25f, &px, &py);
+    fv_kvp_table_coords(table, n, 2.0f, px - v.gx, py - v.gy, &X, &V, &level, &sigma);
+    if (m.levels > 1) fv_kphi_halve_cell(&m, 1, threadIdx.x, blockIdx.x);
+    fv_kphi_sample(&m, X, V, level, out);
+    out[3] = sigma + (float)fv_kvp_nearest_cell(m.rows[0], m.w, 4, X, V);
+}
+
+/* Visual-Polar's trace (kernel/vp_trace.h): one grid sample's path on the flat scene. */
+#include "kernel/vp_trace.h"
+
+__global__ void fv_check_vp_trace(fv_kscene s, fv_kvp_trace_frame f, fv_kvp_gbuf g, fv_kvp_trace_counts *c)
+{
+    fv_kvp_trace_sample(&s, &f, &g, (long)blockIdx.x * blockDim.x + threadIdx.x, c);
+}
+
+/* Visual-Polar's foveated blur (kernel/vp_blur.h): a pixel of each pass. */
+#include "kernel/vp_blur.h"
+
+__global__ void fv_check_vp_blur(fv_kblur_table t, const float *sigma, float *rgb, float *tmp)
+{
+    fv_kblur_h_pixel(&t, sigma, rgb, tmp, threadIdx.x, blockIdx.x);
+    fv_kblur_v_pixel(&t, sigma, tmp, rgb, threadIdx.x, blockIdx.x);
+}
+
+/* Visual-Polar's history reprojection (kernel/vp_reproject.h): one grid sample. */
+#include "kernel/vp_reproject.h"
+
+__global__ void fv_check_vp_reproject(fv_kvp_reproject_frame f, float *prev_coord)
+{
+    const long i = (long)blockIdx.x * blockDim.x + threadIdx.x;
+    fv_kvp_reproject_sample(&f, i, &prev_coord[2 * i]);
+}

@@ -15,6 +15,7 @@
 #include <string.h>
 #include <cmocka.h>
 #include "filter/blur.h"
+#include "kernel/vp_blur.h"
 
 static float *filled(size_t n, float v)
 {
@@ -369,6 +370,53 @@ static void test_bad_input(void **st)
     free(img), free(ref), free(sig);
 }
 
+/* The kernels' two passes (kernel/vp_blur.h, a pixel at a time: what the portable backend and CUDA
+ * run) against fv_blur_variable (runs of pixels, vectors, slabs of rows), bit for bit. */
+static void kernel_against_filter(int w, int h, const float *sig, unsigned seed)
+{
+    const size_t n = (size_t)w * h;
+    float *img = noise(3 * n, 0.0f, 4.0f, seed), *want = malloc(sizeof(float) * 3 * n), *tmp = malloc(sizeof(float) * 3 * n),
+          *got = malloc(sizeof(float) * 3 * n);
+    memcpy(want, img, sizeof(float) * 3 * n);
+    fv_error err;
+    assert_int_equal(fv_blur_variable(want, w, h, sig, 2, &err), FV_OK);
+    float smax = 0.0f;
+    for (size_t i = 0; i < n; i++) smax = sig[i] > smax ? sig[i] : smax;
+    int nq;
+    size_t nk;
+    fv_blur_table_size(smax, w, h, &nq, &nk);
+    int *off = malloc(sizeof(int) * (size_t)nq);
+    float *k = malloc(sizeof(float) * nk);
+    fv_blur_table_fill(w, h, nq, off, k);
+    fv_kblur_table t = {w, h, (w > h ? w : h) - 1, nq, off, k};
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) fv_kblur_h_pixel(&t, sig, img, tmp, x, y);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) fv_kblur_v_pixel(&t, sig, tmp, got, x, y);
+    for (size_t i = 0; i < 3 * n; i++)
+        if (memcmp(&want[i], &got[i], sizeof(float)) != 0)
+            fail_msg("%dx%d: value %zu (pixel %zu, sigma %g): filter %.9g, kernels %.9g", w, h, i, i / 3, (double)sig[i / 3], (double)want[i],
+                     (double)got[i]);
+    free(img), free(want), free(tmp), free(got), free(off), free(k);
+}
+
+static void test_kernel_passes(void **st)
+{
+    (void)st;
+    float *sig = noise(45 * 330, 1.0f, 7.0f, 4);
+    kernel_against_filter(45, 330, sig, 1);
+    free(sig);
+    sig = noise(67 * 53, 0.0f, 5.0f, 3);
+    kernel_against_filter(67, 53, sig, 2);
+    free(sig);
+    sig = foveated_sigma(150, 97, 40.0, 60.0, 8.0, 70.0, 6.8);
+    kernel_against_filter(150, 97, sig, 3);
+    free(sig);
+    sig = filled(30 * 20, 40.0f); /* beyond the filter's kernel table */
+    kernel_against_filter(30, 20, sig, 4);
+    free(sig);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -377,6 +425,7 @@ int main(void)
         cmocka_unit_test(test_variance),          cmocka_unit_test(test_border_by_hand),
         cmocka_unit_test(test_matches_reference), cmocka_unit_test(test_wide_kernels),
         cmocka_unit_test(test_threads),           cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_kernel_passes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -130,7 +130,7 @@ static void test_refusals(void **st)
         const char *method, *params, *needle;
     } cases[] = {
         {"vpolar", "device=cuda", "method 'vpolar' does not run on device cuda (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)"},
-        {"fpm", "device=portable", "method 'fpm' does not run on device portable (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)"},
+        {"fpm", "device=portable", "method 'fpm' does not run on device portable (methods that do: pt, vpolar, cartesian, cartesian-full, linear-falloff, log-polar, sdf-gt, sdf-relaxed, ipr, fipr)"},
         {"pt", "device=gpu", "device"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {

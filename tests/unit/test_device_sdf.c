@@ -299,7 +299,7 @@ static void test_refusals(void **st)
         {"sdf-gt", "device=portable show=steps", "parameter show=steps: only the cpu device draws diagnostics (device portable renders the image)"},
         {"fipr", "device=portable show=mask", "parameter show=mask: only the cpu device draws diagnostics (device portable renders the image)"},
         {"ipr", "device=portable show=level", "parameter show=level: only the cpu device draws diagnostics (device portable renders the image)"},
-        {"vpolar", "device=portable", "method 'vpolar' does not run on device portable (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)"},
+        {"fpm", "device=portable", "method 'fpm' does not run on device portable (methods that do: pt, vpolar, cartesian, cartesian-full, linear-falloff, log-polar, sdf-gt, sdf-relaxed, ipr, fipr)"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         fv_params *p = fv_test_params_str(cases[i].params);

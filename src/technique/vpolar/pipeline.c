@@ -14,6 +14,8 @@
 #include "core/parallel.h"
 #include "filter/blur.h"
 #include "filter/phi_mips.h"
+#include "kernel/vp_reproject.h"
+#include "technique/vpolar/device.h"
 #include "technique/vpolar/pipeline.h"
 
 #define MAX_MIP_LEVELS 12
@@ -26,6 +28,7 @@ enum { COORDS_NONE = 0, COORDS_STORE, COORDS_READ };
 struct fv_vp_pipeline {
     const fv_scene *scene;
     fv_vp_opts o;
+    fv_vp_device *dev;      /* NULL: the CPU's own stages */
     int sw, sh;             /* screen size the buffers are for, 0 before the first frame */
     double ppd;
     fv_space *space;
@@ -63,6 +66,10 @@ fv_status fv_vp_pipeline_create(const fv_scene *scene, const fv_vp_opts *o, fv_v
     if (!p) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     p->scene = scene;
     p->o = *o;
+    if (o->device != FV_DEVICE_CPU && (s = fv_vp_device_create(scene, o->device, &p->dev, err)) != FV_OK) {
+        free(p);
+        return s;
+    }
     *out = p;
     return FV_OK;
 }
@@ -91,6 +98,7 @@ void fv_vp_pipeline_destroy(fv_vp_pipeline *p)
     free_buffers(p);
     fv_kit_counters_destroy(p->counters);
     fv_scratch_free(&p->blur_room);
+    fv_vp_device_destroy(p->dev);
     free(p);
 }
 
@@ -181,13 +189,9 @@ static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
     for (int64_t i0 = b; i0 < e; i0 += REPROJECT_SPAN) {
         const int n = e - i0 < REPROJECT_SPAN ? (int)(e - i0) : REPROJECT_SPAN;
         for (int k = 0; k < n; k++) {
-            const int64_t i = i0 + k;
-            ok[k] = 0, px[k] = gx, py[k] = gy;
-            if (!p->g.sampled[i] || p->g.id[i] == 0 || (p->onscreen && !p->onscreen[i])) continue;
-            fv_vec3 x = fv_v3(p->g.position[3 * i], p->g.position[3 * i + 1], p->g.position[3 * i + 2]);
             float qx, qy;
-            if (!fv_camera_project(&p->prev_cam, x, &qx, &qy)) continue;
-            if (qx < 0.0f || qy < 0.0f || qx > (float)p->sw || qy > (float)p->sh) continue;
+            ok[k] = 0, px[k] = gx, py[k] = gy;
+            if (!fv_kvp_reproject_screen(&p->g, p->onscreen, &p->prev_cam, p->sw, p->sh, (long)(i0 + k), &qx, &qy)) continue;
             ok[k] = 1, px[k] = qx, py[k] = qy;
         }
         float *pc = &p->prev_coord[2 * i0];
@@ -200,8 +204,8 @@ static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
         }
         #pragma omp simd
         for (int k = 0; k < n; k++) {
-            const float dx = px[k] - gx, dy = py[k] - gy;
-            const float X = fv_space_table_x(p->lut, 3, p->nlut, inv_step, sqrtf(dx * dx + dy * dy)), V = fv_space_turns(dx, dy);
+            float X, V;
+            fv_kvp_table_coords(p->lut, p->nlut, inv_step, px[k] - gx, py[k] - gy, &X, &V, NULL, NULL);
             pc[2 * k] = ok[k] ? X : NAN;
             pc[2 * k + 1] = ok[k] ? V : NAN;
         }
@@ -213,6 +217,7 @@ typedef struct map_ctx {
     const fv_space_view *view;
     fv_film_views out;
     bool identity, polar;
+    fv_kvp_map_frame mf;  /* the frame as the map kernels read it (kernel/vp_map.h) */
 } map_ctx;
 
 /* Visual-Polar stretches its profile (and so its fovea) from the centre gaze's largest ρ to this
@@ -265,77 +270,47 @@ static void map_coords(const map_ctx *c, int64_t y, int x0, int n, float *X, flo
     const float dy = (float)y + 0.5f - gy;
     /* The table's three entries (column, mip level, blur sigma) read the same way. */
     #pragma omp simd
-    for (int k = 0; k < n; k++) {
-        const float dx = (float)(x0 + k) + 0.5f - gx, r = sqrtf(dx * dx + dy * dy);
-        X[k] = fv_space_table_x(lut, 3, p->nlut, inv_step, r);
-        level[k] = fv_space_table_x(lut + 1, 3, p->nlut, inv_step, r);
-        V[k] = fv_space_turns(dx, dy);
-        sigma[k] = fv_space_table_x(lut + 2, 3, p->nlut, inv_step, r);
-    }
+    for (int k = 0; k < n; k++) fv_kvp_table_coords(lut, p->nlut, inv_step, (float)(x0 + k) + 0.5f - gx, dy, &X[k], &V[k], &level[k], &sigma[k]);
     if (p->o.blur) memcpy(&p->sigma[(size_t)y * p->sw + x0], sigma, (size_t)n * sizeof(float));
     if (p->coords_state == COORDS_STORE)
         for (int k = 0; k < n; k++) kept[3 * k] = X[k], kept[3 * k + 1] = V[k], kept[3 * k + 2] = level[k];
 }
 
-/* The film's first-hit buffers of screen pixel pix from grid cell near. */
-static void store_aux(const map_ctx *c, size_t pix, long near)
-{
-    const fv_vp_gbuf *g = &c->p->g;
-    bool hit = g->id[near] != 0;
-    fv_film_store_first_hit(&c->out, pix, hit, g->depth[near],
-                            fv_v3(g->position[3 * near], g->position[3 * near + 1], g->position[3 * near + 2]),
-                            fv_v3(g->normal[3 * near], g->normal[3 * near + 1], g->normal[3 * near + 2]),
-                            fv_v3(g->albedo[3 * near], g->albedo[3 * near + 1], g->albedo[3 * near + 2]),
-                            hit ? (int)g->id[near] - 1 : 0);
-}
-
 /* Screen pixel colours from the sample space (Sec. 3.4), the film's first-hit buffers from the
- * nearest sample, and the blur's sigma (Sec. 3.5), MAP_SPAN pixels of a row at a time. */
+ * nearest sample, and the blur's sigma (Sec. 3.5), MAP_SPAN pixels of a row at a time: a polar
+ * space's coordinates in one vectorised loop (or kept from the last frame), then each pixel's
+ * output with the kernel's step. */
 static void map_rows(void *ctx, int64_t b, int64_t e, int thread)
 {
     map_ctx *c = ctx;
     fv_vp_pipeline *p = c->p;
-    const fv_grid *g = fv_space_grid(p->space);
-    const bool aux = c->out.depth || c->out.normal || c->out.albedo || c->out.position || c->out.id;
     float X[MAP_SPAN], V[MAP_SPAN], level[MAP_SPAN];
     for (int64_t y = b; y < e; y++)
         for (int x0 = 0; x0 < p->sw; x0 += MAP_SPAN) {
             const int n = p->sw - x0 < MAP_SPAN ? p->sw - x0 : MAP_SPAN;
-            if (c->polar) {
+            if (c->polar)
                 map_coords(c, y, x0, n, X, V, level);
-            } else {
-                /* The Cartesian grid: no blur (its sigma, if any, from the table) and level 0. */
-                for (int k = 0; k < n; k++) {
-                    const float px = (float)(x0 + k) + 0.5f, py = (float)y + 0.5f;
-                    if (p->o.blur) {
-                        float dx = px - c->view->gx, dy = py - c->view->gy, t = sqrtf(dx * dx + dy * dy) / LUT_STEP;
-                        int i = (int)t;
-                        i = i < p->nlut - 2 ? i : p->nlut - 2;
-                        float f = t - (float)i;
-                        const float *l0 = &p->lut[3 * i], *l1 = l0 + 3;
-                        p->sigma[(size_t)y * p->sw + x0 + k] = l0[2] + f * (l1[2] - l0[2]);
-                    }
-                    level[k] = 0.0f;
-                    if (!c->identity) fv_space_from_screen(c->view, px, py, &X[k], &V[k], NULL);
-                }
-            }
-            for (int k = 0; k < n; k++) {
-                const size_t pix = (size_t)y * p->sw + x0 + k;
-                if (c->identity) {
-                    memcpy(&c->out.color[3 * pix], &p->g.color[3 * pix], 3 * sizeof(float));
-                    if (aux) store_aux(c, pix, (long)pix);
-                    continue;
-                }
-                fv_phi_mips_sample(p->mips, X[k], V[k], level[k], &c->out.color[3 * pix]);
-                if (!aux) continue;
-                int gx = (int)X[k];
-                gx = gx < 0 ? 0 : (gx >= g->w ? g->w - 1 : gx);
-                int nr = fv_grid_col_h(g, gx);
-                int gy = (int)(V[k] * (float)nr);
-                gy = gy < 0 ? 0 : (gy >= nr ? nr - 1 : gy);
-                store_aux(c, pix, (long)gy * g->w + gx);
-            }
+            else
+                for (int k = 0; k < n; k++) fv_kvp_map_coords(&c->mf, x0 + k, (int)y, &X[k], &V[k], &level[k]);
+            for (int k = 0; k < n; k++) fv_kvp_map_out(&c->mf, (size_t)y * p->sw + x0 + k, X[k], V[k], level[k], &c->out);
         }
+}
+
+/* The map stage's frame for the kernels. */
+static void map_frame(const fv_vp_pipeline *p, const fv_space_view *view, bool identity, fv_kvp_map_frame *mf)
+{
+    memset(mf, 0, sizeof *mf);
+    mf->space = *fv_space_kernel(p->space);
+    mf->view = fv_space_kview(view);
+    mf->col_h = fv_space_grid(p->space)->col_h;
+    mf->g = p->g;
+    fv_phi_mips_kernel(p->mips, &mf->mips);
+    mf->lut = p->lut;
+    mf->nlut = p->nlut;
+    mf->inv_step = 1.0f / LUT_STEP;
+    mf->polar = fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN;
+    mf->identity = identity;
+    mf->sigma = p->o.blur ? p->sigma : NULL;
 }
 
 fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
@@ -388,7 +363,12 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     job.counters = fv_kit_counters_reuse(&p->counters);
     fv_vp_trace_result tr;
     fv_stage_clock t0 = fv_stage_clock_now();
-    bool traced = fv_vp_trace(&job, &p->g, &tr);
+    bool traced;
+    if (p->dev) {
+        if ((s = fv_vp_device_trace(p->dev, &job, &p->g, &tr, &traced, err)) != FV_OK) return s;
+    } else {
+        traced = fv_vp_trace(&job, &p->g, &tr);
+    }
     const fv_stage_clock t1 = fv_stage_clock_now();
     const double t_trace = t1.wall - t0.wall;
     fv_stage_add(stats, "trace", t0, t1);
@@ -409,7 +389,21 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
              * stayed kept it). */
             reproject_ctx rc = {p, fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN && p->prev_view.gx == p->lut_gx &&
                                        p->prev_view.gy == p->lut_gy};
-            fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
+            if (p->dev && (rc.lut || fv_space_kind_of(p->space) == FV_SPACE_CARTESIAN)) {
+                fv_kvp_reproject_frame rf;
+                memset(&rf, 0, sizeof rf);
+                rf.space = *fv_space_kernel(p->space);
+                rf.g = p->g;
+                rf.onscreen = p->onscreen;
+                rf.prev_cam = p->prev_cam;
+                rf.prev_view = fv_space_kview(&p->prev_view);
+                rf.prev_lut = p->lut;
+                rf.nlut = p->nlut;
+                rf.inv_step = 1.0f / LUT_STEP;
+                fv_vp_device_reproject(p->dev, &rf, p->prev_coord, frame->threads);
+            } else {
+                fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
+            }
         }
         fv_svgf_frame fr = {p->g.color, p->g.reflectance, p->g.normal, p->g.depth, p->g.position, p->g.id,
                             hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
@@ -433,7 +427,12 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     /* 3. mipmaps along φ (Sec. 3.4) */
     bool identity = fv_space_kind_of(p->space) == FV_SPACE_CARTESIAN && g->w == p->sw && g->h == p->sh;
     t0 = fv_stage_clock_now();
-    if (!identity) fv_phi_mips_build(p->mips, p->g.color, frame->threads);
+    if (!identity) {
+        if (p->dev)
+            fv_vp_device_mips(p->dev, p->mips, p->g.color, frame->threads);
+        else
+            fv_phi_mips_build(p->mips, p->g.color, frame->threads);
+    }
     fv_stage_stop(stats, "mip", t0);
 
     /* 4. back to the screen */
@@ -447,19 +446,27 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     /* A gaze that stays (a still eye, a screenshot, the viewer) reuses the coordinates: from the
      * second frame at the same gaze they are kept (if the memory is there), from the third read.
      * A gaze that moves never pays for keeping them. */
-    const bool still = view.gx == p->map_gx && view.gy == p->map_gy;
+    const bool still = !p->dev && view.gx == p->map_gx && view.gy == p->map_gy; /* a device recomputes them */
     p->coords_state = !mc.polar || !still ? COORDS_NONE : (p->coords_state == COORDS_NONE ? COORDS_STORE : COORDS_READ);
     if (p->coords_state == COORDS_STORE && !p->coords && !(p->coords = fv_alloc_array((size_t)p->sw * p->sh, 3 * sizeof(float))))
         p->coords_state = COORDS_NONE;
     p->map_gx = view.gx, p->map_gy = view.gy;
     if (p->coords_state != COORDS_READ) build_radial_lut(p, &view);
     fv_stats_add_count(stats, "map_reused", p->coords_state == COORDS_READ);
-    fv_parallel_for(p->sh, 8, frame->threads, map_rows, &mc);
+    map_frame(p, &view, identity, &mc.mf);
+    if (p->dev)
+        fv_vp_device_map(p->dev, &mc.mf, &mc.out, frame->threads);
+    else
+        fv_parallel_for(p->sh, 8, frame->threads, map_rows, &mc);
     fv_stage_stop(stats, "map", t0);
 
     /* 5. foveated blur (Sec. 3.5) */
     t0 = fv_stage_clock_now();
-    if (p->o.blur && (s = fv_blur_variable_in(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, &p->blur_room, err)) != FV_OK) return s;
+    if (p->o.blur) {
+        s = p->dev ? fv_vp_device_blur(p->dev, fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, err)
+                   : fv_blur_variable_in(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, &p->blur_room, err);
+        if (s != FV_OK) return s;
+    }
     fv_stage_stop(stats, "blur", t0);
     fv_kit_phase(&prog, frame, 0.8, 0.2);
     return fv_kit_phase_end(&prog, err);

@@ -14,6 +14,7 @@
 
 #include <stdbool.h>
 #include "filter/svgf.h"
+#include "fovea/device.h"
 #include "fovea/film.h"
 #include "fovea/frame.h"
 #include "fovea/stats.h"
@@ -37,6 +38,7 @@ typedef struct fv_vp_opts {
                                   iterations: every pass everywhere */
     double periphery_deg;      /* where the periphery's fewer passes start (blur_ramp_deg by default),
                                   stretched with the space like the blur's profile */
+    fv_device device;          /* cpu, or portable: trace, mipmaps and map as kernels (device.h) */
 } fv_vp_opts;
 
 typedef struct fv_vp_pipeline fv_vp_pipeline;

@@ -30,6 +30,7 @@
 #define EQ2_AT_FLAT 105.04624271125317 /* Eq. 2 at 5.79 degrees (test_vp_space checks it) */
 #define FIT_MAX_DEGREE 10
 #define FIT_POINTS 1025
+_Static_assert(FIT_MAX_DEGREE + 1 == FV_KVP_MAX_COEF, "the kernel's copy of the fit holds every coefficient");
 
 struct fv_space {
     fv_space_opts o;
@@ -45,6 +46,7 @@ struct fv_space {
     double coef[FIT_MAX_DEGREE + 1];
     int ncoef;
     fv_space_info info;
+    fv_kvp_space k;        /* the flat copy the kernels read */
 };
 
 void fv_space_opts_default(fv_space_kind kind, fv_space_opts *o)
@@ -75,13 +77,6 @@ static double acuity_area_inverse(double a, double lo, double hi)
         else hi = m;
     }
     return 0.5 * (lo + hi);
-}
-
-static double poly_eval(const double *c, int n, double t)
-{
-    double r = 0.0;
-    for (int i = n - 1; i >= 0; i--) r = r * t + c[i];
-    return r;
 }
 
 /* Least-squares fit of y(t) on [0, 1] by a polynomial of degree n - 1: normal equations solved by
@@ -184,7 +179,7 @@ static fv_status build_vpolar(fv_space *s, fv_error *err)
     poly_fit(t, y, FIT_POINTS, s->ncoef, s->coef);
     double worst = 0.0;
     for (int k = 0; k < FIT_POINTS; k++) {
-        double e = fabs(poly_eval(s->coef, s->ncoef, t[k]) - y[k]);
+        double e = fabs(fv_kvp_poly(s->coef, s->ncoef, t[k]) - y[k]);
         if (e > worst) worst = e;
     }
     free(t);
@@ -259,6 +254,13 @@ fv_status fv_space_create(const fv_space_opts *o, int screen_w, int screen_h, do
             float phi = 2.0f * FV_PI * ((float)y + 0.5f) / (float)s->grid.h;
             s->row_cs[2 * y] = cosf(phi), s->row_cs[2 * y + 1] = sinf(phi);
         }
+    s->k.kind = (int)o->kind;
+    s->k.sw = s->sw, s->k.sh = s->sh;
+    s->k.gw = s->grid.w, s->k.gh = s->grid.h;
+    s->k.x_f = s->x_f, s->k.s_f = s->s_f;
+    memcpy(s->k.coef, s->coef, sizeof s->coef);
+    s->k.ncoef = s->ncoef;
+    s->k.lp_alpha = o->lp_alpha;
     s->count = 0;
     for (int x = 0; x < s->grid.w; x++) s->count += fv_grid_col_h(&s->grid, x);
     *out = s;
@@ -299,24 +301,11 @@ fv_space_view fv_space_view_at(const fv_space *s, fv_gaze g)
 
 float fv_space_radius(const fv_space_view *v, float X)
 {
-    const fv_space *s = v->space;
-    if (s->o.kind == FV_SPACE_VPOLAR) {
-        double frac;
-        if (X <= s->x_f) {
-            frac = s->s_f * (X > 0.0f ? X : 0.0f) / s->x_f;
-        } else {
-            double t = (X - s->x_f) / (s->grid.w - s->x_f);
-            frac = poly_eval(s->coef, s->ncoef, t > 1.0 ? 1.0 : t);
-        }
-        return (float)(frac * v->rho_max);
-    }
-    if (s->o.kind == FV_SPACE_LOGPOLAR) {
-        float u = X / (float)s->grid.w;
-        u = u < 0.0f ? 0.0f : u;
-        return expf(v->log_rho_max * powf(u, (float)s->o.lp_alpha));
-    }
-    return 0.0f;
+    const fv_kvp_view kv = fv_space_kview(v);
+    return fv_kvp_radius(&v->space->k, &kv, X);
 }
+
+const fv_kvp_space *fv_space_kernel(const fv_space *s) { return &s->k; }
 
 long fv_space_onscreen_mask(const fv_space_view *v, float reach_px, uint8_t *mask)
 {
@@ -382,24 +371,15 @@ void fv_space_radial_table(const fv_space_view *v, float step, int n, int stride
 
 void fv_space_to_screen(const fv_space_view *v, float X, float V, float *px, float *py)
 {
-    const fv_space *s = v->space;
-    if (s->o.kind == FV_SPACE_CARTESIAN) {
-        *px = X * (float)s->sw / (float)s->grid.w;
-        *py = V * (float)s->sh;
-        return;
-    }
-    float r = fv_space_radius(v, X);
-    float phi = 2.0f * FV_PI * V;
-    *px = v->gx + r * cosf(phi);
-    *py = v->gy + r * sinf(phi);
+    const fv_kvp_view kv = fv_space_kview(v);
+    fv_kvp_to_screen(&v->space->k, &kv, X, V, px, py);
 }
 
 void fv_space_from_screen(const fv_space_view *v, float px, float py, float *X, float *V, float *phi_per_px)
 {
     const fv_space *s = v->space;
     if (s->o.kind == FV_SPACE_CARTESIAN) {
-        *X = px * (float)s->grid.w / (float)s->sw;
-        *V = py / (float)s->sh;
+        fv_kvp_cartesian_from_screen(&s->k, px, py, X, V);
         if (phi_per_px) *phi_per_px = 0.0f;
         return;
     }

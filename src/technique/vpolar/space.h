@@ -28,6 +28,7 @@
 #include "filter/grid.h"
 #include "fovea/gaze.h"
 #include "fovea/status.h"
+#include "kernel/vp_space.h"
 
 typedef enum fv_space_kind { FV_SPACE_CARTESIAN = 0, FV_SPACE_VPOLAR, FV_SPACE_LOGPOLAR } fv_space_kind;
 
@@ -87,59 +88,21 @@ void fv_space_from_screen(const fv_space_view *v, float px, float py, float *X, 
 /* Screen radius (pixels from the gaze) of column coordinate X. */
 float fv_space_radius(const fv_space_view *v, float X);
 
-/* The angle of (dx, dy) in turns, [0, 1) like the V of fv_space_from_screen, within 3e-7 of the
- * exact angle (test_vp_space), written so that a loop over pixels vectorises (the map stage:
- * atan2f from libm was a quarter of its time). The octant is folded onto [0, pi/4] and beyond
- * tan(pi/8) shifted by pi/4 (atan a = pi/4 + atan((a - 1)/(a + 1))), leaving |t| <= tan(pi/8),
- * where t P(t^2) with P of degree 4 (least-squares fit on that interval, ours) is within 4e-9 rad.
- * Every case is arithmetic on a 0-or-1 factor or a select on the integer bits, never a branch
- * around floating-point work: with trapping math on, GCC will not turn such a branch back into
- * a vector select, and the loop would stay scalar. */
-static inline float fv_space_bit_float(int32_t cond) /* 1.0f when cond, else 0.0f */
-{
-    union { int32_t i; float f; } u = {-cond & 0x3f800000};
-    return u.f;
-}
-
-static inline float fv_space_turns(float dx, float dy)
-{
-    const float ax = fabsf(dx), ay = fabsf(dy);
-    const float mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
-    const float a = mn / (mx > 1e-30f ? mx : 1e-30f);
-    const float big = fv_space_bit_float(a > 0.41421356f);
-    const float t = (a - big) / (1.0f + big * a), u = t * t; /* a / 1 below tan(pi/8): exact */
-    const float poly = 0.999999922f + u * (-0.333323067f + u * (0.199638607f + u * (-0.137683572f + u * 0.0776761543f)));
-    float r = big * 0.785398163f + t * poly;                   /* in [0, pi/4] */
-    r += fv_space_bit_float(ay > ax) * (1.57079633f - 2.0f * r); /* pi/2 - r */
-    r += fv_space_bit_float(dx < 0.0f) * (3.14159265f - 2.0f * r); /* pi - r */
-    float v = r * 0.159154943f;
-    union { float f; int32_t i; } uv = {v}, uy = {dy};
-    uv.i ^= uy.i & (int32_t)0x80000000; /* the lower half plane: -v (v >= 0) */
-    v = uv.f + fv_space_bit_float(uv.f < 0.0f);
-    uv.f = v;
-    uv.i &= -(int32_t)(v < 1.0f); /* rounding up to 1 is the angle 0 */
-    return uv.f;
-}
-
 /* A radial table of one view, for the lookups that depend only on the distance from the gaze (the
  * map stage, the denoiser's reprojection): entry i, at table[i * stride], holds the column X at
  * distance i * step from the gaze (fv_space_from_screen along +x) and, next to it, the mip level
  * (log2 of the rows one pixel spans along φ, 0 below one row); n >= 2 entries. */
 void fv_space_radial_table(const fv_space_view *v, float step, int n, int stride, float *table);
 
-/* The column at distance r >= 0 from the gaze, linear between the entries of a radial table (the
- * last interval continues past its end); 1 / step as inv_step. From table + 1 the same reads the
- * mip level, and any value a caller keeps every `stride` floats beside them (the pipeline's blur
- * sigma). For a Visual-Polar table every
- * 0.5 px at 1280x1440, within 1e-3 columns of fv_space_from_screen (test_vp_space): X is linear in
- * the fovea and smooth beyond it (Eq. 2 meets the fovea's pi e^2 with its slope). */
-static inline float fv_space_table_x(const float *table, int stride, int n, float inv_step, float r)
+/* fv_space_turns and fv_space_table_x, the per-pixel steps of the lookups through such a table,
+ * are kernel code: kernel/vp_space.h. */
+
+/* The flat form of the space (kernel/vp_space.h) and of a view of it, for the kernels. */
+const fv_kvp_space *fv_space_kernel(const fv_space *s);
+static inline fv_kvp_view fv_space_kview(const fv_space_view *v)
 {
-    const float t = r * inv_step;
-    int i = (int)t;
-    i = i < n - 2 ? i : n - 2;
-    const float f = t - (float)i;
-    return table[stride * i] + f * (table[stride * (i + 1)] - table[stride * i]);
+    fv_kvp_view k = {v->gx, v->gy, v->rho_max, v->log_rho_max};
+    return k;
 }
 
 /* For every grid cell (storage w * h, rows beyond a column's height 0): 1 when some point of the

@@ -8,6 +8,7 @@
 
 typedef struct trace_ctx {
     const fv_vp_trace_job *job;
+    fv_kvp_trace_frame kf;
     const fv_vp_gbuf *g;
     const fv_grid *grid;
     fv_kit_counters *counters; /* rays, NaN, paths (FV_KIT_USER0) */
@@ -15,27 +16,34 @@ typedef struct trace_ctx {
 
 double fv_vp_survival(const fv_space_view *v, float px, float py, double px_per_deg, double e0, double e1, double p)
 {
-    float dx = px - v->gx, dy = py - v->gy;
-    return fv_acuity_linear(sqrt((double)dx * dx + (double)dy * dy) / px_per_deg, e0, e1, p);
+    const fv_kvp_view kv = fv_space_kview(v);
+    return fv_kvp_survival(&kv, px, py, px_per_deg, e0, e1, p);
 }
 
-static void store_miss(const fv_vp_gbuf *g, long i)
+void fv_vp_trace_kframe(const fv_vp_trace_job *job, fv_kvp_trace_frame *out)
 {
-    memset(&g->color[3 * i], 0, 3 * sizeof(float));
-    memset(&g->albedo[3 * i], 0, 3 * sizeof(float));
-    memset(&g->reflectance[3 * i], 0, 3 * sizeof(float));
-    memset(&g->normal[3 * i], 0, 3 * sizeof(float));
-    memset(&g->position[3 * i], 0, 3 * sizeof(float));
-    g->depth[i] = INFINITY;
-    g->id[i] = 0;
+    memset(out, 0, sizeof *out);
+    const fv_space *sp = job->view.space;
+    out->space = *fv_space_kernel(sp);
+    out->view = fv_space_kview(&job->view);
+    out->col_h = fv_space_grid(sp)->col_h;
+    out->cam = job->cam;
+    out->pt = job->pt;
+    out->seed = job->frame->seed;
+    out->eye = job->frame->eye;
+    out->index = job->frame->index;
+    out->onscreen = job->skip_offscreen ? job->onscreen : NULL;
+    out->kill = job->kill;
+    out->kill_e0 = job->kill_e0, out->kill_e1 = job->kill_e1, out->kill_p = job->kill_p;
+    out->px_per_deg = job->px_per_deg;
 }
 
-/* Traces up to eight samples (grid pixel indices, -1 for an empty lane) as one camera packet. */
+/* Traces up to eight samples (grid pixel indices, -1 for an empty lane) as one camera packet: each
+ * placed and stored by the kernel's steps (kernel/vp_trace.h), the camera rays through Embree. */
 static void trace_packet(trace_ctx *c, const long *pix, int thread)
 {
     const fv_vp_trace_job *j = c->job;
     const fv_vp_gbuf *g = c->g;
-    const int w = c->grid->w;
     fv_vec3 dir[8];
     fv_rng rng[8];
     bool active[8];
@@ -47,25 +55,12 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
         dir[k] = j->cam.forward;
         if (pix[k] < 0) continue;
         long i = pix[k];
-        int x = (int)(i % w), y = (int)(i / w);
-        rng[k] = fv_kit_rng(j->frame, (uint64_t)i, 0);
-        /* Jitter inside the grid cell: the temporal accumulation of the denoiser then integrates
-         * over the cell instead of converging to one aliased point. */
-        float X = (float)x + fv_rng_next(&rng[k]);
-        float V = ((float)y + fv_rng_next(&rng[k])) / (float)fv_grid_col_h(c->grid, x);
-        float px, py;
-        fv_space_to_screen(&j->view, X, V, &px, &py);
-        bool go = !(j->skip_offscreen && j->onscreen && !j->onscreen[i]);
-        if (go && j->kill) {
-            fv_rng kr = fv_rng_stream(j->frame->seed, FV_STREAM_KILL, (uint64_t)i * 2 + (uint64_t)j->frame->eye, 0, (uint64_t)j->frame->index);
-            go = fv_rng_next(&kr) < (float)fv_vp_survival(&j->view, px, py, j->px_per_deg, j->kill_e0, j->kill_e1, j->kill_p);
-        }
+        bool go = fv_kvp_sample_ray(&c->kf, i, &rng[k], &dir[k]);
         g->sampled[i] = go;
         if (!go) {
-            store_miss(g, i);
+            fv_kvp_store_miss(g, i);
             continue;
         }
-        dir[k] = fv_camera_dir(&j->cam, px, py);
         active[k] = true;
         nactive++;
     }
@@ -82,19 +77,7 @@ static void trace_packet(trace_ctx *c, const long *pix, int thread)
         for (int n = 1; n < j->pt.spp; n++)
             L = fv_add(L, fv_kit_guard(fv_path_trace_from(j->scene, &j->pt, j->cam.pos, dir[k], &hits[k], ok[k], &rng[k], NULL, &rays), &bad));
         if (j->pt.spp > 1) L = fv_scale(L, 1.0f / (float)j->pt.spp);
-        g->color[3 * i] = L.x, g->color[3 * i + 1] = L.y, g->color[3 * i + 2] = L.z;
-        if (first.hit) {
-            g->albedo[3 * i] = first.albedo.x, g->albedo[3 * i + 1] = first.albedo.y, g->albedo[3 * i + 2] = first.albedo.z;
-            memcpy(&g->reflectance[3 * i], &first.reflectance, 3 * sizeof(float));
-            g->normal[3 * i] = first.n.x, g->normal[3 * i + 1] = first.n.y, g->normal[3 * i + 2] = first.n.z;
-            g->position[3 * i] = first.p.x, g->position[3 * i + 1] = first.p.y, g->position[3 * i + 2] = first.p.z;
-            g->depth[i] = first.t;
-            g->id[i] = (uint32_t)first.obj + 1u;
-        } else {
-            fv_vec3 keep = L;
-            store_miss(g, i);
-            g->color[3 * i] = keep.x, g->color[3 * i + 1] = keep.y, g->color[3 * i + 2] = keep.z;
-        }
+        fv_kvp_store_sample(g, i, L, &first);
     }
     fv_kit_count(c->counters, thread, FV_KIT_RAYS, rays);
     fv_kit_count(c->counters, thread, FV_KIT_USER0, (uint64_t)nactive);
@@ -135,6 +118,7 @@ bool fv_vp_trace(const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_re
     c->job = job;
     c->g = g;
     c->grid = fv_space_grid(job->view.space);
+    fv_vp_trace_kframe(job, &c->kf);
     const fv_grid *grid = c->grid;
     bool done = true;
     if (job->order == FV_VP_ORDER_RANDOM && job->perm)

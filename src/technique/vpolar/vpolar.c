@@ -145,7 +145,8 @@ static fv_status read_opts(vp_kind kind, fv_params *p, fv_vp_opts *o, vp_show *s
     return FV_OK;
 }
 
-static fv_status create_kind(vp_kind kind, const char *name, const fv_scene *scene, fv_params *params, void **state, fv_error *err)
+static fv_status create_kind(vp_kind kind, const char *name, const fv_scene *scene, fv_params *params, fv_device device, void **state,
+                             fv_error *err)
 {
     vp_state *st = calloc(1, sizeof *st);
     if (!st) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
@@ -153,6 +154,7 @@ static fv_status create_kind(vp_kind kind, const char *name, const fv_scene *sce
     st->kind = kind;
     st->scene = scene;
     fv_status s = read_opts(kind, params, &st->o, &st->show, err);
+    st->o.device = device;
     for (int e = 0; s == FV_OK && e < 2; e++) s = fv_vp_pipeline_create(scene, &st->o, &st->eye[e], err);
     if (s != FV_OK) {
         fv_vp_pipeline_destroy(st->eye[0]);
@@ -286,26 +288,54 @@ static void vp_destroy(void *state)
     free(st);
 }
 
+static fv_status create_vpolar_on(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
+{
+    (void)l;
+    return create_kind(K_VPOLAR, "vpolar", s, p, d, st, e);
+}
 static fv_status create_vpolar(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
 {
-    return create_kind(K_VPOLAR, "vpolar", s, p, st, e);
+    return create_vpolar_on(s, p, FV_DEVICE_CPU, l, st, e);
+}
+static fv_status create_cartesian_on(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
+{
+    (void)l;
+    return create_kind(K_CARTESIAN, "cartesian", s, p, d, st, e);
 }
 static fv_status create_cartesian(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
 {
-    return create_kind(K_CARTESIAN, "cartesian", s, p, st, e);
+    return create_cartesian_on(s, p, FV_DEVICE_CPU, l, st, e);
+}
+static fv_status create_cartesian_full_on(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
+{
+    (void)l;
+    return create_kind(K_CARTESIAN_FULL, "cartesian-full", s, p, d, st, e);
 }
 static fv_status create_cartesian_full(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
 {
-    return create_kind(K_CARTESIAN_FULL, "cartesian-full", s, p, st, e);
+    return create_cartesian_full_on(s, p, FV_DEVICE_CPU, l, st, e);
+}
+static fv_status create_linear_falloff_on(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
+{
+    (void)l;
+    return create_kind(K_LINEAR_FALLOFF, "linear-falloff", s, p, d, st, e);
 }
 static fv_status create_linear_falloff(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
 {
-    return create_kind(K_LINEAR_FALLOFF, "linear-falloff", s, p, st, e);
+    return create_linear_falloff_on(s, p, FV_DEVICE_CPU, l, st, e);
+}
+static fv_status create_logpolar_on(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
+{
+    (void)l;
+    return create_kind(K_LOGPOLAR, "log-polar", s, p, d, st, e);
 }
 static fv_status create_logpolar(const fv_scene *s, fv_params *p, const fv_log *l, void **st, fv_error *e)
 {
-    return create_kind(K_LOGPOLAR, "log-polar", s, p, st, e);
+    return create_logpolar_on(s, p, FV_DEVICE_CPU, l, st, e);
 }
+
+/* The devices beyond the CPU: the portable backend (technique/vpolar/device.h). */
+#define VP_DEVICES (1u << FV_DEVICE_PORTABLE)
 
 /* The furnace with one bounce (max_depth 2): emission 0.5 seen directly, plus 0.25 and 0.125
  * gathered at the two vertices; the denoiser and the blur preserve a constant image. */
@@ -391,7 +421,7 @@ const fv_technique_class fv_technique_vpolar = {
     .name = "vpolar",
     .summary = "foveated path tracing in Visual-Polar space: 1 spp on the VP grid, SVGF in VP space, φ-mipmapped mapping, foveated blur",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_vpolar_params), .main = REDUCTION_STEPS,
-    .create = create_vpolar, .render = vp_render, .destroy = vp_destroy,
+    .create = create_vpolar, .create_on = create_vpolar_on, .devices = VP_DEVICES, .render = vp_render, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
 
@@ -399,7 +429,7 @@ const fv_technique_class fv_technique_cartesian = {
     .name = "cartesian",
     .summary = "uniform screen grid with vpolar's sample count, SVGF, bilinear upscaling (Visual-Polar Sec. 4.3 baseline)",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_cartesian_params), .main = REDUCTION_STEPS,
-    .create = create_cartesian, .render = vp_render, .destroy = vp_destroy,
+    .create = create_cartesian, .create_on = create_cartesian_on, .devices = VP_DEVICES, .render = vp_render, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp",
 };
 
@@ -407,7 +437,7 @@ const fv_technique_class fv_technique_cartesian_full = {
     .name = "cartesian-full",
     .summary = "1 spp at full resolution with SVGF: the cost reference of Visual-Polar Fig. 12",
     .family = FV_FAMILY_VPOLAR, .baseline = "pt", FV_CLASS_PARAMS(k_cartesian_full_params), .main = BOUNCE_STEPS,
-    .create = create_cartesian_full, .render = vp_render, .destroy = vp_destroy,
+    .create = create_cartesian_full, .create_on = create_cartesian_full_on, .devices = VP_DEVICES, .render = vp_render, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp",
 };
 
@@ -415,7 +445,7 @@ const fv_technique_class fv_technique_linear_falloff = {
     .name = "linear-falloff",
     .summary = "full-resolution launch, paths killed at random outside the fovea (Weier et al. 2016), SVGF, blur",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_linear_falloff_params), .main = BOUNCE_STEPS,
-    .create = create_linear_falloff, .render = vp_render, .destroy = vp_destroy,
+    .create = create_linear_falloff, .create_on = create_linear_falloff_on, .devices = VP_DEVICES, .render = vp_render, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
 
@@ -423,6 +453,6 @@ const fv_technique_class fv_technique_logpolar = {
     .name = "log-polar",
     .summary = "kernel log-polar space (Meng et al. 2018), SVGF in log-polar space, φ-mipmapped mapping",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_logpolar_params), .main = BOUNCE_STEPS,
-    .create = create_logpolar, .render = vp_render, .destroy = vp_destroy,
+    .create = create_logpolar, .create_on = create_logpolar_on, .devices = VP_DEVICES, .render = vp_render, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };

@@ -1,0 +1,200 @@
+/* fovea — the Visual-Polar family's stages on the portable backend (device.h): the kernels of
+ * kernel/vp_trace.h and kernel/vp_map.h, a cell or pixel at a time over tiles on the CPU's
+ * threads. */
+#include <stdlib.h>
+#include <string.h>
+#include "core/alloc.h"
+#include "core/parallel.h"
+#include "filter/blur.h"
+#include "kernel/vp_blur.h"
+#include "kernel/vp_reproject.h"
+#include "scene/export.h"
+#include "technique/vpolar/device.h"
+
+struct fv_vp_device {
+    const fv_scene *scene;
+    fv_scene_export *flat;
+    float *blur_tmp;       /* the horizontal pass's image, kept between frames */
+    size_t blur_pixels;
+};
+
+fv_status fv_vp_device_create(const fv_scene *scene, fv_device device, fv_vp_device **out, fv_error *err)
+{
+    *out = NULL;
+    if (device != FV_DEVICE_PORTABLE) return fv_error_set(err, FV_ERR_INVALID, "the Visual-Polar family runs on device portable only");
+    fv_vp_device *d = calloc(1, sizeof *d);
+    if (!d) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    d->scene = scene;
+    fv_status s = fv_scene_export_create(scene, &d->flat, err);
+    if (s != FV_OK) {
+        free(d);
+        return s;
+    }
+    *out = d;
+    return FV_OK;
+}
+
+void fv_vp_device_destroy(fv_vp_device *d)
+{
+    if (!d) return;
+    fv_scene_export_destroy(d->flat);
+    free(d->blur_tmp);
+    free(d);
+}
+
+typedef struct trace_job {
+    const fv_kscene *scene;
+    fv_kvp_trace_frame f;
+    fv_kvp_gbuf g;
+    fv_kvp_trace_counts *c; /* per thread */
+} trace_job;
+
+static void trace_tile(void *ctx, const fv_tile *t)
+{
+    trace_job *j = ctx;
+    const int w = j->f.space.gw;
+    for (int y = t->y0; y < t->y1; y++)
+        for (int x = t->x0; x < t->x1; x++)
+            if (y < (j->f.col_h ? j->f.col_h[x] : j->f.space.gh)) fv_kvp_trace_sample(j->scene, &j->f, &j->g, (long)y * w + x, &j->c[t->thread]);
+}
+
+fv_status fv_vp_device_trace(fv_vp_device *d, const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_result *res, bool *done,
+                             fv_error *err)
+{
+    memset(res, 0, sizeof *res);
+    *done = false;
+    /* the flat scene at the frame's time (moving instances) */
+    fv_status s = fv_scene_export_update(d->flat, d->scene, err);
+    if (s != FV_OK) return s;
+    trace_job j;
+    j.scene = fv_scene_export_view(d->flat);
+    fv_vp_trace_kframe(job, &j.f);
+    j.g = *g;
+    const int nt = fv_thread_count(job->frame->threads);
+    if (!(j.c = calloc((size_t)nt, sizeof *j.c))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    *done = fv_parallel_tiles(j.f.space.gw, j.f.space.gh, job->frame->threads, trace_tile, &j, fv_kit_progress_fn, job->progress);
+    for (int t = 0; t < nt; t++) res->rays += j.c[t].rays, res->paths += j.c[t].paths, res->nan_paths += j.c[t].nan_paths;
+    free(j.c);
+    return FV_OK;
+}
+
+typedef struct mips_job {
+    fv_kphi_mips m;
+    const float *rgb;
+    int level;
+} mips_job;
+
+static void mips_tile(void *ctx, const fv_tile *t)
+{
+    const mips_job *j = ctx;
+    const size_t stride = 3 * (size_t)j->m.w;
+    for (int y = t->y0; y < t->y1; y++)
+        for (int x = t->x0; x < t->x1; x++) {
+            if (j->level > 0) {
+                fv_kphi_halve_cell(&j->m, j->level, x, y);
+                continue;
+            }
+            const size_t i = (size_t)y * stride + 3 * (size_t)x;
+            for (int c = 0; c < 3; c++) j->m.img[0][i + c] = j->rgb[i + c];
+        }
+}
+
+void fv_vp_device_mips(fv_vp_device *d, fv_phi_mips *m, const float *rgb, int threads)
+{
+    (void)d;
+    mips_job j;
+    fv_phi_mips_kernel(m, &j.m);
+    j.rgb = rgb;
+    /* a level reads the one before: one pass per level */
+    for (j.level = 0; j.level < j.m.levels; j.level++)
+        fv_parallel_tiles(j.m.w, fv_phi_mips_grid(m, j.level)->h, threads, mips_tile, &j, NULL, NULL);
+}
+
+typedef struct map_job {
+    const fv_kvp_map_frame *mf;
+    fv_film_views out;
+} map_job;
+
+static void map_tile(void *ctx, const fv_tile *t)
+{
+    const map_job *j = ctx;
+    for (int y = t->y0; y < t->y1; y++)
+        for (int x = t->x0; x < t->x1; x++) fv_kvp_map_pixel(j->mf, x, y, &j->out);
+}
+
+void fv_vp_device_map(fv_vp_device *d, const fv_kvp_map_frame *mf, const fv_film_views *out, int threads)
+{
+    (void)d;
+    map_job j = {mf, *out};
+    fv_parallel_tiles(mf->space.sw, mf->space.sh, threads, map_tile, &j, NULL, NULL);
+}
+
+typedef struct blur_job {
+    fv_kblur_table t;
+    const float *sigma;
+    float *rgb, *tmp;
+    int vertical;
+} blur_job;
+
+static void blur_tile(void *ctx, const fv_tile *t)
+{
+    const blur_job *j = ctx;
+    for (int y = t->y0; y < t->y1; y++)
+        for (int x = t->x0; x < t->x1; x++)
+            if (j->vertical)
+                fv_kblur_v_pixel(&j->t, j->sigma, j->tmp, j->rgb, x, y);
+            else
+                fv_kblur_h_pixel(&j->t, j->sigma, j->rgb, j->tmp, x, y);
+}
+
+fv_status fv_vp_device_blur(fv_vp_device *d, float *rgb, int w, int h, const float *sigma, int threads, fv_error *err)
+{
+    const size_t n = (size_t)w * h;
+    if (d->blur_pixels != n) {
+        free(d->blur_tmp);
+        d->blur_tmp = fv_alloc_array(n, 3 * sizeof(float));
+        d->blur_pixels = d->blur_tmp ? n : 0;
+        if (!d->blur_tmp) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the blur of a %dx%d image", w, h);
+    }
+    /* the kernels up to the image's largest sigma (the pipeline's sigmas are finite and >= 0) */
+    float smax = 0.0f;
+    for (size_t i = 0; i < n; i++) smax = sigma[i] > smax ? sigma[i] : smax;
+    blur_job j;
+    int nq;
+    size_t nk;
+    fv_blur_table_size(smax, w, h, &nq, &nk);
+    int *off = fv_alloc_array((size_t)nq, sizeof(int));
+    float *k = fv_alloc_array(nk, sizeof(float));
+    if (!off || !k) {
+        free(off), free(k);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the blur's kernels");
+    }
+    fv_blur_table_fill(w, h, nq, off, k);
+    j.t = (fv_kblur_table){w, h, (w > h ? w : h) - 1, nq, off, k};
+    j.sigma = sigma;
+    j.rgb = rgb;
+    j.tmp = d->blur_tmp;
+    /* the vertical pass reads the horizontal one's whole neighbourhood: two passes */
+    for (j.vertical = 0; j.vertical < 2; j.vertical++) fv_parallel_tiles(w, h, threads, blur_tile, &j, NULL, NULL);
+    free(off), free(k);
+    return FV_OK;
+}
+
+typedef struct reproject_job {
+    const fv_kvp_reproject_frame *f;
+    float *prev_coord;
+} reproject_job;
+
+static void reproject_range(void *ctx, int64_t b, int64_t e, int thread)
+{
+    (void)thread;
+    const reproject_job *j = ctx;
+    for (int64_t i = b; i < e; i++) fv_kvp_reproject_sample(j->f, (long)i, &j->prev_coord[2 * i]);
+}
+
+void fv_vp_device_reproject(fv_vp_device *d, const fv_kvp_reproject_frame *f, float *prev_coord, int threads)
+{
+    (void)d;
+    reproject_job j = {f, prev_coord};
+    fv_parallel_for((int64_t)f->space.gw * f->space.gh, 4096, threads, reproject_range, &j);
+}

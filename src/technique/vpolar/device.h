@@ -1,0 +1,41 @@
+/* fovea — the Visual-Polar family's stages on a device backend (docs/gpu.md): the trace (a grid
+ * sample at a time, kernel/vp_trace.h, on the flat scene and its BVH), the φ-mipmaps (a cell of a
+ * level at a time), the map to the screen (a pixel at a time, kernel/vp_map.h) and the foveated
+ * blur (a pixel of each pass at a time, kernel/vp_blur.h). The portable
+ * backend runs each stage over tiles of its grid on the CPU's threads, which is what CI tests
+ * against the CPU pipeline. The pipeline (pipeline.c) keeps the buffers and the temporal state
+ * either way. The reprojection of the denoiser's history is a kernel too (kernel/vp_reproject.h);
+ * the denoiser itself (filter/svgf.h) runs on the host between the trace and the mipmaps.
+ */
+#ifndef FV_TECHNIQUE_VPOLAR_DEVICE_H
+#define FV_TECHNIQUE_VPOLAR_DEVICE_H
+
+#include "filter/phi_mips.h"
+#include "fovea/device.h"
+#include "fovea/film.h"
+#include "kernel/vp_map.h"
+#include "kernel/vp_reproject.h"
+#include "technique/vpolar/trace.h"
+
+typedef struct fv_vp_device fv_vp_device;
+
+/* device: portable (cuda is refused here until its pipeline exists). */
+fv_status fv_vp_device_create(const fv_scene *scene, fv_device device, fv_vp_device **out, fv_error *err);
+void fv_vp_device_destroy(fv_vp_device *d);
+
+/* The trace stage: every valid cell of the job's grid into g, as fv_vp_trace (the launch order
+ * changes nothing: each sample has its own random stream). *done false: cancelled. */
+fv_status fv_vp_device_trace(fv_vp_device *d, const fv_vp_trace_job *job, const fv_vp_gbuf *g, fv_vp_trace_result *res, bool *done,
+                             fv_error *err);
+/* The denoiser's history coordinates (kernel/vp_reproject.h): every cell of the grid into
+ * prev_coord (2 floats a cell). */
+void fv_vp_device_reproject(fv_vp_device *d, const fv_kvp_reproject_frame *f, float *prev_coord, int threads);
+/* Every level of m from rgb (level 0 a copy), as fv_phi_mips_build. */
+void fv_vp_device_mips(fv_vp_device *d, fv_phi_mips *m, const float *rgb, int threads);
+/* The map stage: every pixel of the screen. */
+void fv_vp_device_map(fv_vp_device *d, const fv_kvp_map_frame *mf, const fv_film_views *out, int threads);
+/* The foveated blur (kernel/vp_blur.h): rgb (w x h) in place with the per-pixel sigma, as
+ * fv_blur_variable, bit for bit; its scratch image is kept between frames. */
+fv_status fv_vp_device_blur(fv_vp_device *d, float *rgb, int w, int h, const float *sigma, int threads, fv_error *err);
+
+#endif
