@@ -88,9 +88,8 @@ fv_status fv_phi_mips_create(const fv_grid *g, int max_levels, fv_phi_mips **out
     for (int k = 0; k < m->levels; k++) {
         if (!(m->rowsf[k] = fv_alloc_array((size_t)g->w, sizeof(float)))) goto nomem;
         for (int x = 0; x < g->w; x++) m->rowsf[k][x] = (float)m->rows[k][x];
-        /* Zeroed: rows beyond a column's height are never written by the build. One float more: the
-         * 4-wide read of the last pixel (see lookup). */
-        m->img[k] = fv_calloc_array(3 * (size_t)m->grid[k].w * (size_t)m->grid[k].h + 1, sizeof(float));
+        /* Zeroed: rows beyond a column's height are never written by the build. */
+        m->img[k] = fv_calloc_array(3 * (size_t)m->grid[k].w * (size_t)m->grid[k].h, sizeof(float));
         if (!m->img[k]) goto nomem;
     }
     *out = m;
@@ -149,95 +148,11 @@ fv_region_begin();
 fv_region_end();
 }
 
-/* floor(f) for f > -1 (lookups only see f >= -0.5): truncation, minus one for negative f. */
-static inline int floor_small(float f)
-{
-    return (int)f - (f < 0.0f);
-}
-
-#if defined(__GNUC__)
-/* Four floats from any float address (GCC and Clang vector extensions): a pixel's RGB and one float
- * of the next pixel (every level has one float of padding after its last pixel), so a tap is one
- * load and two vector operations. */
-typedef float v4f __attribute__((vector_size(16), aligned(4), may_alias));
-#define PX(p) (*(const v4f *)(const void *)(p))
-#else
-typedef struct v4f {
-    float v[4];
-} v4f;
-#endif
-
-/* acc + wgt times the bilinear lookup of level k at columns xa (weight 1 - tx) and xb (weight tx),
- * V already in [0, 1]. Same taps and weights as fv_grid_bilinear, and per channel the same
- * operations in the same order. */
-static inline v4f lookup(const fv_phi_mips *m, int k, int xa, int xb, float tx, float V, float wgt, v4f acc)
-{
-    const float *img = m->img[k];
-    const int *rows = m->rows[k];
-    const float *rowsf = m->rowsf[k];
-    const size_t stride = 3 * (size_t)m->w;
-    for (int c = 0; c < 2; c++) {
-        const int x = c ? xb : xa, n = rows[x];
-        const float fy = V * rowsf[x] - 0.5f;
-        int y0 = floor_small(fy), y1 = y0 + 1;
-        const float ty = fy - (float)y0, wc = wgt * (c ? tx : 1.0f - tx);
-        /* V in [0, 1] puts fy in [-0.5, n - 0.5]: y0 in [-1, n - 1], y1 in [0, n] */
-        if (m->wrap) {
-            y0 = y0 < 0 ? n - 1 : y0;
-            y1 = y1 >= n ? 0 : y1;
-        } else {
-            y0 = y0 < 0 ? 0 : y0;
-            y1 = y1 >= n ? n - 1 : y1;
-        }
-        const float w0 = wc * (1.0f - ty), w1 = wc * ty;
-        const float *p0 = img + (size_t)y0 * stride + 3 * (size_t)x, *p1 = img + (size_t)y1 * stride + 3 * (size_t)x;
-#if defined(__GNUC__)
-        acc += w0 * PX(p0);
-        acc += w1 * PX(p1);
-#else
-        for (int ch = 0; ch < 3; ch++) acc.v[ch] += w0 * p0[ch], acc.v[ch] += w1 * p1[ch];
-#endif
-    }
-    return acc;
-}
-
+/* The map stage samples through the kernel (kernel/vp_map.h); this is the same lookup for host
+ * callers, so there is one implementation of it. */
 void fv_phi_mips_sample(const fv_phi_mips *m, float X, float V, float level, float out[3])
 {
-    /* Columns clamp: X outside [0, w] reads the edge column, as fv_grid_bilinear does. */
-    const float wf = (float)m->w;
-    X = X >= 0.0f ? (X <= wf ? X : wf) : 0.0f; /* also NaN -> 0 */
-    if (m->wrap) {
-        if (!(V >= 0.0f && V < 1.0f)) V -= floorf(V); /* one turn is the same angle */
-        if (!(V >= 0.0f && V <= 1.0f)) V = 0.0f;      /* NaN or infinite */
-    } else {
-        V = V >= 0.0f ? (V <= 1.0f ? V : 1.0f) : 0.0f;
-    }
-    const float fx = X - 0.5f;
-    const int x0 = floor_small(fx);
-    const float tx = fx - (float)x0;
-    const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 < m->w ? x0 + 1 : m->w - 1;
-
-    int k = 0;
-    float t = 0.0f;
-    if (level > 0.0f) { /* NaN -> level 0 */
-        const float top = (float)(m->levels - 1);
-        if (level < top) {
-            k = (int)level;
-            t = level - (float)k;
-        } else {
-            k = m->levels - 1;
-        }
-    }
-    v4f acc = {0};
-    if (t > 0.0f) {
-        acc = lookup(m, k, xa, xb, tx, V, 1.0f - t, acc);
-        acc = lookup(m, k + 1, xa, xb, tx, V, t, acc);
-    } else {
-        acc = lookup(m, k, xa, xb, tx, V, 1.0f, acc);
-    }
-#if defined(__GNUC__)
-    out[0] = acc[0], out[1] = acc[1], out[2] = acc[2];
-#else
-    out[0] = acc.v[0], out[1] = acc.v[1], out[2] = acc.v[2];
-#endif
+    fv_kphi_mips km;
+    fv_phi_mips_kernel(m, &km);
+    fv_kphi_sample(&km, X, V, level, out);
 }

@@ -1,9 +1,9 @@
 /* fovea — the mipmaps along φ and the map stage of Visual-Polar path tracing (Sec. 3.4) as kernel
  * code: one cell of a level built from the level below (filter/phi_mips.c has the weights), a
  * trilinear lookup along φ, and one screen pixel of the map from the sample space. The CPU's
- * phi_mips.c builds its levels with the cell function and keeps its own 4-wide lookup, which per
- * channel does the same operations in the same order as fv_kphi_sample (test_vp_kernels compares
- * them bit for bit); the portable backend and CUDA run these a cell or pixel at a time.
+ * phi_mips.c builds its levels with the cell function and samples with fv_kphi_sample (its
+ * fv_phi_mips_sample is this lookup); the portable backend and CUDA run these a cell or pixel at
+ * a time.
  */
 #ifndef FV_KERNEL_VP_MAP_H
 #define FV_KERNEL_VP_MAP_H

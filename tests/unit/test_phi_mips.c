@@ -438,38 +438,6 @@ static void test_bad_arguments(void **st)
     assert_int_equal(fv_phi_mips_levels(NULL), 0);
 }
 
-/* The kernels' lookup (kernel/vp_map.h, scalar, what the portable backend and CUDA run) against the
- * CPU's 4-wide one: the same bits at every (X, V, level), in range, out of range, wrapping or not,
- * and at NaN. The two are separate code, so this is where a change to one of them shows. */
-static void test_kernel_lookup_bits(void **st)
-{
-    (void)st;
-    fv_error err;
-    unsigned seed = 11;
-    for (int wrap = 0; wrap < 2; wrap++) {
-        fv_grid g = {4, 8, wrap ? k_cols : NULL, wrap != 0};
-        fv_phi_mips *m;
-        assert_int_equal(fv_phi_mips_create(&g, 16, &m, &err), FV_OK);
-        float *img = grid_image(&g, NULL, 5u + (unsigned)wrap);
-        fv_phi_mips_build(m, img, 2);
-        fv_kphi_mips km;
-        fv_phi_mips_kernel(m, &km);
-        assert_int_equal(km.levels, fv_phi_mips_levels(m));
-        for (int i = 0; i < 4000; i++) {
-            float X = 6.0f * frand(&seed) - 1.0f, V = 3.0f * frand(&seed) - 1.0f, level = 5.0f * frand(&seed) - 0.5f;
-            if (i % 97 == 0) X = NAN;
-            if (i % 89 == 0) V = NAN;
-            if (i % 83 == 0) level = NAN;
-            float a[3], b[3];
-            fv_phi_mips_sample(m, X, V, level, a);
-            fv_kphi_sample(&km, X, V, level, b);
-            assert_memory_equal(a, b, sizeof a);
-        }
-        free(img);
-        fv_phi_mips_destroy(m);
-    }
-}
-
 /* The map stage's nearest cell: column clamped to the grid, row to its column (hand-worked on the
  * {1, 3, 8, 5} columns). */
 static void test_nearest_cell(void **st)
@@ -492,7 +460,7 @@ int main(void)
         cmocka_unit_test(test_columns_blend),     cmocka_unit_test(test_fractional_levels),
         cmocka_unit_test(test_nan_coordinates),
         cmocka_unit_test(test_threads),           cmocka_unit_test(test_bad_arguments),
-        cmocka_unit_test(test_kernel_lookup_bits), cmocka_unit_test(test_nearest_cell),
+        cmocka_unit_test(test_nearest_cell),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
