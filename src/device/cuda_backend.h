@@ -40,25 +40,36 @@ fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, const fv_film_
                             double *kernel_ms, fv_error *err);
 void fv_cuda_pt_destroy(fv_cuda_pt *c);
 
-/* sdf-gt and sdf-relaxed (kernel/sdf_pixel.h): the GPU's buffers for the world and the film, kept
- * between frames and grown when a frame needs more. */
+/* The sphere-tracing family (kernel/sdf_pixel.h, kernel/sdf_pyramid.h): the GPU's buffers for the
+ * world, the films, the pyramid and fipr's history, kept between frames and grown when a frame
+ * needs more. Each render takes `eyes` eyes (1, or 2: a stereo pair, f, out and fov one per eye):
+ * every eye's kernels are launched on one stream, one after the other with no host wait between
+ * them (each eye has its own film on the GPU), and the host waits once, for the films' buffers
+ * that are set and the counters; *syncs receives the host waits (1). */
 typedef struct fv_cuda_sdf fv_cuda_sdf;
 fv_status fv_cuda_sdf_create(fv_cuda_sdf **out, fv_error *err);
-/* Copies the world (host memory, the flat form) to the GPU, renders every pixel into the film's
- * buffers (host memory), and adds the costs to *counts; *kernel_ms the kernel's own time. */
-fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, const struct fv_ksdf_frame *f, const fv_film_views *out,
-                             struct fv_ksdf_counts *counts, double *kernel_ms, fv_error *err);
-/* ipr and fipr (kernel/sdf_pyramid.h, kernel/sdf_pixel.h): shape gives the pyramid's sizes, levels
- * and min filter (its pointers are not read); fov (NULL for ipr) fipr's mask and refresh, edge its
- * Sobel threshold; shadow_reuse keeps level L-2's visibility. Every pass is a kernel launched on one
- * stream with no host synchronisation between them, the pyramid's buffers and fipr's history (per
- * eye) stay on the GPU between frames (reallocated only when the size changes), the world is copied
- * only when it changed; the host receives the film's buffers that are set, the costs (added to
- * *counts), and with mask_out (w x h, NULL: not asked) fipr's mask. *syncs: the host waits of the
- * frame (1: the end). */
-fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, const struct fv_ksdf_frame *f, const struct fv_kpyr *shape,
-                                     const struct fv_kpyr_fovea *fov, float edge, bool shadow_reuse, const fv_film_views *out,
-                                     uint8_t *mask_out, struct fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err);
+/* sdf-gt and sdf-relaxed: copies the world (host memory, the flat form) to the GPU where it changed,
+ * renders every pixel of each eye into its film's buffers (host memory), and adds the costs of all
+ * eyes to *counts; *kernel_ms the kernels' own time. */
+fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, int eyes, const struct fv_ksdf_frame *f, const fv_film_views *out,
+                             struct fv_ksdf_counts *counts, double *kernel_ms, int *syncs, fv_error *err);
+/* What ipr and fipr ask of a pyramid frame besides its shape: fipr's Sobel threshold (edge),
+ * shadow_reuse (level L-2's visibility kept), and fipr's pass 5 (blur: a Gaussian of blur_sigma
+ * pixels over the mask's transitions, kernel/sdf_pyramid.h and kernel/vp_blur.h, on the GPU). */
+typedef struct fv_cuda_pyr_opts {
+    float edge;
+    bool shadow_reuse;
+    bool blur;
+    float blur_sigma;
+} fv_cuda_pyr_opts;
+/* ipr and fipr: shape gives the pyramid's sizes, levels and min filter (its pointers are not read;
+ * every eye has this size); fov (NULL for ipr) fipr's mask and refresh per eye. Every pass is a
+ * kernel; the pyramid's buffers and fipr's history (per eye: fov[e].eye_index) stay on the GPU
+ * between frames (reallocated only when the size changes), the world is copied only when it
+ * changed; the costs of all eyes are added to *counts. */
+fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, int eyes, const struct fv_ksdf_frame *f, const struct fv_kpyr *shape,
+                                     const struct fv_kpyr_fovea *fov, const fv_cuda_pyr_opts *po, const fv_film_views *out,
+                                     struct fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err);
 void fv_cuda_sdf_destroy(fv_cuda_sdf *c);
 
 #ifdef __cplusplus

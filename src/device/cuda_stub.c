@@ -40,19 +40,18 @@ fv_status fv_cuda_sdf_create(fv_cuda_sdf **out, fv_error *err)
     return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
 }
 
-fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, const struct fv_ksdf_frame *f, const fv_film_views *out,
-                             struct fv_ksdf_counts *counts, double *kernel_ms, fv_error *err)
+fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, int eyes, const struct fv_ksdf_frame *f, const fv_film_views *out,
+                             struct fv_ksdf_counts *counts, double *kernel_ms, int *syncs, fv_error *err)
 {
-    (void)c, (void)w, (void)f, (void)out, (void)counts, (void)kernel_ms;
+    (void)c, (void)w, (void)eyes, (void)f, (void)out, (void)counts, (void)kernel_ms, (void)syncs;
     return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
 }
 
-fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, const struct fv_ksdf_frame *f, const struct fv_kpyr *shape,
-                                     const struct fv_kpyr_fovea *fov, float edge, bool shadow_reuse, const fv_film_views *out,
-                                     uint8_t *mask_out, struct fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err)
+fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, int eyes, const struct fv_ksdf_frame *f, const struct fv_kpyr *shape,
+                                     const struct fv_kpyr_fovea *fov, const fv_cuda_pyr_opts *po, const fv_film_views *out,
+                                     struct fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err)
 {
-    (void)c, (void)w, (void)f, (void)shape, (void)fov, (void)edge, (void)shadow_reuse, (void)out, (void)mask_out, (void)counts;
-    (void)kernel_ms, (void)syncs;
+    (void)c, (void)w, (void)eyes, (void)f, (void)shape, (void)fov, (void)po, (void)out, (void)counts, (void)kernel_ms, (void)syncs;
     return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
 }
 

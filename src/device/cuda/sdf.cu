@@ -5,14 +5,15 @@
  * (kernel/sdf_pyramid.h), its middle level, then the target (fv_ksdf_target_pixel): the very
  * functions the portable backend runs on the CPU (docs/gpu.md).
  *
- * Memory: the world's arrays (programs, moving objects, lights, materials), the film, the pyramid's
- * levels, edges, mask and visibility, and fipr's history per eye keep their GPU buffers between
- * frames, reallocated only when a frame needs another size. The world is copied in only when its
- * bytes changed since the last copy (a host mirror is compared: a moving object or light changes
- * it, a still scene is copied once). A pyramid frame's passes are launched on one stream with no
- * host wait between them; the host waits once, for the displayed buffers (and fipr's mask when the
- * host blurs it) and the counters. The costs are summed per block in shared memory, then once per
- * block into the global counters.
+ * Memory: the world's arrays (programs, moving objects, lights, materials), a film per eye, the
+ * pyramid's levels, edges, mask and visibility, pass 5's sigma, scratch image and kernels, and
+ * fipr's history per eye keep their GPU buffers between frames, reallocated only when a frame needs
+ * another size. The world and the blur's kernels are copied in only when their bytes changed since
+ * the last copy (a host mirror is compared: a moving object or light changes the world, a still
+ * scene is copied once). A frame's passes, for one eye or both eyes of a stereo pair, are launched
+ * on one stream with no host wait between them; the host waits once, for the displayed buffers of
+ * every eye and the counters (pass 5 blurs on the GPU, so the mask never comes back). The costs
+ * are summed per block in shared memory, then once per block into the global counters.
  */
 #include <cuda_runtime.h>
 #include <limits.h>
@@ -21,7 +22,9 @@
 #include <string.h>
 #include "device/cuda/common.h"
 #include "device/cuda_backend.h"
+#include "filter/blur.h"
 #include "kernel/sdf_pixel.h"
+#include "kernel/vp_blur.h"
 
 /* Threads of a block: 8 x 8 pixels, whose rays start coherent. */
 #define FV_CUDA_SDF_BLOCK 8
@@ -52,9 +55,22 @@ typedef struct dev_history {
     int *stamp;
 } dev_history;
 
+/* fipr's pass 5 on the GPU: the sigma image, the horizontal pass's image, and the kernels
+ * (filter/blur.h's table, built on the host for the image's size and sigma, copied when changed). */
+typedef struct dev_blur {
+    float *sigma, *tmp;
+    size_t pixels;
+    dev_array off, k;
+    int *host_off;          /* the table on the host, for (w, h, smax) */
+    float *host_k;
+    int w, h, nq;
+    size_t nk;
+    float smax;
+} dev_blur;
+
 struct fv_cuda_sdf {
     dev_array ops, objs, lights, mats;
-    fv_cuda_film film;
+    fv_cuda_film film[2];       /* per eye: a stereo pair is read back after both eyes ran */
     unsigned long long *counts; /* FV_CUDA_PYR_COUNTS */
     cudaEvent_t start, stop;
     cudaStream_t stream;        /* the pyramid's passes */
@@ -63,6 +79,7 @@ struct fv_cuda_sdf {
     bool k_fipr, k_vis;
     unsigned *far;              /* pass 2's farthest tip depth, as float bits */
     dev_history hist[2];
+    dev_blur blur;
 };
 
 static fv_status fill(dev_array *a, const void *src, size_t bytes, fv_error *err)
@@ -115,6 +132,17 @@ static void history_free(dev_history *h)
     memset(h, 0, sizeof *h);
 }
 
+static void blur_free(dev_blur *b)
+{
+    cudaFree(b->sigma);
+    cudaFree(b->tmp);
+    dev_array_free(&b->off);
+    dev_array_free(&b->k);
+    free(b->host_off);
+    free(b->host_k);
+    memset(b, 0, sizeof *b);
+}
+
 extern "C" void fv_cuda_sdf_destroy(fv_cuda_sdf *c)
 {
     if (!c) return;
@@ -122,7 +150,9 @@ extern "C" void fv_cuda_sdf_destroy(fv_cuda_sdf *c)
     dev_array_free(&c->objs);
     dev_array_free(&c->lights);
     dev_array_free(&c->mats);
-    fv_cuda_film_free(&c->film);
+    fv_cuda_film_free(&c->film[0]);
+    fv_cuda_film_free(&c->film[1]);
+    blur_free(&c->blur);
     pyramid_free(c);
     history_free(&c->hist[0]);
     history_free(&c->hist[1]);
@@ -195,31 +225,70 @@ static fv_status upload_world(fv_cuda_sdf *c, const fv_ksdf_world *w, fv_ksdf_wo
     return FV_OK;
 }
 
-extern "C" fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const fv_ksdf_world *w, const fv_ksdf_frame *f, const fv_film_views *out,
-                                        fv_ksdf_counts *counts, double *kernel_ms, fv_error *err)
+/* Copies the device film's n pixels into host's buffers that are set, on the stream. */
+static cudaError_t film_read_async(const fv_cuda_film *f, const fv_film_views *host, size_t n, cudaStream_t st)
 {
-    fv_ksdf_world dw;
-    fv_status s = upload_world(c, w, &dw, err);
-    if (s != FV_OK) return s;
-    const size_t n = (size_t)f->cam.width * (size_t)f->cam.height;
-    fv_film_views dv;
-    if ((s = fv_cuda_film_prepare(&c->film, out, n, &dv, err)) != FV_OK) return s;
-    cudaError_t e;
-    if ((e = cudaMemset(c->counts, 0, FV_CUDA_SDF_COUNTS * sizeof(unsigned long long))) != cudaSuccess)
-        return fv_cuda_fail(e, "clearing counters", err);
-    dim3 block(FV_CUDA_SDF_BLOCK, FV_CUDA_SDF_BLOCK);
-    dim3 grid((unsigned)((f->cam.width + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK),
-              (unsigned)((f->cam.height + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK));
-    cudaEventRecord(c->start);
-    fv_cuda_sdf_kernel<<<grid, block>>>(dw, *f, dv, c->counts);
-    cudaEventRecord(c->stop);
-    if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the sphere-tracing kernel", err);
-    if ((e = cudaEventSynchronize(c->stop)) != cudaSuccess) return fv_cuda_fail(e, "running the sphere-tracing kernel", err);
+    struct {
+        void *host;
+        const void *dev;
+        size_t bytes;
+    } back[6] = {{host->color, f->color, 3 * n * sizeof(float)},       {host->depth, f->depth, n * sizeof(float)},
+                 {host->normal, f->normal, 3 * n * sizeof(float)},     {host->albedo, f->albedo, 3 * n * sizeof(float)},
+                 {host->position, f->position, 3 * n * sizeof(float)}, {host->id, f->id, n * sizeof(uint32_t)}};
+    cudaError_t e = cudaSuccess;
+    for (int i = 0; i < 6 && e == cudaSuccess; i++)
+        if (back[i].host) e = cudaMemcpyAsync(back[i].host, back[i].dev, back[i].bytes, cudaMemcpyDeviceToHost, st);
+    return e;
+}
+
+/* The end of a frame: every eye's film and the first `ncounts` counters into kc, enqueued after
+ * the kernels, then the frame's one host wait (*syncs = 1); *kernel_ms from the events. */
+static fv_status finish(fv_cuda_sdf *c, int eyes, const fv_film_views *out, const size_t *n, unsigned long long *kc, int ncounts,
+                        double *kernel_ms, int *syncs, const char *what, fv_error *err)
+{
+    cudaStream_t st = c->stream;
+    cudaError_t e = cudaSuccess;
+    for (int i = 0; i < eyes && e == cudaSuccess; i++) e = film_read_async(&c->film[i], &out[i], n[i], st);
+    if (e == cudaSuccess) e = cudaMemcpyAsync(kc, c->counts, (size_t)ncounts * sizeof *kc, cudaMemcpyDeviceToHost, st);
+    if (e == cudaSuccess) e = cudaStreamSynchronize(st);
+    *syncs = 1;
+    if (e != cudaSuccess) return fv_cuda_fail(e, what, err);
     float ms = 0.0f;
     cudaEventElapsedTime(&ms, c->start, c->stop);
     *kernel_ms = ms;
+    return FV_OK;
+}
+
+extern "C" fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const fv_ksdf_world *w, int eyes, const fv_ksdf_frame *f, const fv_film_views *out,
+                                        fv_ksdf_counts *counts, double *kernel_ms, int *syncs, fv_error *err)
+{
+    *syncs = 0;
+    if (eyes < 1 || eyes > 2) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %d eyes", eyes);
+    fv_ksdf_world dw;
+    fv_status s = upload_world(c, w, &dw, err);
+    if (s != FV_OK) return s;
+    /* every eye's film first: nothing between the launches but launches */
+    size_t n[2];
+    fv_film_views dv[2];
+    for (int i = 0; i < eyes; i++) {
+        n[i] = (size_t)f[i].cam.width * (size_t)f[i].cam.height;
+        if ((s = fv_cuda_film_prepare(&c->film[i], &out[i], n[i], &dv[i], err)) != FV_OK) return s;
+    }
+    cudaStream_t st = c->stream;
+    cudaError_t e;
+    if ((e = cudaMemsetAsync(c->counts, 0, FV_CUDA_SDF_COUNTS * sizeof(unsigned long long), st)) != cudaSuccess)
+        return fv_cuda_fail(e, "clearing counters", err);
+    dim3 block(FV_CUDA_SDF_BLOCK, FV_CUDA_SDF_BLOCK);
+    cudaEventRecord(c->start, st);
+    for (int i = 0; i < eyes; i++) {
+        dim3 grid((unsigned)((f[i].cam.width + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK),
+                  (unsigned)((f[i].cam.height + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK));
+        fv_cuda_sdf_kernel<<<grid, block, 0, st>>>(dw, f[i], dv[i], c->counts);
+    }
+    cudaEventRecord(c->stop, st);
+    if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the sphere-tracing kernel", err);
     unsigned long long k[FV_CUDA_SDF_COUNTS];
-    if ((e = cudaMemcpy(k, c->counts, sizeof k, cudaMemcpyDeviceToHost)) != cudaSuccess) return fv_cuda_fail(e, "reading counters", err);
+    if ((s = finish(c, eyes, out, n, k, FV_CUDA_SDF_COUNTS, kernel_ms, syncs, "running the sphere-tracing kernel", err)) != FV_OK) return s;
     counts->rays += k[0];
     counts->steps += k[1];
     counts->exhausted += k[2];
@@ -227,7 +296,7 @@ extern "C" fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const fv_ksdf_world *w, 
     counts->shade.shadow_rays += k[4];
     counts->shade.shadow_steps += k[5];
     counts->shade.normal_evals += k[6];
-    return fv_cuda_film_read(&c->film, out, n, err);
+    return FV_OK;
 }
 
 /* ---- ipr and fipr: a kernel per pass ---- */
@@ -419,72 +488,129 @@ static fv_status history_ensure(fv_cuda_sdf *c, int eye, int index, fv_error *er
     return FV_OK;
 }
 
-/* Copies the device film's n pixels into host's buffers that are set, on the stream. */
-static cudaError_t film_read_async(const fv_cuda_film *f, const fv_film_views *host, size_t n, cudaStream_t st)
+/* ---- fipr's pass 5: the transitions' sigma, then the blur's two passes (kernel/vp_blur.h) ---- */
+
+__global__ void fv_cuda_pyr_sigma(const uint8_t *mask, int w, int h, float blur_sigma, float *sigma)
 {
-    struct {
-        void *host;
-        const void *dev;
-        size_t bytes;
-    } back[6] = {{host->color, f->color, 3 * n * sizeof(float)},       {host->depth, f->depth, n * sizeof(float)},
-                 {host->normal, f->normal, 3 * n * sizeof(float)},     {host->albedo, f->albedo, 3 * n * sizeof(float)},
-                 {host->position, f->position, 3 * n * sizeof(float)}, {host->id, f->id, n * sizeof(uint32_t)}};
-    cudaError_t e = cudaSuccess;
-    for (int i = 0; i < 6 && e == cudaSuccess; i++)
-        if (back[i].host) e = cudaMemcpyAsync(back[i].host, back[i].dev, back[i].bytes, cudaMemcpyDeviceToHost, st);
-    return e;
+    CELL_XY;
+    if (x < w && y < h) sigma[(size_t)y * w + x] = fv_kpyr_blur_sigma(mask, w, h, x, y, blur_sigma);
 }
 
-extern "C" fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const fv_ksdf_world *w, const fv_ksdf_frame *f, const fv_kpyr *shape,
-                                                const fv_kpyr_fovea *fov, float edge, bool shadow_reuse, const fv_film_views *out,
-                                                uint8_t *mask_out, fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err)
+__global__ void fv_cuda_blur_h(fv_kblur_table t, const float *sigma, const float *src, float *tmp)
+{
+    CELL_XY;
+    if (x < t.w && y < t.h) fv_kblur_h_pixel(&t, sigma, src, tmp, x, y);
+}
+
+__global__ void fv_cuda_blur_v(fv_kblur_table t, const float *sigma, const float *tmp, float *out)
+{
+    CELL_XY;
+    if (x < t.w && y < t.h) fv_kblur_v_pixel(&t, sigma, tmp, out, x, y);
+}
+
+/* Pass 5's buffers for a w x h image and its kernels up to smax (the table rebuilt on the host
+ * only when the size or sigma changes, copied only when its bytes do); *t the table's views. */
+static fv_status blur_ensure(fv_cuda_sdf *c, int w, int h, float smax, fv_kblur_table *t, fv_error *err)
+{
+    dev_blur *b = &c->blur;
+    const size_t n = (size_t)w * h;
+    cudaError_t e;
+    if (b->pixels != n) {
+        cudaFree(b->sigma);
+        cudaFree(b->tmp);
+        b->sigma = b->tmp = NULL;
+        b->pixels = 0;
+        if ((e = cudaMalloc((void **)&b->sigma, n * sizeof(float))) != cudaSuccess ||
+            (e = cudaMalloc((void **)&b->tmp, 3 * n * sizeof(float))) != cudaSuccess)
+            return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for fipr's blur")
+                                                  : fv_cuda_fail(e, "allocating fipr's blur", err);
+        b->pixels = n;
+    }
+    if (!b->host_off || b->w != w || b->h != h || b->smax != smax) {
+        free(b->host_off);
+        free(b->host_k);
+        b->host_k = NULL;
+        fv_blur_table_size(smax, w, h, &b->nq, &b->nk);
+        b->host_off = (int *)malloc((size_t)b->nq * sizeof(int));
+        b->host_k = (float *)malloc(b->nk * sizeof(float));
+        if (!b->host_off || !b->host_k) {
+            free(b->host_off), free(b->host_k);
+            b->host_off = NULL, b->host_k = NULL;
+            return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the blur's kernels");
+        }
+        fv_blur_table_fill(w, h, b->nq, b->host_off, b->host_k);
+        b->w = w, b->h = h, b->smax = smax;
+    }
+    fv_status s;
+    if ((s = fill(&b->off, b->host_off, (size_t)b->nq * sizeof(int), err)) != FV_OK ||
+        (s = fill(&b->k, b->host_k, b->nk * sizeof(float), err)) != FV_OK)
+        return s;
+    t->w = w;
+    t->h = h;
+    t->rcap = (w > h ? w : h) - 1;
+    t->nq = b->nq;
+    t->off = (const int *)b->off.p;
+    t->k = (const float *)b->k.p;
+    return FV_OK;
+}
+
+extern "C" fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const fv_ksdf_world *w, int eyes, const fv_ksdf_frame *f, const fv_kpyr *shape,
+                                                const fv_kpyr_fovea *fov, const fv_cuda_pyr_opts *po, const fv_film_views *out,
+                                                fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err)
 {
     *syncs = 0;
+    if (eyes < 1 || eyes > 2) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %d eyes", eyes);
     fv_ksdf_world dw;
     fv_status s = upload_world(c, w, &dw, err);
     if (s != FV_OK) return s;
-    const bool fipr = fov != NULL;
+    const bool fipr = fov != NULL, blurred = fipr && po->blur;
     const int L = shape->L;
-    if ((s = pyramid_ensure(c, shape, fipr, shadow_reuse && L > 1, err)) != FV_OK) return s;
+    if ((s = pyramid_ensure(c, shape, fipr, po->shadow_reuse && L > 1, err)) != FV_OK) return s;
     const size_t n = (size_t)shape->w * (size_t)shape->h;
-    fv_film_views dv;
-    if ((s = fv_cuda_film_prepare(&c->film, out, n, &dv, err)) != FV_OK) return s;
+    const size_t ns[2] = {n, n};
+    fv_film_views dv[2];
+    for (int i = 0; i < eyes; i++)
+        if ((s = fv_cuda_film_prepare(&c->film[i], &out[i], n, &dv[i], err)) != FV_OK) return s;
+    fv_kblur_table bt;
+    if (blurred && (s = blur_ensure(c, shape->w, shape->h, po->blur_sigma, &bt, err)) != FV_OK) return s;
     cudaStream_t st = c->stream;
     cudaError_t e;
     if ((e = cudaMemsetAsync(c->counts, 0, FV_CUDA_PYR_COUNTS * sizeof(unsigned long long), st)) != cudaSuccess)
         return fv_cuda_fail(e, "clearing counters", err);
-    if (fipr && (s = history_ensure(c, fov->eye_index, fov->index, err)) != FV_OK) return s;
     fv_kpyr *k = &c->k;
     const dim3 block(FV_CUDA_SDF_BLOCK, FV_CUDA_SDF_BLOCK);
-    const int index = fipr ? fov->index : 0;
     cudaEventRecord(c->start, st);
-    /* the levels traced whole (fipr: all but the middle, which the mask decides) */
-    const int full_below = fipr ? L - 2 : L - 1;
-    for (int i = 0; i < full_below; i++)
-        fv_cuda_pyr_level<<<grid_of(k->lv[i].w, k->lv[i].h), block, 0, st>>>(dw, *f, *k, i, index, c->counts);
-    if (fipr) {
-        const size_t ntip = (size_t)k->lv[0].w * k->lv[0].h;
-        cudaMemsetAsync(c->far, 0, sizeof(unsigned), st);
-        fv_cuda_pyr_far<<<blocks_of(ntip), 256, 0, st>>>(k->depth[0], (int)ntip, c->far);
-        fv_cuda_pyr_sobel<<<grid_of(k->lv[0].w, k->lv[0].h), block, 0, st>>>(*k, c->far, edge);
-        fv_cuda_pyr_mask<<<grid_of(k->w, k->h), block, 0, st>>>(*k, *fov, c->counts);
-        fv_cuda_pyr_need<<<grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, 0, st>>>(*k, *fov, c->counts);
-        fv_cuda_pyr_level<<<grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, 0, st>>>(dw, *f, *k, L - 2, index, c->counts);
+    /* eye after eye on the stream: the pyramid's buffers are the eyes' in turn (the stream orders
+     * eye 1's passes after eye 0's), the films and histories are each eye's own */
+    for (int i = 0; i < eyes; i++) {
+        if (fipr && (s = history_ensure(c, fov[i].eye_index, fov[i].index, err)) != FV_OK) return s;
+        const int index = fipr ? fov[i].index : 0;
+        /* the levels traced whole (fipr: all but the middle, which the mask decides) */
+        const int full_below = fipr ? L - 2 : L - 1;
+        for (int l = 0; l < full_below; l++)
+            fv_cuda_pyr_level<<<grid_of(k->lv[l].w, k->lv[l].h), block, 0, st>>>(dw, f[i], *k, l, index, c->counts);
+        if (fipr) {
+            const size_t ntip = (size_t)k->lv[0].w * k->lv[0].h;
+            cudaMemsetAsync(c->far, 0, sizeof(unsigned), st);
+            fv_cuda_pyr_far<<<blocks_of(ntip), 256, 0, st>>>(k->depth[0], (int)ntip, c->far);
+            fv_cuda_pyr_sobel<<<grid_of(k->lv[0].w, k->lv[0].h), block, 0, st>>>(*k, c->far, po->edge);
+            fv_cuda_pyr_mask<<<grid_of(k->w, k->h), block, 0, st>>>(*k, fov[i], c->counts);
+            fv_cuda_pyr_need<<<grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, 0, st>>>(*k, fov[i], c->counts);
+            fv_cuda_pyr_level<<<grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, 0, st>>>(dw, f[i], *k, L - 2, index, c->counts);
+        }
+        fv_cuda_pyr_target<<<grid_of(k->w, k->h), block, 0, st>>>(dw, f[i], *k, dv[i], c->counts);
+        if (blurred) {
+            /* pass 5 on this eye's colour, in place through the scratch image */
+            fv_cuda_pyr_sigma<<<grid_of(k->w, k->h), block, 0, st>>>(k->mask, k->w, k->h, po->blur_sigma, c->blur.sigma);
+            fv_cuda_blur_h<<<grid_of(k->w, k->h), block, 0, st>>>(bt, c->blur.sigma, dv[i].color, c->blur.tmp);
+            fv_cuda_blur_v<<<grid_of(k->w, k->h), block, 0, st>>>(bt, c->blur.sigma, c->blur.tmp, dv[i].color);
+        }
     }
-    fv_cuda_pyr_target<<<grid_of(k->w, k->h), block, 0, st>>>(dw, *f, *k, dv, c->counts);
     cudaEventRecord(c->stop, st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the pyramid's kernels", err);
     /* what the host receives, then its one wait */
     unsigned long long kc[FV_CUDA_PYR_COUNTS];
-    e = film_read_async(&c->film, out, n, st);
-    if (e == cudaSuccess && mask_out && fipr) e = cudaMemcpyAsync(mask_out, k->mask, n, cudaMemcpyDeviceToHost, st);
-    if (e == cudaSuccess) e = cudaMemcpyAsync(kc, c->counts, sizeof kc, cudaMemcpyDeviceToHost, st);
-    if (e == cudaSuccess) e = cudaStreamSynchronize(st);
-    *syncs = 1;
-    if (e != cudaSuccess) return fv_cuda_fail(e, "running the pyramid's kernels", err);
-    float ms = 0.0f;
-    cudaEventElapsedTime(&ms, c->start, c->stop);
-    *kernel_ms = ms;
+    if ((s = finish(c, eyes, out, ns, kc, FV_CUDA_PYR_COUNTS, kernel_ms, syncs, "running the pyramid's kernels", err)) != FV_OK) return s;
     counts->all.rays += kc[0];
     counts->all.steps += kc[1];
     counts->all.exhausted += kc[2];

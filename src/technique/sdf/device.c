@@ -5,6 +5,7 @@
 #include <string.h>
 #include "core/alloc.h"
 #include "core/parallel.h"
+#include "filter/blur.h"
 #include "device/cuda_backend.h"
 #include "kernel/sdf_pixel.h"
 #include "technique/kit.h"
@@ -18,9 +19,8 @@ struct fv_sdf_device {
     /* ipr and fipr */
     fv_kpyr k;                  /* portable: the pyramid's host buffers */
     fv_pyramid_history hist[2]; /* portable, fipr: the middle level kept per eye */
-    uint8_t *mask;              /* cuda, fipr with blur: the mask read back */
-    float *sigma;               /* fipr with blur: pass 5's sigma */
-    size_t blur_pixels;         /* the size mask and sigma have */
+    float *sigma, *blur_tmp;    /* portable, fipr with blur: pass 5's sigma and horizontal pass */
+    size_t blur_pixels;         /* the size sigma and blur_tmp have */
 };
 
 fv_status fv_sdf_device_create(const fv_scene *scene, const fv_sdf_opts *o, fv_device device, fv_sdf_device **out, fv_error *err)
@@ -48,14 +48,14 @@ void fv_sdf_device_destroy(fv_sdf_device *d)
     fv_pyramid_free(&d->k);
     fv_pyramid_history_free(&d->hist[0]);
     fv_pyramid_history_free(&d->hist[1]);
-    free(d->mask);
     free(d->sigma);
+    free(d->blur_tmp);
     free(d);
 }
 
 /* ---- the portable backend: each pass's kernel steps over tiles of its grid on the CPU's threads ---- */
 
-typedef enum pass { PASS_LEVEL, PASS_SOBEL, PASS_MASK, PASS_NEED, PASS_TARGET } pass;
+typedef enum pass { PASS_LEVEL, PASS_SOBEL, PASS_MASK, PASS_NEED, PASS_TARGET, PASS_SIGMA } pass;
 
 typedef struct tile_job {
     const fv_ksdf_world *world;
@@ -66,6 +66,7 @@ typedef struct tile_job {
     pass what;
     int level;                /* PASS_LEVEL */
     float sky, edge;          /* PASS_SOBEL */
+    float *sigma, blur_sigma; /* PASS_SIGMA */
     fv_ksdf_counts *c;        /* per thread: the pass's costs */
     uint64_t *n;              /* per thread: mask pixels (PASS_MASK), edge pixels (PASS_MASK), refreshed rays (PASS_NEED) */
 } tile_job;
@@ -96,6 +97,7 @@ static void pass_tile(void *ctx, const fv_tile *tile)
                 break;
             }
             case PASS_TARGET: fv_ksdf_target_pixel(j->world, &j->f, k, x, y, &j->out, c); break;
+            case PASS_SIGMA: j->sigma[(size_t)y * k->w + x] = fv_kpyr_blur_sigma(k->mask, k->w, k->h, x, y, j->blur_sigma); break;
             }
 }
 
@@ -181,9 +183,9 @@ static fv_status portable_pyramid(fv_sdf_device *d, tile_job *j, const fv_frame 
         s = run_pass(j, PASS_SOBEL, -1, low->w, low->h, frame, &prog, base, 0.0, sum, NULL, err);
         if (s == FV_OK) s = run_pass(j, PASS_MASK, -1, w, h, frame, &prog, base, 0.0, sum, mask_n, err);
         if (s == FV_OK) s = run_pass(j, PASS_NEED, -1, mid->w, mid->h, frame, &prog, base, 0.0, sum, need_n, err);
-        sum->masked = mask_n[0];
-        sum->edges = mask_n[1];
-        sum->refreshed = need_n[0];
+        sum->masked += mask_n[0];
+        sum->edges += mask_n[1];
+        sum->refreshed += need_n[0];
         double span = (double)mid->w * mid->h / total;
         if (s == FV_OK) s = run_pass(j, PASS_LEVEL, L - 2, mid->w, mid->h, frame, &prog, base, span, sum, NULL, err);
         base += span;
@@ -223,29 +225,50 @@ static void report(const fv_sdf_opts *o, const fv_ksdf_pyr_counts *pc, double sa
     }
 }
 
-/* fipr's pass 5 on the host, after either backend (filter/blur.h; not yet a kernel). */
-static fv_status blur(fv_sdf_device *d, const uint8_t *mask, const fv_film_views *out, int w, int h, int threads, fv_error *err)
+/* fipr's pass 5 on the portable backend, on this eye's mask (the pyramid's, until the next eye):
+ * the transitions' sigma a pixel at a time, then the blur's two kernel passes (filter/blur.h),
+ * the steps CUDA launches. */
+static fv_status portable_blur(fv_sdf_device *d, tile_job *j, const fv_frame *frame, fv_error *err)
 {
-    return fv_sdf_blur_transitions(out->color, mask, d->sigma, w, h, d->o.blur_sigma, threads, NULL, err);
+    const int w = j->f.cam.width, h = j->f.cam.height;
+    j->sigma = d->sigma;
+    j->blur_sigma = d->o.blur_sigma;
+    fv_ksdf_pyr_counts none;
+    memset(&none, 0, sizeof none);
+    fv_kit_progress prog = {0};
+    const int nt = fv_thread_count(frame->threads);
+    j->c = fv_calloc_array((size_t)nt, sizeof *j->c);
+    j->n = fv_calloc_array((size_t)nt * 2, sizeof *j->n);
+    fv_status s = j->c && j->n ? run_pass(j, PASS_SIGMA, -1, w, h, frame, &prog, 1.0, 0.0, &none, NULL, err)
+                               : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    free(j->c);
+    free(j->n);
+    j->c = NULL;
+    j->n = NULL;
+    return s == FV_OK ? fv_blur_kernel_passes(j->out.color, d->blur_tmp, w, h, d->sigma, d->o.blur_sigma, frame->threads, err) : s;
 }
 
-fv_status fv_sdf_device_render(fv_sdf_device *d, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+/* Renders `eyes` eyes of one frame (1, or a stereo pair of one size): the world built once for
+ * them; on CUDA every eye's passes are launched before the one host wait, on the portable backend
+ * the eyes run one after the other through the same passes. */
+static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
 {
-    tile_job j;
-    memset(&j, 0, sizeof j);
-    fv_status s = fv_frame_camera(frame->camera, film, &j.f.cam, err);
-    if (s != FV_OK) return s;
+    tile_job j[2];
+    memset(j, 0, sizeof j);
+    fv_status s;
+    for (int e = 0; e < eyes; e++)
+        if ((s = fv_frame_camera(frames[e].camera, films[e], &j[e].f.cam, err)) != FV_OK) return s;
     const fv_sdf_opts *o = &d->o;
     const bool pyramid = o->method == FV_SDF_IPR || o->method == FV_SDF_FIPR;
-    const bool blurred = o->method == FV_SDF_FIPR && o->blur;
-    const int w = j.f.cam.width, h = j.f.cam.height;
+    const bool fipr = o->method == FV_SDF_FIPR, blurred = fipr && o->blur;
+    const int w = j[0].f.cam.width, h = j[0].f.cam.height;
     const size_t np = (size_t)w * h;
-    if (blurred && d->blur_pixels != np) {
-        free(d->mask);
+    if (blurred && !d->cuda && d->blur_pixels != np) {
         free(d->sigma);
-        d->mask = fv_alloc_array(np, 1);
+        free(d->blur_tmp);
         d->sigma = fv_alloc_array(np, sizeof(float));
-        d->blur_pixels = d->mask && d->sigma ? np : 0;
+        d->blur_tmp = fv_alloc_array(np, 3 * sizeof(float));
+        d->blur_pixels = d->sigma && d->blur_tmp ? np : 0;
         if (!d->blur_pixels) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for fipr's blur");
     }
     fv_sdf_world world;
@@ -253,26 +276,31 @@ fv_status fv_sdf_device_render(fv_sdf_device *d, const fv_frame *frame, fv_film 
     if ((s = fv_sdf_world_build(&world, d->scene, err)) != FV_OK) return s;
     fv_stats_add_ms(stats, "scene", fv_time_ms() - t0);
     const int S = fv_sdf_samples_per_axis(o->spp);
-    j.world = &world.k;
-    j.f.S = S;
-    /* a target sample's angular footprint per unit distance, as the CPU pipeline's */
-    j.f.eps_k = o->hit * (2.0f * j.f.cam.tan_half_x / (float)(w * S));
-    j.f.march = o->march;
-    j.f.shade = o->shade;
-    j.out = fv_film_views_of(film);
-    const double samples = (double)w * h * o->spp;
+    fv_ksdf_frame f[2];
+    fv_film_views out[2];
+    for (int e = 0; e < eyes; e++) {
+        j[e].world = &world.k;
+        j[e].f.S = S;
+        /* a target sample's angular footprint per unit distance, as the CPU pipeline's */
+        j[e].f.eps_k = o->hit * (2.0f * j[e].f.cam.tan_half_x / (float)(w * S));
+        j[e].f.march = o->march;
+        j[e].f.shade = o->shade;
+        j[e].out = fv_film_views_of(films[e]);
+        f[e] = j[e].f;
+        out[e] = j[e].out;
+    }
+    const double samples = (double)w * h * o->spp * eyes;
     fv_ksdf_pyr_counts c;
     memset(&c, 0, sizeof c);
-    const uint8_t *mask = NULL;
+    double blur_ms = 0.0;
     t0 = fv_time_ms();
     if (d->cuda) {
         double kernel_ms = 0.0;
         int syncs = 0;
         if (!pyramid) {
-            s = fv_cuda_sdf_render(d->cuda, &world.k, &j.f, &j.out, &c.all, &kernel_ms, err);
+            s = fv_cuda_sdf_render(d->cuda, &world.k, eyes, f, out, &c.all, &kernel_ms, &syncs, err);
             c.level_rays[0] = c.all.rays;
             c.level_steps[0] = c.all.steps;
-            syncs = 1;
         } else {
             fv_kpyr shape;
             memset(&shape, 0, sizeof shape);
@@ -284,34 +312,53 @@ fv_status fv_sdf_device_render(fv_sdf_device *d, const fv_frame *frame, fv_film 
             shape.sh = h * S;
             shape.min_filter = o->min_filter;
             fv_kpyr_levels(shape.sw, shape.sh, shape.L, shape.lv);
-            fv_kpyr_fovea fov;
-            if (o->method == FV_SDF_FIPR) fv_sdf_fovea_of(frame, o, w, h, &fov);
-            s = fv_cuda_sdf_pyramid_render(d->cuda, &world.k, &j.f, &shape, o->method == FV_SDF_FIPR ? &fov : NULL, o->edge, o->shadow_reuse,
-                                           &j.out, blurred ? d->mask : NULL, &c, &kernel_ms, &syncs, err);
-            mask = d->mask;
+            fv_kpyr_fovea fov[2];
+            for (int e = 0; e < eyes && fipr; e++) fv_sdf_fovea_of(&frames[e], o, w, h, &fov[e]);
+            const fv_cuda_pyr_opts po = {o->edge, o->shadow_reuse, blurred, o->blur_sigma};
+            s = fv_cuda_sdf_pyramid_render(d->cuda, &world.k, eyes, f, &shape, fipr ? fov : NULL, &po, out, &c, &kernel_ms, &syncs, err);
         }
         fv_stats_add_ms(stats, "kernel", kernel_ms);
         fv_stats_add_count(stats, "host_syncs", (double)syncs);
-    } else if (!pyramid) {
-        const int nt = fv_thread_count(frame->threads);
-        j.c = fv_calloc_array((size_t)nt, sizeof *j.c);
-        j.n = fv_calloc_array((size_t)nt * 2, sizeof *j.n);
-        fv_kit_progress prog = {0};
-        s = j.c && j.n ? run_pass(&j, PASS_TARGET, 0, w, h, frame, &prog, 0.0, 1.0, &c, NULL, err) : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-        free(j.c);
-        free(j.n);
     } else {
-        s = portable_pyramid(d, &j, frame, &c, err);
-        mask = d->k.mask;
+        for (int e = 0; e < eyes && s == FV_OK; e++) {
+            if (!pyramid) {
+                const int nt = fv_thread_count(frames[e].threads);
+                j[e].c = fv_calloc_array((size_t)nt, sizeof *j[e].c);
+                j[e].n = fv_calloc_array((size_t)nt * 2, sizeof *j[e].n);
+                fv_kit_progress prog = {0};
+                s = j[e].c && j[e].n ? run_pass(&j[e], PASS_TARGET, 0, w, h, &frames[e], &prog, 0.0, 1.0, &c, NULL, err)
+                                     : fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+                free(j[e].c);
+                free(j[e].n);
+            } else {
+                s = portable_pyramid(d, &j[e], &frames[e], &c, err);
+            }
+            if (s == FV_OK && blurred) {
+                double tb = fv_time_ms();
+                s = portable_blur(d, &j[e], &frames[e], err);
+                blur_ms += fv_time_ms() - tb;
+            }
+        }
     }
-    fv_stats_add_ms(stats, "target", fv_time_ms() - t0);
+    fv_stats_add_ms(stats, "target", fv_time_ms() - t0 - blur_ms);
+    if (blurred && !d->cuda) fv_stats_add_ms(stats, "blur", blur_ms);
     fv_sdf_world_free(&world);
-    if (s == FV_OK && blurred) {
-        t0 = fv_time_ms();
-        s = blur(d, mask, &j.out, w, h, frame->threads, err);
-        fv_stats_add_ms(stats, "blur", fv_time_ms() - t0);
-    }
     if (s != FV_OK) return s;
     report(o, &c, samples, stats);
     return FV_OK;
+}
+
+fv_status fv_sdf_device_render(fv_sdf_device *d, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+{
+    return render_eyes(d, 1, frame, &film, stats, err);
+}
+
+fv_status fv_sdf_device_render_pair(fv_sdf_device *d, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    /* the pair shares the pyramid's buffers: eyes of different sizes go one at a time */
+    if (fv_film_width(films[0]) != fv_film_width(films[1]) || fv_film_height(films[0]) != fv_film_height(films[1])) {
+        fv_status s = render_eyes(d, 1, &frames[0], &films[0], stats, err);
+        return s == FV_OK ? render_eyes(d, 1, &frames[1], &films[1], stats, err) : s;
+    }
+    return render_eyes(d, 2, frames, films, stats, err);
 }

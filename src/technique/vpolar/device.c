@@ -6,7 +6,6 @@
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "filter/blur.h"
-#include "kernel/vp_blur.h"
 #include "kernel/vp_reproject.h"
 #include "scene/export.h"
 #include "technique/vpolar/device.h"
@@ -129,24 +128,6 @@ void fv_vp_device_map(fv_vp_device *d, const fv_kvp_map_frame *mf, const fv_film
     fv_parallel_tiles(mf->space.sw, mf->space.sh, threads, map_tile, &j, NULL, NULL);
 }
 
-typedef struct blur_job {
-    fv_kblur_table t;
-    const float *sigma;
-    float *rgb, *tmp;
-    int vertical;
-} blur_job;
-
-static void blur_tile(void *ctx, const fv_tile *t)
-{
-    const blur_job *j = ctx;
-    for (int y = t->y0; y < t->y1; y++)
-        for (int x = t->x0; x < t->x1; x++)
-            if (j->vertical)
-                fv_kblur_v_pixel(&j->t, j->sigma, j->tmp, j->rgb, x, y);
-            else
-                fv_kblur_h_pixel(&j->t, j->sigma, j->rgb, j->tmp, x, y);
-}
-
 fv_status fv_vp_device_blur(fv_vp_device *d, float *rgb, int w, int h, const float *sigma, int threads, fv_error *err)
 {
     const size_t n = (size_t)w * h;
@@ -159,25 +140,7 @@ fv_status fv_vp_device_blur(fv_vp_device *d, float *rgb, int w, int h, const flo
     /* the kernels up to the image's largest sigma (the pipeline's sigmas are finite and >= 0) */
     float smax = 0.0f;
     for (size_t i = 0; i < n; i++) smax = sigma[i] > smax ? sigma[i] : smax;
-    blur_job j;
-    int nq;
-    size_t nk;
-    fv_blur_table_size(smax, w, h, &nq, &nk);
-    int *off = fv_alloc_array((size_t)nq, sizeof(int));
-    float *k = fv_alloc_array(nk, sizeof(float));
-    if (!off || !k) {
-        free(off), free(k);
-        return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the blur's kernels");
-    }
-    fv_blur_table_fill(w, h, nq, off, k);
-    j.t = (fv_kblur_table){w, h, (w > h ? w : h) - 1, nq, off, k};
-    j.sigma = sigma;
-    j.rgb = rgb;
-    j.tmp = d->blur_tmp;
-    /* the vertical pass reads the horizontal one's whole neighbourhood: two passes */
-    for (j.vertical = 0; j.vertical < 2; j.vertical++) fv_parallel_tiles(w, h, threads, blur_tile, &j, NULL, NULL);
-    free(off), free(k);
-    return FV_OK;
+    return fv_blur_kernel_passes(rgb, d->blur_tmp, w, h, sigma, smax, threads, err);
 }
 
 typedef struct reproject_job {
