@@ -2,7 +2,8 @@
  *
  * The sequence driver (fovea/drive.h) fills frames for the CLI, the benchmark harness and the
  * viewer; a C user who drives a technique by hand starts from fv_frame_init. A stereo frame is two
- * calls of fv_technique_render, eye 0 (left) then eye 1 (right), with the same index and time.
+ * calls of fv_technique_render, eye 0 (left) then eye 1 (right), with the same index and time, or
+ * one call of fv_technique_render_pair with both (what the driver does).
  * A frame only points at cameras and the eye model: they must outlive the render call.
  */
 #ifndef FOVEA_FRAME_H

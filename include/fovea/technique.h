@@ -147,6 +147,14 @@ FV_API fv_status fv_technique_create(const char *name, const fv_scene *scene, co
  * added to *stats (not cleared). FV_ERR_CANCELLED when the frame's progress callback asked so;
  * the film's contents are then undefined. */
 FV_API fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);
+/* Renders both eyes of a stereo frame: frames[0] is eye 0 and frames[1] eye 1, both with
+ * eye_count 2 and the same index and time, films[e] of frames[e]'s camera's size. The same images
+ * and counters as fv_technique_render for eye 0 then eye 1 (what it does for a method without a
+ * pair path); a method with one (the sphere tracers on a device, docs/gpu.md) runs both eyes at
+ * once, with no host round trip between them on a GPU. Each eye reports progress through its own
+ * frame's callback. */
+FV_API fv_status fv_technique_render_pair(fv_technique *t, const fv_frame frames[2], fv_film *const films[2], fv_stats *stats,
+                                          fv_error *err);
 /* The method's registry name (a static string). */
 FV_API const char *fv_technique_name_of(const fv_technique *t);
 /* NULL is ignored. */

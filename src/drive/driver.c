@@ -144,32 +144,36 @@ static bool on_eye_progress(void *user, double f)
     return p->fn(p->user, (p->frame + (p->eye + f) / p->eyes) / p->frames);
 }
 
-/* Renders views v as the technique's frame `seen` (its index: warm-up frames first). */
+/* Renders views v as the technique's frame `seen` (its index: warm-up frames first); a stereo
+ * frame as a pair (fv_technique_render_pair), so a device runs both eyes without a host round
+ * trip between them. */
 static fv_status render_views(fv_driver *d, fv_technique *t, const fv_frame_views *v, int seen, const fv_frame_views *pv,
                               fv_film *const *films, fv_stats *stats, eye_progress *ep, fv_error *err)
 {
     fv_status s = fv_scene_set_time(d->scene, v->time, err);
+    fv_frame fr[2];
+    eye_progress eps[2];
     for (int e = 0; e < v->eye_count && s == FV_OK; e++) {
         if (!films[e]) return fv_error_set(err, FV_ERR_INVALID, "driver: no film for eye %d", e);
-        fv_frame fr;
-        fv_frame_init(&fr, &v->camera[e]);
-        fr.time = v->time;
-        fr.index = seen;
-        fr.seed = d->o.seed;
-        fr.threads = d->o.threads;
-        fr.eye = e;
-        fr.eye_count = v->eye_count;
-        fr.prev_camera = pv ? &pv->camera[e] : NULL;
-        fr.left_camera = e == 1 ? &v->camera[0] : NULL;
-        fr.gaze = v->gaze[e];
-        fr.eye_model = v->eye_model;
+        fv_frame_init(&fr[e], &v->camera[e]);
+        fr[e].time = v->time;
+        fr[e].index = seen;
+        fr[e].seed = d->o.seed;
+        fr[e].threads = d->o.threads;
+        fr[e].eye = e;
+        fr[e].eye_count = v->eye_count;
+        fr[e].prev_camera = pv ? &pv->camera[e] : NULL;
+        fr[e].left_camera = e == 1 ? &v->camera[0] : NULL;
+        fr[e].gaze = v->gaze[e];
+        fr[e].eye_model = v->eye_model;
         if (ep->fn) {
-            ep->eye = e;
-            fr.progress = on_eye_progress;
-            fr.progress_user = ep;
+            eps[e] = *ep;
+            eps[e].eye = e;
+            fr[e].progress = on_eye_progress;
+            fr[e].progress_user = &eps[e];
         }
-        s = fv_technique_render(t, &fr, films[e], stats, err);
     }
+    if (s == FV_OK) s = v->eye_count == 2 ? fv_technique_render_pair(t, fr, films, stats, err) : fv_technique_render(t, &fr[0], films[0], stats, err);
     if (s == FV_OK) {
         d->last = *v;
         d->last_seen = seen;

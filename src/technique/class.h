@@ -59,6 +59,11 @@ typedef struct fv_technique_class {
     /* Renders one eye of one frame (frame->eye) into film, whose size matches frame->camera.
      * Adds stage timings and counters to stats. */
     fv_status (*render)(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);
+    /* Optional: renders both eyes of a stereo frame (frames[0] eye 0, frames[1] eye 1, same index
+     * and time; films[e] matches frames[e]'s camera) in one call, so a device can run both eyes
+     * without a host round trip between them. Its images and counters must be those of render
+     * called for eye 0 then eye 1. NULL: fv_technique_render_pair calls render twice. */
+    fv_status (*render_pair)(void *state, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err);
     void (*destroy)(void *state);
     /* Devices beyond the CPU (fovea/device.h): a bit (1 << FV_DEVICE_*) per device the method
      * also runs on; 0 for a CPU-only method. Such a method is created by create_on, which is told

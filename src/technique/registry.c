@@ -233,9 +233,9 @@ static bool relay_progress(void *user, double fraction)
     return !r->cancelled;
 }
 
-fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+/* What every render checks of a frame and its film. */
+static fv_status check_frame(const fv_frame *frame, const fv_film *film, fv_error *err)
 {
-    if (!t || !frame || !film || !stats) return fv_error_set(err, FV_ERR_INVALID, "render: missing technique, frame, film or stats");
     if (!frame->camera) return fv_error_set(err, FV_ERR_INVALID, "render: the frame has no camera");
     if (frame->eye_count < 1 || frame->eye_count > 2 || frame->eye < 0 || frame->eye >= frame->eye_count)
         return fv_error_set(err, FV_ERR_INVALID, "render: eye %d of %d (expected eye 0, or 0 and 1 of a stereo pair)", frame->eye,
@@ -243,20 +243,61 @@ fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_film *f
     if (frame->camera->width != fv_film_width(film) || frame->camera->height != fv_film_height(film))
         return fv_error_set(err, FV_ERR_INVALID, "render: camera size %dx%d differs from the film's %dx%d", frame->camera->width,
                             frame->camera->height, fv_film_width(film), fv_film_height(film));
+    return FV_OK;
+}
+
+/* A frame whose progress goes through r (unchanged when it has none). */
+static void relay_frame(const fv_frame *frame, relay *r, fv_frame *out)
+{
+    *out = *frame;
+    *r = (relay){frame->progress, frame->progress_user, false};
+    if (frame->progress) {
+        out->progress = relay_progress;
+        out->progress_user = r;
+    }
+}
+
+fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+{
+    if (!t || !frame || !film || !stats) return fv_error_set(err, FV_ERR_INVALID, "render: missing technique, frame, film or stats");
+    fv_status s = check_frame(frame, film, err);
+    if (s != FV_OK) return s;
     /* Every eye reports the parallel regions it opened (core/parallel.h; docs/threads.md): each
      * region wakes the team, so fewer is better paced. */
     const uint64_t regions = fv_region_count();
-    fv_status s;
-    relay r = {frame->progress, frame->progress_user, false};
-    if (!frame->progress) {
-        s = t->cls->render(t->state, frame, film, stats, err);
-    } else {
-        fv_frame f = *frame;
-        f.progress = relay_progress;
-        f.progress_user = &r;
-        s = t->cls->render(t->state, &f, film, stats, err);
-        if (s == FV_OK && r.cancelled) s = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    relay r;
+    fv_frame f;
+    relay_frame(frame, &r, &f);
+    s = t->cls->render(t->state, &f, film, stats, err);
+    if (s == FV_OK && r.cancelled) s = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    fv_stats_add_count(stats, "parallel_regions", (double)(fv_region_count() - regions));
+    return s;
+}
+
+fv_status fv_technique_render_pair(fv_technique *t, const fv_frame frames[2], fv_film *const films[2], fv_stats *stats, fv_error *err)
+{
+    if (!t || !frames || !films || !films[0] || !films[1] || !stats)
+        return fv_error_set(err, FV_ERR_INVALID, "render: missing technique, frames, films or stats");
+    for (int e = 0; e < 2; e++) {
+        if (frames[e].eye != e || frames[e].eye_count != 2)
+            return fv_error_set(err, FV_ERR_INVALID, "render: a stereo pair's frame %d is eye %d of %d (expected eye %d of 2)", e, frames[e].eye,
+                                frames[e].eye_count, e);
+        fv_status s = check_frame(&frames[e], films[e], err);
+        if (s != FV_OK) return s;
     }
+    if (frames[0].index != frames[1].index || frames[0].time != frames[1].time)
+        return fv_error_set(err, FV_ERR_INVALID, "render: a stereo pair's eyes differ in frame index (%d, %d) or time (%g, %g)", frames[0].index,
+                            frames[1].index, frames[0].time, frames[1].time);
+    if (!t->cls->render_pair) {
+        fv_status s = fv_technique_render(t, &frames[0], films[0], stats, err);
+        return s == FV_OK ? fv_technique_render(t, &frames[1], films[1], stats, err) : s;
+    }
+    const uint64_t regions = fv_region_count();
+    relay r[2];
+    fv_frame f[2];
+    for (int e = 0; e < 2; e++) relay_frame(&frames[e], &r[e], &f[e]);
+    fv_status s = t->cls->render_pair(t->state, f, films, stats, err);
+    if (s == FV_OK && (r[0].cancelled || r[1].cancelled)) s = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
     fv_stats_add_count(stats, "parallel_regions", (double)(fv_region_count() - regions));
     return s;
 }

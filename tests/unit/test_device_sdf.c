@@ -286,6 +286,167 @@ static void test_options(void **st)
     fv_scene_destroy(s);
 }
 
+/* Colour NaN first, so a pixel a render leaves unwritten cannot pass. */
+static void poison(fv_film *film)
+{
+    fv_film_clear(film);
+    float *col = fv_film_color(film);
+    for (size_t k = 0, m = (size_t)3 * fv_film_width(film) * fv_film_height(film); k < m; k++) col[k] = NAN;
+}
+
+static size_t film_diff(fv_film *a, fv_film *b)
+{
+    const size_t n = (size_t)fv_film_width(a) * fv_film_height(a);
+    double max_abs = 0.0;
+    return differing(fv_film_color_const(a), fv_film_color_const(b), 3 * n, &max_abs) +
+           differing(fv_film_depth(a), fv_film_depth(b), n, &max_abs) + differing(fv_film_normal(a), fv_film_normal(b), 3 * n, &max_abs) +
+           differing(fv_film_albedo(a), fv_film_albedo(b), 3 * n, &max_abs) +
+           differing(fv_film_position(a), fv_film_position(b), 3 * n, &max_abs) +
+           (memcmp(fv_film_id(a), fv_film_id(b), n * sizeof(uint32_t)) != 0);
+}
+
+/* A stereo sequence on the portable backend, each frame as a pair (fv_technique_render_pair: the
+ * world built once, both eyes' passes) and as two per-eye calls on another instance, the scene's
+ * time moving 0.1 s a frame: every eye's film and every counter equal, bit for bit, frame after
+ * frame (fipr's history per eye carried through both paths), and the pair's films equal to the CPU
+ * pipeline's (which builds its world afresh each frame). The world is built once for a scene
+ * where nothing moves and once a frame where something does (sdf-columns' lights), whichever path
+ * asks for it. */
+static void compare_pair(const char *scene, const char *method, const char *params, int w, int h, int frames, bool moves)
+{
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load(scene, &s, &v) != 0) fail_msg("cannot load %s", scene);
+    fv_camera centre, cam[2];
+    fv_view_camera(v, s, 0.0, w, h, &centre);
+    fv_camera_stereo(&centre, 0.08f, &cam[0], &cam[1]);
+    char pp[160], pc[160];
+    snprintf(pp, sizeof pp, "%s device=portable", params);
+    snprintf(pc, sizeof pc, "%s device=cpu", params);
+    fv_technique *each = create(method, pp, s), *pair = create(method, pp, s), *cpu = create(method, pc, s);
+    fv_film *a[2], *b[2], *c[2];
+    fv_error err;
+    for (int e = 0; e < 2; e++)
+        if (fv_film_create(w, h, AUX, &a[e], &err) != FV_OK || fv_film_create(w, h, AUX, &b[e], &err) != FV_OK ||
+            fv_film_create(w, h, AUX, &c[e], &err) != FV_OK)
+            fail_msg("%s", err.msg);
+    double builds[2] = {0.0, 0.0};
+    for (int i = 0; i < frames; i++) {
+        const double time = 0.1 * i;
+        if (fv_scene_set_time(s, time, &err) != FV_OK) fail_msg("%s", err.msg);
+        fv_frame f[2];
+        for (int e = 0; e < 2; e++) {
+            fv_frame_init(&f[e], &cam[e]);
+            f[e].time = time;
+            f[e].seed = 5;
+            f[e].index = i;
+            f[e].eye = e;
+            f[e].eye_count = 2;
+            f[e].prev_camera = i > 0 ? &cam[e] : NULL;
+            f[e].left_camera = e == 1 ? &cam[0] : NULL;
+            f[e].gaze.x = 0.35f + 0.12f * (float)i + 0.04f * (float)e;
+            f[e].gaze.y = 0.55f - 0.08f * (float)i;
+            poison(a[e]);
+            poison(b[e]);
+            poison(c[e]);
+        }
+        fv_stats sa, sb, sc;
+        fv_stats_clear(&sa);
+        fv_stats_clear(&sb);
+        fv_stats_clear(&sc);
+        for (int e = 0; e < 2; e++)
+            if (fv_technique_render(each, &f[e], a[e], &sa, &err) != FV_OK || fv_technique_render(cpu, &f[e], c[e], &sc, &err) != FV_OK)
+                fail_msg("%s: frame %d eye %d: %s", method, i, e, err.msg);
+        if (fv_technique_render_pair(pair, f, b, &sb, &err) != FV_OK) fail_msg("%s: pair %d: %s", method, i, err.msg);
+        char what[256];
+        snprintf(what, sizeof what, "%s %s [%s] %dx%d frame %d", method, scene, params, w, h, i);
+        for (int e = 0; e < 2; e++) {
+            size_t d = film_diff(a[e], b[e]);
+            if (d) fail_msg("%s eye %d: the pair's film differs from the per-eye call's in %zu values", what, e, d);
+            if ((d = film_diff(c[e], b[e]))) fail_msg("%s eye %d: the pair's film differs from the CPU's in %zu values", what, e, d);
+        }
+        if (!(fv_stats_get_count(&sa, "rays") > 0)) fail_msg("%s: nothing traced", what);
+        /* every counter of the per-eye calls but the parallel regions, and the CPU's counters */
+        if (sa.n_counters != sb.n_counters) fail_msg("%s: %d counters per eye, %d for the pair", what, sa.n_counters, sb.n_counters);
+        for (int k = 0; k < sa.n_counters; k++) {
+            const char *key = sa.counter[k].name;
+            if (strcmp(key, "parallel_regions") == 0) continue;
+            if (sa.counter[k].value != fv_stats_get_count(&sb, key))
+                fail_msg("%s: counter %s: per eye %g, pair %g", what, key, sa.counter[k].value, fv_stats_get_count(&sb, key));
+        }
+        compare_counters(what, &sc, &sb, strcmp(method, "ipr") == 0 || strcmp(method, "fipr") == 0 ? 3 : 1, strcmp(method, "fipr") == 0);
+        builds[0] += fv_stats_get_count(&sa, "world_builds");
+        builds[1] += fv_stats_get_count(&sb, "world_builds");
+        if (i == frames - 1)
+            printf("%s: both eyes equal (and the CPU's), %g rays, world built %g times per eye, %g for the pairs\n", what,
+                   fv_stats_get_count(&sb, "rays"), builds[0], builds[1]);
+    }
+    const double want = moves ? frames : 1;
+    if (builds[0] != want || builds[1] != want)
+        fail_msg("%s %s: the world built %g (per eye) and %g (pairs) times over %d frames, expected %g", method, scene, builds[0], builds[1], frames, want);
+    for (int e = 0; e < 2; e++) {
+        fv_film_destroy(a[e]);
+        fv_film_destroy(b[e]);
+        fv_film_destroy(c[e]);
+    }
+    fv_technique_destroy(each);
+    fv_technique_destroy(pair);
+    fv_technique_destroy(cpu);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+static void test_pair(void **st)
+{
+    (void)st;
+    compare_pair("sdf-primitives", "sdf-gt", "spp=4", 48, 36, 2, false);
+    compare_pair("sdf-columns", "sdf-relaxed", "spp=1", 40, 30, 3, true);
+    compare_pair("sdf-temple", "ipr", "spp=4 shadow_reuse=true", 40, 30, 2, false);
+    /* fipr: each eye's history carried over 3 and 5 frames, refreshed every other and every
+     * fourth, under moving lights and with pass 5 */
+    compare_pair("sdf-columns", "fipr", "spp=1 refresh=2", 48, 36, 3, true);
+    compare_pair("sdf-temple", "fipr", "spp=4 refresh=4 shadow_reuse=true blur=true", 40, 30, 5, false);
+}
+
+/* fv_technique_render_pair refuses frames that are not one stereo frame's eyes, naming what. */
+static void test_pair_refusals(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    assert_int_equal(fv_test_load("sdf-primitives", &s, &v), 0);
+    fv_camera cam;
+    fv_view_camera(v, s, 0.0, 16, 12, &cam);
+    fv_technique *t = create("sdf-gt", "device=portable", s);
+    fv_film *films[2];
+    fv_error err;
+    for (int e = 0; e < 2; e++) assert_int_equal(fv_film_create(16, 12, 0, &films[e], &err), FV_OK);
+    fv_frame f[2];
+    for (int e = 0; e < 2; e++) {
+        fv_frame_init(&f[e], &cam);
+        f[e].eye = e;
+        f[e].eye_count = 2;
+    }
+    fv_stats stats;
+    fv_stats_clear(&stats);
+    assert_int_equal(fv_technique_render_pair(t, f, films, &stats, &err), FV_OK);
+    f[1].eye = 0;
+    fv_test_expect_fail(fv_technique_render_pair(t, f, films, &stats, &err), &err, FV_ERR_INVALID,
+                        "render: a stereo pair's frame 1 is eye 0 of 2 (expected eye 1 of 2)", "two left eyes");
+    f[1].eye = 1;
+    f[1].index = 1;
+    fv_test_expect_fail(fv_technique_render_pair(t, f, films, &stats, &err), &err, FV_ERR_INVALID,
+                        "render: a stereo pair's eyes differ in frame index (0, 1) or time (0, 0)", "two frames");
+    f[1].index = 0;
+    f[0].eye_count = 1;
+    fv_test_expect_fail(fv_technique_render_pair(t, f, films, &stats, &err), &err, FV_ERR_INVALID,
+                        "render: a stereo pair's frame 0 is eye 0 of 1 (expected eye 0 of 2)", "a mono frame");
+    for (int e = 0; e < 2; e++) fv_film_destroy(films[e]);
+    fv_technique_destroy(t);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
 /* What the device backends refuse: diagnostics, and methods without a device form. */
 static void test_refusals(void **st)
 {
@@ -331,6 +492,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_primitives), cmocka_unit_test(test_columns), cmocka_unit_test(test_temple),
                                        cmocka_unit_test(test_options), cmocka_unit_test(test_ipr),
-                                       cmocka_unit_test(test_fipr), cmocka_unit_test(test_refusals)};
+                                       cmocka_unit_test(test_fipr), cmocka_unit_test(test_pair), cmocka_unit_test(test_pair_refusals),
+                                       cmocka_unit_test(test_refusals)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -21,6 +21,12 @@ struct fv_sdf_device {
     fv_pyramid_history hist[2]; /* portable, fipr: the middle level kept per eye */
     float *sigma, *blur_tmp;    /* portable, fipr with blur: pass 5's sigma and horizontal pass */
     size_t blur_pixels;         /* the size sigma and blur_tmp have */
+    /* The world, kept between frames: rebuilt (fv_sdf_world_refresh) only when the scene's time
+     * changed and something in it moves, so a still scene builds it once. */
+    fv_sdf_world world;
+    bool world_ok;              /* world holds the scene at world_time */
+    double world_time;
+    bool moves;                 /* an SDF object or a delta light is animated */
 };
 
 fv_status fv_sdf_device_create(const fv_scene *scene, const fv_sdf_opts *o, fv_device device, fv_sdf_device **out, fv_error *err)
@@ -30,6 +36,9 @@ fv_status fv_sdf_device_create(const fv_scene *scene, const fv_sdf_opts *o, fv_d
     if (!d) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     d->scene = scene;
     d->o = *o;
+    d->moves = fv_scene_lights_move(scene);
+    for (int i = 0; i < fv_scene_object_count(scene) && !d->moves; i++)
+        d->moves = fv_scene_object_kind(scene, i) == FV_OBJECT_SDF && fv_scene_object_dynamic(scene, i);
     if (device == FV_DEVICE_CUDA) {
         fv_status s = fv_cuda_sdf_create(&d->cuda, err);
         if (s != FV_OK) {
@@ -48,6 +57,7 @@ void fv_sdf_device_destroy(fv_sdf_device *d)
     fv_pyramid_free(&d->k);
     fv_pyramid_history_free(&d->hist[0]);
     fv_pyramid_history_free(&d->hist[1]);
+    fv_sdf_world_free(&d->world);
     free(d->sigma);
     free(d->blur_tmp);
     free(d);
@@ -248,6 +258,22 @@ static fv_status portable_blur(fv_sdf_device *d, tile_job *j, const fv_frame *fr
     return s == FV_OK ? fv_blur_kernel_passes(j->out.color, d->blur_tmp, w, h, d->sigma, d->o.blur_sigma, frame->threads, err) : s;
 }
 
+/* The world at the scene's current time: the kept one while it stands for it. */
+static fv_status world_at_time(fv_sdf_device *d, fv_stats *stats, fv_error *err)
+{
+    const double t = fv_scene_time(d->scene);
+    if (d->world_ok && (!d->moves || t == d->world_time)) return FV_OK;
+    d->world_ok = false;
+    double t0 = fv_time_ms();
+    fv_status s = fv_sdf_world_refresh(&d->world, d->scene, err);
+    if (s != FV_OK) return s;
+    d->world_ok = true;
+    d->world_time = t;
+    fv_stats_add_ms(stats, "scene", fv_time_ms() - t0);
+    fv_stats_add_count(stats, "world_builds", 1.0);
+    return FV_OK;
+}
+
 /* Renders `eyes` eyes of one frame (1, or a stereo pair of one size): the world built once for
  * them; on CUDA every eye's passes are launched before the one host wait, on the portable backend
  * the eyes run one after the other through the same passes. */
@@ -271,15 +297,14 @@ static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
         d->blur_pixels = d->sigma && d->blur_tmp ? np : 0;
         if (!d->blur_pixels) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for fipr's blur");
     }
-    fv_sdf_world world;
-    double t0 = fv_time_ms();
-    if ((s = fv_sdf_world_build(&world, d->scene, err)) != FV_OK) return s;
-    fv_stats_add_ms(stats, "scene", fv_time_ms() - t0);
+    if ((s = world_at_time(d, stats, err)) != FV_OK) return s;
+    const fv_sdf_world *world = &d->world;
+    double t0;
     const int S = fv_sdf_samples_per_axis(o->spp);
     fv_ksdf_frame f[2];
     fv_film_views out[2];
     for (int e = 0; e < eyes; e++) {
-        j[e].world = &world.k;
+        j[e].world = &world->k;
         j[e].f.S = S;
         /* a target sample's angular footprint per unit distance, as the CPU pipeline's */
         j[e].f.eps_k = o->hit * (2.0f * j[e].f.cam.tan_half_x / (float)(w * S));
@@ -298,7 +323,7 @@ static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
         double kernel_ms = 0.0;
         int syncs = 0;
         if (!pyramid) {
-            s = fv_cuda_sdf_render(d->cuda, &world.k, eyes, f, out, &c.all, &kernel_ms, &syncs, err);
+            s = fv_cuda_sdf_render(d->cuda, &world->k, eyes, f, out, &c.all, &kernel_ms, &syncs, err);
             c.level_rays[0] = c.all.rays;
             c.level_steps[0] = c.all.steps;
         } else {
@@ -315,7 +340,7 @@ static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
             fv_kpyr_fovea fov[2];
             for (int e = 0; e < eyes && fipr; e++) fv_sdf_fovea_of(&frames[e], o, w, h, &fov[e]);
             const fv_cuda_pyr_opts po = {o->edge, o->shadow_reuse, blurred, o->blur_sigma};
-            s = fv_cuda_sdf_pyramid_render(d->cuda, &world.k, eyes, f, &shape, fipr ? fov : NULL, &po, out, &c, &kernel_ms, &syncs, err);
+            s = fv_cuda_sdf_pyramid_render(d->cuda, &world->k, eyes, f, &shape, fipr ? fov : NULL, &po, out, &c, &kernel_ms, &syncs, err);
         }
         fv_stats_add_ms(stats, "kernel", kernel_ms);
         fv_stats_add_count(stats, "host_syncs", (double)syncs);
@@ -342,7 +367,6 @@ static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
     }
     fv_stats_add_ms(stats, "target", fv_time_ms() - t0 - blur_ms);
     if (blurred && !d->cuda) fv_stats_add_ms(stats, "blur", blur_ms);
-    fv_sdf_world_free(&world);
     if (s != FV_OK) return s;
     report(o, &c, samples, stats);
     return FV_OK;

@@ -119,6 +119,16 @@ static fv_status render(void *state, const fv_frame *frame, fv_film *film, fv_st
     return st->dev ? fv_sdf_device_render(st->dev, frame, film, stats, err) : fv_sdf_pipeline_render(st->pipe, frame, film, stats, err);
 }
 
+/* A stereo frame: both eyes at once on a device (one host wait on CUDA); the CPU pipeline renders
+ * them one after the other, as two render calls do. */
+static fv_status render_pair(void *state, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    family_state *st = state;
+    if (st->dev) return fv_sdf_device_render_pair(st->dev, frames, films, stats, err);
+    fv_status s = render(state, &frames[0], films[0], stats, err);
+    return s == FV_OK ? render(state, &frames[1], films[1], stats, err) : s;
+}
+
 static void destroy(void *state)
 {
     family_state *st = state;
@@ -212,7 +222,7 @@ static const fv_param_info k_fipr_params[] = {
 
 #define SDF_CLASS(id, nm, sum, base, table, fn, fn_on, devs, fov, warmup)                                             \
     const fv_technique_class id = {.name = nm, .summary = sum, .family = FV_FAMILY_SDF, .baseline = base, FV_CLASS_PARAMS(table), \
-                                   .main = SDF_STEPS, .create = fn, .create_on = fn_on, .devices = devs, .render = render, .destroy = destroy, .sdf_only = true,         \
+                                   .main = SDF_STEPS, .create = fn, .create_on = fn_on, .devices = devs, .render = render, .render_pair = render_pair, .destroy = destroy, .sdf_only = true, \
                                    .test_params = "spp=1", .furnace_radiance = 1.0, .furnace_tolerance = 0.01, .spp_param = "spp", \
                                    .foveated = fov, .warmup_frames = warmup}
 
