@@ -15,6 +15,10 @@
  * within an ulp of the probability, so the counts are still required to be equal.) A pyramid frame
  * must report one host wait (host_syncs): its passes are launched without any between them. If the GPU
  * shows more, the first run's printout says where, and the bound is revised with that measurement.
+ * A stereo frame through fv_technique_render_pair (both eyes' kernels on the stream, one host wait
+ * for the pair) must equal the two per-eye CUDA calls bit for bit (the same kernels in the same
+ * order) and the portable pair within the bounds above, with host_syncs 1 per pair, fipr's
+ * histories carried on the GPU and the scene's lights moving (sdf-columns).
  * Exits 77 (skipped) where CUDA cannot run: a build without CUDA, a machine without a GPU.
  */
 #include <math.h>
@@ -207,6 +211,98 @@ static void test_temple(void **st)
     compare("sdf-temple", "sdf-relaxed", 96, 72, 16);
 }
 
+/* A stereo sequence, the scene's time moving 0.1 s a frame: CUDA's pairs against CUDA's per-eye
+ * calls (bit for bit) and against portable's pairs (the bounds above); one host wait per pair. */
+static void compare_pair(const char *scene, const char *method, const char *params, int w, int h, int frames)
+{
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load(scene, &s, &v) != 0) fail_msg("cannot load %s", scene);
+    fv_camera centre, cam[2];
+    fv_view_camera(v, s, 0.0, w, h, &centre);
+    fv_camera_stereo(&centre, 0.08f, &cam[0], &cam[1]);
+    char pp[160], pc[160];
+    snprintf(pp, sizeof pp, "%s device=portable", params);
+    snprintf(pc, sizeof pc, "%s device=cuda", params);
+    fv_technique *tp = create(method, pp, s), *pair = create(method, pc, s), *each = create(method, pc, s);
+    fv_film *p[2], *c[2], *e1[2];
+    fv_error err;
+    const int aux = FV_AUX_DEPTH | FV_AUX_NORMAL | FV_AUX_ID;
+    for (int e = 0; e < 2; e++)
+        if (fv_film_create(w, h, aux, &p[e], &err) != FV_OK || fv_film_create(w, h, aux, &c[e], &err) != FV_OK ||
+            fv_film_create(w, h, aux, &e1[e], &err) != FV_OK)
+            fail_msg("%s", err.msg);
+    const size_t n = (size_t)w * h;
+    for (int i = 0; i < frames; i++) {
+        const double time = 0.1 * i;
+        if (fv_scene_set_time(s, time, &err) != FV_OK) fail_msg("%s", err.msg);
+        fv_frame f[2];
+        for (int e = 0; e < 2; e++) {
+            fv_frame_init(&f[e], &cam[e]);
+            f[e].time = time;
+            f[e].seed = 5;
+            f[e].index = i;
+            f[e].eye = e;
+            f[e].eye_count = 2;
+            f[e].prev_camera = i > 0 ? &cam[e] : NULL;
+            f[e].left_camera = e == 1 ? &cam[0] : NULL;
+            f[e].gaze.x = 0.35f + 0.12f * (float)i + 0.04f * (float)e;
+            f[e].gaze.y = 0.55f - 0.08f * (float)i;
+            fv_film_clear(c[e]);
+            float *col = fv_film_color(c[e]);
+            for (size_t k = 0; k < 3 * n; k++) col[k] = NAN;
+        }
+        fv_stats sp, sc, se;
+        fv_stats_clear(&sp);
+        fv_stats_clear(&sc);
+        fv_stats_clear(&se);
+        if (fv_technique_render_pair(tp, f, p, &sp, &err) != FV_OK || fv_technique_render_pair(pair, f, c, &sc, &err) != FV_OK)
+            fail_msg("%s: pair %d: %s", method, i, err.msg);
+        for (int e = 0; e < 2; e++)
+            if (fv_technique_render(each, &f[e], e1[e], &se, &err) != FV_OK) fail_msg("%s: frame %d eye %d: %s", method, i, e, err.msg);
+        char what[256];
+        snprintf(what, sizeof what, "%s %s [%s] %dx%d stereo frame %d", method, scene, params, w, h, i);
+        for (int e = 0; e < 2; e++) {
+            fv_test_agreement r = fv_test_agree(p[e], c[e], 1e-4);
+            printf("%s eye %d: %.3f%% of pixels within 1e-4 of portable, largest mean difference %.3g%%, host syncs %g (per-eye calls %g)\n", what, e,
+                   100.0 * r.equal_share, 100.0 * r.max_mean_rel, fv_stats_get_count(&sc, "host_syncs"), fv_stats_get_count(&se, "host_syncs"));
+            if (!(r.equal_share >= 0.995)) fail_msg("%s eye %d: only %.3f%% of pixels agree within 1e-4", what, e, 100.0 * r.equal_share);
+            if (!(r.max_mean_rel <= 1e-4)) fail_msg("%s eye %d: means differ by %.3g%%", what, e, 100.0 * r.max_mean_rel);
+            if (memcmp(fv_film_color_const(c[e]), fv_film_color_const(e1[e]), 3 * n * sizeof(float)) != 0 ||
+                memcmp(fv_film_depth(c[e]), fv_film_depth(e1[e]), n * sizeof(float)) != 0)
+                fail_msg("%s eye %d: the pair differs from the per-eye calls", what, e);
+        }
+        static const char *const keys[] = {"rays", "steps", "shadow_rays", "shadow_steps", "normal_evals", "exhausted_rays", "mask_pixels",
+                                           "edge_pixels", "refreshed_pixels"};
+        for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
+            if (fv_stats_get_count(&sp, keys[k]) != fv_stats_get_count(&sc, keys[k]) || fv_stats_get_count(&se, keys[k]) != fv_stats_get_count(&sc, keys[k]))
+                fail_msg("%s: counter %s: portable %g, cuda pair %g, cuda per eye %g", what, keys[k], fv_stats_get_count(&sp, keys[k]),
+                         fv_stats_get_count(&sc, keys[k]), fv_stats_get_count(&se, keys[k]));
+        if (fv_stats_get_count(&sc, "host_syncs") != 1.0) fail_msg("%s: %g host waits for the pair", what, fv_stats_get_count(&sc, "host_syncs"));
+        if (fv_stats_get_count(&se, "host_syncs") != 2.0) fail_msg("%s: %g host waits for two eyes", what, fv_stats_get_count(&se, "host_syncs"));
+    }
+    for (int e = 0; e < 2; e++) {
+        fv_film_destroy(p[e]);
+        fv_film_destroy(c[e]);
+        fv_film_destroy(e1[e]);
+    }
+    fv_technique_destroy(tp);
+    fv_technique_destroy(pair);
+    fv_technique_destroy(each);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+static void test_pair(void **st)
+{
+    (void)st;
+    compare_pair("sdf-primitives", "sdf-gt", "spp=4", 160, 120, 2);
+    compare_pair("sdf-columns", "sdf-relaxed", "spp=1", 160, 120, 3);
+    compare_pair("sdf-temple", "ipr", "spp=4 shadow_reuse=true", 96, 72, 2);
+    compare_pair("sdf-columns", "fipr", "spp=1 refresh=2", 160, 120, 4);
+    compare_pair("sdf-temple", "fipr", "spp=16 refresh=4 shadow_reuse=true blur=true", 96, 72, 5);
+}
+
 int main(void)
 {
     char why[256];
@@ -215,6 +311,6 @@ int main(void)
         return 77;
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_primitives), cmocka_unit_test(test_columns), cmocka_unit_test(test_temple),
-                                       cmocka_unit_test(test_ipr), cmocka_unit_test(test_fipr)};
+                                       cmocka_unit_test(test_ipr), cmocka_unit_test(test_fipr), cmocka_unit_test(test_pair)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
