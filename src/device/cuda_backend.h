@@ -34,10 +34,12 @@ typedef struct fv_cuda_pt fv_cuda_pt;
 fv_status fv_cuda_pt_create(const struct fv_kscene *host, fv_cuda_pt **out, fv_error *err);
 /* Brings the GPU's copy to the host snapshot's time: what moves (instances, top level, lights). */
 fv_status fv_cuda_pt_update(fv_cuda_pt *c, const struct fv_kscene *host, fv_error *err);
-/* Renders into the film's buffers (host memory): colour and whichever auxiliary buffers are set.
- * *rays and *nan_samples receive the counts; *kernel_ms the kernel's own time (events). */
-fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays, uint64_t *nan_samples,
-                            double *kernel_ms, fv_error *err);
+/* Renders `eyes` eyes (1, or 2: a stereo pair, f and out one per eye, both kernels launched before
+ * the one host wait) into the films' buffers (host memory): colour and whichever auxiliary buffers
+ * are set. *rays and *nan_samples receive the counts of all eyes; *kernel_ms the kernels' own time
+ * (events); *syncs the host waits (1). */
+fv_status fv_cuda_pt_render(fv_cuda_pt *c, int eyes, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays, uint64_t *nan_samples,
+                            double *kernel_ms, int *syncs, fv_error *err);
 void fv_cuda_pt_destroy(fv_cuda_pt *c);
 
 /* The sphere-tracing family (kernel/sdf_pixel.h, kernel/sdf_pyramid.h): the GPU's buffers for the

@@ -25,10 +25,10 @@ fv_status fv_cuda_pt_update(fv_cuda_pt *c, const struct fv_kscene *host, fv_erro
     return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
 }
 
-fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays, uint64_t *nan_samples,
-                            double *kernel_ms, fv_error *err)
+fv_status fv_cuda_pt_render(fv_cuda_pt *c, int eyes, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays, uint64_t *nan_samples,
+                            double *kernel_ms, int *syncs, fv_error *err)
 {
-    (void)c, (void)f, (void)out, (void)rays, (void)nan_samples, (void)kernel_ms;
+    (void)c, (void)eyes, (void)f, (void)out, (void)rays, (void)nan_samples, (void)kernel_ms, (void)syncs;
     return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
 }
 

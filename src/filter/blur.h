@@ -17,6 +17,10 @@
 #include "core/scratch.h"
 #include "fovea/status.h"
 
+#ifdef __cplusplus
+extern "C" { /* device/cuda/sdf.cu builds pass 5's kernels with the table functions */
+#endif
+
 /* Sigma profile of Sec. 3.5: 0 up to fovea_deg, rising linearly to sigma_max at ramp_deg, held at
  * sigma_max beyond (the paper: 0 in the fovea, 6.8 pixels at 30 degrees at 1280x1440). A NaN
  * eccentricity gets 0; ramp_deg <= fovea_deg makes the profile a step at fovea_deg. */
@@ -43,4 +47,7 @@ void fv_blur_table_fill(int w, int h, int nq, int *off, float *k);
  * The same bits as fv_blur_variable (test_blur). */
 fv_status fv_blur_kernel_passes(float *rgb, float *tmp, int w, int h, const float *sigma, float smax, int threads, fv_error *err);
 
+#ifdef __cplusplus
+}
+#endif
 #endif

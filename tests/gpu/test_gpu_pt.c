@@ -2,7 +2,9 @@
  * against `pt` on the portable backend, which runs the same kernel source on the CPU with the same
  * random numbers, so the images agree pixel by pixel within float tolerance (the GPU's cosf and
  * sinf differ from the C library's in the last bits, which may send a rare path elsewhere); two
- * CUDA runs are bit-identical; the first-hit buffers agree. Exits 77 (skipped) where CUDA cannot
+ * CUDA runs are bit-identical; the first-hit buffers agree. A stereo frame through
+ * fv_technique_render_pair (both eyes' kernels, one host wait) equals the two per-eye calls bit for
+ * bit, with host_syncs 1 for the pair. Exits 77 (skipped) where CUDA cannot
  * run: a build without CUDA, a machine without a GPU.
  */
 #include <setjmp.h>
@@ -79,6 +81,65 @@ static void test_sdf(void **st)
     compare_scene("sdf-primitives", 96, 96, 0.0, 1);
 }
 
+/* A moving scene's stereo frames on CUDA as pairs and as per-eye calls: the same bits, one host
+ * wait per pair (two for the per-eye calls). */
+static void test_pair(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load("cornell-fpm", &s, &v) != 0) fail_msg("cannot load cornell-fpm");
+    fv_camera centre, cam[2];
+    fv_view_camera(v, s, 0.0, 96, 72, &centre);
+    fv_camera_stereo(&centre, 0.06f, &cam[0], &cam[1]);
+    fv_params *p = fv_test_params_str("spp=4 device=cuda");
+    fv_technique *pair = NULL, *each = NULL;
+    fv_error err;
+    if (fv_technique_create("pt", s, p, NULL, &pair, &err) != FV_OK || fv_technique_create("pt", s, p, NULL, &each, &err) != FV_OK)
+        fail_msg("%s", err.msg);
+    fv_film *a[2], *b[2];
+    for (int e = 0; e < 2; e++)
+        if (fv_film_create(96, 72, FV_AUX_DEPTH | FV_AUX_ID, &a[e], &err) != FV_OK || fv_film_create(96, 72, FV_AUX_DEPTH | FV_AUX_ID, &b[e], &err) != FV_OK)
+            fail_msg("%s", err.msg);
+    for (int i = 0; i < 3; i++) {
+        const double time = 0.2 * i;
+        if (fv_scene_set_time(s, time, &err) != FV_OK) fail_msg("%s", err.msg);
+        fv_frame f[2];
+        for (int e = 0; e < 2; e++) {
+            fv_frame_init(&f[e], &cam[e]);
+            f[e].time = time;
+            f[e].index = i;
+            f[e].seed = 11;
+            f[e].eye = e;
+            f[e].eye_count = 2;
+        }
+        fv_stats sp, se;
+        fv_stats_clear(&sp);
+        fv_stats_clear(&se);
+        if (fv_technique_render_pair(pair, f, b, &sp, &err) != FV_OK) fail_msg("pair %d: %s", i, err.msg);
+        for (int e = 0; e < 2; e++)
+            if (fv_technique_render(each, &f[e], a[e], &se, &err) != FV_OK) fail_msg("frame %d eye %d: %s", i, e, err.msg);
+        printf("pt cornell-fpm stereo frame %d: rays %g (per eye %g), host syncs %g (per eye %g)\n", i, fv_stats_get_count(&sp, "rays"),
+               fv_stats_get_count(&se, "rays"), fv_stats_get_count(&sp, "host_syncs"), fv_stats_get_count(&se, "host_syncs"));
+        for (int e = 0; e < 2; e++)
+            if (memcmp(fv_film_color_const(a[e]), fv_film_color_const(b[e]), (size_t)3 * 96 * 72 * sizeof(float)) != 0 ||
+                memcmp(fv_film_depth(a[e]), fv_film_depth(b[e]), (size_t)96 * 72 * sizeof(float)) != 0)
+                fail_msg("frame %d eye %d: the pair differs from the per-eye call", i, e);
+        if (fv_stats_get_count(&sp, "rays") != fv_stats_get_count(&se, "rays")) fail_msg("frame %d: the pair counts other rays", i);
+        if (fv_stats_get_count(&sp, "host_syncs") != 1.0 || fv_stats_get_count(&se, "host_syncs") != 2.0)
+            fail_msg("frame %d: %g host waits for the pair, %g for two eyes", i, fv_stats_get_count(&sp, "host_syncs"), fv_stats_get_count(&se, "host_syncs"));
+    }
+    for (int e = 0; e < 2; e++) {
+        fv_film_destroy(a[e]);
+        fv_film_destroy(b[e]);
+    }
+    fv_technique_destroy(pair);
+    fv_technique_destroy(each);
+    fv_params_destroy(p);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
 int main(void)
 {
     char why[256];
@@ -87,6 +148,6 @@ int main(void)
         return 77;
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_cornell), cmocka_unit_test(test_city), cmocka_unit_test(test_moving),
-                                       cmocka_unit_test(test_textured), cmocka_unit_test(test_sdf)};
+                                       cmocka_unit_test(test_textured), cmocka_unit_test(test_sdf), cmocka_unit_test(test_pair)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -74,6 +74,23 @@ static inline fv_status fv_cuda_film_read(const fv_cuda_film *f, const fv_film_v
     return FV_OK;
 }
 
+/* The same enqueued on stream st, after the kernels before it: the caller's one wait (a stream
+ * synchronisation) covers them all. */
+static inline cudaError_t fv_cuda_film_read_async(const fv_cuda_film *f, const fv_film_views *host, size_t n, cudaStream_t st)
+{
+    struct {
+        void *host;
+        const void *dev;
+        size_t bytes;
+    } back[6] = {{host->color, f->color, 3 * n * sizeof(float)},       {host->depth, f->depth, n * sizeof(float)},
+                 {host->normal, f->normal, 3 * n * sizeof(float)},     {host->albedo, f->albedo, 3 * n * sizeof(float)},
+                 {host->position, f->position, 3 * n * sizeof(float)}, {host->id, f->id, n * sizeof(uint32_t)}};
+    cudaError_t e = cudaSuccess;
+    for (int i = 0; i < 6 && e == cudaSuccess; i++)
+        if (back[i].host) e = cudaMemcpyAsync(back[i].host, back[i].dev, back[i].bytes, cudaMemcpyDeviceToHost, st);
+    return e;
+}
+
 static inline void fv_cuda_film_free(fv_cuda_film *f)
 {
     cudaFree(f->color);

@@ -25,7 +25,7 @@ struct fv_cuda_pt {
     void *owned[32];         /* every device allocation of the scene, freed at destroy */
     int nowned;
     fv_ktexture *tex_host;   /* the texture records with device texel pointers, as uploaded */
-    fv_cuda_film film;       /* kept between frames of one size */
+    fv_cuda_film film[2];    /* per eye (a stereo pair is read back after both ran), kept between frames of one size */
     unsigned long long *counts; /* rays, non-finite estimates */
     cudaEvent_t start, stop;
 };
@@ -136,7 +136,8 @@ extern "C" void fv_cuda_pt_destroy(fv_cuda_pt *c)
 {
     if (!c) return;
     for (int i = 0; i < c->nowned; i++) cudaFree(c->owned[i]);
-    fv_cuda_film_free(&c->film);
+    fv_cuda_film_free(&c->film[0]);
+    fv_cuda_film_free(&c->film[1]);
     cudaFree(c->counts);
     if (c->start) cudaEventDestroy(c->start);
     if (c->stop) cudaEventDestroy(c->stop);
@@ -172,28 +173,41 @@ __global__ void fv_cuda_pt_kernel(fv_kscene s, fv_kpt_frame f, fv_film_views out
     if (bad) atomicAdd(&counts[1], (unsigned long long)bad);
 }
 
-extern "C" fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays,
-                                       uint64_t *nan_samples, double *kernel_ms, fv_error *err)
+extern "C" fv_status fv_cuda_pt_render(fv_cuda_pt *c, int eyes, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays,
+                                       uint64_t *nan_samples, double *kernel_ms, int *syncs, fv_error *err)
 {
-    const size_t n = (size_t)f->cam.width * (size_t)f->cam.height;
-    fv_film_views dv;
-    fv_status s = fv_cuda_film_prepare(&c->film, out, n, &dv, err);
-    if (s != FV_OK) return s;
+    *syncs = 0;
+    if (eyes < 1 || eyes > 2) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %d eyes", eyes);
+    /* every eye's film first: nothing between the launches but launches */
+    size_t n[2];
+    fv_film_views dv[2];
+    fv_status s;
+    for (int i = 0; i < eyes; i++) {
+        n[i] = (size_t)f[i].cam.width * (size_t)f[i].cam.height;
+        if ((s = fv_cuda_film_prepare(&c->film[i], &out[i], n[i], &dv[i], err)) != FV_OK) return s;
+    }
+    cudaStream_t st = 0;
     cudaError_t e;
-    if ((e = cudaMemset(c->counts, 0, 2 * sizeof(unsigned long long))) != cudaSuccess) return fv_cuda_fail(e, "clearing counters", err);
+    if ((e = cudaMemsetAsync(c->counts, 0, 2 * sizeof(unsigned long long), st)) != cudaSuccess) return fv_cuda_fail(e, "clearing counters", err);
     dim3 block(FV_CUDA_BLOCK, FV_CUDA_BLOCK);
-    dim3 grid((unsigned)((f->cam.width + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK), (unsigned)((f->cam.height + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK));
-    cudaEventRecord(c->start);
-    fv_cuda_pt_kernel<<<grid, block>>>(c->dev, *f, dv, c->counts);
-    cudaEventRecord(c->stop);
+    cudaEventRecord(c->start, st);
+    for (int i = 0; i < eyes; i++) {
+        dim3 grid((unsigned)((f[i].cam.width + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK), (unsigned)((f[i].cam.height + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK));
+        fv_cuda_pt_kernel<<<grid, block, 0, st>>>(c->dev, f[i], dv[i], c->counts);
+    }
+    cudaEventRecord(c->stop, st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the pt kernel", err);
-    if ((e = cudaEventSynchronize(c->stop)) != cudaSuccess) return fv_cuda_fail(e, "running the pt kernel", err);
+    /* what the host receives, enqueued behind the kernels, then its one wait */
+    unsigned long long counts[2];
+    for (int i = 0; i < eyes && e == cudaSuccess; i++) e = fv_cuda_film_read_async(&c->film[i], &out[i], n[i], st);
+    if (e == cudaSuccess) e = cudaMemcpyAsync(counts, c->counts, sizeof counts, cudaMemcpyDeviceToHost, st);
+    if (e == cudaSuccess) e = cudaStreamSynchronize(st);
+    *syncs = 1;
+    if (e != cudaSuccess) return fv_cuda_fail(e, "running the pt kernel", err);
     float ms = 0.0f;
     cudaEventElapsedTime(&ms, c->start, c->stop);
     *kernel_ms = ms;
-    unsigned long long counts[2];
-    if ((e = cudaMemcpy(counts, c->counts, sizeof counts, cudaMemcpyDeviceToHost)) != cudaSuccess) return fv_cuda_fail(e, "reading counters", err);
     *rays = counts[0];
     *nan_samples = counts[1];
-    return fv_cuda_film_read(&c->film, out, n, err);
+    return FV_OK;
 }

@@ -225,22 +225,6 @@ static fv_status upload_world(fv_cuda_sdf *c, const fv_ksdf_world *w, fv_ksdf_wo
     return FV_OK;
 }
 
-/* Copies the device film's n pixels into host's buffers that are set, on the stream. */
-static cudaError_t film_read_async(const fv_cuda_film *f, const fv_film_views *host, size_t n, cudaStream_t st)
-{
-    struct {
-        void *host;
-        const void *dev;
-        size_t bytes;
-    } back[6] = {{host->color, f->color, 3 * n * sizeof(float)},       {host->depth, f->depth, n * sizeof(float)},
-                 {host->normal, f->normal, 3 * n * sizeof(float)},     {host->albedo, f->albedo, 3 * n * sizeof(float)},
-                 {host->position, f->position, 3 * n * sizeof(float)}, {host->id, f->id, n * sizeof(uint32_t)}};
-    cudaError_t e = cudaSuccess;
-    for (int i = 0; i < 6 && e == cudaSuccess; i++)
-        if (back[i].host) e = cudaMemcpyAsync(back[i].host, back[i].dev, back[i].bytes, cudaMemcpyDeviceToHost, st);
-    return e;
-}
-
 /* The end of a frame: every eye's film and the first `ncounts` counters into kc, enqueued after
  * the kernels, then the frame's one host wait (*syncs = 1); *kernel_ms from the events. */
 static fv_status finish(fv_cuda_sdf *c, int eyes, const fv_film_views *out, const size_t *n, unsigned long long *kc, int ncounts,
@@ -248,7 +232,7 @@ static fv_status finish(fv_cuda_sdf *c, int eyes, const fv_film_views *out, cons
 {
     cudaStream_t st = c->stream;
     cudaError_t e = cudaSuccess;
-    for (int i = 0; i < eyes && e == cudaSuccess; i++) e = film_read_async(&c->film[i], &out[i], n[i], st);
+    for (int i = 0; i < eyes && e == cudaSuccess; i++) e = fv_cuda_film_read_async(&c->film[i], &out[i], n[i], st);
     if (e == cudaSuccess) e = cudaMemcpyAsync(kc, c->counts, (size_t)ncounts * sizeof *kc, cudaMemcpyDeviceToHost, st);
     if (e == cudaSuccess) e = cudaStreamSynchronize(st);
     *syncs = 1;

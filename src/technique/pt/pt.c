@@ -161,50 +161,65 @@ static void pt_flat_tile(void *ctx, const fv_tile *tile)
     fv_kit_count(j->counters, tile->thread, FV_KIT_NAN, bad);
 }
 
-static fv_status pt_render_flat(pt_state *st, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+/* `eyes` eyes of one frame (1, or both of a stereo pair) on the flat scene, brought to the frame's
+ * time once: on CUDA both eyes' kernels before the one host wait, on the portable backend one eye
+ * after the other. */
+static fv_status pt_render_flat(pt_state *st, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
 {
-    const fv_camera *cam = frame->camera;
-    pt_flat_job j;
-    memset(&j, 0, sizeof j);
-    fv_status s = fv_frame_camera(cam, film, &j.f.cam, err);
-    if (s != FV_OK) return s;
+    pt_flat_job j[2];
+    memset(j, 0, sizeof j);
+    fv_status s;
+    for (int e = 0; e < eyes; e++)
+        if ((s = fv_frame_camera(frames[e].camera, films[e], &j[e].f.cam, err)) != FV_OK) return s;
     fv_stage_clock t0 = fv_stage_clock_now();
     if ((s = fv_scene_export_update(st->flat, st->scene, err)) != FV_OK) return s;
     if (st->cuda && (s = fv_cuda_pt_update(st->cuda, fv_scene_export_view(st->flat), err)) != FV_OK) return s;
     fv_stage_stop(stats, "scene", t0);
-    j.scene = fv_scene_export_view(st->flat);
-    j.f.seed = frame->seed;
-    j.f.eye = frame->eye;
-    j.f.frame = frame->index;
-    j.f.opt = st->opt;
-    j.out = fv_film_views_of(film);
-    fv_stats_add_count(stats, "samples", (double)cam->width * cam->height * st->opt.spp);
+    fv_kpt_frame f[2];
+    fv_film_views out[2];
+    for (int e = 0; e < eyes; e++) {
+        const fv_camera *cam = frames[e].camera;
+        j[e].scene = fv_scene_export_view(st->flat);
+        j[e].f.seed = frames[e].seed;
+        j[e].f.eye = frames[e].eye;
+        j[e].f.frame = frames[e].index;
+        j[e].f.opt = st->opt;
+        j[e].out = fv_film_views_of(films[e]);
+        f[e] = j[e].f;
+        out[e] = j[e].out;
+        fv_stats_add_count(stats, "samples", (double)cam->width * cam->height * st->opt.spp);
+    }
     if (st->cuda) {
         uint64_t rays = 0, bad = 0;
         double kernel_ms = 0.0;
+        int syncs = 0;
         /* on the device: no serial share (the CPU only waits) */
         const double tk = fv_time_ms();
-        if ((s = fv_cuda_pt_render(st->cuda, &j.f, &j.out, &rays, &bad, &kernel_ms, err)) != FV_OK) return s;
+        if ((s = fv_cuda_pt_render(st->cuda, eyes, f, out, &rays, &bad, &kernel_ms, &syncs, err)) != FV_OK) return s;
         fv_stats_add_ms(stats, "trace", fv_time_ms() - tk);
         fv_stats_add_ms(stats, "kernel", kernel_ms);
         fv_stats_add_count(stats, "rays", (double)rays);
         fv_stats_add_count(stats, "nan_samples", (double)bad);
+        fv_stats_add_count(stats, "host_syncs", (double)syncs);
         return FV_OK;
     }
-    if (!(j.counters = fv_kit_counters_reuse(&st->counters))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    fv_kit_progress prog = {0};
-    fv_kit_phase(&prog, frame, 0.0, 1.0);
-    t0 = fv_stage_clock_now();
-    bool done = fv_parallel_tiles(cam->width, cam->height, frame->threads, pt_flat_tile, &j, fv_kit_progress_fn, &prog);
-    fv_stage_stop(stats, "trace", t0);
-    fv_kit_report(j.counters, stats);
-    return done ? FV_OK : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    for (int e = 0; e < eyes; e++) {
+        if (!(j[e].counters = fv_kit_counters_reuse(&st->counters))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        fv_kit_progress prog = {0};
+        fv_kit_phase(&prog, &frames[e], 0.0, 1.0);
+        t0 = fv_stage_clock_now();
+        bool done = fv_parallel_tiles(j[e].f.cam.width, j[e].f.cam.height, frames[e].threads, pt_flat_tile, &j[e], fv_kit_progress_fn, &prog);
+        fv_stage_stop(stats, "trace", t0);
+        fv_kit_report(j[e].counters, stats);
+        if (!done) return fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    }
+    return FV_OK;
 }
 
 static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
     pt_state *st = state;
-    if (st->device != FV_DEVICE_CPU) return pt_render_flat(st, frame, film, stats, err);
+    if (st->device != FV_DEVICE_CPU) return pt_render_flat(st, 1, frame, &film, stats, err);
     const fv_camera *cam = frame->camera;
     pt_job j;
     memset(&j, 0, sizeof j);
@@ -225,6 +240,16 @@ static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv
     for (int b = st->block_first; b < st->block_first + st->block_count; b++) range_spp += fv_blocks_samples(st->opt.spp, b);
     fv_stats_add_count(stats, "samples", (double)cam->width * cam->height * range_spp);
     return done ? FV_OK : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+}
+
+/* A stereo frame: on a device both eyes at once (one host wait on CUDA); on the CPU one after the
+ * other, as two render calls do. */
+static fv_status pt_render_pair(void *state, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    pt_state *st = state;
+    if (st->device != FV_DEVICE_CPU) return pt_render_flat(st, 2, frames, films, stats, err);
+    fv_status s = pt_render(state, &frames[0], films[0], stats, err);
+    return s == FV_OK ? pt_render(state, &frames[1], films[1], stats, err) : s;
 }
 
 /* transport/path.c reads the first three (fv_path_read_opts), this file the blocks: 2^20 samples
@@ -250,6 +275,7 @@ const fv_technique_class fv_technique_pt = {
     .create_on = pt_create,
     .devices = (1u << FV_DEVICE_PORTABLE) | (1u << FV_DEVICE_CUDA),
     .render = pt_render,
+    .render_pair = pt_render_pair,
     .destroy = pt_destroy,
     /* furnace: 1 - 0.5^9 with 8 vertices, Russian roulette unbiased */
     .test_params = "spp=64",
