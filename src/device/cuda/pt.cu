@@ -7,8 +7,9 @@
  * coherence; it is measured against this one before it replaces it.
  *
  * Memory: the scene's arrays are copied once at create; update re-copies only what time changes
- * (objects' transforms, instances, the top-level BVH, the light table). The film's buffers stay
- * allocated between frames of one size.
+ * (objects' transforms, instances, the top-level BVH, the light table). The films' buffers (one per
+ * eye) stay allocated between frames of one size; a stereo pair's two kernels are launched before
+ * the one host wait that reads both films back.
  */
 #include <cuda_runtime.h>
 #include <stdio.h>
