@@ -175,12 +175,77 @@ static void test_refusals(void **st)
     fv_scene_destroy(s);
 }
 
+/* A moving scene's stereo frames through fv_technique_render_pair (pt's pair: the flat scene
+ * updated once, then each eye) on portable, and through two render calls on cpu and portable: the
+ * pair equals the portable per-eye calls bit for bit, film and counters; on cpu the registry's
+ * fallback is the two calls. */
+static void test_pair(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load("cornell-fpm", &s, &v) != 0) fail_msg("cannot load cornell-fpm");
+    fv_camera centre, cam[2];
+    fv_view_camera(v, s, 0.0, 40, 30, &centre);
+    fv_camera_stereo(&centre, 0.06f, &cam[0], &cam[1]);
+    const char *params[2] = {"spp=2 device=portable", "spp=2 device=cpu"};
+    for (int d = 0; d < 2; d++) {
+        fv_params *p = fv_test_params_str(params[d]);
+        fv_technique *pair = NULL, *each = NULL;
+        fv_error err;
+        if (fv_technique_create("pt", s, p, NULL, &pair, &err) != FV_OK || fv_technique_create("pt", s, p, NULL, &each, &err) != FV_OK)
+            fail_msg("%s", err.msg);
+        fv_film *a[2], *b[2];
+        for (int e = 0; e < 2; e++)
+            if (fv_film_create(40, 30, FV_AUX_DEPTH | FV_AUX_ID, &a[e], &err) != FV_OK || fv_film_create(40, 30, FV_AUX_DEPTH | FV_AUX_ID, &b[e], &err) != FV_OK)
+                fail_msg("%s", err.msg);
+        for (int i = 0; i < 2; i++) {
+            const double time = 0.25 * i;
+            if (fv_scene_set_time(s, time, &err) != FV_OK) fail_msg("%s", err.msg);
+            fv_frame f[2];
+            for (int e = 0; e < 2; e++) {
+                fv_frame_init(&f[e], &cam[e]);
+                f[e].time = time;
+                f[e].index = i;
+                f[e].seed = 9;
+                f[e].eye = e;
+                f[e].eye_count = 2;
+            }
+            fv_stats sp, se;
+            fv_stats_clear(&sp);
+            fv_stats_clear(&se);
+            if (fv_technique_render_pair(pair, f, b, &sp, &err) != FV_OK) fail_msg("%s: pair %d: %s", params[d], i, err.msg);
+            for (int e = 0; e < 2; e++)
+                if (fv_technique_render(each, &f[e], a[e], &se, &err) != FV_OK) fail_msg("%s: frame %d eye %d: %s", params[d], i, e, err.msg);
+            for (int e = 0; e < 2; e++)
+                if (memcmp(fv_film_color_const(a[e]), fv_film_color_const(b[e]), (size_t)3 * 40 * 30 * sizeof(float)) != 0 ||
+                    memcmp(fv_film_depth(a[e]), fv_film_depth(b[e]), (size_t)40 * 30 * sizeof(float)) != 0)
+                    fail_msg("%s: frame %d eye %d: the pair differs from the per-eye call", params[d], i, e);
+            static const char *const keys[] = {"rays", "nan_samples", "samples"};
+            for (size_t k = 0; k < 3; k++)
+                if (fv_stats_get_count(&sp, keys[k]) != fv_stats_get_count(&se, keys[k]))
+                    fail_msg("%s: frame %d: counter %s: pair %g, per eye %g", params[d], i, keys[k], fv_stats_get_count(&sp, keys[k]),
+                             fv_stats_get_count(&se, keys[k]));
+            if (!(fv_stats_get_count(&sp, "rays") > 0)) fail_msg("%s: nothing traced", params[d]);
+        }
+        for (int e = 0; e < 2; e++) {
+            fv_film_destroy(a[e]);
+            fv_film_destroy(b[e]);
+        }
+        fv_technique_destroy(pair);
+        fv_technique_destroy(each);
+        fv_params_destroy(p);
+    }
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cornell),       cmocka_unit_test(test_city),      cmocka_unit_test(test_moving_object),
         cmocka_unit_test(test_textured_mesh), cmocka_unit_test(test_sdf_scene), cmocka_unit_test(test_sdf_union_81), cmocka_unit_test(test_refusals),
-        cmocka_unit_test(test_emission_texture),
+        cmocka_unit_test(test_emission_texture), cmocka_unit_test(test_pair),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
