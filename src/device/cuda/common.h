@@ -74,8 +74,8 @@ static inline fv_status fv_cuda_film_read(const fv_cuda_film *f, const fv_film_v
     return FV_OK;
 }
 
-/* The same enqueued on stream st, after the kernels before it: the caller's one wait (a stream
- * synchronisation) covers them all. */
+/* Queues the copies of the device film's n pixels into host's buffers that are set on stream st; the
+ * caller waits for the stream once, after whatever else it reads back. */
 static inline cudaError_t fv_cuda_film_read_async(const fv_cuda_film *f, const fv_film_views *host, size_t n, cudaStream_t st)
 {
     struct {
