@@ -159,6 +159,14 @@ FV_HD FV_KSVGF_INLINE float fv_ksvgf_atrous_dist(int c)
     return c == 0 ? 1.0f : c == 1 ? sqrtf(2.0f) : c == 2 ? 2.0f : c == 3 ? sqrtf(5.0f) : sqrtf(8.0f);
 }
 
+/* Host: sigma_normal's squarings (fv_ksvgf.sq): k when it is 2^k, k <= 16, else -1. */
+static inline int fv_ksvgf_squarings(float sigma_normal)
+{
+    for (int k = 0; k <= 16; k++)
+        if (sigma_normal == (float)(1 << k)) return k;
+    return -1;
+}
+
 /* The columns pass `pass` filters: [0, cut); the others go through unchanged. */
 FV_HD FV_KSVGF_INLINE int fv_ksvgf_pass_cut(const fv_ksvgf *k, int pass) { return pass < k->periph_passes ? k->g.w : k->periph_x; }
 
