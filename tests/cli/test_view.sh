@@ -66,6 +66,10 @@ SCRIPT
 (cd "$TMP" && xvfb-run -a "$VIEW" cornell --method vpolar --size 320x180 --threads 2 --script "$TMP/bare.txt") \
   >"$TMP/run2.out" 2>&1 || fail "the second scripted session failed: $(cat "$TMP/run2.out")"
 [ "$(grep -c '' "$TMP/fps.csv" 2>/dev/null)" = 11 ] || fail "--fps-log should hold a header and 10 frames: $(cat "$TMP/fps.csv" 2>/dev/null)"
+# each line's display time is its own column, and render plus display fit in the frame
+awk -F, 'NR == 1 { ok = ($3 == "render_ms" && $4 == "frame_ms" && $5 == "display_ms"); next }
+  { if (!($5 > 0 && $3 + $5 <= $4 + 0.02)) ok = 0 } END { exit !ok }' "$TMP/fps.csv" ||
+  fail "--fps-log: display_ms missing or render + display beyond the frame: $(cat "$TMP/fps.csv")"
 
 # --device: pt's frames from the portable backend (the GPU's kernel on the CPU) reach the window.
 cat >"$TMP/dev.txt" <<SCRIPT

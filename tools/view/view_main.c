@@ -44,7 +44,7 @@ static int prepare(fv_vw_app *app, fv_vw_script *script)
         return fv_cli_fail(k_cmd, s, err.msg);
     if (a->fps_log) {
         if (!(app->fps_log = fopen(a->fps_log, "w"))) return fv_cli_usage_error(k_cmd, "--fps-log %s: cannot write there", a->fps_log);
-        fprintf(app->fps_log, "frame,method,render_ms,frame_ms,baseline,baseline_ms,stages_ms\n");
+        fprintf(app->fps_log, "frame,method,render_ms,frame_ms,display_ms,baseline,baseline_ms,stages_ms\n");
     }
     fv_camera c;
     fv_view_camera(app->view, app->scene, 0.0, a->width, a->height, &c);
@@ -151,6 +151,9 @@ static int run(fv_vw_app *app, sdl_out *o, fv_vw_script *script)
             rc = fv_cli_fail(k_cmd, s, err.msg);
             break;
         }
+        /* display: from the rendered films to the presented window (tone map, overlay, the one texture
+         * upload of the frame, present), logged apart from the render */
+        const double t_shown = fv_time_ms();
         for (int i = 0; i < np; i++) fv_vw_blit(&canvas, &panels[i], app->srgb);
         if (app->overlay)
             for (int i = 0; i < np; i++)
@@ -160,6 +163,7 @@ static int run(fv_vw_app *app, sdl_out *o, fv_vw_script *script)
         SDL_RenderClear(o->ren);
         SDL_RenderCopy(o->ren, o->tex, NULL, NULL);
         SDL_RenderPresent(o->ren);
+        const double display_ms = fv_time_ms() - t_shown;
 
         for (; script->next < script->count && script->cmd[script->next].frame <= app->frame; script->next++) {
             const fv_vw_cmd *c = &script->cmd[script->next];
@@ -175,7 +179,7 @@ static int run(fv_vw_app *app, sdl_out *o, fv_vw_script *script)
         dt = ms / 1000.0;
         if (dt > 0.25) dt = 0.25; /* a slow frame (or a method switch) must not throw the camera far */
         if (app->fps_log) {
-            fprintf(app->fps_log, "%ld,%s,%.2f,%.2f,%s,%.2f,", app->frame, fv_technique_name(app->main.method), app->main.ms, ms,
+            fprintf(app->fps_log, "%ld,%s,%.2f,%.2f,%.2f,%s,%.2f,", app->frame, fv_technique_name(app->main.method), app->main.ms, ms, display_ms,
                     app->split && app->base.tech ? fv_technique_name(app->base.method) : "", app->split && app->base.tech ? app->base.ms : 0.0);
             for (int i = 0; i < app->main.stats.n_stages; i++)
                 fprintf(app->fps_log, "%s%s=%.2f", i ? " " : "", app->main.stats.stage[i].name, app->main.stats.stage[i].value);
