@@ -106,7 +106,8 @@ FV_API void fv_driver_set_gaze(fv_driver *d, fv_gaze g);
 FV_API void fv_driver_set_camera(fv_driver *d, const fv_camera *c);
 
 /* Renders frame `index` with technique t: sets the scene's time, then renders eye 0 (and eye 1)
- * into films[0] (and films[1]), adding both eyes' stats to *stats. `continues`: t's previous
+ * into films[0] (and films[1]), adding both eyes' stats to *stats. A stereo driver given no
+ * films[1] renders the left eye alone, as a mono frame at the left eye's view. `continues`: t's previous
  * render was frame index - 1 of this driver, so its history reprojects from that frame's cameras;
  * false starts a new sequence. progress (optional) receives the fraction of the whole frame and
  * may cancel it (FV_ERR_CANCELLED). */

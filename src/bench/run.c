@@ -110,6 +110,7 @@ typedef struct render_job {
     const fv_bench_method *m;
     const fv_log *log;
     const fv_bench_split *split; /* NULL: one process */
+    bool left_only;              /* a stereo scenario's reference: the measured left eye alone */
 } render_job;
 
 typedef fv_status (*frame_fn)(void *user, int index, fv_film *film, double ms, const fv_stats *stats, fv_error *err);
@@ -124,12 +125,12 @@ static bool keep_going(void *user, double fraction)
 static fv_status render_sequence(const render_job *j, int first, int nframes, frame_fn on_frame, void *user, fv_error *err)
 {
     fv_technique *t = NULL;
-    /* A stereo scenario renders both eyes per frame (both timed); the left eye is the one
-     * measured and shown. */
+    /* A stereo scenario renders both eyes per frame of a method (both timed); the left eye is
+     * the one measured and shown, so its reference renders the left eye alone. */
     fv_film *films[2] = {NULL, NULL};
     fv_status st = fv_technique_create(j->m->method, j->scene, j->m->params, j->log, &t, err);
     if (st != FV_OK) fv_error_prefix(err, "%s: ", j->m->label);
-    for (int e = 0; e < fv_driver_eye_count(j->driver) && st == FV_OK; e++)
+    for (int e = 0; e < (j->left_only ? 1 : fv_driver_eye_count(j->driver)) && st == FV_OK; e++)
         st = fv_film_create(j->sc->width, j->sc->height, 0, &films[e], err);
     fv_film *film = films[0];
     for (int i = first; i < nframes && st == FV_OK; i++) {
@@ -297,7 +298,7 @@ static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene,
         say(info->opt, "%s: rendering %d frame(s) with %s (%d cached)%s", m->label, alone ? n - first : nmissing, m->method, *cached,
             alone ? "" : ", split over the ranks");
         /* References are rendered on their own random stream (core/rng.h). */
-        render_job j = {sc, scene, info->ref_driver, m, info->opt->log, sp};
+        render_job j = {sc, scene, info->ref_driver, m, info->opt->log, sp, true};
         ref_ctx c = {frames, (const char *const *)paths, slot, 0.0};
         if (alone) {
             /* Render the whole measured sequence (a temporal reference needs its history); frames
@@ -380,7 +381,7 @@ static fv_status probe_reference(fv_bench_run_info *info, fv_scene *scene, const
     fv_drive_opts o = *dopt;
     o.seed = fv_seed_reference_probe(sc->seed);
     st = fv_driver_create(scene, view, &o, &driver, err);
-    render_job j = {sc, scene, driver, &probe, info->opt->log, sp};
+    render_job j = {sc, scene, driver, &probe, info->opt->log, sp, true};
     bool split = false;
     /* every rank has its driver before any splits the still; a failure there or in the split is
      * already the job's */
@@ -539,7 +540,7 @@ static fv_status method_begin(const fv_bench_run_info *info, fv_scene *scene, fr
     c->last = fv_alloc_array(npix, 3 * sizeof(float));
     if (!res->ms || !mr->stage_per_rep || !mr->frame_ms || !c->flip_map || !c->last) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_stats_clear(&mr->stage_names);
-    mr->j = (render_job){sc, scene, info->driver, res->m, info->opt->log, info->opt->split};
+    mr->j = (render_job){sc, scene, info->driver, res->m, info->opt->log, info->opt->split, false};
     return render_sequence(&mr->j, 0, 1, on_warmup_frame, NULL, err);
 }
 

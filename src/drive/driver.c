@@ -153,7 +153,10 @@ static fv_status render_views(fv_driver *d, fv_technique *t, const fv_frame_view
     fv_status s = fv_scene_set_time(d->scene, v->time, err);
     fv_frame fr[2];
     eye_progress eps[2];
-    for (int e = 0; e < v->eye_count && s == FV_OK; e++) {
+    /* a stereo frame with no film for the right eye: the left eye alone, as a mono frame (a
+     * bench reference, measured against the left eye only) */
+    const int eyes = v->eye_count == 2 && !films[1] ? 1 : v->eye_count;
+    for (int e = 0; e < eyes && s == FV_OK; e++) {
         if (!films[e]) return fv_error_set(err, FV_ERR_INVALID, "driver: no film for eye %d", e);
         fv_frame_init(&fr[e], &v->camera[e]);
         fr[e].time = v->time;
@@ -161,7 +164,7 @@ static fv_status render_views(fv_driver *d, fv_technique *t, const fv_frame_view
         fr[e].seed = d->o.seed;
         fr[e].threads = d->o.threads;
         fr[e].eye = e;
-        fr[e].eye_count = v->eye_count;
+        fr[e].eye_count = eyes;
         fr[e].prev_camera = pv ? &pv->camera[e] : NULL;
         fr[e].left_camera = e == 1 ? &v->camera[0] : NULL;
         fr[e].gaze = v->gaze[e];
@@ -169,11 +172,12 @@ static fv_status render_views(fv_driver *d, fv_technique *t, const fv_frame_view
         if (ep->fn) {
             eps[e] = *ep;
             eps[e].eye = e;
+            eps[e].eyes = eyes;
             fr[e].progress = on_eye_progress;
             fr[e].progress_user = &eps[e];
         }
     }
-    if (s == FV_OK) s = v->eye_count == 2 ? fv_technique_render_pair(t, fr, films, stats, err) : fv_technique_render(t, &fr[0], films[0], stats, err);
+    if (s == FV_OK) s = eyes == 2 ? fv_technique_render_pair(t, fr, films, stats, err) : fv_technique_render(t, &fr[0], films[0], stats, err);
     if (s == FV_OK) {
         d->last = *v;
         d->last_seen = seen;

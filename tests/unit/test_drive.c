@@ -337,6 +337,22 @@ static void test_render_progress_and_cancel(void **st)
     double sum0 = 0, sum1 = 0;
     for (int i = 0; i < 3 * 64 * 64; i++) sum0 += fv_film_color(films[0])[i], sum1 += fv_film_color(films[1])[i];
     assert_true(sum0 > 0.0 && sum1 > 0.0 && sum0 != sum1);
+    /* no film for the right eye: the left eye alone, the same pixels, half the samples, and its
+     * progress runs to 1 over that one eye */
+    fv_film *left_film[2] = {NULL, NULL};
+    assert_int_equal(fv_film_create(64, 64, 0, &left_film[0], &err), FV_OK);
+    fv_stats pair_stats, left_stats;
+    fv_stats_clear(&pair_stats);
+    fv_stats_clear(&left_stats);
+    assert_int_equal(fv_driver_render(d, t, 0, false, films, &pair_stats, NULL, NULL, &err), FV_OK);
+    progress_log one = {{0}, 0, -1};
+    assert_int_equal(fv_driver_render(d, t, 0, false, left_film, &left_stats, on_progress, &one, &err), FV_OK);
+    assert_memory_equal(fv_film_color(left_film[0]), fv_film_color(films[0]), 3 * 64 * 64 * sizeof(float));
+    assert_float_equal(fv_stats_get_count(&left_stats, "samples"), 64.0 * 64.0 * 2.0, 0.0);
+    assert_float_equal(fv_stats_get_count(&pair_stats, "samples"), 2.0 * 64.0 * 64.0 * 2.0, 0.0);
+    assert_true(one.n >= 2 && one.f[0] > 0.0 && one.f[0] < 0.5);
+    assert_float_equal(one.f[one.n - 1], 1.0, 1e-12);
+    fv_film_destroy(left_film[0]);
     /* cancel in the left eye: the frame stops with FV_ERR_CANCELLED; the next frame renders */
     progress_log stop = {{0}, 0, 2};
     assert_int_equal(fv_driver_render(d, t, 1, true, films, &stats, on_progress, &stop, &err), FV_ERR_CANCELLED);
