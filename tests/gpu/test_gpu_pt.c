@@ -3,7 +3,8 @@
  * random numbers, so the images agree pixel by pixel within float tolerance (the GPU's cosf and
  * sinf differ from the C library's in the last bits, which may send a rare path elsewhere); two
  * CUDA runs are bit-identical; the first-hit buffers agree. Exits 77 (skipped) where CUDA cannot
- * run: a build without CUDA, a machine without a GPU.
+ * run: a build without CUDA, a machine without a GPU. Built a second time against the CUDA
+ * simulator (sim_test_gpu_pt, tests/gpu/sim_checks.h), where it also counts the host's waits.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -14,6 +15,7 @@
 #include <cmocka.h>
 #include "fovea/fovea.h"
 #include "../unit/testkit.h"
+#include "sim_checks.h"
 
 static void compare_scene(const char *name, int w, int h, double time, int frames)
 {
@@ -25,7 +27,10 @@ static void compare_scene(const char *name, int w, int h, double time, int frame
     fv_camera cam;
     fv_view_camera(v, s, time, w, h, &cam);
     fv_film *p = fv_test_render_pt(s, &cam, "spp=4 device=portable", time, frames, 11);
+    fv_sim_mark m = fv_sim_now();
     fv_film *c1 = fv_test_render_pt(s, &cam, "spp=4 device=cuda", time, frames, 11);
+    fv_sim_expect(m, (uint64_t)frames, frames, name); /* a frame: one launch, one wait (then the copies back) */
+    fv_sim_expect_freed(name);
     fv_film *c2 = fv_test_render_pt(s, &cam, "spp=4 device=cuda", time, frames, 11);
     fv_test_agreement r = fv_test_agree(p, c1, 1e-3);
     printf("%s: portable (%.4f %.4f %.4f) cuda (%.4f %.4f %.4f): largest mean difference %.3g%%, %.2f%% of pixels equal within 1e-3, "
@@ -84,7 +89,7 @@ int main(void)
     char why[256];
     if (!fv_device_available(FV_DEVICE_CUDA, why, sizeof why)) {
         printf("skipped: %s\n", why);
-        return 77;
+        return FV_GPU_TEST_NO_DEVICE;
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_cornell), cmocka_unit_test(test_city), cmocka_unit_test(test_moving),
                                        cmocka_unit_test(test_textured), cmocka_unit_test(test_sdf)};

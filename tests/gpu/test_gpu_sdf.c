@@ -15,7 +15,9 @@
  * within an ulp of the probability, so the counts are still required to be equal.) A pyramid frame
  * must report one host wait (host_syncs): its passes are launched without any between them. If the GPU
  * shows more, the first run's printout says where, and the bound is revised with that measurement.
- * Exits 77 (skipped) where CUDA cannot run: a build without CUDA, a machine without a GPU.
+ * Exits 77 (skipped) where CUDA cannot run: a build without CUDA, a machine without a GPU. Built a
+ * second time against the CUDA simulator (sim_test_gpu_sdf, tests/gpu/sim_checks.h), where the host's
+ * waits are also counted, not only reported.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -27,6 +29,7 @@
 #include <cmocka.h>
 #include "fovea/fovea.h"
 #include "../unit/testkit.h"
+#include "sim_checks.h"
 
 static fv_film *render(const char *method, const char *params, const fv_scene *s, const fv_camera *cam, fv_stats *stats)
 {
@@ -56,7 +59,12 @@ static void compare(const char *scene, const char *method, int w, int h, int spp
     snprintf(pp, sizeof pp, "spp=%d device=portable", spp);
     snprintf(pc, sizeof pc, "spp=%d device=cuda", spp);
     fv_stats sp, sc, sc2;
-    fv_film *p = render(method, pp, s, &cam, &sp), *c1 = render(method, pc, s, &cam, &sc), *c2 = render(method, pc, s, &cam, &sc2);
+    fv_film *p = render(method, pp, s, &cam, &sp);
+    fv_sim_mark m = fv_sim_now();
+    fv_film *c1 = render(method, pc, s, &cam, &sc);
+    fv_sim_expect(m, 1, 1, method); /* one launch, one wait */
+    fv_sim_expect_freed(method);
+    fv_film *c2 = render(method, pc, s, &cam, &sc2);
     fv_test_agreement r = fv_test_agree(p, c1, 1e-4);
     const float *a = fv_film_color_const(p), *b = fv_film_color_const(c1);
     const size_t n = (size_t)w * h;
@@ -135,7 +143,9 @@ static void compare_pyramid(const char *scene, const char *method, const char *p
             f.gaze.y = 0.6f - 0.07f * (float)i;
             fv_stats sp, sc, sc2;
             frame_into(tp, &f, p, &sp);
+            fv_sim_mark m = fv_sim_now();
             frame_into(tc, &f, c1, &sc);
+            fv_sim_expect(m, 1, -1, method); /* what host_syncs reports (checked below) is what the host did */
             frame_into(tc2, &f, c2, &sc2);
             fv_test_agreement r = fv_test_agree(p, c1, 1e-4);
             const float *a = fv_film_color_const(p), *b = fv_film_color_const(c1);
@@ -166,6 +176,7 @@ static void compare_pyramid(const char *scene, const char *method, const char *p
     fv_technique_destroy(tp);
     fv_technique_destroy(tc);
     fv_technique_destroy(tc2);
+    fv_sim_expect_freed(method);
     fv_view_destroy(v);
     fv_scene_destroy(s);
 }
@@ -212,7 +223,7 @@ int main(void)
     char why[256];
     if (!fv_device_available(FV_DEVICE_CUDA, why, sizeof why)) {
         printf("skipped: %s\n", why);
-        return 77;
+        return FV_GPU_TEST_NO_DEVICE;
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_primitives), cmocka_unit_test(test_columns), cmocka_unit_test(test_temple),
                                        cmocka_unit_test(test_ipr), cmocka_unit_test(test_fipr)};

@@ -184,7 +184,7 @@ extern "C" fv_status fv_cuda_pt_render(fv_cuda_pt *c, const fv_kpt_frame *f, con
     dim3 block(FV_CUDA_BLOCK, FV_CUDA_BLOCK);
     dim3 grid((unsigned)((f->cam.width + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK), (unsigned)((f->cam.height + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK));
     cudaEventRecord(c->start);
-    fv_cuda_pt_kernel<<<grid, block>>>(c->dev, *f, dv, c->counts);
+    FV_CUDA_LAUNCH(fv_cuda_pt_kernel, grid, block, 0)(c->dev, *f, dv, c->counts);
     cudaEventRecord(c->stop);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the pt kernel", err);
     if ((e = cudaEventSynchronize(c->stop)) != cudaSuccess) return fv_cuda_fail(e, "running the pt kernel", err);

@@ -211,7 +211,7 @@ extern "C" fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const fv_ksdf_world *w, 
     dim3 grid((unsigned)((f->cam.width + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK),
               (unsigned)((f->cam.height + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK));
     cudaEventRecord(c->start);
-    fv_cuda_sdf_kernel<<<grid, block>>>(dw, *f, dv, c->counts);
+    FV_CUDA_LAUNCH(fv_cuda_sdf_kernel, grid, block, 0)(dw, *f, dv, c->counts);
     cudaEventRecord(c->stop);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the sphere-tracing kernel", err);
     if ((e = cudaEventSynchronize(c->stop)) != cudaSuccess) return fv_cuda_fail(e, "running the sphere-tracing kernel", err);
@@ -413,7 +413,7 @@ static fv_status history_ensure(fv_cuda_sdf *c, int eye, int index, fv_error *er
         h->sh = k->sh;
         index = 0;
     }
-    if (index == 0) fv_cuda_pyr_forget<<<blocks_of(n), 256, 0, c->stream>>>(h->stamp, (int)n);
+    if (index == 0) FV_CUDA_LAUNCH(fv_cuda_pyr_forget, blocks_of(n), 256, c->stream)(h->stamp, (int)n);
     k->hist_color = h->color;
     k->hist_stamp = h->stamp;
     return FV_OK;
@@ -461,17 +461,17 @@ extern "C" fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const fv_ksdf_wo
     /* the levels traced whole (fipr: all but the middle, which the mask decides) */
     const int full_below = fipr ? L - 2 : L - 1;
     for (int i = 0; i < full_below; i++)
-        fv_cuda_pyr_level<<<grid_of(k->lv[i].w, k->lv[i].h), block, 0, st>>>(dw, *f, *k, i, index, c->counts);
+        FV_CUDA_LAUNCH(fv_cuda_pyr_level, grid_of(k->lv[i].w, k->lv[i].h), block, st)(dw, *f, *k, i, index, c->counts);
     if (fipr) {
         const size_t ntip = (size_t)k->lv[0].w * k->lv[0].h;
         cudaMemsetAsync(c->far, 0, sizeof(unsigned), st);
-        fv_cuda_pyr_far<<<blocks_of(ntip), 256, 0, st>>>(k->depth[0], (int)ntip, c->far);
-        fv_cuda_pyr_sobel<<<grid_of(k->lv[0].w, k->lv[0].h), block, 0, st>>>(*k, c->far, edge);
-        fv_cuda_pyr_mask<<<grid_of(k->w, k->h), block, 0, st>>>(*k, *fov, c->counts);
-        fv_cuda_pyr_need<<<grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, 0, st>>>(*k, *fov, c->counts);
-        fv_cuda_pyr_level<<<grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, 0, st>>>(dw, *f, *k, L - 2, index, c->counts);
+        FV_CUDA_LAUNCH(fv_cuda_pyr_far, blocks_of(ntip), 256, st)(k->depth[0], (int)ntip, c->far);
+        FV_CUDA_LAUNCH(fv_cuda_pyr_sobel, grid_of(k->lv[0].w, k->lv[0].h), block, st)(*k, c->far, edge);
+        FV_CUDA_LAUNCH(fv_cuda_pyr_mask, grid_of(k->w, k->h), block, st)(*k, *fov, c->counts);
+        FV_CUDA_LAUNCH(fv_cuda_pyr_need, grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, st)(*k, *fov, c->counts);
+        FV_CUDA_LAUNCH(fv_cuda_pyr_level, grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, st)(dw, *f, *k, L - 2, index, c->counts);
     }
-    fv_cuda_pyr_target<<<grid_of(k->w, k->h), block, 0, st>>>(dw, *f, *k, dv, c->counts);
+    FV_CUDA_LAUNCH(fv_cuda_pyr_target, grid_of(k->w, k->h), block, st)(dw, *f, *k, dv, c->counts);
     cudaEventRecord(c->stop, st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the pyramid's kernels", err);
     /* what the host receives, then its one wait */
