@@ -5,9 +5,14 @@
  * The simulated device is one per process, as a real CUDA context is: its state lives in one object
  * (device()), created at first use and checked at exit for what was never freed.
  */
+#include <limits.h>
+#include <linux/futex.h>
 #include <pthread.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <map>
@@ -45,44 +50,41 @@ namespace {
 }
 
 /* A barrier whose members may leave it: a thread whose kernel has returned takes no further part
- * in its block's __syncthreads (as on the GPU), so the others do not wait for it. */
+ * in its block's __syncthreads (as on the GPU), so the others do not wait for it. One atomic word
+ * holds the members (high half) and the arrivals (low half), and the waiters sleep on the phase
+ * with a futex, so that a crossing wakes each thread once and no lock is contended (a block's
+ * threads cross a barrier several times: this is most of the simulator's cost). */
 class Barrier {
-    std::mutex m;
-    std::condition_variable cv;
-    unsigned expected = 0, arrived = 0;
-    unsigned long long phase = 0;
+    std::atomic<uint64_t> state{0};
+    std::atomic<uint32_t> phase{0};
 
-    void release()
+    void release(uint64_t s)
     {
-        arrived = 0;
-        phase++;
-        cv.notify_all();
+        state.store(s & ~(uint64_t)0xffffffffu, std::memory_order_relaxed);
+        phase.fetch_add(1, std::memory_order_release);
+        syscall(SYS_futex, reinterpret_cast<uint32_t *>(&phase), FUTEX_WAKE_PRIVATE, INT_MAX, nullptr, nullptr, 0);
     }
 
 public:
-    void reset(unsigned n)
-    {
-        std::lock_guard<std::mutex> l(m);
-        expected = n;
-        arrived = 0;
-    }
+    /* Only while no thread is inside. */
+    void reset(unsigned n) { state.store((uint64_t)n << 32, std::memory_order_relaxed); }
     /* Waits for the others; the last to arrive runs complete() first, while the rest still wait. */
     template <class F> void wait(F &&complete)
     {
-        std::unique_lock<std::mutex> l(m);
-        const unsigned long long p = phase;
-        if (++arrived == expected) {
+        const uint32_t p = phase.load(std::memory_order_acquire);
+        const uint64_t s = state.fetch_add(1, std::memory_order_acq_rel) + 1;
+        if ((uint32_t)s == (uint32_t)(s >> 32)) {
             complete();
-            release();
+            release(s);
             return;
         }
-        cv.wait(l, [&] { return phase != p; });
+        while (phase.load(std::memory_order_acquire) == p)
+            syscall(SYS_futex, reinterpret_cast<uint32_t *>(&phase), FUTEX_WAIT_PRIVATE, p, nullptr, nullptr, 0);
     }
     void leave()
     {
-        std::lock_guard<std::mutex> l(m);
-        expected--;
-        if (arrived > 0 && arrived == expected) release();
+        const uint64_t s = state.fetch_sub((uint64_t)1 << 32, std::memory_order_acq_rel) - ((uint64_t)1 << 32);
+        if ((uint32_t)s > 0 && (uint32_t)s == (uint32_t)(s >> 32)) release(s);
     }
 };
 
