@@ -92,9 +92,16 @@ struct cudaDeviceProp {
 /* One block runs at a time, so a function static is the block's shared memory. */
 #define __shared__ static
 
-/* Set for each simulated thread before it runs the kernel. */
-extern thread_local uint3 threadIdx, blockIdx;
-extern thread_local dim3 blockDim, gridDim;
+/* Set for each simulated thread before it runs the kernel (thread-local; functions, since GCC's
+ * UBSan misreads an extern thread_local object of another translation unit as a null pointer). */
+const uint3 &fv_cuda_sim_thread_idx(void);
+const uint3 &fv_cuda_sim_block_idx(void);
+const dim3 &fv_cuda_sim_block_dim(void);
+const dim3 &fv_cuda_sim_grid_dim(void);
+#define threadIdx (fv_cuda_sim_thread_idx())
+#define blockIdx (fv_cuda_sim_block_idx())
+#define blockDim (fv_cuda_sim_block_dim())
+#define gridDim (fv_cuda_sim_grid_dim())
 
 void fv_cuda_sim_syncthreads(void);
 #define __syncthreads() fv_cuda_sim_syncthreads()

@@ -22,8 +22,15 @@
 #include "cuda_runtime.h"
 #include "fv_cuda_sim.h"
 
-thread_local uint3 threadIdx, blockIdx;
-thread_local dim3 blockDim, gridDim;
+namespace {
+thread_local uint3 t_thread_idx, t_block_idx;
+thread_local dim3 t_block_dim, t_grid_dim;
+} // namespace
+
+const uint3 &fv_cuda_sim_thread_idx(void) { return t_thread_idx; }
+const uint3 &fv_cuda_sim_block_idx(void) { return t_block_idx; }
+const dim3 &fv_cuda_sim_block_dim(void) { return t_block_dim; }
+const dim3 &fv_cuda_sim_grid_dim(void) { return t_grid_dim; }
 
 struct fv_cuda_sim_stream {
     int unused;
@@ -168,13 +175,13 @@ class Pool {
     {
         t_pool = this;
         t_id = id;
-        blockDim = j.block;
-        gridDim = j.grid;
-        threadIdx = uint3{id % j.block.x, id / j.block.x % j.block.y, id / (j.block.x * j.block.y)};
+        t_block_dim = j.block;
+        t_grid_dim = j.grid;
+        t_thread_idx = uint3{id % j.block.x, id / j.block.x % j.block.y, id / (j.block.x * j.block.y)};
         for (unsigned z = 0; z < j.grid.z; z++)
             for (unsigned y = 0; y < j.grid.y; y++)
                 for (unsigned x = 0; x < j.grid.x; x++) {
-                    blockIdx = uint3{x, y, z};
+                    t_block_idx = uint3{x, y, z};
                     j.body(j.ctx);
                     sync.leave();
                     block_end.wait([&] { end_block(j); });
@@ -190,7 +197,7 @@ class Pool {
                 die(j.file, j.line,
                     "kernel %s, block (%u, %u, %u): thread %u reached __syncthreads %u times, thread 0 %u times (CUDA leaves this "
                     "undefined)",
-                    j.kernel, blockIdx.x, blockIdx.y, blockIdx.z, i, sync_calls[i], sync_calls[0]);
+                    j.kernel, t_block_idx.x, t_block_idx.y, t_block_idx.z, i, sync_calls[i], sync_calls[0]);
         sync_calls.assign(j.threads, 0);
         sync.reset(j.threads);
         blocks_run++;
