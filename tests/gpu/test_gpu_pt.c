@@ -84,6 +84,24 @@ static void test_sdf(void **st)
     compare_scene("sdf-primitives", 96, 96, 0.0, 1);
 }
 
+#ifdef FOVEA_CUDA_SIM
+/* The simulator only: every device allocation of pt's backend (the scene at create, the film and
+ * counters, the moving scene's update) failing in turn, as on a full GPU. */
+static void test_out_of_memory(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load("cornell-fpm", &s, &v) != 0) fail_msg("cannot load cornell-fpm");
+    fv_camera cam;
+    fv_view_camera(v, s, 0.7, 24, 16, &cam);
+    fv_sim_frames r = {s, &cam, "pt", "spp=1 device=cuda", 2, 0.7};
+    if (fv_sim_walk_allocation_failures(fv_sim_run_frames, &r, "pt") < 10) fail_msg("pt: fewer device allocations than the scene has arrays");
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+#endif
+
 int main(void)
 {
     char why[256];
@@ -92,6 +110,10 @@ int main(void)
         return FV_GPU_TEST_NO_DEVICE;
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_cornell), cmocka_unit_test(test_city), cmocka_unit_test(test_moving),
-                                       cmocka_unit_test(test_textured), cmocka_unit_test(test_sdf)};
+                                       cmocka_unit_test(test_textured), cmocka_unit_test(test_sdf),
+#ifdef FOVEA_CUDA_SIM
+                                       cmocka_unit_test(test_out_of_memory)
+#endif
+    };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

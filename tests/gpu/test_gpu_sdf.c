@@ -218,6 +218,29 @@ static void test_temple(void **st)
     compare("sdf-temple", "sdf-relaxed", 96, 72, 16);
 }
 
+#ifdef FOVEA_CUDA_SIM
+/* The simulator only: every device allocation of the sphere tracers' backend (counters, stream,
+ * world, film, pyramid, fipr's history) failing in turn, as on a full GPU. */
+static void test_out_of_memory(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load("sdf-primitives", &s, &v) != 0) fail_msg("cannot load sdf-primitives");
+    fv_camera cam;
+    fv_view_camera(v, s, 0.0, 32, 24, &cam);
+    static const char *const methods[][2] = {{"sdf-gt", "spp=1 device=cuda"},
+                                             {"ipr", "spp=1 shadow_reuse=true device=cuda"},
+                                             {"fipr", "spp=1 refresh=2 device=cuda"}};
+    for (size_t i = 0; i < sizeof methods / sizeof methods[0]; i++) {
+        fv_sim_frames r = {s, &cam, methods[i][0], methods[i][1], 2, 0.0};
+        if (fv_sim_walk_allocation_failures(fv_sim_run_frames, &r, methods[i][0]) < 5) fail_msg("%s: too few device allocations", methods[i][0]);
+    }
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+#endif
+
 int main(void)
 {
     char why[256];
@@ -226,6 +249,10 @@ int main(void)
         return FV_GPU_TEST_NO_DEVICE;
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_primitives), cmocka_unit_test(test_columns), cmocka_unit_test(test_temple),
-                                       cmocka_unit_test(test_ipr), cmocka_unit_test(test_fipr)};
+                                       cmocka_unit_test(test_ipr), cmocka_unit_test(test_fipr),
+#ifdef FOVEA_CUDA_SIM
+                                       cmocka_unit_test(test_out_of_memory)
+#endif
+    };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

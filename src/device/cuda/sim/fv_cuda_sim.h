@@ -20,10 +20,15 @@ typedef struct fv_cuda_sim_counts {
     uint64_t live_allocations; /* device allocations not yet freed */
     uint64_t live_bytes;
     uint64_t live_streams, live_events;
+    uint64_t injected_failures; /* allocations failed by fv_cuda_sim_fail_allocation */
 } fv_cuda_sim_counts;
 
 /* The counts since the process started (the live ones: now). */
 void fv_cuda_sim_counts_get(fv_cuda_sim_counts *out);
+
+/* Makes the n-th cudaMalloc from now (0: the next) fail with cudaErrorMemoryAllocation, as a full
+ * GPU would; n < 0 cancels. So a test can walk every allocation's failure path in turn. */
+void fv_cuda_sim_fail_allocation(int64_t n);
 
 #ifdef __cplusplus
 }

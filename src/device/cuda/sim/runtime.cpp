@@ -255,6 +255,7 @@ public:
     std::set<const fv_cuda_sim_event *> events;
     cudaError_t last = cudaSuccess; /* for cudaGetLastError */
     bool queued = false;            /* work was queued since the host last waited */
+    int64_t fail_in = -1;           /* fv_cuda_sim_fail_allocation */
     fv_cuda_sim_counts counts = {};
     Pool pool;
 
@@ -500,12 +501,16 @@ cudaError_t fv_cuda_sim_malloc(void **p, size_t bytes, const char *file, int lin
     if (!p) return cudaErrorInvalidValue;
     *p = nullptr;
     if (bytes == 0) return cudaSuccess;
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    if (d.fail_in >= 0 && d.fail_in-- == 0) {
+        d.counts.injected_failures++;
+        return cudaErrorMemoryAllocation;
+    }
     void *q = malloc(bytes);
     if (!q) return cudaErrorMemoryAllocation;
     /* CUDA does not clear new memory: NaN floats and all-ones integers make a read before a write show */
     memset(q, 0xff, bytes);
-    Device &d = device();
-    std::lock_guard<std::mutex> l(d.m);
     d.allocs[(uintptr_t)q] = Allocation{bytes, file, line};
     d.counts.live_allocations++;
     d.counts.live_bytes += bytes;
@@ -581,4 +586,11 @@ extern "C" void fv_cuda_sim_counts_get(fv_cuda_sim_counts *out)
     *out = d.counts;
     out->live_streams = d.streams.size();
     out->live_events = d.events.size();
+}
+
+extern "C" void fv_cuda_sim_fail_allocation(int64_t n)
+{
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    d.fail_in = n < 0 ? -1 : n;
 }
