@@ -1,8 +1,8 @@
 /* fovea — the CUDA simulator (docs/gpu.md, "The CUDA simulator"): the part of the CUDA runtime API
- * that the .cu files of device/cuda use, implemented on the host, so that a build without nvcc compiles those
- * very files as C++ and the tests execute their host orchestration (allocations, copies, launches
- * and their order, streams, events, the host's waits, readback, counters) and their kernels on the
- * CPU. Only the simulator build (CMake FOVEA_CUDA_SIM: the test-only library fovea_sim) puts this
+ * that the .cu files of device/cuda use, implemented on the host, so that a build without nvcc
+ * compiles those very files as C++ and the tests execute their host orchestration (allocations,
+ * copies, launches and their order, streams, events, the host's waits, readback, counters) and
+ * their kernels on the CPU. Only the simulator build (CMake FOVEA_CUDA_SIM: the test-only library fovea_sim) puts this
  * folder first on the include path; nvcc never sees it, and the shipped library does not contain it.
  *
  * What it checks, aborting with a line that names the call site: a cudaFree of a pointer that is
@@ -176,7 +176,8 @@ cudaError_t fv_cuda_sim_memset(void *p, int value, size_t bytes, bool async, cud
 #define cudaMalloc(p, bytes) fv_cuda_sim_malloc((p), (bytes), __FILE__, __LINE__)
 #define cudaFree(p) fv_cuda_sim_free((p), __FILE__, __LINE__)
 #define cudaMemcpy(dst, src, bytes, kind) fv_cuda_sim_memcpy((dst), (src), (bytes), (kind), false, 0, __FILE__, __LINE__)
-#define cudaMemcpyAsync(dst, src, bytes, kind, ...) fv_cuda_sim_memcpy((dst), (src), (bytes), (kind), true, fv_cuda_sim_stream_arg(__VA_ARGS__), __FILE__, __LINE__)
+#define cudaMemcpyAsync(dst, src, bytes, kind, ...) \
+    fv_cuda_sim_memcpy((dst), (src), (bytes), (kind), true, fv_cuda_sim_stream_arg(__VA_ARGS__), __FILE__, __LINE__)
 #define cudaMemset(p, value, bytes) fv_cuda_sim_memset((p), (value), (bytes), false, 0, __FILE__, __LINE__)
 #define cudaMemsetAsync(p, value, bytes, ...) fv_cuda_sim_memset((p), (value), (bytes), true, fv_cuda_sim_stream_arg(__VA_ARGS__), __FILE__, __LINE__)
 /* The async calls' stream argument is optional, as in CUDA. */
