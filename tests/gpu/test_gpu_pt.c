@@ -5,7 +5,8 @@
  * CUDA runs are bit-identical; the first-hit buffers agree. A stereo frame through
  * fv_technique_render_pair (both eyes' kernels, one host wait) equals the two per-eye calls bit for
  * bit, with host_syncs 1 for the pair. Exits 77 (skipped) where CUDA cannot
- * run: a build without CUDA, a machine without a GPU.
+ * run: a build without CUDA, a machine without a GPU. Built a second time against the CUDA
+ * simulator (sim_test_gpu_pt, tests/gpu/sim_checks.h), where it also counts the host's waits.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -16,6 +17,7 @@
 #include <cmocka.h>
 #include "fovea/fovea.h"
 #include "../unit/testkit.h"
+#include "sim_checks.h"
 
 static void compare_scene(const char *name, int w, int h, double time, int frames)
 {
@@ -27,7 +29,10 @@ static void compare_scene(const char *name, int w, int h, double time, int frame
     fv_camera cam;
     fv_view_camera(v, s, time, w, h, &cam);
     fv_film *p = fv_test_render_pt(s, &cam, "spp=4 device=portable", time, frames, 11);
+    fv_sim_mark m = fv_sim_now();
     fv_film *c1 = fv_test_render_pt(s, &cam, "spp=4 device=cuda", time, frames, 11);
+    fv_sim_expect(m, (uint64_t)frames, frames, name); /* a frame: one launch, one wait (then the copies back) */
+    fv_sim_expect_freed(name);
     fv_film *c2 = fv_test_render_pt(s, &cam, "spp=4 device=cuda", time, frames, 11);
     fv_test_agreement r = fv_test_agree(p, c1, 1e-3);
     printf("%s: portable (%.4f %.4f %.4f) cuda (%.4f %.4f %.4f): largest mean difference %.3g%%, %.2f%% of pixels equal within 1e-3, "
@@ -140,14 +145,36 @@ static void test_pair(void **st)
     fv_scene_destroy(s);
 }
 
+#ifdef FOVEA_CUDA_SIM
+/* The simulator only: every device allocation of pt's backend (the scene at create, the film and
+ * counters, the moving scene's update) failing in turn, as on a full GPU. */
+static void test_out_of_memory(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load("cornell-fpm", &s, &v) != 0) fail_msg("cannot load cornell-fpm");
+    fv_camera cam;
+    fv_view_camera(v, s, 0.7, 24, 16, &cam);
+    fv_sim_frames r = {s, &cam, "pt", "spp=1 device=cuda", 2, 0.7};
+    if (fv_sim_walk_allocation_failures(fv_sim_run_frames, &r, "pt") < 10) fail_msg("pt: fewer device allocations than the scene has arrays");
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+#endif
+
 int main(void)
 {
     char why[256];
     if (!fv_device_available(FV_DEVICE_CUDA, why, sizeof why)) {
         printf("skipped: %s\n", why);
-        return 77;
+        return FV_GPU_TEST_NO_DEVICE;
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_cornell), cmocka_unit_test(test_city), cmocka_unit_test(test_moving),
-                                       cmocka_unit_test(test_textured), cmocka_unit_test(test_sdf), cmocka_unit_test(test_pair)};
+                                       cmocka_unit_test(test_textured), cmocka_unit_test(test_sdf), cmocka_unit_test(test_pair),
+#ifdef FOVEA_CUDA_SIM
+                                       cmocka_unit_test(test_out_of_memory)
+#endif
+    };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -19,7 +19,9 @@
  * for the pair) must equal the two per-eye CUDA calls bit for bit (the same kernels in the same
  * order) and the portable pair within the bounds above, with host_syncs 1 per pair, fipr's
  * histories carried on the GPU and the scene's lights moving (sdf-columns).
- * Exits 77 (skipped) where CUDA cannot run: a build without CUDA, a machine without a GPU.
+ * Exits 77 (skipped) where CUDA cannot run: a build without CUDA, a machine without a GPU. Built a
+ * second time against the CUDA simulator (sim_test_gpu_sdf, tests/gpu/sim_checks.h), where the host's
+ * waits are also counted, not only reported.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -31,6 +33,7 @@
 #include <cmocka.h>
 #include "fovea/fovea.h"
 #include "../unit/testkit.h"
+#include "sim_checks.h"
 
 static fv_film *render(const char *method, const char *params, const fv_scene *s, const fv_camera *cam, fv_stats *stats)
 {
@@ -60,7 +63,12 @@ static void compare(const char *scene, const char *method, int w, int h, int spp
     snprintf(pp, sizeof pp, "spp=%d device=portable", spp);
     snprintf(pc, sizeof pc, "spp=%d device=cuda", spp);
     fv_stats sp, sc, sc2;
-    fv_film *p = render(method, pp, s, &cam, &sp), *c1 = render(method, pc, s, &cam, &sc), *c2 = render(method, pc, s, &cam, &sc2);
+    fv_film *p = render(method, pp, s, &cam, &sp);
+    fv_sim_mark m = fv_sim_now();
+    fv_film *c1 = render(method, pc, s, &cam, &sc);
+    fv_sim_expect(m, 1, 1, method); /* one launch, one wait */
+    fv_sim_expect_freed(method);
+    fv_film *c2 = render(method, pc, s, &cam, &sc2);
     fv_test_agreement r = fv_test_agree(p, c1, 1e-4);
     const float *a = fv_film_color_const(p), *b = fv_film_color_const(c1);
     const size_t n = (size_t)w * h;
@@ -139,7 +147,9 @@ static void compare_pyramid(const char *scene, const char *method, const char *p
             f.gaze.y = 0.6f - 0.07f * (float)i;
             fv_stats sp, sc, sc2;
             frame_into(tp, &f, p, &sp);
+            fv_sim_mark m = fv_sim_now();
             frame_into(tc, &f, c1, &sc);
+            fv_sim_expect(m, 1, -1, method); /* what host_syncs reports (checked below) is what the host did */
             frame_into(tc2, &f, c2, &sc2);
             fv_test_agreement r = fv_test_agree(p, c1, 1e-4);
             const float *a = fv_film_color_const(p), *b = fv_film_color_const(c1);
@@ -170,6 +180,7 @@ static void compare_pyramid(const char *scene, const char *method, const char *p
     fv_technique_destroy(tp);
     fv_technique_destroy(tc);
     fv_technique_destroy(tc2);
+    fv_sim_expect_freed(method);
     fv_view_destroy(v);
     fv_scene_destroy(s);
 }
@@ -303,14 +314,41 @@ static void test_pair(void **st)
     compare_pair("sdf-temple", "fipr", "spp=16 refresh=4 shadow_reuse=true blur=true", 96, 72, 5);
 }
 
+#ifdef FOVEA_CUDA_SIM
+/* The simulator only: every device allocation of the sphere tracers' backend (counters, stream,
+ * world, film, pyramid, fipr's history) failing in turn, as on a full GPU. */
+static void test_out_of_memory(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load("sdf-primitives", &s, &v) != 0) fail_msg("cannot load sdf-primitives");
+    fv_camera cam;
+    fv_view_camera(v, s, 0.0, 32, 24, &cam);
+    static const char *const methods[][2] = {{"sdf-gt", "spp=1 device=cuda"},
+                                             {"ipr", "spp=1 shadow_reuse=true device=cuda"},
+                                             {"fipr", "spp=1 refresh=2 device=cuda"}};
+    for (size_t i = 0; i < sizeof methods / sizeof methods[0]; i++) {
+        fv_sim_frames r = {s, &cam, methods[i][0], methods[i][1], 2, 0.0};
+        if (fv_sim_walk_allocation_failures(fv_sim_run_frames, &r, methods[i][0]) < 5) fail_msg("%s: too few device allocations", methods[i][0]);
+    }
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+#endif
+
 int main(void)
 {
     char why[256];
     if (!fv_device_available(FV_DEVICE_CUDA, why, sizeof why)) {
         printf("skipped: %s\n", why);
-        return 77;
+        return FV_GPU_TEST_NO_DEVICE;
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_primitives), cmocka_unit_test(test_columns), cmocka_unit_test(test_temple),
-                                       cmocka_unit_test(test_ipr), cmocka_unit_test(test_fipr), cmocka_unit_test(test_pair)};
+                                       cmocka_unit_test(test_ipr), cmocka_unit_test(test_fipr), cmocka_unit_test(test_pair),
+#ifdef FOVEA_CUDA_SIM
+                                       cmocka_unit_test(test_out_of_memory)
+#endif
+    };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,6 +1,7 @@
-/* fovea — what the CUDA backends share (device/cuda/pt.cu, device/cuda/sdf.cu): the error line of a
- * failed CUDA call, and a film on the GPU, its buffers kept between frames of one size and read
- * back into the host film's buffers that are set. Host code only; included by .cu files.
+/* fovea — what the CUDA backends share (device/cuda/pt.cu, device/cuda/sdf.cu): the launch macro
+ * (device/cuda/launch.h, FV_CUDA_LAUNCH), the error line of a failed CUDA call, and a film on the
+ * GPU, its buffers kept between frames of one size and read back into the host film's buffers that
+ * are set. Host code only; included by .cu files.
  */
 #ifndef FV_DEVICE_CUDA_COMMON_H
 #define FV_DEVICE_CUDA_COMMON_H
@@ -9,6 +10,7 @@
 #include <stdint.h>
 #include "fovea/film.h"
 #include "fovea/status.h"
+#include "device/cuda/launch.h"
 
 static inline fv_status fv_cuda_fail(cudaError_t e, const char *what, fv_error *err)
 {

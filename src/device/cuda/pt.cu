@@ -194,7 +194,7 @@ extern "C" fv_status fv_cuda_pt_render(fv_cuda_pt *c, int eyes, const fv_kpt_fra
     cudaEventRecord(c->start, st);
     for (int i = 0; i < eyes; i++) {
         dim3 grid((unsigned)((f[i].cam.width + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK), (unsigned)((f[i].cam.height + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK));
-        fv_cuda_pt_kernel<<<grid, block, 0, st>>>(c->dev, f[i], dv[i], c->counts);
+        FV_CUDA_LAUNCH(fv_cuda_pt_kernel, grid, block, st)(c->dev, f[i], dv[i], c->counts);
     }
     cudaEventRecord(c->stop, st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the pt kernel", err);

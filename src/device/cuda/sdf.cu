@@ -267,7 +267,7 @@ extern "C" fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const fv_ksdf_world *w, 
     for (int i = 0; i < eyes; i++) {
         dim3 grid((unsigned)((f[i].cam.width + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK),
                   (unsigned)((f[i].cam.height + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK));
-        fv_cuda_sdf_kernel<<<grid, block, 0, st>>>(dw, f[i], dv[i], c->counts);
+        FV_CUDA_LAUNCH(fv_cuda_sdf_kernel, grid, block, st)(dw, f[i], dv[i], c->counts);
     }
     cudaEventRecord(c->stop, st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the sphere-tracing kernel", err);
@@ -466,7 +466,7 @@ static fv_status history_ensure(fv_cuda_sdf *c, int eye, int index, fv_error *er
         h->sh = k->sh;
         index = 0;
     }
-    if (index == 0) fv_cuda_pyr_forget<<<blocks_of(n), 256, 0, c->stream>>>(h->stamp, (int)n);
+    if (index == 0) FV_CUDA_LAUNCH(fv_cuda_pyr_forget, blocks_of(n), 256, c->stream)(h->stamp, (int)n);
     k->hist_color = h->color;
     k->hist_stamp = h->stamp;
     return FV_OK;
@@ -572,22 +572,22 @@ extern "C" fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const fv_ksdf_wo
         /* the levels traced whole (fipr: all but the middle, which the mask decides) */
         const int full_below = fipr ? L - 2 : L - 1;
         for (int l = 0; l < full_below; l++)
-            fv_cuda_pyr_level<<<grid_of(k->lv[l].w, k->lv[l].h), block, 0, st>>>(dw, f[i], *k, l, index, c->counts);
+            FV_CUDA_LAUNCH(fv_cuda_pyr_level, grid_of(k->lv[l].w, k->lv[l].h), block, st)(dw, f[i], *k, l, index, c->counts);
         if (fipr) {
             const size_t ntip = (size_t)k->lv[0].w * k->lv[0].h;
             cudaMemsetAsync(c->far, 0, sizeof(unsigned), st);
-            fv_cuda_pyr_far<<<blocks_of(ntip), 256, 0, st>>>(k->depth[0], (int)ntip, c->far);
-            fv_cuda_pyr_sobel<<<grid_of(k->lv[0].w, k->lv[0].h), block, 0, st>>>(*k, c->far, po->edge);
-            fv_cuda_pyr_mask<<<grid_of(k->w, k->h), block, 0, st>>>(*k, fov[i], c->counts);
-            fv_cuda_pyr_need<<<grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, 0, st>>>(*k, fov[i], c->counts);
-            fv_cuda_pyr_level<<<grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, 0, st>>>(dw, f[i], *k, L - 2, index, c->counts);
+            FV_CUDA_LAUNCH(fv_cuda_pyr_far, blocks_of(ntip), 256, st)(k->depth[0], (int)ntip, c->far);
+            FV_CUDA_LAUNCH(fv_cuda_pyr_sobel, grid_of(k->lv[0].w, k->lv[0].h), block, st)(*k, c->far, po->edge);
+            FV_CUDA_LAUNCH(fv_cuda_pyr_mask, grid_of(k->w, k->h), block, st)(*k, fov[i], c->counts);
+            FV_CUDA_LAUNCH(fv_cuda_pyr_need, grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, st)(*k, fov[i], c->counts);
+            FV_CUDA_LAUNCH(fv_cuda_pyr_level, grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, st)(dw, f[i], *k, L - 2, index, c->counts);
         }
-        fv_cuda_pyr_target<<<grid_of(k->w, k->h), block, 0, st>>>(dw, f[i], *k, dv[i], c->counts);
+        FV_CUDA_LAUNCH(fv_cuda_pyr_target, grid_of(k->w, k->h), block, st)(dw, f[i], *k, dv[i], c->counts);
         if (blurred) {
             /* pass 5 on this eye's colour, in place through the scratch image */
-            fv_cuda_pyr_sigma<<<grid_of(k->w, k->h), block, 0, st>>>(k->mask, k->w, k->h, po->blur_sigma, c->blur.sigma);
-            fv_cuda_blur_h<<<grid_of(k->w, k->h), block, 0, st>>>(bt, c->blur.sigma, dv[i].color, c->blur.tmp);
-            fv_cuda_blur_v<<<grid_of(k->w, k->h), block, 0, st>>>(bt, c->blur.sigma, c->blur.tmp, dv[i].color);
+            FV_CUDA_LAUNCH(fv_cuda_pyr_sigma, grid_of(k->w, k->h), block, st)(k->mask, k->w, k->h, po->blur_sigma, c->blur.sigma);
+            FV_CUDA_LAUNCH(fv_cuda_blur_h, grid_of(k->w, k->h), block, st)(bt, c->blur.sigma, dv[i].color, c->blur.tmp);
+            FV_CUDA_LAUNCH(fv_cuda_blur_v, grid_of(k->w, k->h), block, st)(bt, c->blur.sigma, c->blur.tmp, dv[i].color);
         }
     }
     cudaEventRecord(c->stop, st);

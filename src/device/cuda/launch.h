@@ -1,0 +1,26 @@
+/* fovea — how the .cu files of device/cuda launch a kernel: FV_CUDA_LAUNCH(kernel, grid, block, stream)(args...)
+ * instead of CUDA's kernel<<<grid, block, 0, stream>>>(args...). Under nvcc it is exactly that
+ * triple-chevron launch; in the CUDA simulator build (FOVEA_CUDA_SIM, docs/gpu.md "The CUDA
+ * simulator") it runs the kernel on the host, every thread of a block on a thread of its own,
+ * through sim/cuda_runtime.h. The chevrons are not C++, so every launch goes through this macro:
+ * then the host compiler compiles the same .cu files and the tests execute their host code.
+ *
+ * stream: a cudaStream_t, or 0 for the default stream. The launches take no dynamic shared memory
+ * (kernels declare __shared__ arrays of a fixed size); a kernel that needs it adds a macro here.
+ */
+#ifndef FV_DEVICE_CUDA_LAUNCH_H
+#define FV_DEVICE_CUDA_LAUNCH_H
+
+#include <cuda_runtime.h>
+
+#if defined(__CUDACC__)
+#define FV_CUDA_LAUNCH(kernel, grid, block, stream) kernel<<<(grid), (block), 0, (stream)>>>
+#elif defined(FV_CUDA_SIM)
+/* sim/cuda_runtime.h defines FV_CUDA_SIM and the launcher; the name and call site go into its
+ * messages. */
+#define FV_CUDA_LAUNCH(kernel, grid, block, stream) fv_cuda_sim::launch(kernel, #kernel, (grid), (block), (stream), __FILE__, __LINE__)
+#else
+#error "device/cuda/*.cu are compiled by nvcc or, in the simulator build, with device/cuda/sim first on the include path"
+#endif
+
+#endif
