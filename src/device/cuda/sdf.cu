@@ -37,13 +37,6 @@
 #define FV_CUDA_PYR_LEVEL_STEPS (FV_CUDA_PYR_LEVEL_RAYS + FV_PYRAMID_MAX_LEVELS)
 #define FV_CUDA_PYR_COUNTS (FV_CUDA_PYR_LEVEL_STEPS + FV_PYRAMID_MAX_LEVELS)
 
-/* A device array that grows and is refilled from the host when what it holds changed. */
-typedef struct dev_array {
-    void *p;
-    size_t cap;   /* bytes */
-    void *mirror; /* host copy of what p holds, bytes long */
-    size_t bytes;
-} dev_array;
 
 /* fipr's middle level of one eye on the GPU (pyramid.h's fv_pyramid_history). */
 typedef struct dev_history {
@@ -53,7 +46,7 @@ typedef struct dev_history {
 } dev_history;
 
 struct fv_cuda_sdf {
-    dev_array ops, objs, lights, mats;
+    fv_cuda_mirror ops, objs, lights, mats;
     fv_cuda_film film;
     unsigned long long *counts; /* FV_CUDA_PYR_COUNTS */
     cudaEvent_t start, stop;
@@ -64,36 +57,6 @@ struct fv_cuda_sdf {
     unsigned *far;              /* pass 2's farthest tip depth, as float bits */
     dev_history hist[2];
 };
-
-static fv_status fill(dev_array *a, const void *src, size_t bytes, fv_error *err)
-{
-    if (bytes == 0) return FV_OK;
-    if (a->p && bytes == a->bytes && memcmp(a->mirror, src, bytes) == 0) return FV_OK; /* unchanged since the last copy */
-    cudaError_t e;
-    if (bytes > a->cap) {
-        cudaFree(a->p);
-        free(a->mirror);
-        a->p = a->mirror = NULL;
-        a->cap = a->bytes = 0;
-        if (!(a->mirror = malloc(bytes))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-        if ((e = cudaMalloc(&a->p, bytes)) != cudaSuccess)
-            return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for the world")
-                                                  : fv_cuda_fail(e, "allocating the world", err);
-        a->cap = bytes;
-    }
-    a->bytes = 0; /* stale until the copy succeeds */
-    if ((e = cudaMemcpy(a->p, src, bytes, cudaMemcpyHostToDevice)) != cudaSuccess) return fv_cuda_fail(e, "copying the world", err);
-    memcpy(a->mirror, src, bytes);
-    a->bytes = bytes;
-    return FV_OK;
-}
-
-static void dev_array_free(dev_array *a)
-{
-    cudaFree(a->p);
-    free(a->mirror);
-    memset(a, 0, sizeof *a);
-}
 
 static void pyramid_free(fv_cuda_sdf *c)
 {
@@ -118,10 +81,10 @@ static void history_free(dev_history *h)
 extern "C" void fv_cuda_sdf_destroy(fv_cuda_sdf *c)
 {
     if (!c) return;
-    dev_array_free(&c->ops);
-    dev_array_free(&c->objs);
-    dev_array_free(&c->lights);
-    dev_array_free(&c->mats);
+    fv_cuda_mirror_free(&c->ops);
+    fv_cuda_mirror_free(&c->objs);
+    fv_cuda_mirror_free(&c->lights);
+    fv_cuda_mirror_free(&c->mats);
     fv_cuda_film_free(&c->film);
     pyramid_free(c);
     history_free(&c->hist[0]);
@@ -183,10 +146,10 @@ static fv_status upload_world(fv_cuda_sdf *c, const fv_ksdf_world *w, fv_ksdf_wo
 {
     *dw = *w;
     fv_status s;
-    if ((s = fill(&c->ops, w->ops, (size_t)w->nops * sizeof(fv_sdf_op), err)) != FV_OK ||
-        (s = fill(&c->objs, w->objs, (size_t)w->count * sizeof(fv_ksdf_object), err)) != FV_OK ||
-        (s = fill(&c->lights, w->lights, (size_t)w->nlights * sizeof(fv_ksdf_light), err)) != FV_OK ||
-        (s = fill(&c->mats, w->mats, (size_t)w->nmat * sizeof(fv_material), err)) != FV_OK)
+    if ((s = fv_cuda_mirror_fill(&c->ops, w->ops, (size_t)w->nops * sizeof(fv_sdf_op), 0, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->objs, w->objs, (size_t)w->count * sizeof(fv_ksdf_object), 0, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->lights, w->lights, (size_t)w->nlights * sizeof(fv_ksdf_light), 0, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->mats, w->mats, (size_t)w->nmat * sizeof(fv_material), 0, "the world", err)) != FV_OK)
         return s;
     dw->ops = (const fv_sdf_op *)c->ops.p;
     dw->objs = (const fv_ksdf_object *)c->objs.p;
@@ -419,22 +382,6 @@ static fv_status history_ensure(fv_cuda_sdf *c, int eye, int index, fv_error *er
     return FV_OK;
 }
 
-/* Copies the device film's n pixels into host's buffers that are set, on the stream. */
-static cudaError_t film_read_async(const fv_cuda_film *f, const fv_film_views *host, size_t n, cudaStream_t st)
-{
-    struct {
-        void *host;
-        const void *dev;
-        size_t bytes;
-    } back[6] = {{host->color, f->color, 3 * n * sizeof(float)},       {host->depth, f->depth, n * sizeof(float)},
-                 {host->normal, f->normal, 3 * n * sizeof(float)},     {host->albedo, f->albedo, 3 * n * sizeof(float)},
-                 {host->position, f->position, 3 * n * sizeof(float)}, {host->id, f->id, n * sizeof(uint32_t)}};
-    cudaError_t e = cudaSuccess;
-    for (int i = 0; i < 6 && e == cudaSuccess; i++)
-        if (back[i].host) e = cudaMemcpyAsync(back[i].host, back[i].dev, back[i].bytes, cudaMemcpyDeviceToHost, st);
-    return e;
-}
-
 extern "C" fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const fv_ksdf_world *w, const fv_ksdf_frame *f, const fv_kpyr *shape,
                                                 const fv_kpyr_fovea *fov, float edge, bool shadow_reuse, const fv_film_views *out,
                                                 uint8_t *mask_out, fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err)
@@ -476,7 +423,7 @@ extern "C" fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const fv_ksdf_wo
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the pyramid's kernels", err);
     /* what the host receives, then its one wait */
     unsigned long long kc[FV_CUDA_PYR_COUNTS];
-    e = film_read_async(&c->film, out, n, st);
+    e = fv_cuda_film_read_async(&c->film, out, n, st);
     if (e == cudaSuccess && mask_out && fipr) e = cudaMemcpyAsync(mask_out, k->mask, n, cudaMemcpyDeviceToHost, st);
     if (e == cudaSuccess) e = cudaMemcpyAsync(kc, c->counts, sizeof kc, cudaMemcpyDeviceToHost, st);
     if (e == cudaSuccess) e = cudaStreamSynchronize(st);

@@ -1,0 +1,453 @@
+/* fovea — the CUDA backend of the Visual-Polar family (see device/cuda_backend.h): a frame of one
+ * eye as a sequence of kernels on one stream, the functions the portable backend runs on the CPU
+ * (technique/vpolar/device.c), a thread a cell or a pixel:
+ *
+ *   trace (fv_kvp_trace_sample, pt's path kernel on the flat scene of device/cuda/scene.h)
+ *   -> the denoiser's history coordinates (fv_kvp_reproject_sample) -> [SVGF: not yet on the GPU]
+ *   -> φ-mipmaps (level 0 a copy, then fv_kphi_halve_cell a level per launch, each reading the one
+ *      before) -> map (fv_kvp_map_pixel: colour, first-hit buffers, the blur's sigma)
+ *   -> foveated blur (fv_kblur_h_pixel into a scratch image, fv_kblur_v_pixel back into the film).
+ *
+ * Memory: the grid's buffers, the history's coordinates, the mipmap levels, the blur's sigma and
+ * scratch image and the film keep their GPU buffers between frames, reallocated only when a size
+ * changes. What the host builds per screen size or per gaze (column heights, the on-screen mask,
+ * the mipmaps' shape, the radial table, the blur's kernels) goes through fv_cuda_mirror, copied only
+ * when its bytes changed; the scene only when its time moved. The radial table is copied after the
+ * reprojection is queued: until then the GPU's copy is the previous frame's, which is the table the
+ * reprojection needs (the previous view's), so one buffer serves both in stream order.
+ *
+ * The host waits once a frame, at the end, for the film's buffers that are set and the counters
+ * (res->syncs = 1). Stage times come from events between the stages.
+ *
+ * Indices: every kernel bounds its thread to its grid (x < w, y < h; a cell beyond its column's
+ * height is not traced; a mip cell beyond its column's rows is left by fv_kphi_halve_cell), the
+ * kernels clamp their lookups (kernel/vp_map.h, kernel/vp_space.h), and the blur refuses a sigma
+ * beyond its table with a NaN pixel instead of reading past the table (the host sizes the table to a
+ * bound of every sigma, so this does not happen).
+ */
+#include <cuda_runtime.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "device/cuda/common.h"
+#include "device/cuda/scene.h"
+#include "device/cuda_backend.h"
+#include "kernel/vp_blur.h"
+#include "kernel/vp_map.h"
+#include "kernel/vp_reproject.h"
+#include "kernel/vp_trace.h"
+
+/* Threads of a block: 8 x 8 cells or pixels, whose camera rays start coherent. */
+#define FV_CUDA_VP_BLOCK 8
+#define FV_CUDA_VP_THREADS 256 /* one-dimensional launches */
+
+enum { ST_TRACE = 0, ST_DENOISE, ST_MIP, ST_MAP, ST_BLUR, ST_COUNT };
+
+struct fv_cuda_vp {
+    fv_cuda_scene scene;
+    cudaStream_t stream;
+    cudaEvent_t ev[ST_COUNT + 1]; /* before each stage, and after the last */
+    /* the sample grid, gw x gh cells (0: none yet) */
+    int gw, gh;
+    fv_kvp_gbuf g;                /* device buffers */
+    float *prev_coord;            /* 2 per cell */
+    /* the screen, sw x sh pixels */
+    int sw, sh;
+    float *sigma;                 /* the blur's, per pixel */
+    float *blur_tmp;              /* the horizontal pass, 3 per pixel */
+    fv_cuda_film film;
+    /* the φ-mipmaps: level k has mip_h[k] rows of storage, mip_w columns */
+    int mip_levels, mip_w, mip_h[FV_KPHI_MAX_LEVELS];
+    float *mip_img[FV_KPHI_MAX_LEVELS];
+    float *shape_host;            /* the shape packed for one copy: per level rows, rowsf, inv_src */
+    size_t shape_cap;             /* floats */
+    fv_cuda_mirror col_h, onscreen, shape, lut, blur_off, blur_k;
+    unsigned long long *counts;   /* rays, paths, non-finite paths */
+};
+
+static unsigned blocks_of(size_t n)
+{
+    return (unsigned)((n + FV_CUDA_VP_THREADS - 1) / FV_CUDA_VP_THREADS);
+}
+
+static dim3 tiles_of(int w, int h)
+{
+    return dim3((unsigned)((w + FV_CUDA_VP_BLOCK - 1) / FV_CUDA_VP_BLOCK), (unsigned)((h + FV_CUDA_VP_BLOCK - 1) / FV_CUDA_VP_BLOCK));
+}
+
+/* ---- kernels ---- */
+
+__global__ void fv_cuda_vp_fill(float *p, size_t n, float v)
+{
+    const size_t i = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
+    if (i < n) p[i] = v;
+}
+
+/* The trace stage: cell (x, y) when it is a valid cell of its column. The counts are summed per
+ * block in shared memory, then once per block into the global ones. */
+__global__ void fv_cuda_vp_trace(fv_kscene s, fv_kvp_trace_frame f, fv_kvp_gbuf g, unsigned long long *counts)
+{
+    __shared__ unsigned long long sum[3];
+    const int tid = (int)(threadIdx.y * blockDim.x + threadIdx.x);
+    if (tid < 3) sum[tid] = 0;
+    __syncthreads();
+    const int x = (int)(blockIdx.x * blockDim.x + threadIdx.x), y = (int)(blockIdx.y * blockDim.y + threadIdx.y);
+    if (x < f.space.gw && y < f.space.gh && y < (f.col_h ? f.col_h[x] : f.space.gh)) {
+        fv_kvp_trace_counts c;
+        c.rays = c.paths = c.nan_paths = 0;
+        fv_kvp_trace_sample(&s, &f, &g, (long)y * f.space.gw + x, &c);
+        if (c.rays) atomicAdd(&sum[0], (unsigned long long)c.rays);
+        if (c.paths) atomicAdd(&sum[1], (unsigned long long)c.paths);
+        if (c.nan_paths) atomicAdd(&sum[2], (unsigned long long)c.nan_paths);
+    }
+    __syncthreads();
+    if (tid < 3 && sum[tid]) atomicAdd(&counts[tid], sum[tid]);
+}
+
+/* The history coordinates of every cell (NaN where there is none). */
+__global__ void fv_cuda_vp_reproject(fv_kvp_reproject_frame f, float *prev_coord)
+{
+    const size_t i = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
+    if (i < (size_t)f.space.gw * (size_t)f.space.gh) fv_kvp_reproject_sample(&f, (long)i, &prev_coord[2 * i]);
+}
+
+/* Mip level k >= 1 from level k - 1: cell (x, j) of its h rows of storage. */
+__global__ void fv_cuda_vp_halve(fv_kphi_mips m, int k, int h)
+{
+    const int x = (int)(blockIdx.x * blockDim.x + threadIdx.x), j = (int)(blockIdx.y * blockDim.y + threadIdx.y);
+    if (x < m.w && j < h) fv_kphi_halve_cell(&m, k, x, j);
+}
+
+/* The map stage at screen pixel (x, y). */
+__global__ void fv_cuda_vp_map(fv_kvp_map_frame mf, fv_film_views out)
+{
+    const int x = (int)(blockIdx.x * blockDim.x + threadIdx.x), y = (int)(blockIdx.y * blockDim.y + threadIdx.y);
+    if (x < mf.space.sw && y < mf.space.sh) fv_kvp_map_pixel(&mf, x, y, &out);
+}
+
+/* A sigma whose kernel is not in the table: the pixel becomes NaN (visible to every check) rather
+ * than a read past the table. The host's bound makes this unreachable. */
+__device__ static bool fv_cuda_vp_blur_outside(const fv_kblur_table *t, const float *sigma, float *dst, int x, int y)
+{
+    const size_t pix = (size_t)y * (size_t)t->w + (size_t)x;
+    const int q = fv_kblur_quantise(sigma[pix]);
+    if (q >= 0 && q < t->nq) return false;
+    for (int c = 0; c < 3; c++) dst[3 * pix + c] = NAN;
+    return true;
+}
+
+__global__ void fv_cuda_vp_blur_h(fv_kblur_table t, const float *sigma, const float *src, float *tmp)
+{
+    const int x = (int)(blockIdx.x * blockDim.x + threadIdx.x), y = (int)(blockIdx.y * blockDim.y + threadIdx.y);
+    if (x < t.w && y < t.h && !fv_cuda_vp_blur_outside(&t, sigma, tmp, x, y)) fv_kblur_h_pixel(&t, sigma, src, tmp, x, y);
+}
+
+__global__ void fv_cuda_vp_blur_v(fv_kblur_table t, const float *sigma, const float *tmp, float *out)
+{
+    const int x = (int)(blockIdx.x * blockDim.x + threadIdx.x), y = (int)(blockIdx.y * blockDim.y + threadIdx.y);
+    if (x < t.w && y < t.h && !fv_cuda_vp_blur_outside(&t, sigma, out, x, y)) fv_kblur_v_pixel(&t, sigma, tmp, out, x, y);
+}
+
+/* ---- buffers ---- */
+
+static void grid_free(fv_cuda_vp *c)
+{
+    fv_kvp_gbuf *g = &c->g;
+    cudaFree(g->color), cudaFree(g->albedo), cudaFree(g->normal), cudaFree(g->depth), cudaFree(g->position);
+    cudaFree(g->reflectance), cudaFree(g->id), cudaFree(g->sampled), cudaFree(c->prev_coord);
+    memset(g, 0, sizeof *g);
+    c->prev_coord = NULL;
+    c->gw = c->gh = 0;
+}
+
+/* The grid's buffers for gw x gh cells, "no surface, not sampled" everywhere when new: the rows
+ * beyond a column's height keep that for good (the trace writes only valid cells), as on the host. */
+static fv_status grid_ensure(fv_cuda_vp *c, int gw, int gh, fv_error *err)
+{
+    if (c->gw == gw && c->gh == gh && c->g.color) return FV_OK;
+    grid_free(c);
+    const size_t n = (size_t)gw * (size_t)gh;
+    fv_kvp_gbuf *g = &c->g;
+    cudaStream_t st = c->stream;
+    cudaError_t e;
+    if ((e = cudaMalloc((void **)&g->color, 3 * n * sizeof(float))) != cudaSuccess ||
+        (e = cudaMalloc((void **)&g->albedo, 3 * n * sizeof(float))) != cudaSuccess ||
+        (e = cudaMalloc((void **)&g->reflectance, 3 * n * sizeof(float))) != cudaSuccess ||
+        (e = cudaMalloc((void **)&g->normal, 3 * n * sizeof(float))) != cudaSuccess ||
+        (e = cudaMalloc((void **)&g->position, 3 * n * sizeof(float))) != cudaSuccess ||
+        (e = cudaMalloc((void **)&g->depth, n * sizeof(float))) != cudaSuccess ||
+        (e = cudaMalloc((void **)&g->id, n * sizeof(uint32_t))) != cudaSuccess ||
+        (e = cudaMalloc((void **)&g->sampled, n)) != cudaSuccess ||
+        (e = cudaMalloc((void **)&c->prev_coord, 2 * n * sizeof(float))) != cudaSuccess ||
+        (e = cudaMemsetAsync(g->color, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
+        (e = cudaMemsetAsync(g->albedo, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
+        (e = cudaMemsetAsync(g->reflectance, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
+        (e = cudaMemsetAsync(g->normal, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
+        (e = cudaMemsetAsync(g->position, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
+        (e = cudaMemsetAsync(g->id, 0, n * sizeof(uint32_t), st)) != cudaSuccess ||
+        (e = cudaMemsetAsync(g->sampled, 0, n, st)) != cudaSuccess) {
+        grid_free(c);
+        return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for a %dx%d sample grid", gw, gh)
+                                              : fv_cuda_fail(e, "allocating the sample grid", err);
+    }
+    fv_cuda_vp_fill<<<blocks_of(n), FV_CUDA_VP_THREADS, 0, st>>>(g->depth, n, INFINITY);
+    c->gw = gw, c->gh = gh;
+    return FV_OK;
+}
+
+static void screen_free(fv_cuda_vp *c)
+{
+    cudaFree(c->sigma), cudaFree(c->blur_tmp);
+    c->sigma = c->blur_tmp = NULL;
+    c->sw = c->sh = 0;
+}
+
+static fv_status screen_ensure(fv_cuda_vp *c, int sw, int sh, fv_error *err)
+{
+    if (c->sw == sw && c->sh == sh && c->sigma) return FV_OK;
+    screen_free(c);
+    const size_t n = (size_t)sw * (size_t)sh;
+    cudaError_t e;
+    if ((e = cudaMalloc((void **)&c->sigma, n * sizeof(float))) != cudaSuccess ||
+        (e = cudaMalloc((void **)&c->blur_tmp, 3 * n * sizeof(float))) != cudaSuccess) {
+        screen_free(c);
+        return fv_cuda_fail(e, "allocating the blur's buffers", err);
+    }
+    c->sw = sw, c->sh = sh;
+    return FV_OK;
+}
+
+static void mips_free(fv_cuda_vp *c)
+{
+    for (int k = 0; k < FV_KPHI_MAX_LEVELS; k++) cudaFree(c->mip_img[k]), c->mip_img[k] = NULL;
+    c->mip_levels = c->mip_w = 0;
+    memset(c->mip_h, 0, sizeof c->mip_h);
+}
+
+/* The mip levels' storage for the frame's shape, and the shape (rows, rowsf, inv_src of every level,
+ * packed) on the GPU; *dm the chain with device pointers. */
+static fv_status mips_ensure(fv_cuda_vp *c, const fv_cuda_vp_frame *f, fv_kphi_mips *dm, fv_error *err)
+{
+    const fv_kphi_mips *m = &f->mip_shape;
+    const int L = m->levels, w = m->w;
+    if (L < 1 || L > FV_KPHI_MAX_LEVELS || w != f->trace.space.gw || f->mip_h[0] != f->trace.space.gh)
+        return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: the φ-mipmaps' shape does not match the grid");
+    for (int k = 0; k < L; k++)
+        if (f->mip_h[k] < 1 || !m->rows[k] || !m->rowsf[k] || (k > 0 && !m->inv_src[k]))
+            return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: the φ-mipmaps' level %d has no shape", k);
+    cudaError_t e;
+    if (L != c->mip_levels || w != c->mip_w || memcmp(f->mip_h, c->mip_h, (size_t)L * sizeof(int)) != 0) {
+        mips_free(c);
+        for (int k = 0; k < L; k++) {
+            /* 3 floats a pixel on w columns, one float of padding (filter/phi_mips.c's layout) */
+            const size_t floats = 3 * (size_t)w * (size_t)f->mip_h[k] + 1;
+            if ((e = cudaMalloc((void **)&c->mip_img[k], floats * sizeof(float))) != cudaSuccess ||
+                (e = cudaMemsetAsync(c->mip_img[k], 0, floats * sizeof(float), c->stream)) != cudaSuccess) {
+                mips_free(c);
+                return fv_cuda_fail(e, "allocating the φ-mipmaps", err);
+            }
+        }
+        c->mip_levels = L, c->mip_w = w;
+        memcpy(c->mip_h, f->mip_h, (size_t)L * sizeof(int));
+    }
+    /* level k's rows (ints), rowsf and inv_src (floats; level 0 has no source): 3 w words a level */
+    const size_t words = 3 * (size_t)w * (size_t)L;
+    if (words > c->shape_cap) {
+        free(c->shape_host);
+        if (!(c->shape_host = (float *)malloc(words * sizeof(float)))) {
+            c->shape_cap = 0;
+            return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        }
+        c->shape_cap = words;
+    }
+    for (int k = 0; k < L; k++) {
+        float *o = c->shape_host + 3 * (size_t)w * (size_t)k;
+        memcpy(o, m->rows[k], (size_t)w * sizeof(int));
+        memcpy(o + w, m->rowsf[k], (size_t)w * sizeof(float));
+        if (k > 0)
+            memcpy(o + 2 * w, m->inv_src[k], (size_t)w * sizeof(float));
+        else
+            memset(o + 2 * w, 0, (size_t)w * sizeof(float));
+    }
+    fv_status s = fv_cuda_mirror_fill(&c->shape, c->shape_host, words * sizeof(float), c->stream, "the φ-mipmaps' shape", err);
+    if (s != FV_OK) return s;
+    memset(dm, 0, sizeof *dm);
+    dm->levels = L, dm->w = w, dm->wrap = m->wrap;
+    float *base = (float *)c->shape.p;
+    for (int k = 0; k < L; k++) {
+        float *o = base + 3 * (size_t)w * (size_t)k;
+        dm->rows[k] = (const int *)o;
+        dm->rowsf[k] = o + w;
+        dm->inv_src[k] = k > 0 ? o + 2 * w : NULL;
+        dm->img[k] = c->mip_img[k];
+    }
+    return FV_OK;
+}
+
+extern "C" void fv_cuda_vp_destroy(fv_cuda_vp *c)
+{
+    if (!c) return;
+    if (c->stream) cudaStreamSynchronize(c->stream); /* nothing queued may outlive its buffers */
+    fv_cuda_scene_free(&c->scene);
+    grid_free(c);
+    screen_free(c);
+    mips_free(c);
+    free(c->shape_host);
+    fv_cuda_film_free(&c->film);
+    fv_cuda_mirror_free(&c->col_h);
+    fv_cuda_mirror_free(&c->onscreen);
+    fv_cuda_mirror_free(&c->shape);
+    fv_cuda_mirror_free(&c->lut);
+    fv_cuda_mirror_free(&c->blur_off);
+    fv_cuda_mirror_free(&c->blur_k);
+    cudaFree(c->counts);
+    for (int i = 0; i <= ST_COUNT; i++)
+        if (c->ev[i]) cudaEventDestroy(c->ev[i]);
+    if (c->stream) cudaStreamDestroy(c->stream);
+    free(c);
+}
+
+extern "C" fv_status fv_cuda_vp_create(const fv_kscene *host, fv_cuda_vp **out, fv_error *err)
+{
+    *out = NULL;
+    fv_cuda_vp *c = (fv_cuda_vp *)calloc(1, sizeof *c);
+    if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    fv_status s = fv_cuda_scene_upload(&c->scene, host, err);
+    cudaError_t e = cudaSuccess;
+    if (s == FV_OK && (e = cudaStreamCreate(&c->stream)) != cudaSuccess) s = fv_cuda_fail(e, "creating a stream", err);
+    for (int i = 0; s == FV_OK && i <= ST_COUNT; i++)
+        if ((e = cudaEventCreate(&c->ev[i])) != cudaSuccess) s = fv_cuda_fail(e, "creating events", err);
+    if (s == FV_OK && (e = cudaMalloc((void **)&c->counts, 3 * sizeof(unsigned long long))) != cudaSuccess)
+        s = fv_cuda_fail(e, "allocating counters", err);
+    if (s != FV_OK) {
+        fv_cuda_vp_destroy(c);
+        return s;
+    }
+    *out = c;
+    return FV_OK;
+}
+
+/* ---- a frame ---- */
+
+/* The frame's sizes and tables agree with one another (what the kernels' indices rely on). */
+static fv_status check_frame(const fv_cuda_vp_frame *f, fv_error *err)
+{
+    const fv_kvp_space *sp = &f->trace.space;
+    const char *bad = NULL;
+    if (sp->gw < 1 || sp->gh < 1 || sp->sw < 1 || sp->sh < 1) bad = "an empty grid or screen";
+    else if (f->map.space.gw != sp->gw || f->map.space.gh != sp->gh || f->map.space.sw != sp->sw || f->map.space.sh != sp->sh)
+        bad = "the map's space is not the trace's";
+    else if (f->map.col_h != f->trace.col_h) bad = "the map's column heights are not the trace's";
+    else if (!f->map.lut || f->map.nlut < 3) bad = "no radial table";
+    else if (f->map.identity && (sp->gw != sp->sw || sp->gh != sp->sh)) bad = "an identity map on a grid not the screen's size";
+    else if (!f->map.identity && !f->mips) bad = "a map without φ-mipmaps";
+    else if (f->history && (f->reproject.space.gw != sp->gw || f->reproject.space.gh != sp->gh || f->reproject.nlut != f->map.nlut))
+        bad = "the reprojection's space or table is not the frame's";
+    else if (f->history && f->trace.onscreen && f->reproject.onscreen && f->trace.onscreen != f->reproject.onscreen)
+        bad = "two on-screen masks";
+    else if (f->blur && (!f->map.sigma || f->blur_table.w != sp->sw || f->blur_table.h != sp->sh || f->blur_table.nq < 1 ||
+                         !f->blur_table.off || !f->blur_table.k || f->blur_nk < 1))
+        bad = "a blur without its table or sigma";
+    return bad ? fv_error_set(err, FV_ERR_INTERNAL, "CUDA: Visual-Polar frame: %s", bad) : FV_OK;
+}
+
+extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res,
+                                       fv_error *err)
+{
+    memset(res, 0, sizeof *res);
+    fv_status s = check_frame(f, err);
+    if (s != FV_OK) return s;
+    const int gw = f->trace.space.gw, gh = f->trace.space.gh, sw = f->trace.space.sw, sh = f->trace.space.sh;
+    const size_t n = (size_t)gw * (size_t)gh, ns = (size_t)sw * (size_t)sh;
+    cudaStream_t st = c->stream;
+    cudaError_t e;
+
+    /* What the frame needs on the GPU: buffers (kept), the scene at the frame's time, the host's
+     * tables where they changed. */
+    fv_film_views dv;
+    const uint8_t *mask = f->trace.onscreen ? f->trace.onscreen : (f->history ? f->reproject.onscreen : NULL);
+    fv_kphi_mips dm;
+    memset(&dm, 0, sizeof dm);
+    if ((s = grid_ensure(c, gw, gh, err)) != FV_OK || (s = screen_ensure(c, sw, sh, err)) != FV_OK ||
+        (s = fv_cuda_film_prepare(&c->film, out, ns, &dv, err)) != FV_OK || (s = fv_cuda_scene_update(&c->scene, f->scene, st, err)) != FV_OK ||
+        (f->trace.col_h && (s = fv_cuda_mirror_fill(&c->col_h, f->trace.col_h, (size_t)gw * sizeof(int), st, "the column heights", err)) != FV_OK) ||
+        (mask && (s = fv_cuda_mirror_fill(&c->onscreen, mask, n, st, "the on-screen mask", err)) != FV_OK) ||
+        (f->mips && (s = mips_ensure(c, f, &dm, err)) != FV_OK) ||
+        (f->blur && ((s = fv_cuda_mirror_fill(&c->blur_off, f->blur_table.off, (size_t)f->blur_table.nq * sizeof(int), st, "the blur's kernels", err)) != FV_OK ||
+                     (s = fv_cuda_mirror_fill(&c->blur_k, f->blur_table.k, f->blur_nk * sizeof(float), st, "the blur's kernels", err)) != FV_OK)))
+        return s;
+    const int *dcol_h = f->trace.col_h ? (const int *)c->col_h.p : NULL;
+    const uint8_t *dmask = mask ? (const uint8_t *)c->onscreen.p : NULL;
+    if ((e = cudaMemsetAsync(c->counts, 0, 3 * sizeof(unsigned long long), st)) != cudaSuccess) return fv_cuda_fail(e, "clearing counters", err);
+
+    /* 1. trace */
+    cudaEventRecord(c->ev[ST_TRACE], st);
+    fv_kvp_trace_frame tf = f->trace;
+    tf.col_h = dcol_h;
+    tf.onscreen = f->trace.onscreen ? dmask : NULL;
+    fv_cuda_vp_trace<<<tiles_of(gw, gh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), 0, st>>>(c->scene.dev, tf, c->g, c->counts);
+
+    /* 2. the denoiser: the history's coordinates, then SVGF's launches (not yet kernels: the
+     *    technique refuses denoise=true on this device until they are) */
+    cudaEventRecord(c->ev[ST_DENOISE], st);
+    if (f->history) {
+        fv_kvp_reproject_frame rf = f->reproject;
+        rf.g = c->g;
+        rf.onscreen = f->reproject.onscreen ? dmask : NULL;
+        rf.prev_lut = c->lut.p ? (const float *)c->lut.p : NULL;
+        if (!rf.prev_lut && rf.space.kind != FV_KVP_CARTESIAN)
+            return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: a history without the previous frame's radial table");
+        fv_cuda_vp_reproject<<<blocks_of(n), FV_CUDA_VP_THREADS, 0, st>>>(rf, c->prev_coord);
+    }
+
+    /* 3. φ-mipmaps: level 0 the grid's colour, then each level from the one before */
+    cudaEventRecord(c->ev[ST_MIP], st);
+    if (f->mips) {
+        if ((e = cudaMemcpyAsync(dm.img[0], c->g.color, 3 * n * sizeof(float), cudaMemcpyDeviceToDevice, st)) != cudaSuccess)
+            return fv_cuda_fail(e, "copying the φ-mipmaps' level 0", err);
+        for (int k = 1; k < dm.levels; k++)
+            fv_cuda_vp_halve<<<tiles_of(dm.w, f->mip_h[k]), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), 0, st>>>(dm, k, f->mip_h[k]);
+    }
+
+    /* 4. map: this frame's radial table replaces the previous one (the reprojection is queued) */
+    cudaEventRecord(c->ev[ST_MAP], st);
+    if ((s = fv_cuda_mirror_fill(&c->lut, f->map.lut, (size_t)f->map.nlut * 3 * sizeof(float), st, "the radial table", err)) != FV_OK) return s;
+    fv_kvp_map_frame mf = f->map;
+    mf.col_h = dcol_h;
+    mf.g = c->g;
+    mf.mips = dm;
+    mf.lut = (const float *)c->lut.p;
+    mf.sigma = f->blur ? c->sigma : NULL;
+    fv_cuda_vp_map<<<tiles_of(sw, sh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), 0, st>>>(mf, dv);
+
+    /* 5. the foveated blur, in place in the film's colour through the scratch image */
+    cudaEventRecord(c->ev[ST_BLUR], st);
+    if (f->blur) {
+        fv_kblur_table bt = f->blur_table;
+        bt.off = (const int *)c->blur_off.p;
+        bt.k = (const float *)c->blur_k.p;
+        fv_cuda_vp_blur_h<<<tiles_of(sw, sh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), 0, st>>>(bt, c->sigma, dv.color, c->blur_tmp);
+        fv_cuda_vp_blur_v<<<tiles_of(sw, sh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), 0, st>>>(bt, c->sigma, c->blur_tmp, dv.color);
+    }
+    cudaEventRecord(c->ev[ST_COUNT], st);
+    if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the Visual-Polar kernels", err);
+
+    /* The one host wait: the film's buffers that are set and the counters. */
+    unsigned long long counts[3] = {0, 0, 0};
+    e = fv_cuda_film_read_async(&c->film, out, ns, st);
+    if (e == cudaSuccess) e = cudaMemcpyAsync(counts, c->counts, sizeof counts, cudaMemcpyDeviceToHost, st);
+    if (e == cudaSuccess) e = cudaStreamSynchronize(st);
+    res->syncs = 1;
+    if (e != cudaSuccess) return fv_cuda_fail(e, "running the Visual-Polar kernels", err);
+    res->rays = counts[0], res->paths = counts[1], res->nan_paths = counts[2];
+    for (int i = 0; i < ST_COUNT; i++) {
+        float ms = 0.0f;
+        cudaEventElapsedTime(&ms, c->ev[i], c->ev[i + 1]);
+        res->stage_ms[i] = ms;
+    }
+    float ms = 0.0f;
+    cudaEventElapsedTime(&ms, c->ev[ST_TRACE], c->ev[ST_COUNT]);
+    res->kernel_ms = ms;
+    return FV_OK;
+}
