@@ -26,10 +26,12 @@
 #ifndef FV_FILTER_DEMOD_H
 #define FV_FILTER_DEMOD_H
 
+#include "fovea/math.h"
+
 #define FV_DEMOD_MIN 1e-3f
 
-/* The demodulation factors d of albedo a (3 floats each). */
-static inline void fv_demod_factors(const float *a, float *d)
+/* The demodulation factors d of albedo a (3 floats each); FV_HD: SVGF's kernels use it too. */
+FV_HD static inline void fv_demod_factors(const float *a, float *d)
 {
     if (a[0] < FV_DEMOD_MIN && a[1] < FV_DEMOD_MIN && a[2] < FV_DEMOD_MIN) {
         d[0] = d[1] = d[2] = 1.0f;

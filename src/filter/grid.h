@@ -15,6 +15,9 @@
  * Continuous coordinates: X in [0, w] along the columns (column x covers [x, x + 1), centre x + 0.5)
  * and V in [0, 1) along a column (row y of column x covers [y, y + 1) / col_h[x]). For a screen grid
  * V = Y / h with Y the continuous row coordinate.
+ *
+ * Plain C marked FV_HD: the same functions serve the CPU filters and the device kernels
+ * (kernel/svgf.h), which nvcc compiles for the GPU.
  */
 #ifndef FV_FILTER_GRID_H
 #define FV_FILTER_GRID_H
@@ -22,6 +25,7 @@
 #include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include "fovea/math.h"
 
 typedef struct fv_grid {
     int w, h;           /* storage size */
@@ -29,14 +33,14 @@ typedef struct fv_grid {
     bool wrap;          /* true: polar grid (rows wrap, columns clamp); false: screen grid */
 } fv_grid;
 
-static inline int fv_grid_col_h(const fv_grid *g, int x) { return g->col_h ? g->col_h[x] : g->h; }
+FV_HD static inline int fv_grid_col_h(const fv_grid *g, int x) { return g->col_h ? g->col_h[x] : g->h; }
 
-static inline bool fv_grid_valid(const fv_grid *g, int x, int y)
+FV_HD static inline bool fv_grid_valid(const fv_grid *g, int x, int y)
 {
     return x >= 0 && x < g->w && y >= 0 && y < fv_grid_col_h(g, x);
 }
 
-static inline int fv_grid_wrap_row(int y, int n)
+FV_HD static inline int fv_grid_wrap_row(int y, int n)
 {
     int r = y % n;
     return r < 0 ? r + n : r;
@@ -46,7 +50,7 @@ static inline int fv_grid_wrap_row(int y, int n)
  * tap falls outside a screen grid. In a polar grid the tap column is clamped to [0, w), the tap
  * starts from the row of that column at the same angle as (x, y) (columns differ in height) and the
  * row offset wraps around the column. */
-static inline long fv_grid_tap(const fv_grid *g, int x, int y, int dx, int dy)
+FV_HD static inline long fv_grid_tap(const fv_grid *g, int x, int y, int dx, int dy)
 {
     if (!g->wrap) {
         int xx = x + dx, yy = y + dy;
@@ -67,7 +71,7 @@ static inline long fv_grid_tap(const fv_grid *g, int x, int y, int dx, int dy)
 /* The four taps and weights of a bilinear lookup at continuous (X, V): two columns (clamped), and
  * in each column the two rows around V, wrapped on a polar grid and clamped on a screen grid.
  * Weights sum to 1 (some taps may coincide at the edges). */
-static inline void fv_grid_bilinear(const fv_grid *g, float X, float V, long idx[4], float wt[4])
+FV_HD static inline void fv_grid_bilinear(const fv_grid *g, float X, float V, long idx[4], float wt[4])
 {
     float fx = X - 0.5f;
     int x0 = (int)floorf(fx);
@@ -96,7 +100,7 @@ static inline void fv_grid_bilinear(const fv_grid *g, float X, float V, long idx
 }
 
 /* Continuous (X, V) of the centre of pixel (x, y). */
-static inline void fv_grid_centre(const fv_grid *g, int x, int y, float *X, float *V)
+FV_HD static inline void fv_grid_centre(const fv_grid *g, int x, int y, float *X, float *V)
 {
     *X = (float)x + 0.5f;
     *V = ((float)y + 0.5f) / (float)fv_grid_col_h(g, x);

@@ -145,6 +145,21 @@ static bool lines_off(void)
     return v && strcmp(v, "off") == 0;
 }
 
+fv_status fv_svgf_grid_validate(const fv_grid *grid, fv_error *err)
+{
+    if (!grid || grid->w < 1 || grid->h < 1)
+        return fv_error_set(err, FV_ERR_INVALID, "SVGF: grid size %dx%d", grid ? grid->w : 0, grid ? grid->h : 0);
+    if (grid->col_h)
+        for (int x = 0; x < grid->w; x++)
+            if (grid->col_h[x] < 1 || grid->col_h[x] > grid->h)
+                return fv_error_set(err, FV_ERR_INVALID, "SVGF: column %d has %d rows, not in [1, %d]", x, grid->col_h[x],
+                                    grid->h);
+    /* Pixel indices are ints in the inner loops (what the vectoriser can gather with). */
+    if ((long long)grid->w * grid->h > INT32_MAX)
+        return fv_error_set(err, FV_ERR_INVALID, "SVGF: grid %dx%d is too large", grid->w, grid->h);
+    return FV_OK;
+}
+
 fv_status fv_svgf_create(const fv_grid *grid, const fv_svgf_opts *o, fv_svgf **out, fv_error *err)
 {
     if (!out) return fv_error_set(err, FV_ERR_INVALID, "SVGF: no output handle");
@@ -156,24 +171,13 @@ fv_status fv_svgf_create(const fv_grid *grid, const fv_svgf_opts *o, fv_svgf **o
     }
     fv_status s = fv_svgf_opts_validate(o, err);
     if (s != FV_OK) return s;
-    if (!grid || grid->w < 1 || grid->h < 1)
-        return fv_error_set(err, FV_ERR_INVALID, "SVGF: grid size %dx%d", grid ? grid->w : 0, grid ? grid->h : 0);
-    if (grid->col_h)
-        for (int x = 0; x < grid->w; x++)
-            if (grid->col_h[x] < 1 || grid->col_h[x] > grid->h)
-                return fv_error_set(err, FV_ERR_INVALID, "SVGF: column %d has %d rows, not in [1, %d]", x, grid->col_h[x],
-                                    grid->h);
-    /* Pixel indices are ints in the inner loops (what the vectoriser can gather with). */
-    if ((long long)grid->w * grid->h > INT32_MAX)
-        return fv_error_set(err, FV_ERR_INVALID, "SVGF: grid %dx%d is too large", grid->w, grid->h);
+    if ((s = fv_svgf_grid_validate(grid, err)) != FV_OK) return s;
     fv_svgf *f = calloc(1, sizeof *f);
     if (!f) return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the SVGF filter");
     f->g = *grid;
     f->o = *o;
     f->n = (size_t)grid->w * (size_t)grid->h;
-    f->normal_squarings = -1;
-    for (int k = 0; k <= 16; k++)
-        if (o->sigma_normal == (float)(1 << k)) f->normal_squarings = k;
+    f->normal_squarings = fv_ksvgf_squarings(o->sigma_normal);
     f->full_from = grid->w;
     while (f->full_from > 0 && fv_grid_col_h(grid, f->full_from - 1) == grid->h) f->full_from--;
     /* Zeroed memory: the pixels that are never surfaces keep zero features and values. */
@@ -252,111 +256,45 @@ void fv_svgf_reset(fv_svgf *f)
 
 /* ---- A. classification, demodulation, temporal accumulation */
 
-/* The history at prev_coord (X, V), blended from the consistent taps of a bilinear lookup:
- * out = (r, g, b, m1, m2, length). False when there is none. */
-static bool fetch_history(const fv_svgf *f, const float *pc, const float *np, const float *xp, float depth, uint32_t id,
-                          float out[6])
+/* The kernels' view of the filter for this frame (kernel/svgf.h): the per-pixel steps that are not
+ * vectorised sweeps are the kernels' own functions. */
+static void kernel_view(const fv_svgf *f, const fv_svgf_frame *fr, bool history, fv_ksvgf *k)
 {
-    const fv_grid *g = &f->g;
-    float X = pc[0], V = pc[1];
-    if (!isfinite(X) || !isfinite(V)) return false;
-    if (!g->wrap) {
-        if (X < 0.0f || X > (float)g->w || V < 0.0f || V > 1.0f) return false;
-    } else {
-        /* Columns clamp (the lookup would clamp them anyway; this keeps floorf's result in int
-         * range), rows wrap. */
-        X = X < 0.0f ? 0.0f : (X > (float)g->w ? (float)g->w : X);
-        if (V < 0.0f || V >= 1.0f) V -= floorf(V);
-    }
-    long idx[4];
-    float wt[4];
-    fv_grid_bilinear(g, X, V, idx, wt);
-    float ax = fabsf(xp[0]), ay = fabsf(xp[1]), az = fabsf(xp[2]), big = ax > ay ? ax : ay;
-    big = big > az ? big : az;
-    float tol = HIST_POS_REL * (depth > HIST_DEPTH_MIN ? depth : HIST_DEPTH_MIN) + HIST_POS_ULP * big;
-    float tol2 = tol * tol;
-    const float *pnx = f->nx[1], *pny = f->ny[1], *pnz = f->nz[1], *plen = f->len[1];
-    float acc[6] = {0, 0, 0, 0, 0, 0}, wsum = 0.0f;
-    for (int k = 0; k < 4; k++) {
-        long q = idx[k];
-        /* Length 0 marks every pixel that cannot serve as history: rows beyond the column's
-         * height, no surface, no path, non-finite input. */
-        if (!(wt[k] > 0.0f) || !(plen[q] > 0.0f) || f->hist_id[q] != id) continue;
-        if (!(pnx[q] * np[0] + pny[q] * np[1] + pnz[q] * np[2] > HIST_COS)) continue;
-        const float *xq = &f->hist_pos[3 * q];
-        float dx = xq[0] - xp[0], dy = xq[1] - xp[1], dz = xq[2] - xp[2];
-        if (!(dx * dx + dy * dy + dz * dz < tol2)) continue;
-        const float *c = &f->hist_illum[3 * q];
-        acc[0] += wt[k] * c[0];
-        acc[1] += wt[k] * c[1];
-        acc[2] += wt[k] * c[2];
-        acc[3] += wt[k] * f->m1[1][q];
-        acc[4] += wt[k] * f->m2[1][q];
-        acc[5] += wt[k] * plen[q];
-        wsum += wt[k];
-    }
-    if (wsum < HIST_MIN_WEIGHT) return false;
-    for (int k = 0; k < 6; k++) out[k] = acc[k] / wsum;
-    return true;
+    memset(k, 0, sizeof *k);
+    k->g = f->g;
+    k->alpha_color = f->o.alpha_color, k->alpha_moments = f->o.alpha_moments;
+    k->sigma_depth = f->o.sigma_depth, k->sigma_normal = f->o.sigma_normal, k->sigma_lum = f->o.sigma_lum;
+    k->iterations = f->o.iterations, k->sq = f->normal_squarings;
+    k->periph_x = f->periph_x, k->periph_passes = f->periph_passes;
+    k->history = history;
+    k->color = fr->color, k->albedo = fr->albedo, k->normal = fr->normal, k->depth = fr->depth;
+    k->position = fr->position, k->prev_coord = fr->prev_coord, k->id = fr->id;
+    k->sampled = fr->sampled, k->active = fr->active;
+    k->kind = f->kind, k->surf = f->surf, k->gvar = f->gvar, k->grad = f->grad;
+    k->nx = f->nx[0], k->ny = f->ny[0], k->nz = f->nz[0], k->z = f->z[0], k->m1 = f->m1[0], k->m2 = f->m2[0], k->len = f->len[0];
+    k->pnx = f->nx[1], k->pny = f->ny[1], k->pnz = f->nz[1], k->pz = f->z[1], k->pm1 = f->m1[1], k->pm2 = f->m2[1], k->plen = f->len[1];
+    for (int i = 0; i < 2; i++)
+        for (int c = 0; c < NVAL; c++) k->val[i][c] = f->val[i][c];
+    k->hist_illum = f->hist_illum, k->hist_pos = f->hist_pos, k->hist_id = f->hist_id;
+    k->row_surface = f->row_surface, k->row_hist = f->row_hist, k->row_holes = f->row_holes, k->row_len = f->row_len;
 }
 
-static void sweep_accumulate(fv_svgf *f, const fv_svgf_frame *fr, bool history)
+/* Each pixel through the kernel's step, the row's counters as fv_ksvgf_count_row sums them (here
+ * from the step's results, with no per-pixel flag). */
+static void sweep_accumulate(fv_svgf *f, const fv_ksvgf *k)
 {
-    const fv_grid *g = &f->g;
-    const int w = g->w, h = g->h;
-    const float ac = f->o.alpha_color, am = f->o.alpha_moments;
-    float *const *v = f->val[0];
+    const int w = f->g.w, h = f->g.h;
     #pragma omp for schedule(static, ROWS_PER_BLOCK)
     for (int y = 0; y < h; y++) {
         long n_surface = 0, n_hist = 0, n_holes = 0;
         double len_sum = 0.0;
         for (int x = 0; x < w; x++) {
-            size_t p = (size_t)y * w + x;
-            const float *np = &fr->normal[3 * p];
-            uint8_t k = KIND_NONE;
-            if (y < fv_grid_col_h(g, x) && (!fr->active || fr->active[p])) {
-                if (fr->sampled && !fr->sampled[p]) {
-                    k = KIND_HOLE;
-                } else if (np[0] != 0.0f || np[1] != 0.0f || np[2] != 0.0f) {
-                    const float *c = &fr->color[3 * p], *a = &fr->albedo[3 * p], *xp = &fr->position[3 * p];
-                    float all = c[0] + c[1] + c[2] + a[0] + a[1] + a[2] + np[0] + np[1] + np[2] + fr->depth[p] + xp[0] +
-                                xp[1] + xp[2];
-                    k = isfinite(all) ? KIND_SURFACE : KIND_HOLE;
-                }
-            }
-            f->kind[p] = k;
-            if (k != KIND_SURFACE) {
-                n_holes += k == KIND_HOLE;
-                f->surf[p] = 0.0f;
-                f->nx[0][p] = f->ny[0][p] = f->nz[0][p] = f->z[0][p] = 0.0f;
-                for (int c = 0; c < NVAL; c++) v[c][p] = 0.0f;
-                f->m1[0][p] = f->m2[0][p] = f->len[0][p] = 0.0f;
-                continue;
-            }
-            n_surface++;
-            const float *c = &fr->color[3 * p], *a = &fr->albedo[3 * p];
-            float il[3], d[3];
-            fv_demod_factors(a, d);
-            for (int ch = 0; ch < 3; ch++) il[ch] = c[ch] / d[ch];
-            f->surf[p] = 1.0f;
-            f->nx[0][p] = np[0], f->ny[0][p] = np[1], f->nz[0][p] = np[2], f->z[0][p] = fr->depth[p];
-            float l = luminance(il[0], il[1], il[2]), m1 = l, m2 = l * l, n_len = 1.0f;
-            float hst[6];
-            if (history && fetch_history(f, &fr->prev_coord[2 * p], np, &fr->position[3 * p], fr->depth[p], fr->id[p], hst)) {
-                n_len = hst[5] + 1.0f < LEN_MAX ? hst[5] + 1.0f : LEN_MAX;
-                /* The new sample's weight: 1 / length (a plain mean) until that falls below alpha. */
-                float inv = 1.0f / n_len, wc = ac > inv ? ac : inv, wm = am > inv ? am : inv;
-                for (int ch = 0; ch < 3; ch++) il[ch] = hst[ch] + wc * (il[ch] - hst[ch]);
-                m1 = hst[3] + wm * (m1 - hst[3]);
-                m2 = hst[4] + wm * (m2 - hst[4]);
-                l = luminance(il[0], il[1], il[2]);
-                n_hist++;
-                len_sum += n_len;
-            }
-            v[V_R][p] = il[0], v[V_G][p] = il[1], v[V_B][p] = il[2], v[V_VAR][p] = 0.0f, v[V_LUM][p] = l;
-            f->m1[0][p] = m1;
-            f->m2[0][p] = m2;
-            f->len[0][p] = n_len;
+            const int r = fv_ksvgf_accumulate_pixel(k, x, y);
+            n_holes += r == FV_KSVGF_HOLE;
+            n_surface += r == FV_KSVGF_SURFACE || r == FV_KSVGF_SURFACE_HIST;
+            if (r != FV_KSVGF_SURFACE_HIST) continue;
+            n_hist++;
+            len_sum += f->len[0][(size_t)y * w + x];
         }
         f->row_surface[y] = n_surface;
         f->row_hist[y] = n_hist;
@@ -367,55 +305,25 @@ static void sweep_accumulate(fv_svgf *f, const fv_svgf_frame *fr, bool history)
 
 /* ---- D. remodulation and the history of the next frame */
 
-static void sweep_finish(fv_svgf *f, const fv_svgf_frame *fr, int cur, bool copy_hist)
+static void sweep_finish(const fv_svgf *f, const fv_ksvgf *k)
 {
     const int w = f->g.w, h = f->g.h;
-    float *const *v = f->val[cur];
     #pragma omp for schedule(static, ROWS_PER_BLOCK)
     for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            size_t p = (size_t)y * w + x;
-            if (f->kind[p] != KIND_SURFACE) continue;
-            const float il[3] = {v[V_R][p], v[V_G][p], v[V_B][p]};
-            float d[3];
-            fv_demod_factors(&fr->albedo[3 * p], d);
-            for (int ch = 0; ch < 3; ch++) fr->color[3 * p + ch] = il[ch] * d[ch];
-            if (copy_hist) memcpy(&f->hist_illum[3 * p], il, sizeof il);
-            memcpy(&f->hist_pos[3 * p], &fr->position[3 * p], 3 * sizeof(float));
-            f->hist_id[p] = fr->id[p];
-        }
+        for (int x = 0; x < w; x++) fv_ksvgf_finish_pixel(k, x, y);
 }
 
 /* ---- E. holes: the B3-weighted mean of the filtered surface pixels at the smallest spacing that
  * reaches any, no edge-stopping (the hole's own features are unknown). */
 
-static void sweep_holes(fv_svgf *f, float *color, int nt)
+static void sweep_holes(const fv_svgf *f, const fv_ksvgf *k, int nt)
 {
-    const fv_grid *g = &f->g;
-    const int w = g->w, h = g->h;
-    const uint8_t *kind = f->kind;
-    const int max_step = f->o.iterations > 1 ? 1 << (f->o.iterations - 1) : 1;
+    const int w = f->g.w, h = f->g.h;
     fv_region_begin();
     #pragma omp parallel for schedule(static, ROWS_PER_BLOCK) num_threads(nt)
     for (int y = 0; y < h; y++) {
         if (!f->row_holes[y]) continue;
-        for (int x = 0; x < w; x++) {
-            size_t p = (size_t)y * w + x;
-            if (kind[p] != KIND_HOLE) continue;
-            float s[3] = {0, 0, 0}, ws = 0.0f;
-            for (int step = 1; step <= max_step && ws == 0.0f; step *= 2)
-                for (int j = 0; j < 5; j++)
-                    for (int i = 0; i < 5; i++) {
-                        long q = fv_grid_tap(g, x, y, (i - 2) * step, (j - 2) * step);
-                        if (q < 0 || kind[q] != KIND_SURFACE) continue;
-                        float k = k_b3[i] * k_b3[j];
-                        s[0] += k * color[3 * q];
-                        s[1] += k * color[3 * q + 1];
-                        s[2] += k * color[3 * q + 2];
-                        ws += k;
-                    }
-            for (int ch = 0; ch < 3; ch++) color[3 * p + ch] = ws > 0.0f ? s[ch] / ws : 0.0f;
-        }
+        for (int x = 0; x < w; x++) fv_ksvgf_hole_pixel(k, x, y);
     }
     fv_region_end();
 }
@@ -429,9 +337,8 @@ static void swap_buffers(float *b[2])
     b[1] = t;
 }
 
-fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_svgf_info *info, fv_error *err)
+fv_status fv_svgf_frame_validate(const fv_svgf_frame *fr, fv_error *err)
 {
-    if (!f) return fv_error_set(err, FV_ERR_INVALID, "SVGF: no filter");
     if (!fr) return fv_error_set(err, FV_ERR_INVALID, "SVGF: no frame buffers");
     const struct {
         const char *name;
@@ -440,9 +347,19 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
                  {"depth", fr->depth}, {"position", fr->position}, {"id", fr->id}};
     for (int i = 0; i < 6; i++)
         if (!need[i].p) return fv_error_set(err, FV_ERR_INVALID, "SVGF: no %s buffer", need[i].name);
+    return FV_OK;
+}
+
+fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_svgf_info *info, fv_error *err)
+{
+    if (!f) return fv_error_set(err, FV_ERR_INVALID, "SVGF: no filter");
+    fv_status s = fv_svgf_frame_validate(fr, err);
+    if (s != FV_OK) return s;
     const int nt = fv_thread_count(threads);
     const bool history = f->have_history && fr->prev_coord;
     f->ln_features = false;
+    fv_ksvgf kv;
+    kernel_view(f, fr, history, &kv);
 
     /* The whole filter but the rare hole fill is one parallel region (docs/threads.md): each sweep
      * is an orphaned `omp for` whose implicit barrier orders it before the next, instead of a
@@ -452,7 +369,7 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
     fv_region_begin();
     #pragma omp parallel num_threads(nt)
     {
-        sweep_accumulate(f, fr, history);
+        sweep_accumulate(f, &kv);
         if (f->avx2)
             fv_svgf_variance_avx2(f);
         else
@@ -460,7 +377,7 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
         int cur = 0;
         for (int it = 0; it < f->o.iterations; it++) {
             #pragma omp single
-            f->pass_cut = it < f->periph_passes ? f->g.w : f->periph_x;
+            f->pass_cut = fv_ksvgf_pass_cut(&kv, it);
             if (f->avx2) {
                 fv_svgf_prefilter_avx2(f, f->val[cur][V_VAR]);
                 fv_svgf_atrous_avx2(f, 1 << it, cur, it == 0);
@@ -470,19 +387,13 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
             }
             cur = 1 - cur;
         }
-        sweep_finish(f, fr, cur, f->o.iterations == 0);
+        sweep_finish(f, &kv);
     }
     fv_region_end();
 
-    long n_surface = 0, n_hist = 0, n_holes = 0;
-    double len_sum = 0.0;
-    for (int y = 0; y < f->g.h; y++) {
-        n_surface += f->row_surface[y];
-        n_hist += f->row_hist[y];
-        n_holes += f->row_holes[y];
-        len_sum += f->row_len[y];
-    }
-    if (n_holes) sweep_holes(f, fr->color, nt);
+    fv_svgf_info in;
+    if (fv_ksvgf_sum_rows(f->g.h, f->row_surface, f->row_hist, f->row_holes, f->row_len, &in.history_fraction, &in.mean_history))
+        sweep_holes(f, &kv, nt);
 
     /* This frame's features, moments and lengths become the history (the working values need no
      * swap: sweep A rewrites val[0] whole every frame). */
@@ -494,9 +405,6 @@ fv_status fv_svgf_filter(fv_svgf *f, const fv_svgf_frame *fr, int threads, fv_sv
     swap_buffers(f->m2);
     swap_buffers(f->len);
     f->have_history = true;
-    if (info) {
-        info->history_fraction = n_surface ? (double)n_hist / (double)n_surface : 0.0;
-        info->mean_history = n_hist ? len_sum / (double)n_hist : 0.0;
-    }
+    if (info) *info = in;
     return FV_OK;
 }

@@ -59,6 +59,10 @@ void fv_svgf_opts_default(fv_svgf_opts *o);
  * naming the field otherwise. */
 fv_status fv_svgf_opts_validate(const fv_svgf_opts *o, fv_error *err);
 
+/* A grid SVGF can filter: at least 1x1, every column height in [1, h], at most 2^31 - 1 pixels;
+ * FV_ERR_INVALID naming what is wrong otherwise (fv_svgf_create's check). */
+fv_status fv_svgf_grid_validate(const fv_grid *grid, fv_error *err);
+
 /* The filter and its history for one grid. The grid is copied; its col_h array is not and must
  * outlive the filter. o NULL: the defaults. Bad options, a column height outside [1, h] or more
  * than 2^31 - 1 pixels -> FV_ERR_INVALID; FV_ERR_NOMEM (nothing leaked). Every buffer is allocated
@@ -110,6 +114,9 @@ typedef struct fv_svgf_info {
     double history_fraction;   /* sampled surface pixels that found a consistent history */
     double mean_history;       /* their mean history length, in frames counting this one (0: none) */
 } fv_svgf_info;
+
+/* Every buffer fv_svgf_filter needs is there: FV_ERR_INVALID naming the first missing one. */
+fv_status fv_svgf_frame_validate(const fv_svgf_frame *fr, fv_error *err);
 
 /* Filters fr->color in place. threads 0 = all. FV_ERR_INVALID for missing buffers (nothing
  * changes, the history included). info may be NULL. */

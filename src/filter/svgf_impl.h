@@ -8,16 +8,13 @@
 #include <stdint.h>
 #include <string.h>
 #include "filter/svgf.h"
+#include "kernel/svgf.h"
 
-#define LEN_MAX 256.0f
-#define HIST_MIN_WEIGHT 0.01f
-#define HIST_COS 0.9f           /* normals within ~25 degrees */
-#define HIST_POS_REL 0.05f      /* position tolerance, fraction of the depth */
-#define HIST_DEPTH_MIN 1e-3f
-#define HIST_POS_ULP 1e-5f      /* plus this fraction of the coordinates' size: float rounding */
-#define DEPTH_EPS_REL 1e-4f     /* depth differences this small relative to the depth are free */
-#define LUM_EPS 1e-10f
-#define VAR_TEMPORAL_LEN 4.0f
+/* The constants, the weights' arithmetic and the per-pixel steps that are not sweeps are the
+ * kernels' (kernel/svgf.h): one implementation for the CPU and the devices. */
+#define LEN_MAX FV_KSVGF_LEN_MAX
+#define LUM_EPS FV_KSVGF_LUM_EPS
+#define VAR_TEMPORAL_LEN FV_KSVGF_VAR_TEMPORAL_LEN
 #define CHUNK 64
 #define NTAP 24                 /* taps of the 5x5 kernel besides the centre */
 #define NTAP7 48                /* the same for the 7x7 moments */
@@ -33,8 +30,8 @@
 #define TAP_INLINE static inline
 #endif
 
-enum { KIND_NONE = 0, KIND_SURFACE = 1, KIND_HOLE = 2 };
-enum { V_R, V_G, V_B, V_VAR, V_LUM, NVAL };
+enum { KIND_NONE = FV_KSVGF_NONE, KIND_SURFACE = FV_KSVGF_SURFACE, KIND_HOLE = FV_KSVGF_HOLE };
+enum { V_R = FV_KSVGF_R, V_G = FV_KSVGF_G, V_B = FV_KSVGF_B, V_VAR = FV_KSVGF_VAR, V_LUM = FV_KSVGF_LUM, NVAL = FV_KSVGF_NVAL };
 /* The fovea's lines: the frame's features (normal, depth, depth gradient, 1 on a surface), the
  * pass's inputs (prefiltered variance, values) and its output values. */
 enum { LN_NX, LN_NY, LN_NZ, LN_Z, LN_GRAD, LN_SURF, LN_FEATURES, LN_GVAR = LN_FEATURES, LN_VAL, LN_OUT = LN_VAL + NVAL,
@@ -43,8 +40,8 @@ enum { LN_NX, LN_NY, LN_NZ, LN_Z, LN_GRAD, LN_SURF, LN_FEATURES, LN_GVAR = LN_FE
 #define LINE_GHOST (2 * LINE_STEP_MAX) /* the farthest tap along a line */
 #define LINE_CHUNK (CHUNK - 8)  /* lanes per chunk: a vector may run 7 lanes past the chunk */
 
-static const float k_b3[5] = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
-static const float k_g3[3] = {0.25f, 0.5f, 0.25f};
+static const float k_b3[5] = {FV_KSVGF_B3_0, FV_KSVGF_B3_1, FV_KSVGF_B3_2, FV_KSVGF_B3_1, FV_KSVGF_B3_0};
+static const float k_g3[3] = {FV_KSVGF_G3_0, FV_KSVGF_G3_1, FV_KSVGF_G3_0};
 
 struct fv_svgf {
     fv_grid g;
@@ -86,42 +83,12 @@ struct fv_svgf {
 static inline int imin(int a, int b) { return a < b ? a : b; }
 static inline int imax(int a, int b) { return a > b ? a : b; }
 
-static inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
-
-
-/* The denominator's floor of the depth term: differences below 1e-4 of the depth are rounding. */
-static inline float depth_eps(float z) { return DEPTH_EPS_REL * fabsf(z) + 1e-30f; }
-
-/* e^-x for x >= 0, inline (a call to expf per tap was a quarter of the frame): 2^t with
- * t = -x log2(e) split into an integer i and a fraction whose e^a, a in [-ln2 / 2, ln2 / 2], comes
- * from its Taylor series to the 5th power (truncation error below 2.5e-6, evaluated in Estrin's
- * form: half the dependent operations of Horner's), and 2^i through the exponent bits. Relative
- * error below 4e-6 for x < 10 and 5e-6 up to 87; exactly 1 at 0; exactly 0 from 87 on (where expf
- * is below 2e-38), for +inf and NaN. Branch-free, with the selects on integers (for x >= 0 the
- * bits order like the values), so that loops over taps vectorise. */
-TAP_INLINE float exp_neg(float x)
-{
-    union { float f; int32_t i; } u = {x}, lim = {87.0f}, scale;
-    int32_t in = u.i < lim.i;
-    u.i = in ? u.i : lim.i;
-    float t = -u.f * 1.44269504f;
-    int32_t i = (int32_t)(t - 0.5f); /* t <= 0: truncation rounds t - 0.5 up, i in [-125, 0] */
-    float a = (t - (float)i) * 0.693147181f, a2 = a * a;
-    float p = (1.0f + a) + a2 * ((1.0f / 2 + a * (1.0f / 6)) + a2 * (1.0f / 24 + a * (1.0f / 120)));
-    scale.i = in ? (i + 127) * (1 << 23) : 0;
-    return p * scale.f;
-}
-
-/* max(0, c)^sigma_normal: sq squarings when sigma_normal = 2^sq, else powf. Called with the literal
- * SQ_DEFAULT in the hot loops so that the squarings unroll and the loop vectorises. (c + |c|) / 2
- * is max(c, 0) exactly in a form that vectorises. */
-TAP_INLINE float normal_pow(float c, int sq, float sn)
-{
-    c = 0.5f * (c + fabsf(c));
-    if (sq < 0) return powf(c, sn);
-    for (int k = 0; k < sq; k++) c *= c;
-    return c;
-}
+TAP_INLINE float luminance(float r, float g, float b) { return fv_ksvgf_luminance(r, g, b); }
+TAP_INLINE float depth_eps(float z) { return fv_ksvgf_depth_eps(z); }
+TAP_INLINE float exp_neg(float x) { return fv_ksvgf_exp_neg(x); }
+/* Called with the literal SQ_DEFAULT in the hot loops so that the squarings unroll and the loop
+ * vectorises. */
+TAP_INLINE float normal_pow(float c, int sq, float sn) { return fv_ksvgf_normal_pow(c, sq, sn); }
 
 /* For the pixels [x0, x1) of row y: the run [*a, *b) whose tap (dx, dy) is the pixel x + *off (a
  * plain shift: fv_grid_tap reduces to it there). Pixels outside the run need fv_grid_tap on a polar
@@ -218,14 +185,9 @@ static inline void fallback_taps(const fv_grid *g, const chunk_cols *cc, int ci,
 
 /* ---- B. depth gradient and variance */
 
-/* Along one axis: the smaller one-sided difference to a surface neighbour (see the top of the file). */
 static inline float axis_gradient(const fv_svgf *f, long qm, long qp, float zc)
 {
-    const float *z = f->z[0];
-    float dm = qm >= 0 && f->kind[qm] == KIND_SURFACE ? fabsf(zc - z[qm]) : INFINITY;
-    float dp = qp >= 0 && f->kind[qp] == KIND_SURFACE ? fabsf(z[qp] - zc) : INFINITY;
-    float d = fminf(dm, dp);
-    return isfinite(d) ? d : 0.0f;
+    return fv_ksvgf_axis_gradient(f->kind, f->z[0], qm, qp, zc);
 }
 
 /* The two builds of svgf_sweeps.h: B. depth gradient and variance; C. the variance prefilter and
