@@ -10,6 +10,7 @@
 #include <stdint.h>
 #include "fovea/camera.h"
 #include "fovea/film.h"
+#include "filter/svgf.h"
 #include "fovea/status.h"
 #include "kernel/path.h"
 #include "kernel/vp_blur.h"
@@ -79,13 +80,19 @@ void fv_cuda_vp_destroy(fv_cuda_vp *c);
 /* One frame of one eye, every pointer host memory (the GPU's copies are the backend's). */
 typedef struct fv_cuda_vp_frame {
     const struct fv_kscene *scene; /* at the frame's time: what moved is copied */
-    /* 1. the trace: its space, view, camera, paths and launch (col_h: gw heights or NULL; onscreen:
-     *    gw * gh flags or NULL; the g buffers are ignored) */
+    const uint8_t *onscreen;       /* a polar grid's cells any pixel sees (gw * gh flags), NULL: none;
+                                      the trace's and the reprojection's onscreen are this or NULL */
+    /* 1. the trace: its space, view, camera, paths and launch (col_h: gw heights or NULL; the g
+     *    buffers are ignored) */
     fv_kvp_trace_frame trace;
-    /* 2. the denoiser's history coordinates (history 1: the previous frame of this sequence was
-     *    rendered by this backend and its camera and view are in reproject, whose onscreen is gw * gh
-     *    flags or NULL; its radial table is the one the previous frame mapped with, kept on the GPU:
-     *    prev_lut is ignored) */
+    /* 2. the denoiser (denoise 1: SVGF, kernel/svgf.h, with these options; its buffers and history
+     *    live on the GPU, created with the grid). history 1: the previous frame of this sequence
+     *    was rendered by this backend and its camera and view are in reproject; its radial table is
+     *    the one the previous frame mapped with, kept on the GPU (prev_lut is ignored). The
+     *    denoiser's active cells are onscreen; sampled holes only with kill (linear fall-off). */
+    int denoise;
+    fv_svgf_opts svgf;
+    int periph_x, periph_passes;   /* fv_svgf_set_periphery's (w, iterations: every pass everywhere) */
     int history;
     fv_kvp_reproject_frame reproject;
     /* 3. the φ-mipmaps (mips 0: none, a Cartesian grid the screen's size): the chain's shape (rows,
@@ -105,6 +112,7 @@ typedef struct fv_cuda_vp_frame {
 
 typedef struct fv_cuda_vp_result {
     uint64_t rays, paths, nan_paths;
+    double history_fraction;   /* the denoiser's (fv_svgf_info) */
     double kernel_ms;          /* the frame's launches, first to last (events) */
     double stage_ms[5];        /* trace, denoise, mip, map, blur (events) */
     int syncs;                 /* host waits in the frame: 1 (the end) */

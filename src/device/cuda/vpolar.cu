@@ -3,13 +3,15 @@
  * (technique/vpolar/device.c), a thread a cell or a pixel:
  *
  *   trace (fv_kvp_trace_sample, pt's path kernel on the flat scene of device/cuda/scene.h)
- *   -> the denoiser's history coordinates (fv_kvp_reproject_sample) -> [SVGF: not yet on the GPU]
+ *   -> the denoiser: the history's coordinates (fv_kvp_reproject_sample), then SVGF's steps
+ *      (kernel/svgf.h: accumulate, the rows' counters, variance, per pass prefilter and À-Trous,
+ *      finish, holes), a launch each in the header's order
  *   -> φ-mipmaps (level 0 a copy, then fv_kphi_halve_cell a level per launch, each reading the one
  *      before) -> map (fv_kvp_map_pixel: colour, first-hit buffers, the blur's sigma)
  *   -> foveated blur (fv_kblur_h_pixel into a scratch image, fv_kblur_v_pixel back into the film).
  *
- * Memory: the grid's buffers, the history's coordinates, the mipmap levels, the blur's sigma and
- * scratch image and the film keep their GPU buffers between frames, reallocated only when a size
+ * Memory: the grid's buffers, the history's coordinates, SVGF's buffers and history, the mipmap
+ * levels, the blur's sigma and scratch image and the film keep their GPU buffers between frames, reallocated only when a size
  * changes. What the host builds per screen size or per gaze (column heights, the on-screen mask,
  * the mipmaps' shape, the radial table, the blur's kernels) goes through fv_cuda_mirror, copied only
  * when its bytes changed; the scene only when its time moved. The radial table is copied after the
@@ -17,7 +19,9 @@
  * reprojection needs (the previous view's), so one buffer serves both in stream order.
  *
  * The host waits once a frame, at the end, for the film's buffers that are set and the counters
- * (res->syncs = 1). Stage times come from events between the stages.
+ * (the trace's, and SVGF's per row: res->syncs = 1). SVGF's step 6 (the holes) is launched every
+ * frame rather than only when the rows count a hole, which would need a wait; on a frame without
+ * holes it changes nothing (kernel/svgf.h). Stage times come from events between the stages.
  *
  * Indices: every kernel bounds its thread to its grid (x < w, y < h; a cell beyond its column's
  * height is not traced; a mip cell beyond its column's rows is left by fv_kphi_halve_cell), the
@@ -33,6 +37,7 @@
 #include "device/cuda/common.h"
 #include "device/cuda/scene.h"
 #include "device/cuda_backend.h"
+#include "kernel/svgf.h"
 #include "kernel/vp_blur.h"
 #include "kernel/vp_map.h"
 #include "kernel/vp_reproject.h"
@@ -43,6 +48,17 @@
 #define FV_CUDA_VP_THREADS 256 /* one-dimensional launches */
 
 enum { ST_TRACE = 0, ST_DENOISE, ST_MIP, ST_MAP, ST_BLUR, ST_COUNT };
+
+/* SVGF on the GPU for one grid: kernel/svgf.h's state with device pointers (the frame's inputs are
+ * set per frame), and the host's copies of the rows' counters. */
+typedef struct dev_svgf {
+    fv_ksvgf k;
+    int w, h;                     /* the grid the buffers are for, 0: none */
+    bool have_history;            /* a frame was filtered since the buffers were made */
+    float *feat[2][7];            /* nx, ny, nz, z, m1, m2, len: current and previous (swapped) */
+    long *row_surface, *row_hist, *row_holes; /* host, h each */
+    double *row_len;
+} dev_svgf;
 
 struct fv_cuda_vp {
     fv_cuda_scene scene;
@@ -64,6 +80,7 @@ struct fv_cuda_vp {
     size_t shape_cap;             /* floats */
     fv_cuda_mirror col_h, onscreen, shape, lut, blur_off, blur_k;
     unsigned long long *counts;   /* rays, paths, non-finite paths */
+    dev_svgf svgf;
 };
 
 static unsigned blocks_of(size_t n)
@@ -149,6 +166,30 @@ __global__ void fv_cuda_vp_blur_v(fv_kblur_table t, const float *sigma, const fl
     if (x < t.w && y < t.h && !fv_cuda_vp_blur_outside(&t, sigma, out, x, y)) fv_kblur_v_pixel(&t, sigma, tmp, out, x, y);
 }
 
+/* ---- SVGF (kernel/svgf.h), a launch per step ---- */
+
+enum { SV_ACCUMULATE, SV_VARIANCE, SV_PREFILTER, SV_ATROUS, SV_FINISH, SV_HOLES };
+
+__global__ void fv_cuda_vp_svgf_step(fv_ksvgf k, int step, int pass)
+{
+    const int x = (int)(blockIdx.x * blockDim.x + threadIdx.x), y = (int)(blockIdx.y * blockDim.y + threadIdx.y);
+    if (x >= k.g.w || y >= k.g.h) return;
+    switch (step) {
+    case SV_ACCUMULATE: fv_ksvgf_accumulate_pixel(&k, x, y); break;
+    case SV_VARIANCE: fv_ksvgf_variance_pixel(&k, x, y); break;
+    case SV_PREFILTER: fv_ksvgf_prefilter_pixel(&k, pass, x, y); break;
+    case SV_ATROUS: fv_ksvgf_atrous_pixel(&k, pass, x, y); break;
+    case SV_FINISH: fv_ksvgf_finish_pixel(&k, x, y); break;
+    default: fv_ksvgf_hole_pixel(&k, x, y); break;
+    }
+}
+
+__global__ void fv_cuda_vp_svgf_rows(fv_ksvgf k)
+{
+    const int y = (int)(blockIdx.x * blockDim.x + threadIdx.x);
+    if (y < k.g.h) fv_ksvgf_count_row(&k, y);
+}
+
 /* ---- buffers ---- */
 
 static void grid_free(fv_cuda_vp *c)
@@ -194,6 +235,130 @@ static fv_status grid_ensure(fv_cuda_vp *c, int gw, int gh, fv_error *err)
     fv_cuda_vp_fill<<<blocks_of(n), FV_CUDA_VP_THREADS, 0, st>>>(g->depth, n, INFINITY);
     c->gw = gw, c->gh = gh;
     return FV_OK;
+}
+
+/* Every device buffer of the SVGF state with its size for a w x h grid (n pixels), for allocation
+ * and release in one place. */
+#define SVGF_MAX_BUFFERS 48
+static int svgf_buffers(dev_svgf *d, size_t n, size_t h, void ***ptr, size_t *bytes)
+{
+    int m = 0;
+    fv_ksvgf *k = &d->k;
+#define BUF(p, b) (ptr[m] = (void **)&(p), bytes[m] = (b), m++)
+    BUF(k->surf, n * sizeof(float));
+    BUF(k->gvar, n * sizeof(float));
+    BUF(k->grad, n * sizeof(float));
+    BUF(k->hist_illum, 3 * n * sizeof(float));
+    BUF(k->hist_pos, 3 * n * sizeof(float));
+    for (int i = 0; i < 2; i++) {
+        for (int c = 0; c < 7; c++) BUF(d->feat[i][c], n * sizeof(float));
+        for (int c = 0; c < FV_KSVGF_NVAL; c++) BUF(k->val[i][c], n * sizeof(float));
+    }
+    BUF(k->kind, n);
+    BUF(k->found, n);
+    BUF(k->hist_id, n * sizeof(uint32_t));
+    BUF(k->row_surface, h * sizeof(long));
+    BUF(k->row_hist, h * sizeof(long));
+    BUF(k->row_holes, h * sizeof(long));
+    BUF(k->row_len, h * sizeof(double));
+#undef BUF
+    return m;
+}
+
+static void svgf_free(dev_svgf *d)
+{
+    void **ptr[SVGF_MAX_BUFFERS];
+    size_t bytes[SVGF_MAX_BUFFERS];
+    const int m = svgf_buffers(d, 0, 0, ptr, bytes);
+    for (int i = 0; i < m; i++) cudaFree(*ptr[i]);
+    free(d->row_surface), free(d->row_hist), free(d->row_holes), free(d->row_len);
+    memset(d, 0, sizeof *d);
+}
+
+/* SVGF's buffers for a gw x gh grid, all zeroed (kernel/svgf.h: pixels that are never surfaces keep
+ * zero features and weigh 0 as taps) and without history when new. */
+static fv_status svgf_ensure(fv_cuda_vp *c, int gw, int gh, fv_error *err)
+{
+    dev_svgf *d = &c->svgf;
+    if (d->w == gw && d->h == gh && d->k.surf) return FV_OK;
+    svgf_free(d);
+    const size_t n = (size_t)gw * (size_t)gh, h = (size_t)gh;
+    void **ptr[SVGF_MAX_BUFFERS];
+    size_t bytes[SVGF_MAX_BUFFERS];
+    const int m = svgf_buffers(d, n, h, ptr, bytes);
+    cudaError_t e = cudaSuccess;
+    for (int i = 0; i < m && e == cudaSuccess; i++)
+        if ((e = cudaMalloc(ptr[i], bytes[i])) == cudaSuccess) e = cudaMemsetAsync(*ptr[i], 0, bytes[i], c->stream);
+    if (e != cudaSuccess) {
+        svgf_free(d);
+        return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for SVGF on a %dx%d grid", gw, gh)
+                                              : fv_cuda_fail(e, "allocating SVGF's buffers", err);
+    }
+    if (!(d->row_surface = (long *)calloc(h, sizeof(long))) || !(d->row_hist = (long *)calloc(h, sizeof(long))) ||
+        !(d->row_holes = (long *)calloc(h, sizeof(long))) || !(d->row_len = (double *)calloc(h, sizeof(double)))) {
+        svgf_free(d);
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+    }
+    fv_ksvgf *k = &d->k;
+    float **cur[7] = {&k->nx, &k->ny, &k->nz, &k->z, &k->m1, &k->m2, &k->len};
+    const float **prev[7] = {&k->pnx, &k->pny, &k->pnz, (const float **)&k->pz, &k->pm1, &k->pm2, &k->plen};
+    for (int i = 0; i < 7; i++) *cur[i] = d->feat[0][i], *prev[i] = d->feat[1][i];
+    d->w = gw, d->h = gh;
+    d->have_history = false;
+    return FV_OK;
+}
+
+/* The denoiser's launches for the frame (after the reprojection): kernel/svgf.h's sequence over the
+ * grid in place. The rows' counters are read with the film at the end (a copy to the host's
+ * pageable memory returns only when done: here it would be a wait between the stages). */
+static void svgf_launch(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const int *dcol_h, const uint8_t *dmask)
+{
+    dev_svgf *d = &c->svgf;
+    fv_ksvgf *k = &d->k;
+    cudaStream_t st = c->stream;
+    k->g.w = c->gw, k->g.h = c->gh, k->g.col_h = dcol_h;
+    k->g.wrap = f->trace.space.kind != FV_KVP_CARTESIAN; /* the polar spaces' grids wrap (space.c) */
+    k->alpha_color = f->svgf.alpha_color, k->alpha_moments = f->svgf.alpha_moments;
+    k->sigma_depth = f->svgf.sigma_depth, k->sigma_normal = f->svgf.sigma_normal, k->sigma_lum = f->svgf.sigma_lum;
+    k->iterations = f->svgf.iterations;
+    k->sq = fv_ksvgf_squarings(f->svgf.sigma_normal);
+    /* as fv_svgf_kernels_set_periphery */
+    k->periph_x = f->periph_x < 0 ? 0 : (f->periph_x > c->gw ? c->gw : f->periph_x);
+    k->periph_passes = f->periph_passes < 0 ? 0 : f->periph_passes;
+    /* the frame's inputs: the grid's buffers (SVGF demodulates by the reflectance) */
+    k->color = c->g.color, k->albedo = c->g.reflectance, k->normal = c->g.normal, k->depth = c->g.depth;
+    k->position = c->g.position, k->id = c->g.id;
+    k->prev_coord = f->history ? c->prev_coord : NULL;
+    k->sampled = f->trace.kill ? c->g.sampled : NULL;
+    k->active = dmask;
+    k->history = d->have_history && f->history;
+    const dim3 tiles = tiles_of(c->gw, c->gh), block(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK);
+    fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_ACCUMULATE, 0);
+    fv_cuda_vp_svgf_rows<<<blocks_of((size_t)c->gh), FV_CUDA_VP_THREADS, 0, st>>>(*k);
+    fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_VARIANCE, 0);
+    for (int pass = 0; pass < k->iterations; pass++) {
+        fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_PREFILTER, pass);
+        fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_ATROUS, pass);
+    }
+    fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_FINISH, 0);
+    fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_HOLES, 0);
+    /* this frame's features become the next frame's history (pointers only: the launches above
+     * already hold their copies of the struct) */
+    fv_ksvgf_swap(k);
+    d->have_history = true;
+}
+
+/* Queues the copies of the rows' counters to the host (the frame's end). */
+static cudaError_t svgf_read_rows(dev_svgf *d, cudaStream_t st)
+{
+    const size_t h = (size_t)d->h;
+    const fv_ksvgf *k = &d->k;
+    cudaError_t e;
+    if ((e = cudaMemcpyAsync(d->row_surface, k->row_surface, h * sizeof(long), cudaMemcpyDeviceToHost, st)) != cudaSuccess ||
+        (e = cudaMemcpyAsync(d->row_hist, k->row_hist, h * sizeof(long), cudaMemcpyDeviceToHost, st)) != cudaSuccess ||
+        (e = cudaMemcpyAsync(d->row_holes, k->row_holes, h * sizeof(long), cudaMemcpyDeviceToHost, st)) != cudaSuccess)
+        return e;
+    return cudaMemcpyAsync(d->row_len, k->row_len, h * sizeof(double), cudaMemcpyDeviceToHost, st);
 }
 
 static void screen_free(fv_cuda_vp *c)
@@ -293,6 +458,7 @@ extern "C" void fv_cuda_vp_destroy(fv_cuda_vp *c)
     grid_free(c);
     screen_free(c);
     mips_free(c);
+    svgf_free(&c->svgf);
     free(c->shape_host);
     fv_cuda_film_free(&c->film);
     fv_cuda_mirror_free(&c->col_h);
@@ -344,8 +510,10 @@ static fv_status check_frame(const fv_cuda_vp_frame *f, fv_error *err)
     else if (!f->map.identity && !f->mips) bad = "a map without φ-mipmaps";
     else if (f->history && (f->reproject.space.gw != sp->gw || f->reproject.space.gh != sp->gh || f->reproject.nlut != f->map.nlut))
         bad = "the reprojection's space or table is not the frame's";
-    else if (f->history && f->trace.onscreen && f->reproject.onscreen && f->trace.onscreen != f->reproject.onscreen)
-        bad = "two on-screen masks";
+    else if ((f->trace.onscreen && f->trace.onscreen != f->onscreen) || (f->history && f->reproject.onscreen && f->reproject.onscreen != f->onscreen))
+        bad = "a second on-screen mask";
+    else if (f->history && !f->denoise) bad = "a history without the denoiser";
+    else if (f->denoise && (f->svgf.iterations < 0 || f->svgf.iterations > 10)) bad = "SVGF's iterations outside 0..10";
     else if (f->blur && (!f->map.sigma || f->blur_table.w != sp->sw || f->blur_table.h != sp->sh || f->blur_table.nq < 1 ||
                          !f->blur_table.off || !f->blur_table.k || f->blur_nk < 1))
         bad = "a blur without its table or sigma";
@@ -366,14 +534,14 @@ extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f,
     /* What the frame needs on the GPU: buffers (kept), the scene at the frame's time, the host's
      * tables where they changed. */
     fv_film_views dv;
-    const uint8_t *mask = f->trace.onscreen ? f->trace.onscreen : (f->history ? f->reproject.onscreen : NULL);
+    const uint8_t *mask = f->onscreen;
     fv_kphi_mips dm;
     memset(&dm, 0, sizeof dm);
     if ((s = grid_ensure(c, gw, gh, err)) != FV_OK || (s = screen_ensure(c, sw, sh, err)) != FV_OK ||
         (s = fv_cuda_film_prepare(&c->film, out, ns, &dv, err)) != FV_OK || (s = fv_cuda_scene_update(&c->scene, f->scene, st, err)) != FV_OK ||
         (f->trace.col_h && (s = fv_cuda_mirror_fill(&c->col_h, f->trace.col_h, (size_t)gw * sizeof(int), st, "the column heights", err)) != FV_OK) ||
         (mask && (s = fv_cuda_mirror_fill(&c->onscreen, mask, n, st, "the on-screen mask", err)) != FV_OK) ||
-        (f->mips && (s = mips_ensure(c, f, &dm, err)) != FV_OK) ||
+        (f->mips && (s = mips_ensure(c, f, &dm, err)) != FV_OK) || (f->denoise && (s = svgf_ensure(c, gw, gh, err)) != FV_OK) ||
         (f->blur && ((s = fv_cuda_mirror_fill(&c->blur_off, f->blur_table.off, (size_t)f->blur_table.nq * sizeof(int), st, "the blur's kernels", err)) != FV_OK ||
                      (s = fv_cuda_mirror_fill(&c->blur_k, f->blur_table.k, f->blur_nk * sizeof(float), st, "the blur's kernels", err)) != FV_OK)))
         return s;
@@ -388,10 +556,9 @@ extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f,
     tf.onscreen = f->trace.onscreen ? dmask : NULL;
     fv_cuda_vp_trace<<<tiles_of(gw, gh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), 0, st>>>(c->scene.dev, tf, c->g, c->counts);
 
-    /* 2. the denoiser: the history's coordinates, then SVGF's launches (not yet kernels: the
-     *    technique refuses denoise=true on this device until they are) */
+    /* 2. the denoiser: the history's coordinates, then SVGF's launches */
     cudaEventRecord(c->ev[ST_DENOISE], st);
-    if (f->history) {
+    if (f->denoise && f->history) {
         fv_kvp_reproject_frame rf = f->reproject;
         rf.g = c->g;
         rf.onscreen = f->reproject.onscreen ? dmask : NULL;
@@ -400,6 +567,7 @@ extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f,
             return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: a history without the previous frame's radial table");
         fv_cuda_vp_reproject<<<blocks_of(n), FV_CUDA_VP_THREADS, 0, st>>>(rf, c->prev_coord);
     }
+    if (f->denoise) svgf_launch(c, f, dcol_h, dmask);
 
     /* 3. φ-mipmaps: level 0 the grid's colour, then each level from the one before */
     cudaEventRecord(c->ev[ST_MIP], st);
@@ -437,10 +605,16 @@ extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f,
     unsigned long long counts[3] = {0, 0, 0};
     e = fv_cuda_film_read_async(&c->film, out, ns, st);
     if (e == cudaSuccess) e = cudaMemcpyAsync(counts, c->counts, sizeof counts, cudaMemcpyDeviceToHost, st);
+    if (e == cudaSuccess && f->denoise) e = svgf_read_rows(&c->svgf, st);
     if (e == cudaSuccess) e = cudaStreamSynchronize(st);
     res->syncs = 1;
     if (e != cudaSuccess) return fv_cuda_fail(e, "running the Visual-Polar kernels", err);
     res->rays = counts[0], res->paths = counts[1], res->nan_paths = counts[2];
+    if (f->denoise) {
+        const dev_svgf *d = &c->svgf;
+        double mean_history;
+        fv_ksvgf_sum_rows(d->h, d->row_surface, d->row_hist, d->row_holes, d->row_len, &res->history_fraction, &mean_history);
+    }
     for (int i = 0; i < ST_COUNT; i++) {
         float ms = 0.0f;
         cudaEventElapsedTime(&ms, c->ev[i], c->ev[i + 1]);

@@ -313,6 +313,19 @@ static void map_frame(const fv_vp_pipeline *p, const fv_space_view *view, bool i
     mf->sigma = p->o.blur ? p->sigma : NULL;
 }
 
+/* SVGF's periphery (fv_svgf_set_periphery): with the blur and fewer passes there, the columns
+ * wholly beyond periphery_deg (by default where the blur reaches its full sigma). False: every pass
+ * everywhere (*x_from and *passes untouched). */
+static bool periphery(const fv_vp_pipeline *p, const fv_space_view *view, int *x_from, int *passes)
+{
+    if (!(p->o.blur && p->o.periphery_passes < p->o.svgf.iterations && fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN)) return false;
+    float X, V;
+    fv_space_from_screen(view, view->gx + (float)blur_profile_radius(p, view, p->o.periphery_deg), view->gy, &X, &V, NULL);
+    *x_from = (int)ceilf(X);
+    *passes = p->o.periphery_passes;
+    return true;
+}
+
 /* The trace stage's job for this frame (its progress and counters are the caller's). */
 static void trace_job(const fv_vp_pipeline *p, const fv_frame *frame, const fv_camera_basis *basis, const fv_space_view *view,
                       fv_vp_trace_job *job)
@@ -357,14 +370,21 @@ static void reproject_frame(const fv_vp_pipeline *p, fv_kvp_reproject_frame *rf)
 static fv_status render_whole(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, const fv_vp_trace_job *job,
                               const fv_space_view *view, fv_kit_progress *prog, fv_error *err)
 {
-    if (p->o.denoise) /* vpolar.c refuses it before anything loads; this keeps the pipeline honest */
-        return fv_error_set(err, FV_ERR_INVALID, "SVGF does not run on device cuda yet");
     const fv_grid *g = fv_space_grid(p->space);
     const bool polar = fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN;
     fv_cuda_vp_frame f;
     memset(&f, 0, sizeof f);
+    f.onscreen = p->onscreen;
     fv_vp_trace_kframe(job, &f.trace);
-    /* (the denoiser's history, f.history and f.reproject, goes here with SVGF's kernels) */
+    if (p->o.denoise) {
+        f.denoise = 1;
+        f.svgf = p->o.svgf;
+        f.periph_x = g->w, f.periph_passes = p->o.svgf.iterations;
+        periphery(p, view, &f.periph_x, &f.periph_passes);
+        /* The previous frame mapped with its view's radial table, which the device keeps. */
+        f.history = p->have_prev && frame->prev_camera != NULL;
+        if (f.history) reproject_frame(p, &f.reproject);
+    }
     const bool identity = !polar && g->w == p->sw && g->h == p->sh;
     f.mips = !identity;
     if (f.mips) {
@@ -414,6 +434,7 @@ static fv_status render_whole(fv_vp_pipeline *p, const fv_frame *frame, fv_film 
     fv_stats_add_count(stats, "sample_share", (double)r.paths / ((double)p->sw * p->sh));
     fv_stats_add_count(stats, "mrays_per_s", r.stage_ms[0] > 0.0 ? (double)r.rays / r.stage_ms[0] / 1000.0 : 0.0);
     fv_stats_add_count(stats, "nan_samples", (double)r.nan_paths);
+    if (p->o.denoise) fv_stats_add_count(stats, "history_fraction", r.history_fraction);
     p->prev_cam = job->cam;
     p->prev_view = *view;
     p->have_prev = true;
@@ -494,13 +515,8 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
         }
         fv_svgf_frame fr = {p->g.color, p->g.reflectance, p->g.normal, p->g.depth, p->g.position, p->g.id,
                             hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
-        if (p->o.blur && p->o.periphery_passes < p->o.svgf.iterations && fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
-            /* The columns wholly beyond periphery_deg (by default where the blur reaches its full
-             * sigma). */
-            float X, V;
-            fv_space_from_screen(&view, view.gx + (float)blur_profile_radius(p, &view, p->o.periphery_deg), view.gy, &X, &V, NULL);
-            fv_svgf_set_periphery(p->svgf, (int)ceilf(X), p->o.periphery_passes);
-        }
+        int x_from, passes;
+        if (periphery(p, &view, &x_from, &passes)) fv_svgf_set_periphery(p->svgf, x_from, passes);
         fv_svgf_info info;
         if ((s = fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err)) != FV_OK) return s;
         fv_stats_add_count(stats, "history_fraction", info.history_fraction);

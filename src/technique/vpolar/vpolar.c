@@ -159,9 +159,7 @@ static fv_status create_kind(vp_kind kind, const char *name, const fv_scene *sce
     if (s == FV_OK && device == FV_DEVICE_CUDA && st->show != SHOW_SCREEN)
         s = fv_error_set(err, FV_ERR_INVALID, "parameter show=%s: device cuda renders the image only (devices cpu and portable draw diagnostics)",
                          k_show[st->show]);
-    if (s == FV_OK && device == FV_DEVICE_CUDA && st->o.denoise)
-        s = fv_error_set(err, FV_ERR_INVALID,
-                         "parameter denoise=true: SVGF does not run on device cuda yet (denoise=false, or device cpu or portable)");
+
     for (int e = 0; s == FV_OK && e < 2; e++) s = fv_vp_pipeline_create(scene, &st->o, &st->eye[e], err);
     if (s != FV_OK) {
         fv_vp_pipeline_destroy(st->eye[0]);
