@@ -10,6 +10,9 @@
  *     between two buffers; the first pass also writes the history;
  *  D. remodulate and store this frame's G-buffer as the next frame's history;
  *  E. fill the pixels that had no path (only when there are some).
+ * A, D and E are the kernels' per-pixel steps (kernel/svgf.h: one implementation for the CPU and
+ * the devices), as are the counters' sums and the arithmetic of B and C's weights; B and C are the
+ * vectorised sweeps below, which add each pixel's taps in the kernels' order.
  *
  * Speed: rows are processed in chunks of CHUNK pixels with the taps in the outer loop. For most
  * pixels a tap is a plain shift in memory (screen grids; in polar grids, between full-height

@@ -1,6 +1,7 @@
-/* The Visual-Polar family on the portable backend (technique/vpolar/device.h: the trace, the
- * φ-mipmaps and the map to the screen as kernels, kernel/vp_trace.h and kernel/vp_map.h, a cell or
- * pixel at a time on the CPU's threads; the denoiser and the blur the pipeline's own) against the
+/* The Visual-Polar family on the portable backend (technique/vpolar/device.h: every stage as
+ * kernels, a cell or pixel at a time on the CPU's threads: the trace, kernel/vp_trace.h; the
+ * denoiser's reprojection and its steps, kernel/vp_reproject.h and kernel/svgf.h; the φ-mipmaps;
+ * the map to the screen, kernel/vp_map.h; the blur, kernel/vp_blur.h) against the
  * CPU pipeline (Embree packets, vectorised rows), for each of the five methods over four frames of
  * a sequence whose gaze moves and then stays, so the denoiser's history is reprojected from one
  * gaze's space into another's and then accumulated, and the CPU's kept map coordinates are stored
@@ -8,7 +9,8 @@
  *
  * Everything after the trace is the same arithmetic on both backends (the map kernels are the
  * CPU's own per-pixel steps, the mipmap cells its build, test_phi_mips compares the lookups bit for
- * bit; the denoiser and the blur are the same code), and the trace places every sample and draws
+ * bit; the denoiser's kernels give the CPU filter's bits, test_kernel_svgf; the blur's likewise,
+ * test_blur), and the trace places every sample and draws
  * every random number the same way. What differs is the traversal: Embree's triangle test rounds
  * differently from the flat BVH's (test_traverse), so where a shading normal has a zero component
  * (the Cornell box's axis-aligned walls) an ulp can flip the tangent frame and send a path
@@ -17,6 +19,8 @@
  * same paths, 61%). The denoiser then spreads such a path over its taps. So the bounds are pt's
  * kind, over the four frames:
  *  - every first hit equal (object id, and depth to 1e-4 relative) and the same samples launched;
+ *  - the denoiser's history_fraction within 0.01 (measured: equal in every frame; only a position
+ *    or normal an ulp apart at a consistency threshold could move a pixel);
  *  - the image's mean within 2% (measured: at most 0.7%, log-polar);
  *  - the RMS colour difference below a quarter of the RMS difference between two CPU renders on
  *    different seeds, the noise of the estimate (measured: 1% to 12% of it, cartesian-full the
@@ -112,9 +116,12 @@ static void compare_method(const char *scene, const char *method, const char *pa
         }
         const double same = rms(ca, cb, n), noise = rms(ca, fv_film_color_const(c), n);
         rms_same += same, rms_noise += noise;
+        const double hc = fv_stats_get_count(&sc, "history_fraction"), hp = fv_stats_get_count(&sp, "history_fraction");
         printf("%s %s %dx%d frame %d: %zu/%zu pixels equal bit for bit, rms difference %.4g (another seed: %.4g), ids equal %zu, "
-               "depths equal %zu, samples %g / %g\n",
-               method, params, w, h, i, exact, n, same, noise, ids, depths, fv_stats_get_count(&sc, "samples"), fv_stats_get_count(&sp, "samples"));
+               "depths equal %zu, samples %g / %g, history %.6f / %.6f\n",
+               method, params, w, h, i, exact, n, same, noise, ids, depths, fv_stats_get_count(&sc, "samples"), fv_stats_get_count(&sp, "samples"),
+               hc, hp);
+        if (fabs(hc - hp) > 0.01) fail_msg("%s frame %d: history_fraction cpu %g, portable %g", method, i, hc, hp);
         if (ids != n || depths != n) fail_msg("%s frame %d: first hits differ (ids %zu, depths %zu of %zu)", method, i, ids, depths, n);
         /* the same samples were launched: the skip and the kill are the same arithmetic */
         if (fv_stats_get_count(&sc, "samples") != fv_stats_get_count(&sp, "samples"))

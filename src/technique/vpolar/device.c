@@ -1,11 +1,13 @@
 /* fovea — the Visual-Polar family's stages on the portable backend (device.h): the kernels of
- * kernel/vp_trace.h and kernel/vp_map.h, a cell or pixel at a time over tiles on the CPU's
- * threads; on cuda the flat scene handed to device/cuda/vpolar.cu, which runs whole frames. */
+ * kernel/vp_trace.h, vp_reproject.h, svgf.h (through filter/svgf_kernels.c), phi_mips, vp_map.h and
+ * vp_blur.h, a cell or pixel at a time over tiles on the CPU's threads; on cuda the flat scene
+ * handed to device/cuda/vpolar.cu, which runs whole frames (its SVGF buffers its own). */
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "filter/blur.h"
+#include "filter/svgf_kernels.h"
 #include "kernel/vp_blur.h"
 #include "kernel/vp_reproject.h"
 #include "scene/export.h"
@@ -17,6 +19,7 @@ struct fv_vp_device {
     fv_cuda_vp *cuda;      /* cuda: the GPU's frames (device/cuda_backend.h) */
     float *blur_tmp;       /* the horizontal pass's image, kept between frames */
     size_t blur_pixels;
+    fv_svgf_kernels *svgf; /* the denoiser's buffers and history (NULL: no stage set up) */
 };
 
 fv_status fv_vp_device_create(const fv_scene *scene, fv_device device, fv_vp_device **out, fv_error *err)
@@ -42,6 +45,7 @@ void fv_vp_device_destroy(fv_vp_device *d)
     if (!d) return;
     fv_cuda_vp_destroy(d->cuda);
     fv_scene_export_destroy(d->flat);
+    fv_svgf_kernels_destroy(d->svgf);
     free(d->blur_tmp);
     free(d);
 }
@@ -201,6 +205,30 @@ void fv_vp_device_reproject(fv_vp_device *d, const fv_kvp_reproject_frame *f, fl
     (void)d;
     reproject_job j = {f, prev_coord};
     fv_parallel_for((int64_t)f->space.gw * f->space.gh, 4096, threads, reproject_range, &j);
+}
+
+fv_status fv_vp_device_svgf_setup(fv_vp_device *d, const fv_grid *g, const fv_svgf_opts *o, fv_error *err)
+{
+    fv_vp_device_svgf_release(d);
+    if (d->cuda) return FV_OK; /* the GPU keeps SVGF's buffers itself (device/cuda/vpolar.cu) */
+    return fv_svgf_kernels_create(g, o, &d->svgf, err);
+}
+
+void fv_vp_device_svgf_release(fv_vp_device *d)
+{
+    fv_svgf_kernels_destroy(d->svgf);
+    d->svgf = NULL;
+}
+
+void fv_vp_device_svgf_periphery(fv_vp_device *d, int x_from, int passes)
+{
+    if (d->svgf) fv_svgf_kernels_set_periphery(d->svgf, x_from, passes);
+}
+
+fv_status fv_vp_device_svgf(fv_vp_device *d, const fv_svgf_frame *fr, int threads, fv_svgf_info *info, fv_error *err)
+{
+    if (!d->svgf) return fv_error_set(err, FV_ERR_INVALID, "the device's denoiser was not set up");
+    return fv_svgf_kernels_filter(d->svgf, fr, threads, info, err);
 }
 
 bool fv_vp_device_whole_frame(const fv_vp_device *d)

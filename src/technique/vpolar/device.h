@@ -4,17 +4,19 @@
  * blur (a pixel of each pass at a time, kernel/vp_blur.h). The portable
  * backend runs each stage over tiles of its grid on the CPU's threads, which is what CI tests
  * against the CPU pipeline. The pipeline (pipeline.c) keeps the buffers and the temporal state
- * either way. The reprojection of the denoiser's history is a kernel too (kernel/vp_reproject.h);
- * the denoiser itself (filter/svgf.h) runs on the host between the trace and the mipmaps.
+ * either way. The denoiser (filter/svgf.h) runs as kernels too: the reprojection of its history
+ * (kernel/vp_reproject.h) and its steps (kernel/svgf.h, a pixel at a time, filter/svgf_kernels.h),
+ * its buffers and history kept here between frames.
  *
  * The CUDA backend (device/cuda/vpolar.cu) takes a whole frame instead (fv_vp_device_frame): the
- * stages follow one another on the GPU with no host wait between them, and the grid, the mipmaps
- * and the film stay there.
+ * stages follow one another on the GPU with no host wait between them, and the grid, SVGF's buffers
+ * and history, the mipmaps and the film stay there.
  */
 #ifndef FV_TECHNIQUE_VPOLAR_DEVICE_H
 #define FV_TECHNIQUE_VPOLAR_DEVICE_H
 
 #include "filter/phi_mips.h"
+#include "filter/svgf.h"
 #include "fovea/device.h"
 #include "fovea/film.h"
 #include "device/cuda_backend.h"
@@ -41,6 +43,17 @@ fv_status fv_vp_device_trace(fv_vp_device *d, const fv_vp_trace_job *job, const 
 /* The denoiser's history coordinates (kernel/vp_reproject.h): every cell of the grid into
  * prev_coord (2 floats a cell). */
 void fv_vp_device_reproject(fv_vp_device *d, const fv_kvp_reproject_frame *f, float *prev_coord, int threads);
+/* The denoiser's stage (kernel/svgf.h) for grid g with options o: its buffers (allocated here,
+ * zeroed, kept between frames) and a fresh history. g's col_h must outlive the stage (until the next
+ * setup or release). Errors as fv_svgf_create's. */
+fv_status fv_vp_device_svgf_setup(fv_vp_device *d, const fv_grid *g, const fv_svgf_opts *o, fv_error *err);
+/* Frees the stage's buffers (before its grid goes). */
+void fv_vp_device_svgf_release(fv_vp_device *d);
+/* As fv_svgf_set_periphery, for the stage's following frames. */
+void fv_vp_device_svgf_periphery(fv_vp_device *d, int x_from, int passes);
+/* One frame through the stage, as fv_svgf_filter (the same bits and counters); FV_ERR_INVALID when
+ * no stage was set up. */
+fv_status fv_vp_device_svgf(fv_vp_device *d, const fv_svgf_frame *fr, int threads, fv_svgf_info *info, fv_error *err);
 /* Every level of m from rgb (level 0 a copy), as fv_phi_mips_build. */
 void fv_vp_device_mips(fv_vp_device *d, fv_phi_mips *m, const float *rgb, int threads);
 /* The map stage: every pixel of the screen. */

@@ -78,6 +78,7 @@ static void free_buffers(fv_vp_pipeline *p)
 {
     fv_space_destroy(p->space);
     fv_svgf_destroy(p->svgf);
+    if (p->dev) fv_vp_device_svgf_release(p->dev); /* its grid is the space's */
     fv_phi_mips_destroy(p->mips);
     free(p->g.color), free(p->g.albedo), free(p->g.reflectance), free(p->g.normal), free(p->g.depth), free(p->g.position), free(p->g.id);
     free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm), free(p->lut), free(p->onscreen);
@@ -146,7 +147,9 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
         }
         p->mask_gx = p->mask_gy = NAN;
     }
-    if (p->o.denoise && (s = fv_svgf_create(g, &p->o.svgf, &p->svgf, err)) != FV_OK) {
+    /* The denoiser: on the host for the CPU, as kernels on a device (its buffers there). */
+    if (p->o.denoise && (s = p->dev ? fv_vp_device_svgf_setup(p->dev, g, &p->o.svgf, err) : fv_svgf_create(g, &p->o.svgf, &p->svgf, err)) !=
+                            FV_OK) {
         free_buffers(p);
         return s;
     }
@@ -516,9 +519,15 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
         fv_svgf_frame fr = {p->g.color, p->g.reflectance, p->g.normal, p->g.depth, p->g.position, p->g.id,
                             hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
         int x_from, passes;
-        if (periphery(p, &view, &x_from, &passes)) fv_svgf_set_periphery(p->svgf, x_from, passes);
+        if (periphery(p, &view, &x_from, &passes)) {
+            if (p->dev)
+                fv_vp_device_svgf_periphery(p->dev, x_from, passes);
+            else
+                fv_svgf_set_periphery(p->svgf, x_from, passes);
+        }
         fv_svgf_info info;
-        if ((s = fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err)) != FV_OK) return s;
+        s = p->dev ? fv_vp_device_svgf(p->dev, &fr, frame->threads, &info, err) : fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err);
+        if (s != FV_OK) return s;
         fv_stats_add_count(stats, "history_fraction", info.history_fraction);
     }
     fv_stage_stop(stats, "denoise", t0);
