@@ -368,8 +368,9 @@ static void reproject_frame(const fv_vp_pipeline *p, fv_kvp_reproject_frame *rf)
 
 /* A whole frame on a device that takes one (cuda: device/cuda/vpolar.cu): the host builds what
  * depends on the screen size and the gaze (the on-screen mask above, the radial table, the blur's
- * kernels) and receives the film and the counts; the grid, the denoiser's history coordinates and
- * the mipmaps stay on the device. The stage times are the device's (events). */
+ * kernels) and receives the film and the counts; the grid, the denoiser's history coordinates,
+ * SVGF's buffers and history and the mipmaps stay on the device (the host's copies of the grid stay
+ * unused). The stage times are the device's (events). */
 static fv_status render_whole(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, const fv_vp_trace_job *job,
                               const fv_space_view *view, fv_kit_progress *prog, fv_error *err)
 {
