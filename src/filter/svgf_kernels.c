@@ -1,6 +1,7 @@
 /* fovea — SVGF's kernels on the portable backend (svgf_kernels.h): kernel/svgf.h's steps over
  * tiles, one fv_parallel_tiles per step (a step reads its neighbours' results of the one before,
- * as a GPU launch would). */
+ * as a GPU launch would), in kernel/svgf.h's order, the prefilter inside each pass's launch unless
+ * told otherwise. */
 #include <stdlib.h>
 #include "core/alloc.h"
 #include "core/parallel.h"
@@ -10,6 +11,7 @@
 struct fv_svgf_kernels {
     fv_ksvgf k;         /* the buffers below, the options, and each frame's inputs */
     bool have_history;
+    bool fused;         /* fv_svgf_kernels_set_fused */
     float *feat[2][7];  /* nx, ny, nz, z, m1, m2, len: this frame's and the previous (swapped) */
 };
 
@@ -64,6 +66,7 @@ fv_status fv_svgf_kernels_create(const fv_grid *grid, const fv_svgf_opts *o, fv_
     k->iterations = o->iterations;
     k->sq = fv_ksvgf_squarings(o->sigma_normal);
     k->periph_x = grid->w, k->periph_passes = o->iterations;
+    s->fused = true;
     const size_t n = (size_t)grid->w * (size_t)grid->h, h = (size_t)grid->h;
     float **ptr[MAX_BUFFERS];
     int pp[MAX_BUFFERS];
@@ -96,12 +99,17 @@ void fv_svgf_kernels_set_periphery(fv_svgf_kernels *s, int x_from, int passes)
     s->k.periph_passes = passes < 0 ? 0 : passes;
 }
 
+void fv_svgf_kernels_set_fused(fv_svgf_kernels *s, bool fused)
+{
+    s->fused = fused;
+}
+
 void fv_svgf_kernels_reset(fv_svgf_kernels *s)
 {
     if (s) s->have_history = false;
 }
 
-enum { STEP_ACCUMULATE, STEP_VARIANCE, STEP_PREFILTER, STEP_ATROUS, STEP_FINISH, STEP_HOLES };
+enum { STEP_ACCUMULATE, STEP_VARIANCE, STEP_PREFILTER, STEP_ATROUS, STEP_PREFILTER_ATROUS, STEP_FINISH, STEP_HOLES };
 
 typedef struct step_job {
     const fv_ksvgf *k;
@@ -118,6 +126,7 @@ static void step_tile(void *ctx, const fv_tile *t)
             case STEP_VARIANCE: fv_ksvgf_variance_pixel(k, x, y); break;
             case STEP_PREFILTER: fv_ksvgf_prefilter_pixel(k, j->pass, x, y); break;
             case STEP_ATROUS: fv_ksvgf_atrous_pixel(k, j->pass, x, y); break;
+            case STEP_PREFILTER_ATROUS: fv_ksvgf_prefilter_atrous_pixel(k, j->pass, x, y); break;
             case STEP_FINISH: fv_ksvgf_finish_pixel(k, x, y); break;
             default: fv_ksvgf_hole_pixel(k, x, y); break;
             }
@@ -150,6 +159,10 @@ fv_status fv_svgf_kernels_filter(fv_svgf_kernels *s, const fv_svgf_frame *fr, in
     fv_parallel_for(k->g.h, 16, threads, count_rows, k);
     run_step(k, STEP_VARIANCE, 0, threads);
     for (int pass = 0; pass < k->iterations; pass++) {
+        if (s->fused) {
+            run_step(k, STEP_PREFILTER_ATROUS, pass, threads);
+            continue;
+        }
         run_step(k, STEP_PREFILTER, pass, threads);
         run_step(k, STEP_ATROUS, pass, threads);
     }

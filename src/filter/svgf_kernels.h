@@ -19,6 +19,10 @@ void fv_svgf_kernels_destroy(fv_svgf_kernels *k);
 /* As fv_svgf_set_periphery and fv_svgf_reset. */
 void fv_svgf_kernels_set_periphery(fv_svgf_kernels *k, int x_from, int passes);
 void fv_svgf_kernels_reset(fv_svgf_kernels *k);
+/* How each pass is launched: true (the default) the prefilter inside the pass's launch
+ * (fv_ksvgf_prefilter_atrous_pixel), false a prefilter launch then the pass's. The same bits; for
+ * the tests. */
+void fv_svgf_kernels_set_fused(fv_svgf_kernels *k, bool fused);
 /* As fv_svgf_filter. */
 fv_status fv_svgf_kernels_filter(fv_svgf_kernels *k, const fv_svgf_frame *fr, int threads, fv_svgf_info *info, fv_error *err);
 

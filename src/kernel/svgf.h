@@ -20,7 +20,11 @@
  *   for pass = 0 .. iterations - 1:
  *   3. fv_ksvgf_prefilter_pixel   the 3x3-prefiltered variance of the pass's input;
  *   4. fv_ksvgf_atrous_pixel      the pass (val[pass & 1] -> val[1 - (pass & 1)]);
- *   5. fv_ksvgf_finish_pixel      remodulate into colour, this frame's history positions and ids;
+ *      or 3+4 in one launch: fv_ksvgf_prefilter_atrous_pixel (a pass reads the prefiltered
+ *      variance of its own pixel only, so it can compute it; the same bits);
+ *   5. fv_ksvgf_finish_pixel      remodulate into colour, this frame's history positions and ids
+ *                                 (reads its own pixel only: may also run at the end of the last
+ *                                 pass's launch, in the same thread);
  *   6. fv_ksvgf_hole_pixel        the pixels without a path (reads step 5's colours; only when
  *                                 a row count of holes is non-zero, but harmless otherwise);
  *   7. fv_ksvgf_count_row         one call per row (after step 1, any time): the row's counters,
@@ -86,7 +90,8 @@ typedef struct fv_ksvgf {
     const uint8_t *sampled, *active; /* NULL: every pixel */
     /* state */
     uint8_t *kind;
-    uint8_t *found;             /* 1: a surface with history this frame (for count_row); NULL: not kept */
+    uint8_t *found;             /* 1: a surface with history this frame; NULL: not kept (the CPU's
+                                   filter counts as it goes; fv_ksvgf_count_row needs it) */
     float *surf;                /* 1 on a surface, else 0 (the prefilter's weights) */
     float *gvar, *grad;         /* the pass's prefiltered variance; the depth gradient */
     float *nx, *ny, *nz, *z, *m1, *m2, *len;   /* this frame's features, moments, history length */
@@ -325,17 +330,11 @@ FV_HD static inline void fv_ksvgf_variance_pixel(const fv_ksvgf *k, int x, int y
 
 /* ---- 3, 4. the À-Trous passes */
 
-/* Pixel (x, y) of pass `pass`'s prefilter: the 3x3 Gaussian of the pass's input variance over the
- * surface neighbours (Sec. 4.3), column by column. Only the columns the pass filters need it. */
-FV_HD static inline void fv_ksvgf_prefilter_pixel(const fv_ksvgf *k, int pass, int x, int y)
+/* The prefiltered variance of surface pixel (x, y) for pass `pass`: the 3x3 Gaussian of the pass's
+ * input variance over the surface neighbours (Sec. 4.3), column by column. */
+FV_HD static inline float fv_ksvgf_prefilter_value(const fv_ksvgf *k, int pass, int x, int y)
 {
     const fv_grid *g = &k->g;
-    const size_t p = (size_t)y * (size_t)g->w + (size_t)x;
-    if (x >= fv_ksvgf_pass_cut(k, pass)) return;
-    if (k->kind[p] != FV_KSVGF_SURFACE) {
-        k->gvar[p] = 0.0f;
-        return;
-    }
     const float *var = k->val[pass & 1][FV_KSVGF_VAR];
     float av = 0.0f, aw = 0.0f;
     for (int i = 0; i < 3; i++)
@@ -346,15 +345,25 @@ FV_HD static inline void fv_ksvgf_prefilter_pixel(const fv_ksvgf *k, int pass, i
             av += kk * var[q];
             aw += kk * k->surf[q];
         }
-    k->gvar[p] = av / aw;
+    return av / aw;
+}
+
+/* Pixel (x, y) of pass `pass`'s prefilter into gvar (0 off a surface). Only the columns the pass
+ * filters need it. */
+FV_HD static inline void fv_ksvgf_prefilter_pixel(const fv_ksvgf *k, int pass, int x, int y)
+{
+    const size_t p = (size_t)y * (size_t)k->g.w + (size_t)x;
+    if (x >= fv_ksvgf_pass_cut(k, pass)) return;
+    k->gvar[p] = k->kind[p] == FV_KSVGF_SURFACE ? fv_ksvgf_prefilter_value(k, pass, x, y) : 0.0f;
 }
 
 /* Pixel (x, y) of pass `pass` (taps 2^pass apart), from val[pass & 1] to val[1 - (pass & 1)]: the
  * centre, then the 24 taps row by row, each weighted by the B3 kernel, the normals, the depth and
  * the luminance; the variance filtered alongside with the squared weights. A column the pass does
  * not filter (fv_svgf_set_periphery) goes through unchanged. The first pass also writes the
- * history's illumination. */
-FV_HD static inline void fv_ksvgf_atrous_pixel(const fv_ksvgf *k, int pass, int x, int y)
+ * history's illumination. The prefiltered variance is read at the pixel alone: from gvar
+ * (fv_ksvgf_atrous_pixel, after a prefilter launch), or computed here (fused: one launch a pass). */
+FV_HD static inline void fv_ksvgf_atrous_core(const fv_ksvgf *k, int pass, int x, int y, bool fused)
 {
     const fv_grid *g = &k->g;
     const size_t p = (size_t)y * (size_t)g->w + (size_t)x;
@@ -374,7 +383,8 @@ FV_HD static inline void fv_ksvgf_atrous_pixel(const fv_ksvgf *k, int pass, int 
         return;
     }
     const float wc = FV_KSVGF_B3_2 * FV_KSVGF_B3_2;
-    const float inv_l = 1.0f / (k->sigma_lum * sqrtf(k->gvar[p]) + FV_KSVGF_LUM_EPS);
+    const float gv = fused ? fv_ksvgf_prefilter_value(k, pass, x, y) : k->gvar[p];
+    const float inv_l = 1.0f / (k->sigma_lum * sqrtf(gv) + FV_KSVGF_LUM_EPS);
     const float zs = k->sigma_depth * k->grad[p] * (float)step, ze = fv_ksvgf_depth_eps(k->z[p]);
     const float nxp = k->nx[p], nyp = k->ny[p], nzp = k->nz[p], zp = k->z[p], lp = l[p];
     float ar = wc * r[p], ag = wc * gg[p], ab = wc * b[p], avr = wc * wc * v[p], aw = wc;
@@ -401,6 +411,15 @@ FV_HD static inline void fv_ksvgf_atrous_pixel(const fv_ksvgf *k, int pass, int 
     dst[FV_KSVGF_LUM][p] = fv_ksvgf_luminance(rr, rg, rb);
     if (pass == 0)
         for (int c = 0; c < 3; c++) k->hist_illum[3 * p + c] = dst[FV_KSVGF_R + c][p];
+}
+
+/* The pass after its prefilter launch (fv_ksvgf_prefilter_pixel over every pixel first). */
+FV_HD static inline void fv_ksvgf_atrous_pixel(const fv_ksvgf *k, int pass, int x, int y) { fv_ksvgf_atrous_core(k, pass, x, y, false); }
+
+/* Prefilter and pass in one launch: the same bits as the two launches, gvar not used. */
+FV_HD static inline void fv_ksvgf_prefilter_atrous_pixel(const fv_ksvgf *k, int pass, int x, int y)
+{
+    fv_ksvgf_atrous_core(k, pass, x, y, true);
 }
 
 /* ---- 5. remodulation and this frame's history */

@@ -4,8 +4,8 @@
  * on a screen grid, on the Visual-Polar grid of a 160x90 screen (technique/vpolar/space.c: short
  * columns in the fovea, wrap-around rows, clamped columns) with its off-screen cells inactive and
  * fewer passes in the periphery, and on a log-polar grid; with holes, with sigma_normal 128
- * (squarings) and 100 (powf), with 0, 1 and 5 passes; the counters (history_fraction,
- * mean_history) equal too. Plus a case small enough to work out by hand. */
+ * (squarings) and 100 (powf), with 0, 1 and 5 passes, each pass's prefilter inside its launch and
+ * as a launch of its own; the counters (history_fraction, mean_history) equal too. Plus a case small enough to work out by hand. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -101,6 +101,7 @@ typedef struct run_case {
     int iterations;
     int periph_x, periph_passes; /* periph_x < 0: none */
     bool holes;
+    bool separate;  /* the prefilter as its own launch (fv_svgf_kernels_set_fused false) */
 } run_case;
 
 /* Frames through the plain CPU filter and through the kernels: the same bits, the same counters;
@@ -117,6 +118,7 @@ static double same_bits(const run_case *rc, int frames)
     if (fv_svgf_create(&rc->g, &o, &cpu, &err) != FV_OK) fail_msg("%s", err.msg);
     if (fv_svgf_kernels_create(&rc->g, &o, &ker, &err) != FV_OK) fail_msg("%s", err.msg);
     assert_true(fv_svgf_set_isa(cpu, FV_SVGF_ISA_PLAIN));
+    if (rc->separate) fv_svgf_kernels_set_fused(ker, false);
     if (rc->periph_x >= 0) {
         fv_svgf_set_periphery(cpu, rc->periph_x, rc->periph_passes);
         fv_svgf_kernels_set_periphery(ker, rc->periph_x, rc->periph_passes);
@@ -148,10 +150,10 @@ static void test_screen(void **st)
 {
     (void)st;
     const run_case cases[4] = {
-        {"screen", {61, 37, NULL, false}, NULL, 128.0f, 5, -1, 0, false},
-        {"screen, holes, powf", {61, 37, NULL, false}, NULL, 100.0f, 5, -1, 0, true},
-        {"screen, one pass", {40, 23, NULL, false}, NULL, 128.0f, 1, -1, 0, true},
-        {"screen, no pass", {40, 23, NULL, false}, NULL, 64.0f, 0, -1, 0, true},
+        {"screen", {61, 37, NULL, false}, NULL, 128.0f, 5, -1, 0, false, false},
+        {"screen, holes, powf, separate prefilter", {61, 37, NULL, false}, NULL, 100.0f, 5, -1, 0, true, true},
+        {"screen, one pass", {40, 23, NULL, false}, NULL, 128.0f, 1, -1, 0, true, false},
+        {"screen, no pass", {40, 23, NULL, false}, NULL, 64.0f, 0, -1, 0, true, false},
     };
     for (int i = 0; i < 4; i++) assert_true(same_bits(&cases[i], 5) > 0.5);
 }
@@ -180,10 +182,10 @@ static void test_polar(void **st)
         const long on = fv_space_onscreen_mask(&v, 6.0f, act);
         assert_true(on > 0 && on < fv_space_sample_count(sp)); /* some cells off the screen */
         const run_case cases[4] = {
-            {"polar", *g, act, 128.0f, 5, -1, 0, true},
-            {"polar, periphery", *g, act, 128.0f, 5, g->w / 3, 2, true},
-            {"polar, powf, periphery in the fovea", *g, NULL, 100.0f, 4, 3, 1, true},
-            {"polar, all active, no holes", *g, NULL, 128.0f, 5, -1, 0, false},
+            {"polar", *g, act, 128.0f, 5, -1, 0, true, false},
+            {"polar, periphery, separate prefilter", *g, act, 128.0f, 5, g->w / 3, 2, true, true},
+            {"polar, powf, periphery in the fovea", *g, NULL, 100.0f, 4, 3, 1, true, false},
+            {"polar, all active, no holes", *g, NULL, 128.0f, 5, -1, 0, false, false},
         };
         for (int i = 0; i < 4; i++) assert_true(same_bits(&cases[i], 4) > 0.3);
         free(act);
