@@ -4,7 +4,8 @@
  * CPU with the same random numbers (SVGF included: kernel/svgf.h through filter/svgf_kernels.c). Each of the five methods, and vpolar with two paths a sample and
  * every cell traced, cartesian-full without the denoiser, over four frames whose gaze moves and then
  * stays (so the history is reprojected from one gaze's space into another's on the GPU, with the
- * radial table the GPU kept from the frame before), vpolar in stereo (a pipeline per eye).
+ * radial table the GPU kept from the frame before), vpolar in stereo (a pipeline per eye), with 0
+ * and 2 SVGF passes, and on a moving scene.
  *
  * Bounds, not yet measured on a GPU (none was available when this was written), chosen from what
  * can differ: with --fmad=false the GPU rounds +, -, *, /, sqrtf as the CPU does; the GPU's sinf,
@@ -183,6 +184,15 @@ static void test_logpolar(void **st)
     compare("cornell", "log-polar", "", 160, 120, 1, 0.0);
 }
 
+/* SVGF without a pass (its remodulation a launch of its own) and with few passes, one of them in
+ * the periphery. */
+static void test_svgf_passes(void **st)
+{
+    (void)st;
+    compare("cornell", "vpolar", "svgf_iterations=0", 96, 64, 1, 0.0);
+    compare("cornell", "vpolar", "svgf_iterations=2 periphery_passes=1", 96, 64, 1, 0.0);
+}
+
 /* A moving object: the scene's moving instances copied to the GPU when its time moves. */
 static void test_moving(void **st)
 {
@@ -198,6 +208,7 @@ int main(void)
         return 77;
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_vpolar),         cmocka_unit_test(test_cartesian), cmocka_unit_test(test_cartesian_full),
-                                       cmocka_unit_test(test_linear_falloff), cmocka_unit_test(test_logpolar),  cmocka_unit_test(test_moving)};
+                                       cmocka_unit_test(test_linear_falloff), cmocka_unit_test(test_logpolar),  cmocka_unit_test(test_svgf_passes),
+                                       cmocka_unit_test(test_moving)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

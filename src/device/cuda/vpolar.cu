@@ -4,8 +4,8 @@
  *
  *   trace (fv_kvp_trace_sample, pt's path kernel on the flat scene of device/cuda/scene.h)
  *   -> the denoiser: the history's coordinates (fv_kvp_reproject_sample), then SVGF's steps
- *      (kernel/svgf.h: accumulate, the rows' counters, variance, per pass prefilter and À-Trous,
- *      finish, holes), a launch each in the header's order
+ *      (kernel/svgf.h: accumulate, the rows' counters, variance, a launch per pass with its
+ *      prefilter fused in, the last also remodulating, holes) in the header's order
  *   -> φ-mipmaps (level 0 a copy, then fv_kphi_halve_cell a level per launch, each reading the one
  *      before) -> map (fv_kvp_map_pixel: colour, first-hit buffers, the blur's sigma)
  *   -> foveated blur (fv_kblur_h_pixel into a scratch image, fv_kblur_v_pixel back into the film).
@@ -168,7 +168,7 @@ __global__ void fv_cuda_vp_blur_v(fv_kblur_table t, const float *sigma, const fl
 
 /* ---- SVGF (kernel/svgf.h), a launch per step ---- */
 
-enum { SV_ACCUMULATE, SV_VARIANCE, SV_PREFILTER, SV_ATROUS, SV_FINISH, SV_HOLES };
+enum { SV_ACCUMULATE, SV_VARIANCE, SV_PASS, SV_LAST_PASS, SV_FINISH, SV_HOLES };
 
 __global__ void fv_cuda_vp_svgf_step(fv_ksvgf k, int step, int pass)
 {
@@ -177,8 +177,13 @@ __global__ void fv_cuda_vp_svgf_step(fv_ksvgf k, int step, int pass)
     switch (step) {
     case SV_ACCUMULATE: fv_ksvgf_accumulate_pixel(&k, x, y); break;
     case SV_VARIANCE: fv_ksvgf_variance_pixel(&k, x, y); break;
-    case SV_PREFILTER: fv_ksvgf_prefilter_pixel(&k, pass, x, y); break;
-    case SV_ATROUS: fv_ksvgf_atrous_pixel(&k, pass, x, y); break;
+    /* a pass with its own prefilter (it reads its pixel's prefiltered variance only); the last
+     * pass also remodulates its pixel (which reads that pixel only) */
+    case SV_PASS: fv_ksvgf_prefilter_atrous_pixel(&k, pass, x, y); break;
+    case SV_LAST_PASS:
+        fv_ksvgf_prefilter_atrous_pixel(&k, pass, x, y);
+        fv_ksvgf_finish_pixel(&k, x, y);
+        break;
     case SV_FINISH: fv_ksvgf_finish_pixel(&k, x, y); break;
     default: fv_ksvgf_hole_pixel(&k, x, y); break;
     }
@@ -336,11 +341,9 @@ static void svgf_launch(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const int *dco
     fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_ACCUMULATE, 0);
     fv_cuda_vp_svgf_rows<<<blocks_of((size_t)c->gh), FV_CUDA_VP_THREADS, 0, st>>>(*k);
     fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_VARIANCE, 0);
-    for (int pass = 0; pass < k->iterations; pass++) {
-        fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_PREFILTER, pass);
-        fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_ATROUS, pass);
-    }
-    fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_FINISH, 0);
+    for (int pass = 0; pass < k->iterations; pass++)
+        fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, pass == k->iterations - 1 ? SV_LAST_PASS : SV_PASS, pass);
+    if (k->iterations == 0) fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_FINISH, 0);
     fv_cuda_vp_svgf_step<<<tiles, block, 0, st>>>(*k, SV_HOLES, 0);
     /* this frame's features become the next frame's history (pointers only: the launches above
      * already hold their copies of the struct) */
