@@ -250,8 +250,7 @@ static int svgf_buffers(dev_svgf *d, size_t n, size_t h, void ***ptr, size_t *by
     int m = 0;
     fv_ksvgf *k = &d->k;
 #define BUF(p, b) (ptr[m] = (void **)&(p), bytes[m] = (b), m++)
-    BUF(k->surf, n * sizeof(float));
-    BUF(k->gvar, n * sizeof(float));
+    BUF(k->surf, n * sizeof(float)); /* (gvar: none, the passes prefilter their own pixel) */
     BUF(k->grad, n * sizeof(float));
     BUF(k->hist_illum, 3 * n * sizeof(float));
     BUF(k->hist_pos, 3 * n * sizeof(float));
