@@ -56,6 +56,21 @@ fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const struct fv_ksdf_world 
 }
 
 void fv_cuda_sdf_destroy(fv_cuda_sdf *c) { (void)c; }
+
+fv_status fv_cuda_vp_create(const struct fv_kscene *host, fv_cuda_vp **out, fv_error *err)
+{
+    (void)host;
+    *out = NULL;
+    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
+}
+
+void fv_cuda_vp_destroy(fv_cuda_vp *c) { (void)c; }
+
+fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res, fv_error *err)
+{
+    (void)c, (void)f, (void)out, (void)res;
+    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
+}
 #else
 typedef int fv_cuda_stub_unused; /* ISO C: a translation unit is not empty */
 #endif

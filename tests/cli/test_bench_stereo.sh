@@ -45,7 +45,6 @@ for j in "$SRC"/bench/gpu-*.json; do
 done
 [ "$n" -ge 7 ] || fail "only $n bench/gpu-*.json found"
 # the pacing scenarios: stereo at 1440x1600 per eye, the saccade trace, 90 Hz, cpu and cuda rows
-# (vpolar's cuda rows come with its device port)
 python3 - "$SRC/bench" <<'PY' || fail "the gpu pacing scenarios are not as issue 28 defines them"
 import json, sys
 b = sys.argv[1]
@@ -54,7 +53,7 @@ for name in ("gpu-vp-speed", "gpu-vp-speed-city", "gpu-sdf-speed", "gpu-sdf-spee
     assert d["size"] == [1440, 1600] and d["stereo"] > 0 and d["fps"] == 90, name
     assert d["gaze"] == {"trace": "../scenes/gaze-saccades.csv"}, name
     devs = {m["params"]["device"] for m in d["methods"]}
-    assert devs == ({"cpu"} if "vp" in name else {"cpu", "cuda"}), (name, devs)
+    assert devs == {"cpu", "cuda"}, (name, devs)
     if "sdf" in name:
         assert d["full"]["size"] == [2468, 2740], name
         rows = {(m["method"], m["params"]["spp"], m["params"]["device"]) for m in d["methods"]}

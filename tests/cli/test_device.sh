@@ -7,7 +7,7 @@ R="$FOVEA render"
 expect 2 "device 'gpu' is not one of cpu, portable, cuda, auto" -- $R cornell --device gpu --size 8x8 --out "$OUT"
 expect 2 "device '' is not one of" -- $R cornell --device "" --size 8x8 --out "$OUT"
 # A method without a CUDA version names the methods that have one.
-expect 2 "method 'vpolar' does not run on device cuda (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)" -- $R cornell --method vpolar --device cuda --size 8x8 --out "$OUT"
+expect 2 "method 'fpm' does not run on device cuda (methods that do: pt, vpolar, cartesian, cartesian-full, linear-falloff, log-polar, sdf-gt, sdf-relaxed, ipr, fipr)" -- $R cornell --method fpm --device cuda --size 8x8 --out "$OUT"
 expect 2 "method 'fpm' does not run on device portable (methods that do: pt, vpolar, cartesian, cartesian-full, linear-falloff, log-polar, sdf-gt, sdf-relaxed, ipr, fipr)" -- $R cornell --method fpm --device portable --size 8x8 --out "$OUT"
 # The same refusals through --param.
 expect 2 "parameter device=nope: expected one of cpu, portable, cuda, auto" -- $R cornell --method pt --param device=nope --size 8x8 --out "$OUT"

@@ -28,7 +28,7 @@ expect 2 "unknown method 'nope' (known: pt," -- "$VIEW" cornell --method nope
 sed 's/^fovea render:/fovea view:/' "$TMP/render.err" | cmp -s - "$TMP/err" || fail "fovea view and fovea render word an unknown method differently"
 expect 2 "unknown parameter 'foo'" -- "$VIEW" cornell --method vpolar --param foo=1
 expect 2 "--param svgf_alpha=0.5: svgf_alpha is already set (to 0.3)" -- "$VIEW" cornell --method vpolar --param svgf_alpha=0.3 --param svgf_alpha=0.5
-expect 2 "method 'vpolar' does not run on device cuda (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)" -- "$VIEW" cornell --method vpolar --device cuda
+expect 2 "method 'fpm' does not run on device cuda (methods that do: pt, vpolar, cartesian, cartesian-full, linear-falloff, log-polar, sdf-gt, sdf-relaxed, ipr, fipr)" -- "$VIEW" cornell --method fpm --device cuda
 expect 2 "device 'gpu' is not one of cpu, portable, cuda, auto" -- "$VIEW" cornell --method pt --device gpu
 expect 2 "no display" -- env -u DISPLAY -u SDL_VIDEODRIVER -u WAYLAND_DISPLAY "$VIEW" cornell --method vpolar
 expect 2 "unknown or incomplete command 'jump'" -- "$VIEW" --script /dev/stdin <<<"0 jump"

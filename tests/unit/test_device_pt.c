@@ -129,7 +129,7 @@ static void test_refusals(void **st)
     const struct {
         const char *method, *params, *needle;
     } cases[] = {
-        {"vpolar", "device=cuda", "method 'vpolar' does not run on device cuda (methods that do: pt, sdf-gt, sdf-relaxed, ipr, fipr)"},
+        {"fpm", "device=cuda", "method 'fpm' does not run on device cuda (methods that do: pt, vpolar, cartesian, cartesian-full, linear-falloff, log-polar, sdf-gt, sdf-relaxed, ipr, fipr)"},
         {"fpm", "device=portable", "method 'fpm' does not run on device portable (methods that do: pt, vpolar, cartesian, cartesian-full, linear-falloff, log-polar, sdf-gt, sdf-relaxed, ipr, fipr)"},
         {"pt", "device=gpu", "device"},
     };
@@ -164,8 +164,10 @@ static void test_refusals(void **st)
     assert_int_equal(fv_device_check("fir", "cpu", &d, &err), FV_OK);
     assert_int_equal(d, FV_DEVICE_CPU);
     /* auto: CUDA when it can run, else the CPU; a method without CUDA stays on the CPU. */
-    assert_int_equal(fv_device_parse("auto", "vpolar", &d, &err), FV_OK);
+    assert_int_equal(fv_device_parse("auto", "fpm", &d, &err), FV_OK);
     assert_int_equal(d, FV_DEVICE_CPU);
+    assert_int_equal(fv_device_parse("auto", "vpolar", &d, &err), FV_OK);
+    assert_int_equal(d, can ? FV_DEVICE_CUDA : FV_DEVICE_CPU);
     assert_int_equal(fv_device_parse("auto", "pt", &d, &err), FV_OK);
     assert_int_equal(d, can ? FV_DEVICE_CUDA : FV_DEVICE_CPU);
     assert_true(fv_technique_has_device(fv_technique_index("pt"), FV_DEVICE_PORTABLE));

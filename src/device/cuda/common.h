@@ -1,13 +1,16 @@
-/* fovea — what the CUDA backends share (device/cuda/pt.cu, device/cuda/sdf.cu): the launch macro
- * (device/cuda/launch.h, FV_CUDA_LAUNCH), the error line of a failed CUDA call, and a film on the
- * GPU, its buffers kept between frames of one size and read back into the host film's buffers that
- * are set. Host code only; included by .cu files.
+/* fovea — what the CUDA backends share (device/cuda/pt.cu, sdf.cu, vpolar.cu): the launch macro
+ * (device/cuda/launch.h, FV_CUDA_LAUNCH), the error line of a failed CUDA call, a device array
+ * refilled from the host only when its bytes changed, and a film on the GPU, its buffers kept
+ * between frames of one size and read back into the host film's buffers that are set. Host code
+ * only; included by .cu files.
  */
 #ifndef FV_DEVICE_CUDA_COMMON_H
 #define FV_DEVICE_CUDA_COMMON_H
 
 #include <cuda_runtime.h>
 #include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
 #include "fovea/film.h"
 #include "fovea/status.h"
 #include "device/cuda/launch.h"
@@ -15,6 +18,49 @@
 static inline fv_status fv_cuda_fail(cudaError_t e, const char *what, fv_error *err)
 {
     return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %s while %s", cudaGetErrorString(e), what);
+}
+
+/* A device array that grows and is refilled from the host when what it holds changed. */
+typedef struct fv_cuda_mirror {
+    void *p;
+    size_t cap;   /* bytes */
+    void *mirror; /* host copy of what p holds, bytes long */
+    size_t bytes;
+} fv_cuda_mirror;
+
+/* Makes a hold src's bytes: nothing happens when it already does (the host mirror is compared), so
+ * what does not change between frames is copied once. The copy is queued on stream st (0: the
+ * legacy stream); from pageable memory it is staged before this returns, so src may change after.
+ * what names the data in the error line. */
+static inline fv_status fv_cuda_mirror_fill(fv_cuda_mirror *a, const void *src, size_t bytes, cudaStream_t st, const char *what, fv_error *err)
+{
+    if (bytes == 0) return FV_OK;
+    if (a->p && bytes == a->bytes && memcmp(a->mirror, src, bytes) == 0) return FV_OK; /* unchanged since the last copy */
+    cudaError_t e;
+    if (bytes > a->cap) {
+        cudaFree(a->p);
+        free(a->mirror);
+        a->p = a->mirror = NULL;
+        a->cap = a->bytes = 0;
+        if (!(a->mirror = malloc(bytes))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
+        if ((e = cudaMalloc(&a->p, bytes)) != cudaSuccess)
+            return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for %s", what)
+                                                  : fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %s while allocating %s", cudaGetErrorString(e), what);
+        a->cap = bytes;
+    }
+    a->bytes = 0; /* stale until the copy succeeds */
+    if ((e = cudaMemcpyAsync(a->p, src, bytes, cudaMemcpyHostToDevice, st)) != cudaSuccess)
+        return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %s while copying %s", cudaGetErrorString(e), what);
+    memcpy(a->mirror, src, bytes);
+    a->bytes = bytes;
+    return FV_OK;
+}
+
+static inline void fv_cuda_mirror_free(fv_cuda_mirror *a)
+{
+    cudaFree(a->p);
+    free(a->mirror);
+    memset(a, 0, sizeof *a);
 }
 
 typedef struct fv_cuda_film {

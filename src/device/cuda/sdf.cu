@@ -40,14 +40,6 @@
 #define FV_CUDA_PYR_LEVEL_STEPS (FV_CUDA_PYR_LEVEL_RAYS + FV_PYRAMID_MAX_LEVELS)
 #define FV_CUDA_PYR_COUNTS (FV_CUDA_PYR_LEVEL_STEPS + FV_PYRAMID_MAX_LEVELS)
 
-/* A device array that grows and is refilled from the host when what it holds changed. */
-typedef struct dev_array {
-    void *p;
-    size_t cap;   /* bytes */
-    void *mirror; /* host copy of what p holds, bytes long */
-    size_t bytes;
-} dev_array;
-
 /* fipr's middle level of one eye on the GPU (pyramid.h's fv_pyramid_history). */
 typedef struct dev_history {
     int sw, sh;
@@ -60,7 +52,7 @@ typedef struct dev_history {
 typedef struct dev_blur {
     float *sigma, *tmp;
     size_t pixels;
-    dev_array off, k;
+    fv_cuda_mirror off, k;
     int *host_off;          /* the table on the host, for (w, h, smax) */
     float *host_k;
     int w, h, nq;
@@ -69,7 +61,7 @@ typedef struct dev_blur {
 } dev_blur;
 
 struct fv_cuda_sdf {
-    dev_array ops, objs, lights, mats;
+    fv_cuda_mirror ops, objs, lights, mats;
     fv_cuda_film film[2];       /* per eye: a stereo pair is read back after both eyes ran */
     unsigned long long *counts; /* FV_CUDA_PYR_COUNTS */
     cudaEvent_t start, stop;
@@ -81,36 +73,6 @@ struct fv_cuda_sdf {
     dev_history hist[2];
     dev_blur blur;
 };
-
-static fv_status fill(dev_array *a, const void *src, size_t bytes, fv_error *err)
-{
-    if (bytes == 0) return FV_OK;
-    if (a->p && bytes == a->bytes && memcmp(a->mirror, src, bytes) == 0) return FV_OK; /* unchanged since the last copy */
-    cudaError_t e;
-    if (bytes > a->cap) {
-        cudaFree(a->p);
-        free(a->mirror);
-        a->p = a->mirror = NULL;
-        a->cap = a->bytes = 0;
-        if (!(a->mirror = malloc(bytes))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-        if ((e = cudaMalloc(&a->p, bytes)) != cudaSuccess)
-            return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for the world")
-                                                  : fv_cuda_fail(e, "allocating the world", err);
-        a->cap = bytes;
-    }
-    a->bytes = 0; /* stale until the copy succeeds */
-    if ((e = cudaMemcpy(a->p, src, bytes, cudaMemcpyHostToDevice)) != cudaSuccess) return fv_cuda_fail(e, "copying the world", err);
-    memcpy(a->mirror, src, bytes);
-    a->bytes = bytes;
-    return FV_OK;
-}
-
-static void dev_array_free(dev_array *a)
-{
-    cudaFree(a->p);
-    free(a->mirror);
-    memset(a, 0, sizeof *a);
-}
 
 static void pyramid_free(fv_cuda_sdf *c)
 {
@@ -136,8 +98,8 @@ static void blur_free(dev_blur *b)
 {
     cudaFree(b->sigma);
     cudaFree(b->tmp);
-    dev_array_free(&b->off);
-    dev_array_free(&b->k);
+    fv_cuda_mirror_free(&b->off);
+    fv_cuda_mirror_free(&b->k);
     free(b->host_off);
     free(b->host_k);
     memset(b, 0, sizeof *b);
@@ -146,10 +108,10 @@ static void blur_free(dev_blur *b)
 extern "C" void fv_cuda_sdf_destroy(fv_cuda_sdf *c)
 {
     if (!c) return;
-    dev_array_free(&c->ops);
-    dev_array_free(&c->objs);
-    dev_array_free(&c->lights);
-    dev_array_free(&c->mats);
+    fv_cuda_mirror_free(&c->ops);
+    fv_cuda_mirror_free(&c->objs);
+    fv_cuda_mirror_free(&c->lights);
+    fv_cuda_mirror_free(&c->mats);
     fv_cuda_film_free(&c->film[0]);
     fv_cuda_film_free(&c->film[1]);
     blur_free(&c->blur);
@@ -213,10 +175,10 @@ static fv_status upload_world(fv_cuda_sdf *c, const fv_ksdf_world *w, fv_ksdf_wo
 {
     *dw = *w;
     fv_status s;
-    if ((s = fill(&c->ops, w->ops, (size_t)w->nops * sizeof(fv_sdf_op), err)) != FV_OK ||
-        (s = fill(&c->objs, w->objs, (size_t)w->count * sizeof(fv_ksdf_object), err)) != FV_OK ||
-        (s = fill(&c->lights, w->lights, (size_t)w->nlights * sizeof(fv_ksdf_light), err)) != FV_OK ||
-        (s = fill(&c->mats, w->mats, (size_t)w->nmat * sizeof(fv_material), err)) != FV_OK)
+    if ((s = fv_cuda_mirror_fill(&c->ops, w->ops, (size_t)w->nops * sizeof(fv_sdf_op), 0, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->objs, w->objs, (size_t)w->count * sizeof(fv_ksdf_object), 0, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->lights, w->lights, (size_t)w->nlights * sizeof(fv_ksdf_light), 0, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->mats, w->mats, (size_t)w->nmat * sizeof(fv_material), 0, "the world", err)) != FV_OK)
         return s;
     dw->ops = (const fv_sdf_op *)c->ops.p;
     dw->objs = (const fv_ksdf_object *)c->objs.p;
@@ -526,8 +488,8 @@ static fv_status blur_ensure(fv_cuda_sdf *c, int w, int h, float smax, fv_kblur_
         b->w = w, b->h = h, b->smax = smax;
     }
     fv_status s;
-    if ((s = fill(&b->off, b->host_off, (size_t)b->nq * sizeof(int), err)) != FV_OK ||
-        (s = fill(&b->k, b->host_k, b->nk * sizeof(float), err)) != FV_OK)
+    if ((s = fv_cuda_mirror_fill(&b->off, b->host_off, (size_t)b->nq * sizeof(int), 0, "fipr's blur kernels", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&b->k, b->host_k, b->nk * sizeof(float), 0, "fipr's blur kernels", err)) != FV_OK)
         return s;
     t->w = w;
     t->h = h;

@@ -1,6 +1,7 @@
 /* fovea — the Visual-Polar family's stages on the portable backend (device.h): the kernels of
  * kernel/vp_trace.h, vp_reproject.h, svgf.h (through filter/svgf_kernels.c), phi_mips, vp_map.h and
- * vp_blur.h, a cell or pixel at a time over tiles on the CPU's threads. */
+ * vp_blur.h, a cell or pixel at a time over tiles on the CPU's threads; on cuda the flat scene
+ * handed to device/cuda/vpolar.cu, which runs whole frames (its SVGF buffers its own). */
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
@@ -14,6 +15,7 @@
 struct fv_vp_device {
     const fv_scene *scene;
     fv_scene_export *flat;
+    fv_cuda_vp *cuda;      /* cuda: the GPU's frames (device/cuda_backend.h) */
     float *blur_tmp;       /* the horizontal pass's image, kept between frames */
     size_t blur_pixels;
     fv_svgf_kernels *svgf; /* the denoiser's buffers and history (NULL: no stage set up) */
@@ -22,13 +24,15 @@ struct fv_vp_device {
 fv_status fv_vp_device_create(const fv_scene *scene, fv_device device, fv_vp_device **out, fv_error *err)
 {
     *out = NULL;
-    if (device != FV_DEVICE_PORTABLE) return fv_error_set(err, FV_ERR_INVALID, "the Visual-Polar family runs on device portable only");
+    if (device != FV_DEVICE_PORTABLE && device != FV_DEVICE_CUDA)
+        return fv_error_set(err, FV_ERR_INVALID, "the Visual-Polar family runs on devices portable and cuda only");
     fv_vp_device *d = calloc(1, sizeof *d);
     if (!d) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     d->scene = scene;
     fv_status s = fv_scene_export_create(scene, &d->flat, err);
+    if (s == FV_OK && device == FV_DEVICE_CUDA) s = fv_cuda_vp_create(fv_scene_export_view(d->flat), &d->cuda, err);
     if (s != FV_OK) {
-        free(d);
+        fv_vp_device_destroy(d);
         return s;
     }
     *out = d;
@@ -38,6 +42,7 @@ fv_status fv_vp_device_create(const fv_scene *scene, fv_device device, fv_vp_dev
 void fv_vp_device_destroy(fv_vp_device *d)
 {
     if (!d) return;
+    fv_cuda_vp_destroy(d->cuda);
     fv_scene_export_destroy(d->flat);
     fv_svgf_kernels_destroy(d->svgf);
     free(d->blur_tmp);
@@ -168,6 +173,7 @@ void fv_vp_device_reproject(fv_vp_device *d, const fv_kvp_reproject_frame *f, fl
 fv_status fv_vp_device_svgf_setup(fv_vp_device *d, const fv_grid *g, const fv_svgf_opts *o, fv_error *err)
 {
     fv_vp_device_svgf_release(d);
+    if (d->cuda) return FV_OK; /* the GPU keeps SVGF's buffers itself (device/cuda/vpolar.cu) */
     return fv_svgf_kernels_create(g, o, &d->svgf, err);
 }
 
@@ -186,4 +192,19 @@ fv_status fv_vp_device_svgf(fv_vp_device *d, const fv_svgf_frame *fr, int thread
 {
     if (!d->svgf) return fv_error_set(err, FV_ERR_INVALID, "the device's denoiser was not set up");
     return fv_svgf_kernels_filter(d->svgf, fr, threads, info, err);
+}
+
+bool fv_vp_device_whole_frame(const fv_vp_device *d)
+{
+    return d->cuda != NULL;
+}
+
+fv_status fv_vp_device_frame(fv_vp_device *d, fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res, fv_error *err)
+{
+    if (!d->cuda) return fv_error_set(err, FV_ERR_INTERNAL, "whole frames need device cuda");
+    /* the flat scene at the frame's time (moving instances); the GPU copies what moved */
+    fv_status s = fv_scene_export_update(d->flat, d->scene, err);
+    if (s != FV_OK) return s;
+    f->scene = fv_scene_export_view(d->flat);
+    return fv_cuda_vp_render(d->cuda, f, out, res, err);
 }

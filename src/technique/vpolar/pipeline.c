@@ -316,6 +316,137 @@ static void map_frame(const fv_vp_pipeline *p, const fv_space_view *view, bool i
     mf->sigma = p->o.blur ? p->sigma : NULL;
 }
 
+/* SVGF's periphery (fv_svgf_set_periphery): with the blur and fewer passes there, the columns
+ * wholly beyond periphery_deg (by default where the blur reaches its full sigma). False: every pass
+ * everywhere (*x_from and *passes untouched). */
+static bool periphery(const fv_vp_pipeline *p, const fv_space_view *view, int *x_from, int *passes)
+{
+    if (!(p->o.blur && p->o.periphery_passes < p->o.svgf.iterations && fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN)) return false;
+    float X, V;
+    fv_space_from_screen(view, view->gx + (float)blur_profile_radius(p, view, p->o.periphery_deg), view->gy, &X, &V, NULL);
+    *x_from = (int)ceilf(X);
+    *passes = p->o.periphery_passes;
+    return true;
+}
+
+/* The trace stage's job for this frame (its progress and counters are the caller's). */
+static void trace_job(const fv_vp_pipeline *p, const fv_frame *frame, const fv_camera_basis *basis, const fv_space_view *view,
+                      fv_vp_trace_job *job)
+{
+    memset(job, 0, sizeof *job);
+    job->scene = p->scene;
+    job->pt = p->o.pt;
+    job->cam = *basis;
+    job->view = *view;
+    job->screen_w = p->sw;
+    job->screen_h = p->sh;
+    job->order = p->o.order;
+    job->perm = p->perm;
+    job->nperm = p->nperm;
+    job->skip_offscreen = p->o.skip_offscreen;
+    job->onscreen = p->onscreen;
+    job->kill = p->o.kill;
+    job->kill_e0 = p->o.kill_e0, job->kill_e1 = p->o.kill_e1, job->kill_p = p->o.kill_p;
+    job->px_per_deg = p->ppd;
+    job->frame = frame;
+}
+
+/* The previous frame's reprojection into its grid, as the kernels read it (its radial table p->lut,
+ * still the previous view's). */
+static void reproject_frame(const fv_vp_pipeline *p, fv_kvp_reproject_frame *rf)
+{
+    memset(rf, 0, sizeof *rf);
+    rf->space = *fv_space_kernel(p->space);
+    rf->g = p->g;
+    rf->onscreen = p->onscreen;
+    rf->prev_cam = p->prev_cam;
+    rf->prev_view = fv_space_kview(&p->prev_view);
+    rf->prev_lut = p->lut;
+    rf->nlut = p->nlut;
+    rf->inv_step = 1.0f / LUT_STEP;
+}
+
+/* A whole frame on a device that takes one (cuda: device/cuda/vpolar.cu): the host builds what
+ * depends on the screen size and the gaze (the on-screen mask above, the radial table, the blur's
+ * kernels) and receives the film and the counts; the grid, the denoiser's history coordinates,
+ * SVGF's buffers and history and the mipmaps stay on the device (the host's copies of the grid stay
+ * unused). The stage times are the device's (events). */
+static fv_status render_whole(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, const fv_vp_trace_job *job,
+                              const fv_space_view *view, fv_kit_progress *prog, fv_error *err)
+{
+    const fv_grid *g = fv_space_grid(p->space);
+    const bool polar = fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN;
+    fv_cuda_vp_frame f;
+    memset(&f, 0, sizeof f);
+    f.onscreen = p->onscreen;
+    fv_vp_trace_kframe(job, &f.trace);
+    if (p->o.denoise) {
+        f.denoise = 1;
+        f.svgf = p->o.svgf;
+        f.periph_x = g->w, f.periph_passes = p->o.svgf.iterations;
+        periphery(p, view, &f.periph_x, &f.periph_passes);
+        /* The previous frame mapped with its view's radial table, which the device keeps. */
+        f.history = p->have_prev && frame->prev_camera != NULL;
+        if (f.history) reproject_frame(p, &f.reproject);
+    }
+    const bool identity = !polar && g->w == p->sw && g->h == p->sh;
+    f.mips = !identity;
+    if (f.mips) {
+        fv_phi_mips_kernel(p->mips, &f.mip_shape);
+        for (int k = 0; k < f.mip_shape.levels; k++) f.mip_h[k] = fv_phi_mips_grid(p->mips, k)->h;
+    }
+    /* the map: a device recomputes the coordinates every frame */
+    p->coords_state = COORDS_NONE;
+    p->map_gx = view->gx, p->map_gy = view->gy;
+    build_radial_lut(p, view);
+    fv_stats_add_count(stats, "map_reused", 0.0);
+    map_frame(p, view, identity, &f.map);
+    int *off = NULL;
+    float *k = NULL;
+    if (p->o.blur) {
+        /* A pixel's sigma interpolates two entries of the table's sigma column, so it is at most
+         * their larger one plus rounding: the kernels up to slightly above the column's largest
+         * cover every pixel (a kernel does not depend on how many there are). */
+        float smax = 0.0f;
+        for (int i = 0; i < p->nlut; i++) smax = p->lut[3 * i + 2] > smax ? p->lut[3 * i + 2] : smax;
+        int nq;
+        size_t nk;
+        fv_blur_table_size(smax * 1.001f, p->sw, p->sh, &nq, &nk);
+        off = fv_alloc_array((size_t)nq, sizeof(int));
+        k = fv_alloc_array(nk, sizeof(float));
+        if (!off || !k) {
+            free(off), free(k);
+            return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the blur's kernels");
+        }
+        fv_blur_table_fill(p->sw, p->sh, nq, off, k);
+        f.blur = 1;
+        f.blur_table = (fv_kblur_table){p->sw, p->sh, (p->sw > p->sh ? p->sw : p->sh) - 1, nq, off, k};
+        f.blur_nk = nk;
+    }
+    const fv_film_views out = fv_film_views_of(film);
+    fv_cuda_vp_result r;
+    fv_status s = fv_vp_device_frame(p->dev, &f, &out, &r, err);
+    free(off), free(k);
+    if (s != FV_OK) return s;
+    static const char *const stage[5] = {"trace", "denoise", "mip", "map", "blur"};
+    for (int i = 0; i < 5; i++) fv_stats_add_ms(stats, stage[i], r.stage_ms[i]);
+    fv_stats_add_ms(stats, "kernel", r.kernel_ms);
+    fv_stats_add_count(stats, "host_syncs", (double)r.syncs);
+    fv_stats_add_count(stats, "rays", (double)r.rays);
+    fv_stats_add_count(stats, "samples", (double)r.paths);
+    fv_stats_add_count(stats, "grid_samples", (double)fv_space_sample_count(p->space));
+    fv_stats_add_count(stats, "sample_share", (double)r.paths / ((double)p->sw * p->sh));
+    fv_stats_add_count(stats, "mrays_per_s", r.stage_ms[0] > 0.0 ? (double)r.rays / r.stage_ms[0] / 1000.0 : 0.0);
+    fv_stats_add_count(stats, "nan_samples", (double)r.nan_paths);
+    if (p->o.denoise) fv_stats_add_count(stats, "history_fraction", r.history_fraction);
+    p->prev_cam = job->cam;
+    p->prev_view = *view;
+    p->have_prev = true;
+    /* have_image stays false: the sample-space image is on the device (show= is refused there) */
+    fv_kit_phase(prog, frame, 0.8, 0.2);
+    return fv_kit_phase_end(prog, err);
+}
+
 fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
     const fv_camera *cam = frame->camera, *prev_cam = frame->prev_camera;
@@ -343,26 +474,12 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
 
     /* 1. trace */
     fv_vp_trace_job job;
-    memset(&job, 0, sizeof job);
-    job.scene = p->scene;
-    job.pt = p->o.pt;
-    job.cam = basis;
-    job.view = view;
-    job.screen_w = p->sw;
-    job.screen_h = p->sh;
-    job.order = p->o.order;
-    job.perm = p->perm;
-    job.nperm = p->nperm;
-    job.skip_offscreen = p->o.skip_offscreen;
-    job.onscreen = p->onscreen;
-    job.kill = p->o.kill;
-    job.kill_e0 = p->o.kill_e0, job.kill_e1 = p->o.kill_e1, job.kill_p = p->o.kill_p;
-    job.px_per_deg = p->ppd;
-    job.frame = frame;
+    trace_job(p, frame, &basis, &view, &job);
     /* Progress: the trace is most of a frame; the filters report at their end. */
     fv_kit_progress prog = {0};
     fv_kit_phase(&prog, frame, 0.0, 0.8);
     job.progress = &prog;
+    if (p->dev && fv_vp_device_whole_frame(p->dev)) return render_whole(p, frame, film, stats, &job, &view, &prog, err);
     job.counters = fv_kit_counters_reuse(&p->counters);
     fv_vp_trace_result tr;
     fv_stage_clock t0 = fv_stage_clock_now();
@@ -394,15 +511,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
                                        p->prev_view.gy == p->lut_gy};
             if (p->dev && (rc.lut || fv_space_kind_of(p->space) == FV_SPACE_CARTESIAN)) {
                 fv_kvp_reproject_frame rf;
-                memset(&rf, 0, sizeof rf);
-                rf.space = *fv_space_kernel(p->space);
-                rf.g = p->g;
-                rf.onscreen = p->onscreen;
-                rf.prev_cam = p->prev_cam;
-                rf.prev_view = fv_space_kview(&p->prev_view);
-                rf.prev_lut = p->lut;
-                rf.nlut = p->nlut;
-                rf.inv_step = 1.0f / LUT_STEP;
+                reproject_frame(p, &rf);
                 fv_vp_device_reproject(p->dev, &rf, p->prev_coord, frame->threads);
             } else {
                 fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
@@ -410,15 +519,12 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
         }
         fv_svgf_frame fr = {p->g.color, p->g.reflectance, p->g.normal, p->g.depth, p->g.position, p->g.id,
                             hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
-        if (p->o.blur && p->o.periphery_passes < p->o.svgf.iterations && fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
-            /* The columns wholly beyond periphery_deg (by default where the blur reaches its full
-             * sigma). */
-            float X, V;
-            fv_space_from_screen(&view, view.gx + (float)blur_profile_radius(p, &view, p->o.periphery_deg), view.gy, &X, &V, NULL);
+        int x_from, passes;
+        if (periphery(p, &view, &x_from, &passes)) {
             if (p->dev)
-                fv_vp_device_svgf_periphery(p->dev, (int)ceilf(X), p->o.periphery_passes);
+                fv_vp_device_svgf_periphery(p->dev, x_from, passes);
             else
-                fv_svgf_set_periphery(p->svgf, (int)ceilf(X), p->o.periphery_passes);
+                fv_svgf_set_periphery(p->svgf, x_from, passes);
         }
         fv_svgf_info info;
         s = p->dev ? fv_vp_device_svgf(p->dev, &fr, frame->threads, &info, err) : fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err);

@@ -155,6 +155,11 @@ static fv_status create_kind(vp_kind kind, const char *name, const fv_scene *sce
     st->scene = scene;
     fv_status s = read_opts(kind, params, &st->o, &st->show, err);
     st->o.device = device;
+    /* On cuda the sample grid stays on the GPU: the diagnostics that draw it need its host copy. */
+    if (s == FV_OK && device == FV_DEVICE_CUDA && st->show != SHOW_SCREEN)
+        s = fv_error_set(err, FV_ERR_INVALID, "parameter show=%s: device cuda renders the image only (devices cpu and portable draw diagnostics)",
+                         k_show[st->show]);
+
     for (int e = 0; s == FV_OK && e < 2; e++) s = fv_vp_pipeline_create(scene, &st->o, &st->eye[e], err);
     if (s != FV_OK) {
         fv_vp_pipeline_destroy(st->eye[0]);
@@ -334,8 +339,8 @@ static fv_status create_logpolar(const fv_scene *s, fv_params *p, const fv_log *
     return create_logpolar_on(s, p, FV_DEVICE_CPU, l, st, e);
 }
 
-/* The devices beyond the CPU: the portable backend (technique/vpolar/device.h). */
-#define VP_DEVICES (1u << FV_DEVICE_PORTABLE)
+/* The devices beyond the CPU: the portable backend and CUDA (technique/vpolar/device.h). */
+#define VP_DEVICES ((1u << FV_DEVICE_PORTABLE) | (1u << FV_DEVICE_CUDA))
 
 /* The furnace with one bounce (max_depth 2): emission 0.5 seen directly, plus 0.25 and 0.125
  * gathered at the two vertices; the denoiser and the blur preserve a constant image. */
