@@ -95,26 +95,6 @@ static void compare(const char *scene, const char *method, int w, int h, int spp
     fv_scene_destroy(s);
 }
 
-static fv_technique *create(const char *method, const char *params, const fv_scene *s)
-{
-    fv_params *p = fv_test_params_str(params);
-    fv_technique *t = NULL;
-    fv_error err;
-    if (fv_technique_create(method, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s %s: %s", method, params, err.msg);
-    fv_params_destroy(p);
-    return t;
-}
-
-static void frame_into(fv_technique *t, const fv_frame *f, fv_film *film, fv_stats *stats)
-{
-    fv_film_clear(film);
-    float *col = fv_film_color(film);
-    for (size_t k = 0, m = (size_t)3 * fv_film_width(film) * fv_film_height(film); k < m; k++) col[k] = NAN;
-    fv_error err;
-    fv_stats_clear(stats);
-    if (fv_technique_render(t, f, film, stats, &err) != FV_OK) fail_msg("%s: frame %d: %s", fv_technique_name_of(t), f->index, err.msg);
-}
-
 /* ipr or fipr on portable and twice on CUDA over frames x eyes with a moving gaze. */
 static void compare_pyramid(const char *scene, const char *method, const char *params, int w, int h, int frames, int eyes)
 {
@@ -126,7 +106,7 @@ static void compare_pyramid(const char *scene, const char *method, const char *p
     char pp[160], pc[160];
     snprintf(pp, sizeof pp, "%s device=portable", params);
     snprintf(pc, sizeof pc, "%s device=cuda", params);
-    fv_technique *tp = create(method, pp, s), *tc = create(method, pc, s), *tc2 = create(method, pc, s);
+    fv_technique *tp = fv_test_technique(method, pp, s), *tc = fv_test_technique(method, pc, s), *tc2 = fv_test_technique(method, pc, s);
     fv_film *p = NULL, *c1 = NULL, *c2 = NULL;
     fv_error err;
     const int aux = FV_AUX_DEPTH | FV_AUX_NORMAL | FV_AUX_ID;
@@ -146,11 +126,11 @@ static void compare_pyramid(const char *scene, const char *method, const char *p
             f.gaze.x = 0.3f + 0.1f * (float)i + 0.05f * (float)e;
             f.gaze.y = 0.6f - 0.07f * (float)i;
             fv_stats sp, sc, sc2;
-            frame_into(tp, &f, p, &sp);
+            fv_test_render_fresh(tp, &f, p, &sp);
             fv_sim_mark m = fv_sim_now();
-            frame_into(tc, &f, c1, &sc);
+            fv_test_render_fresh(tc, &f, c1, &sc);
             fv_sim_expect(m, 1, -1, method); /* what host_syncs reports (checked below) is what the host did */
-            frame_into(tc2, &f, c2, &sc2);
+            fv_test_render_fresh(tc2, &f, c2, &sc2);
             fv_test_agreement r = fv_test_agree(p, c1, 1e-4);
             const float *a = fv_film_color_const(p), *b = fv_film_color_const(c1);
             double max_abs = 0.0;
@@ -235,7 +215,7 @@ static void compare_pair(const char *scene, const char *method, const char *para
     char pp[160], pc[160];
     snprintf(pp, sizeof pp, "%s device=portable", params);
     snprintf(pc, sizeof pc, "%s device=cuda", params);
-    fv_technique *tp = create(method, pp, s), *pair = create(method, pc, s), *each = create(method, pc, s);
+    fv_technique *tp = fv_test_technique(method, pp, s), *pair = fv_test_technique(method, pc, s), *each = fv_test_technique(method, pc, s);
     fv_film *p[2], *c[2], *e1[2];
     fv_error err;
     const int aux = FV_AUX_DEPTH | FV_AUX_NORMAL | FV_AUX_ID;

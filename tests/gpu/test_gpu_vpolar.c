@@ -39,27 +39,6 @@
 #define AUX (FV_AUX_DEPTH | FV_AUX_NORMAL | FV_AUX_ALBEDO | FV_AUX_ID | FV_AUX_POSITION)
 #define FRAMES 4
 
-static fv_technique *create(const char *method, const char *params, const fv_scene *s)
-{
-    fv_params *p = fv_test_params_str(params);
-    fv_technique *t = NULL;
-    fv_error err;
-    if (fv_technique_create(method, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s %s: %s", method, params, err.msg);
-    fv_params_destroy(p);
-    return t;
-}
-
-/* One frame of t into film (cleared, colour NaN first, so an unwritten pixel cannot pass). */
-static void frame_into(fv_technique *t, const fv_frame *f, fv_film *film, fv_stats *stats)
-{
-    fv_film_clear(film);
-    float *col = fv_film_color(film);
-    for (size_t k = 0, m = (size_t)3 * fv_film_width(film) * fv_film_height(film); k < m; k++) col[k] = NAN;
-    fv_error err;
-    fv_stats_clear(stats);
-    if (fv_technique_render(t, f, film, stats, &err) != FV_OK) fail_msg("%s: frame %d: %s", fv_technique_name_of(t), f->index, err.msg);
-}
-
 static double rms(const float *a, const float *b, size_t n)
 {
     double sum = 0.0;
@@ -79,7 +58,7 @@ static void compare(const char *scene, const char *method, const char *params, i
     snprintf(pp, sizeof pp, "%s device=portable", params);
     snprintf(pc, sizeof pc, "%s device=cuda", params);
     /* tp and tc draw the same random numbers; tn (portable on another seed) is the noise yardstick */
-    fv_technique *tp = create(method, pp, s), *tn = create(method, pp, s), *tc = create(method, pc, s), *tc2 = create(method, pc, s);
+    fv_technique *tp = fv_test_technique(method, pp, s), *tn = fv_test_technique(method, pp, s), *tc = fv_test_technique(method, pc, s), *tc2 = fv_test_technique(method, pc, s);
     fv_film *p = NULL, *n2 = NULL, *c1 = NULL, *c2 = NULL;
     fv_error err;
     if (fv_film_create(w, h, AUX, &p, &err) != FV_OK || fv_film_create(w, h, AUX, &n2, &err) != FV_OK ||
@@ -101,11 +80,11 @@ static void compare(const char *scene, const char *method, const char *params, i
             f.gaze.x = gaze[i][0] + 0.03f * (float)e;
             f.gaze.y = gaze[i][1];
             fv_stats sp, sn, sc, sc2;
-            frame_into(tp, &f, p, &sp);
-            frame_into(tc, &f, c1, &sc);
-            frame_into(tc2, &f, c2, &sc2);
+            fv_test_render_fresh(tp, &f, p, &sp);
+            fv_test_render_fresh(tc, &f, c1, &sc);
+            fv_test_render_fresh(tc2, &f, c2, &sc2);
             f.seed = 8;
-            frame_into(tn, &f, n2, &sn);
+            fv_test_render_fresh(tn, &f, n2, &sn);
             char what[256];
             snprintf(what, sizeof what, "%s [%s] %s %dx%d frame %d eye %d", method, params, scene, w, h, i, e);
             const float *a = fv_film_color_const(p), *b = fv_film_color_const(c1);

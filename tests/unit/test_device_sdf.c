@@ -122,27 +122,6 @@ static void compare_counters(const char *what, const fv_stats *sc, const fv_stat
     }
 }
 
-static fv_technique *create(const char *method, const char *params, const fv_scene *s)
-{
-    fv_params *p = fv_test_params_str(params);
-    fv_technique *t = NULL;
-    fv_error err;
-    if (fv_technique_create(method, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s %s: %s", method, params, err.msg);
-    fv_params_destroy(p);
-    return t;
-}
-
-/* One frame of t into film (cleared, colour NaN first, so an unwritten pixel cannot pass). */
-static void render_frame(fv_technique *t, const fv_frame *f, fv_film *film, fv_stats *stats)
-{
-    fv_film_clear(film);
-    float *col = fv_film_color(film);
-    for (size_t k = 0, m = (size_t)3 * fv_film_width(film) * fv_film_height(film); k < m; k++) col[k] = NAN;
-    fv_error err;
-    fv_stats_clear(stats);
-    if (fv_technique_render(t, f, film, stats, &err) != FV_OK) fail_msg("%s: frame %d: %s", fv_technique_name_of(t), f->index, err.msg);
-}
-
 /* ipr or fipr (params besides the device) on both backends over `frames` frames of `eyes` eyes
  * (1 or 2), the gaze moving from frame to frame; every frame's film and counters must be equal.
  * Returns the last frame's portable stats in *last. */
@@ -156,7 +135,7 @@ static void compare_pyramid(const char *scene, const char *method, const char *p
     char pc[160], pp[160];
     snprintf(pc, sizeof pc, "%s device=cpu", params);
     snprintf(pp, sizeof pp, "%s device=portable", params);
-    fv_technique *tc = create(method, pc, s), *tp = create(method, pp, s);
+    fv_technique *tc = fv_test_technique(method, pc, s), *tp = fv_test_technique(method, pp, s);
     fv_film *a = NULL, *b = NULL;
     fv_error err;
     if (fv_film_create(w, h, AUX, &a, &err) != FV_OK || fv_film_create(w, h, AUX, &b, &err) != FV_OK) fail_msg("%s", err.msg);
@@ -178,8 +157,8 @@ static void compare_pyramid(const char *scene, const char *method, const char *p
             f.gaze.x = 0.3f + 0.1f * (float)i + 0.05f * (float)e;
             f.gaze.y = 0.6f - 0.07f * (float)i;
             fv_stats sc, sp;
-            render_frame(tc, &f, a, &sc);
-            render_frame(tp, &f, b, &sp);
+            fv_test_render_fresh(tc, &f, a, &sc);
+            fv_test_render_fresh(tp, &f, b, &sp);
             double max_abs = 0.0, sum = 0.0;
             const float *ca = fv_film_color_const(a);
             for (size_t k = 0; k < 3 * n; k++) sum += ca[k];
@@ -323,7 +302,7 @@ static void compare_pair(const char *scene, const char *method, const char *para
     char pp[160], pc[160];
     snprintf(pp, sizeof pp, "%s device=portable", params);
     snprintf(pc, sizeof pc, "%s device=cpu", params);
-    fv_technique *each = create(method, pp, s), *pair = create(method, pp, s), *cpu = create(method, pc, s);
+    fv_technique *each = fv_test_technique(method, pp, s), *pair = fv_test_technique(method, pp, s), *cpu = fv_test_technique(method, pc, s);
     fv_film *a[2], *b[2], *c[2];
     fv_error err;
     for (int e = 0; e < 2; e++)
@@ -417,7 +396,7 @@ static void test_pair_refusals(void **st)
     assert_int_equal(fv_test_load("sdf-primitives", &s, &v), 0);
     fv_camera cam;
     fv_view_camera(v, s, 0.0, 16, 12, &cam);
-    fv_technique *t = create("sdf-gt", "device=portable", s);
+    fv_technique *t = fv_test_technique("sdf-gt", "device=portable", s);
     fv_film *films[2];
     fv_error err;
     for (int e = 0; e < 2; e++) assert_int_equal(fv_film_create(16, 12, 0, &films[e], &err), FV_OK);

@@ -40,27 +40,6 @@
 
 #define AUX (FV_AUX_DEPTH | FV_AUX_NORMAL | FV_AUX_ALBEDO | FV_AUX_ID | FV_AUX_POSITION)
 
-static fv_technique *create(const char *method, const char *params, const fv_scene *s)
-{
-    fv_params *p = fv_test_params_str(params);
-    fv_technique *t = NULL;
-    fv_error err;
-    if (fv_technique_create(method, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s %s: %s", method, params, err.msg);
-    fv_params_destroy(p);
-    return t;
-}
-
-/* One frame of t into film (cleared, colour NaN first, so an unwritten pixel cannot pass). */
-static void render_frame(fv_technique *t, const fv_frame *f, fv_film *film, fv_stats *stats)
-{
-    fv_film_clear(film);
-    float *col = fv_film_color(film);
-    for (size_t k = 0, m = (size_t)3 * fv_film_width(film) * fv_film_height(film); k < m; k++) col[k] = NAN;
-    fv_error err;
-    fv_stats_clear(stats);
-    if (fv_technique_render(t, f, film, stats, &err) != FV_OK) fail_msg("%s: frame %d: %s", fv_technique_name_of(t), f->index, err.msg);
-}
-
 /* Root of the mean squared difference of two colour images. */
 static double rms(const float *a, const float *b, size_t n)
 {
@@ -80,7 +59,7 @@ static void compare_method(const char *scene, const char *method, const char *pa
     snprintf(pc, sizeof pc, "%s device=cpu", params);
     snprintf(pp, sizeof pp, "%s device=portable", params);
     /* tc and tp draw the same random numbers; tn (the CPU on another seed) is the noise yardstick */
-    fv_technique *tc = create(method, pc, s), *tp = create(method, pp, s), *tn = create(method, pc, s);
+    fv_technique *tc = fv_test_technique(method, pc, s), *tp = fv_test_technique(method, pp, s), *tn = fv_test_technique(method, pc, s);
     fv_film *a = NULL, *b = NULL, *c = NULL;
     fv_error err;
     if (fv_film_create(w, h, AUX, &a, &err) != FV_OK || fv_film_create(w, h, AUX, &b, &err) != FV_OK ||
@@ -98,10 +77,10 @@ static void compare_method(const char *scene, const char *method, const char *pa
         f.gaze.x = gaze[i][0];
         f.gaze.y = gaze[i][1];
         fv_stats sc, sp, sn;
-        render_frame(tc, &f, a, &sc);
-        render_frame(tp, &f, b, &sp);
+        fv_test_render_fresh(tc, &f, a, &sc);
+        fv_test_render_fresh(tp, &f, b, &sp);
         f.seed = 8;
-        render_frame(tn, &f, c, &sn);
+        fv_test_render_fresh(tn, &f, c, &sn);
         const float *ca = fv_film_color_const(a), *cb = fv_film_color_const(b);
         size_t exact = 0, ids = 0, depths = 0;
         for (size_t k = 0; k < 3 * n; k++) {

@@ -138,6 +138,30 @@ static inline void fv_test_render_frames(fv_technique *t, const fv_frame *first,
     if (stats) *stats = s;
 }
 
+/* A technique of `method` with the parameters `list` (as fv_test_params_str) in scene s; fails the
+ * test when it cannot be made. */
+static inline fv_technique *fv_test_technique(const char *method, const char *list, const fv_scene *s)
+{
+    fv_params *p = fv_test_params_str(list);
+    fv_technique *t = NULL;
+    fv_error err;
+    if (fv_technique_create(method, s, p, NULL, &t, &err) != FV_OK) fail_msg("%s %s: %s", method, list, err.msg);
+    fv_params_destroy(p);
+    return t;
+}
+
+/* One frame of t into film, its colour set to NaN first so that a pixel the technique does not
+ * write cannot pass a comparison; *stats (cleared first) receives the frame's costs. */
+static inline void fv_test_render_fresh(fv_technique *t, const fv_frame *f, fv_film *film, fv_stats *stats)
+{
+    fv_film_clear(film);
+    float *col = fv_film_color(film);
+    for (size_t k = 0, m = (size_t)3 * fv_film_width(film) * fv_film_height(film); k < m; k++) col[k] = NAN;
+    fv_error err;
+    fv_stats_clear(stats);
+    if (fv_technique_render(t, f, film, stats, &err) != FV_OK) fail_msg("%s: frame %d: %s", fv_technique_name_of(t), f->index, err.msg);
+}
+
 /* One frame (index 0, `seed`) of `method` with the parameters `list` (as fv_test_params_str) in
  * scene s through cam, into a new film the caller destroys. Fails the test on any error. */
 static inline fv_film *fv_test_render_once(const char *method, const char *list, const fv_scene *s, const fv_camera *cam, uint64_t seed)
