@@ -128,13 +128,17 @@ typedef struct fv_cuda_vp_result {
     double history_fraction;   /* the denoiser's (fv_svgf_info) */
     double kernel_ms;          /* the frame's launches, first to last (events) */
     double stage_ms[5];        /* trace, denoise, mip, map, blur (events) */
-    int syncs;                 /* host waits in the frame: 1 (the end) */
+    int syncs;                 /* host waits in the frame: 1 (the end; 0 for a pair's eye 1) */
 } fv_cuda_vp_result;
 
-/* Renders the frame: every stage a kernel (or a sequence of kernels) on one stream with no host wait
- * between them; the host receives the film's buffers that are set (colour, and the auxiliary ones
- * asked for) and the counts. */
-fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res, fv_error *err);
+/* Renders `eyes` frames (1, or 2: a stereo pair, one backend, frame, film and result per eye, each
+ * eye's buffers and history its own backend's): every stage a kernel (or a sequence of kernels) on
+ * the eye's stream with no host wait between them, every eye's frame queued before the host waits
+ * once (eye 1's stream is joined to eye 0's by an event, and eye 0's is synchronized); the host
+ * receives each eye's film buffers that are set (colour, and the auxiliary ones asked for) and
+ * counts. The one wait is res[0].syncs (1); res[1].syncs is 0. */
+fv_status fv_cuda_vp_render(fv_cuda_vp *const *c, int eyes, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res,
+                            fv_error *err);
 
 #ifdef __cplusplus
 }

@@ -66,9 +66,10 @@ fv_status fv_cuda_vp_create(const struct fv_kscene *host, fv_cuda_vp **out, fv_e
 
 void fv_cuda_vp_destroy(fv_cuda_vp *c) { (void)c; }
 
-fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res, fv_error *err)
+fv_status fv_cuda_vp_render(fv_cuda_vp *const *c, int eyes, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res,
+                            fv_error *err)
 {
-    (void)c, (void)f, (void)out, (void)res;
+    (void)c, (void)eyes, (void)f, (void)out, (void)res;
     return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
 }
 #else

@@ -23,6 +23,13 @@
  *  - the denoiser's history fraction within 0.01 of the portable one;
  *  - two CUDA runs bit-identical (colour and first-hit buffers).
  * If the GPU shows more, the printout says where, and the bounds are revised with that measurement.
+ *
+ * A stereo frame through fv_technique_render_pair (both eyes' whole frames queued, each on its own
+ * pipeline and stream, then one host wait for the pair) must equal the two per-eye CUDA calls bit
+ * for bit, every film buffer and counter, over frames whose gaze moves and then stays, with
+ * host_syncs 1 per pair against 2 for the two calls; the portable backend's pair (its per-eye
+ * calls) likewise. Built a second time against the CUDA simulator (sim_test_gpu_vpolar,
+ * tests/gpu/sim_checks.h), where the host's waits are also counted.
  * Exits 77 (skipped) where CUDA cannot run: a build without CUDA, a machine without a GPU.
  */
 #include <math.h>
@@ -35,6 +42,7 @@
 #include <cmocka.h>
 #include "fovea/fovea.h"
 #include "../unit/testkit.h"
+#include "sim_checks.h"
 
 #define AUX (FV_AUX_DEPTH | FV_AUX_NORMAL | FV_AUX_ALBEDO | FV_AUX_ID | FV_AUX_POSITION)
 #define FRAMES 4
@@ -179,15 +187,122 @@ static void test_moving(void **st)
     compare("cornell-fpm", "vpolar", "", 128, 96, 1, 0.25);
 }
 
+static void films_equal(fv_film *a, fv_film *b, const char *what)
+{
+    const size_t n = (size_t)fv_film_width(a) * fv_film_height(a);
+    if (memcmp(fv_film_color_const(a), fv_film_color_const(b), 3 * n * sizeof(float)) != 0 ||
+        memcmp(fv_film_depth(a), fv_film_depth(b), n * sizeof(float)) != 0 || memcmp(fv_film_normal(a), fv_film_normal(b), 3 * n * sizeof(float)) != 0 ||
+        memcmp(fv_film_albedo(a), fv_film_albedo(b), 3 * n * sizeof(float)) != 0 ||
+        memcmp(fv_film_position(a), fv_film_position(b), 3 * n * sizeof(float)) != 0 ||
+        memcmp(fv_film_id_const(a), fv_film_id_const(b), n * sizeof(uint32_t)) != 0)
+        fail_msg("%s: the pair differs from the per-eye calls", what);
+}
+
+/* frames stereo frames of method on device: its pairs (fv_technique_render_pair) against its
+ * per-eye calls (another technique, the same random numbers), bit for bit, host_syncs 1 a pair on
+ * cuda (2 for the two calls). The gaze moves over the first frames, then stays. */
+static void compare_pair(const char *method, const char *params, const char *device, int w, int h, int frames)
+{
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load("cornell", &s, &v) != 0) fail_msg("cannot load cornell");
+    fv_camera centre, cam[2];
+    fv_view_camera(v, s, 0.0, w, h, &centre);
+    fv_camera_stereo(&centre, 0.08f, &cam[0], &cam[1]);
+    char pc[160];
+    snprintf(pc, sizeof pc, "%s device=%s", params, device);
+    const bool cuda = strcmp(device, "cuda") == 0;
+    fv_technique *pair = fv_test_technique(method, pc, s), *each = fv_test_technique(method, pc, s);
+    fv_film *c[2], *e1[2];
+    fv_error err;
+    for (int e = 0; e < 2; e++)
+        if (fv_film_create(w, h, AUX, &c[e], &err) != FV_OK || fv_film_create(w, h, AUX, &e1[e], &err) != FV_OK) fail_msg("%s", err.msg);
+    static const float gaze[][2] = {{0.3f, 0.4f}, {0.6f, 0.55f}, {0.62f, 0.57f}, {0.62f, 0.57f}};
+    const int ngaze = (int)(sizeof gaze / sizeof gaze[0]);
+    const size_t n = (size_t)w * h;
+    for (int i = 0; i < frames; i++) {
+        fv_frame f[2];
+        for (int e = 0; e < 2; e++) {
+            fv_frame_init(&f[e], &cam[e]);
+            f[e].seed = 7;
+            f[e].index = i;
+            f[e].eye = e;
+            f[e].eye_count = 2;
+            f[e].prev_camera = i > 0 ? &cam[e] : NULL;
+            f[e].left_camera = e == 1 ? &cam[0] : NULL;
+            f[e].gaze.x = gaze[i < ngaze ? i : ngaze - 1][0] + 0.03f * (float)e;
+            f[e].gaze.y = gaze[i < ngaze ? i : ngaze - 1][1];
+            fv_film_clear(c[e]);
+            fv_film_clear(e1[e]);
+            float *cc = fv_film_color(c[e]), *ce = fv_film_color(e1[e]);
+            for (size_t k = 0; k < 3 * n; k++) cc[k] = ce[k] = NAN;
+        }
+        char what[256];
+        snprintf(what, sizeof what, "%s [%s] on %s %dx%d stereo frame %d", method, params, device, w, h, i);
+        fv_stats sc, se;
+        fv_stats_clear(&sc);
+        fv_stats_clear(&se);
+        fv_sim_mark m = fv_sim_now();
+        if (fv_technique_render_pair(pair, f, c, &sc, &err) != FV_OK) fail_msg("%s: %s", what, err.msg);
+        if (cuda) fv_sim_expect(m, 1, -1, what); /* what host_syncs reports (checked below) is what the host did */
+        m = fv_sim_now();
+        for (int e = 0; e < 2; e++)
+            if (fv_technique_render(each, &f[e], e1[e], &se, &err) != FV_OK) fail_msg("%s eye %d: %s", what, e, err.msg);
+        if (cuda) fv_sim_expect(m, 2, -1, what);
+        printf("%s: host syncs %g for the pair, %g for two calls; samples %g, history %.4f\n", what, fv_stats_get_count(&sc, "host_syncs"),
+               fv_stats_get_count(&se, "host_syncs"), fv_stats_get_count(&sc, "samples"), fv_stats_get_count(&sc, "history_fraction"));
+        for (int e = 0; e < 2; e++) {
+            char we[280];
+            snprintf(we, sizeof we, "%s eye %d", what, e);
+            films_equal(c[e], e1[e], we);
+            const float *col = fv_film_color_const(c[e]);
+            for (size_t k = 0; k < 3 * n; k++)
+                if (!isfinite(col[k])) fail_msg("%s: value %zu not finite (%g)", we, k, col[k]);
+        }
+        static const char *const keys[] = {"rays", "samples", "grid_samples", "sample_share", "nan_samples", "history_fraction", "map_reused"};
+        for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
+            if (fv_stats_get_count(&sc, keys[k]) != fv_stats_get_count(&se, keys[k]))
+                fail_msg("%s: counter %s: pair %g, per eye %g", what, keys[k], fv_stats_get_count(&sc, keys[k]), fv_stats_get_count(&se, keys[k]));
+        if (!(fv_stats_get_count(&sc, "samples") > 0.0)) fail_msg("%s: no sample traced", what);
+        if (i > 0 && strstr(params, "denoise=false") == NULL && !(fv_stats_get_count(&sc, "history_fraction") > 0.0))
+            fail_msg("%s: no history reused", what);
+        const double want_pair = cuda ? 1.0 : 0.0, want_each = cuda ? 2.0 : 0.0;
+        if (fv_stats_get_count(&sc, "host_syncs") != want_pair) fail_msg("%s: %g host waits for the pair", what, fv_stats_get_count(&sc, "host_syncs"));
+        if (fv_stats_get_count(&se, "host_syncs") != want_each)
+            fail_msg("%s: %g host waits for two eyes", what, fv_stats_get_count(&se, "host_syncs"));
+    }
+    for (int e = 0; e < 2; e++) {
+        fv_film_destroy(c[e]);
+        fv_film_destroy(e1[e]);
+    }
+    fv_technique_destroy(pair);
+    fv_technique_destroy(each);
+    if (cuda) fv_sim_expect_freed(method);
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
+/* Stereo pairs: vpolar (the gaze moving, so each eye's history is reprojected from one gaze's space
+ * into another's), linear-falloff (its killed samples) and cartesian (no mipmaps' levels beyond
+ * one) on cuda; vpolar's pair on portable. */
+static void test_pair(void **st)
+{
+    (void)st;
+    compare_pair("vpolar", "", "cuda", 96, 64, 4);
+    compare_pair("linear-falloff", "", "cuda", 96, 64, 3);
+    compare_pair("cartesian", "denoise=false", "cuda", 96, 64, 3);
+    compare_pair("vpolar", "", "portable", 96, 64, 3);
+}
+
 int main(void)
 {
     char why[256];
     if (!fv_device_available(FV_DEVICE_CUDA, why, sizeof why)) {
         printf("skipped: %s\n", why);
-        return 77;
+        return FV_GPU_TEST_NO_DEVICE;
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_vpolar),         cmocka_unit_test(test_cartesian), cmocka_unit_test(test_cartesian_full),
                                        cmocka_unit_test(test_linear_falloff), cmocka_unit_test(test_logpolar),  cmocka_unit_test(test_svgf_passes),
-                                       cmocka_unit_test(test_moving)};
+                                       cmocka_unit_test(test_moving),         cmocka_unit_test(test_pair)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -19,7 +19,10 @@
  * reprojection needs (the previous view's), so one buffer serves both in stream order.
  *
  * The host waits once a frame, at the end, for the film's buffers that are set and the counters
- * (the trace's, and SVGF's per row: res->syncs = 1). SVGF's step 6 (the holes) is launched every
+ * (the trace's, and SVGF's per row: res->syncs = 1). A stereo pair (fv_cuda_vp_render with two
+ * eyes, each its own fv_cuda_vp: buffers, history and stream) queues both eyes' frames and
+ * read-backs, joins eye 1's stream to eye 0's with an event and waits once for eye 0's stream, so
+ * the pair costs one wait, as one eye does. SVGF's step 6 (the holes) is launched every
  * frame rather than only when the rows count a hole, which would need a wait; on a frame without
  * holes it changes nothing (kernel/svgf.h). Stage times come from events between the stages.
  *
@@ -80,6 +83,8 @@ struct fv_cuda_vp {
     size_t shape_cap;             /* floats */
     fv_cuda_mirror col_h, onscreen, shape, lut, blur_off, blur_k;
     unsigned long long *counts;   /* rays, paths, non-finite paths */
+    unsigned long long counts_host[3]; /* their copy, read back with the film (a pair reads both eyes' before its one wait) */
+    cudaEvent_t queued;           /* after the frame's read-back: a pair's eye 1 joins eye 0's stream here */
     dev_svgf svgf;
 };
 
@@ -472,6 +477,7 @@ extern "C" void fv_cuda_vp_destroy(fv_cuda_vp *c)
     cudaFree(c->counts);
     for (int i = 0; i <= ST_COUNT; i++)
         if (c->ev[i]) cudaEventDestroy(c->ev[i]);
+    if (c->queued) cudaEventDestroy(c->queued);
     if (c->stream) cudaStreamDestroy(c->stream);
     free(c);
 }
@@ -486,6 +492,7 @@ extern "C" fv_status fv_cuda_vp_create(const fv_kscene *host, fv_cuda_vp **out, 
     if (s == FV_OK && (e = cudaStreamCreate(&c->stream)) != cudaSuccess) s = fv_cuda_fail(e, "creating a stream", err);
     for (int i = 0; s == FV_OK && i <= ST_COUNT; i++)
         if ((e = cudaEventCreate(&c->ev[i])) != cudaSuccess) s = fv_cuda_fail(e, "creating events", err);
+    if (s == FV_OK && (e = cudaEventCreate(&c->queued)) != cudaSuccess) s = fv_cuda_fail(e, "creating events", err);
     if (s == FV_OK && (e = cudaMalloc((void **)&c->counts, 3 * sizeof(unsigned long long))) != cudaSuccess)
         s = fv_cuda_fail(e, "allocating counters", err);
     if (s != FV_OK) {
@@ -522,12 +529,11 @@ static fv_status check_frame(const fv_cuda_vp_frame *f, fv_error *err)
     return bad ? fv_error_set(err, FV_ERR_INTERNAL, "CUDA: Visual-Polar frame: %s", bad) : FV_OK;
 }
 
-extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res,
-                                       fv_error *err)
+/* Queues one eye's frame on its stream, then the copies of its film's buffers that are set and its
+ * counters to the host; nothing waits. */
+static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_error *err)
 {
-    memset(res, 0, sizeof *res);
-    fv_status s = check_frame(f, err);
-    if (s != FV_OK) return s;
+    fv_status s;
     const int gw = f->trace.space.gw, gh = f->trace.space.gh, sw = f->trace.space.sw, sh = f->trace.space.sh;
     const size_t n = (size_t)gw * (size_t)gh, ns = (size_t)sw * (size_t)sh;
     cudaStream_t st = c->stream;
@@ -603,15 +609,19 @@ extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f,
     cudaEventRecord(c->ev[ST_COUNT], st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the Visual-Polar kernels", err);
 
-    /* The one host wait: the film's buffers that are set and the counters. */
-    unsigned long long counts[3] = {0, 0, 0};
+    /* What the host receives after the wait: the film's buffers that are set and the counters. */
+    memset(c->counts_host, 0, sizeof c->counts_host);
     e = fv_cuda_film_read_async(&c->film, out, ns, st);
-    if (e == cudaSuccess) e = cudaMemcpyAsync(counts, c->counts, sizeof counts, cudaMemcpyDeviceToHost, st);
+    if (e == cudaSuccess) e = cudaMemcpyAsync(c->counts_host, c->counts, sizeof c->counts_host, cudaMemcpyDeviceToHost, st);
     if (e == cudaSuccess && f->denoise) e = svgf_read_rows(&c->svgf, st);
-    if (e == cudaSuccess) e = cudaStreamSynchronize(st);
-    res->syncs = 1;
-    if (e != cudaSuccess) return fv_cuda_fail(e, "running the Visual-Polar kernels", err);
-    res->rays = counts[0], res->paths = counts[1], res->nan_paths = counts[2];
+    if (e == cudaSuccess) e = cudaEventRecord(c->queued, st);
+    return e == cudaSuccess ? FV_OK : fv_cuda_fail(e, "reading the Visual-Polar frame back", err);
+}
+
+/* One eye's result from what was read back (after the wait). */
+static void frame_result(fv_cuda_vp *c, const fv_cuda_vp_frame *f, fv_cuda_vp_result *res)
+{
+    res->rays = c->counts_host[0], res->paths = c->counts_host[1], res->nan_paths = c->counts_host[2];
     if (f->denoise) {
         const dev_svgf *d = &c->svgf;
         double mean_history;
@@ -625,5 +635,31 @@ extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *c, const fv_cuda_vp_frame *f,
     float ms = 0.0f;
     cudaEventElapsedTime(&ms, c->ev[ST_TRACE], c->ev[ST_COUNT]);
     res->kernel_ms = ms;
+}
+
+extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *const *c, int eyes, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res,
+                                       fv_error *err)
+{
+    if (eyes < 1 || eyes > 2) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: Visual-Polar frames for %d eyes", eyes);
+    fv_status s;
+    for (int e = 0; e < eyes; e++) {
+        memset(&res[e], 0, sizeof res[e]);
+        if ((s = check_frame(&f[e], err)) != FV_OK) return s;
+    }
+    if (eyes == 2 && c[0] == c[1]) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: a stereo pair's eyes share their buffers");
+    /* Every eye queued (each on its own stream, so a pair's two eyes may run side by side), then
+     * the one host wait: eye 0's stream, which waits for eye 1's read-back first. A pair thus costs
+     * one round trip, as a single eye does. */
+    for (int e = 0; e < eyes; e++)
+        if ((s = launch_frame(c[e], &f[e], &out[e], err)) != FV_OK) {
+            /* nothing queued may write into a film after the caller has its error */
+            for (int q = 0; q <= e; q++) cudaStreamSynchronize(c[q]->stream);
+            return s;
+        }
+    cudaError_t ce = eyes == 2 ? cudaStreamWaitEvent(c[0]->stream, c[1]->queued, 0) : cudaSuccess;
+    if (ce == cudaSuccess) ce = cudaStreamSynchronize(c[0]->stream);
+    res[0].syncs = 1;
+    if (ce != cudaSuccess) return fv_cuda_fail(ce, "running the Visual-Polar kernels", err);
+    for (int e = 0; e < eyes; e++) frame_result(c[e], &f[e], &res[e]);
     return FV_OK;
 }

@@ -199,12 +199,18 @@ bool fv_vp_device_whole_frame(const fv_vp_device *d)
     return d->cuda != NULL;
 }
 
-fv_status fv_vp_device_frame(fv_vp_device *d, fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res, fv_error *err)
+fv_status fv_vp_device_frames(fv_vp_device *const *d, int eyes, fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res,
+                              fv_error *err)
 {
-    if (!d->cuda) return fv_error_set(err, FV_ERR_INTERNAL, "whole frames need device cuda");
-    /* the flat scene at the frame's time (moving instances); the GPU copies what moved */
-    fv_status s = fv_scene_export_update(d->flat, d->scene, err);
-    if (s != FV_OK) return s;
-    f->scene = fv_scene_export_view(d->flat);
-    return fv_cuda_vp_render(d->cuda, f, out, res, err);
+    fv_cuda_vp *c[2];
+    if (eyes < 1 || eyes > 2) return fv_error_set(err, FV_ERR_INTERNAL, "whole frames for %d eyes", eyes);
+    for (int e = 0; e < eyes; e++) {
+        if (!d[e]->cuda) return fv_error_set(err, FV_ERR_INTERNAL, "whole frames need device cuda");
+        /* the flat scene at the frame's time (moving instances); the GPU copies what moved */
+        fv_status s = fv_scene_export_update(d[e]->flat, d[e]->scene, err);
+        if (s != FV_OK) return s;
+        f[e].scene = fv_scene_export_view(d[e]->flat);
+        c[e] = d[e]->cuda;
+    }
+    return fv_cuda_vp_render(c, eyes, f, out, res, err);
 }

@@ -8,9 +8,10 @@
  * (kernel/vp_reproject.h) and its steps (kernel/svgf.h, a pixel at a time, filter/svgf_kernels.h),
  * its buffers and history kept here between frames.
  *
- * The CUDA backend (device/cuda/vpolar.cu) takes a whole frame instead (fv_vp_device_frame): the
+ * The CUDA backend (device/cuda/vpolar.cu) takes a whole frame instead (fv_vp_device_frames): the
  * stages follow one another on the GPU with no host wait between them, and the grid, SVGF's buffers
- * and history, the mipmaps and the film stay there.
+ * and history, the mipmaps and the film stay there; a stereo pair's two eyes (a device each) are
+ * queued together and waited for once.
  */
 #ifndef FV_TECHNIQUE_VPOLAR_DEVICE_H
 #define FV_TECHNIQUE_VPOLAR_DEVICE_H
@@ -30,11 +31,14 @@ typedef struct fv_vp_device fv_vp_device;
 fv_status fv_vp_device_create(const fv_scene *scene, fv_device device, fv_vp_device **out, fv_error *err);
 void fv_vp_device_destroy(fv_vp_device *d);
 
-/* True for a backend that renders whole frames (cuda: fv_vp_device_frame); false for one that runs
+/* True for a backend that renders whole frames (cuda: fv_vp_device_frames); false for one that runs
  * the stages below one at a time (portable). */
 bool fv_vp_device_whole_frame(const fv_vp_device *d);
-/* A whole frame (f's scene is set here, to the flat scene at the frame's time) into out. */
-fv_status fv_vp_device_frame(fv_vp_device *d, fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res, fv_error *err);
+/* Whole frames of `eyes` eyes (1, or 2: a stereo pair, a device, frame, film and result per eye;
+ * each f's scene is set here, to its device's flat scene at the frame's time) into out, with one
+ * host wait for them all (fv_cuda_vp_render). */
+fv_status fv_vp_device_frames(fv_vp_device *const *d, int eyes, fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res,
+                              fv_error *err);
 
 /* The trace stage: every valid cell of the job's grid into g, as fv_vp_trace (the launch order
  * changes nothing: each sample has its own random stream). *done false: cancelled. */

@@ -366,14 +366,31 @@ static void reproject_frame(const fv_vp_pipeline *p, fv_kvp_reproject_frame *rf)
     rf->inv_step = 1.0f / LUT_STEP;
 }
 
+/* A whole frame for a device that takes one, as the host prepared it: the device's frame, the
+ * film's views and the blur's kernels (host memory the frame points to until the device has it). */
+typedef struct whole_frame {
+    fv_cuda_vp_frame f;
+    fv_film_views out;
+    int *off;
+    float *k;
+} whole_frame;
+
+static void whole_free(whole_frame *w)
+{
+    free(w->off), free(w->k);
+    w->off = NULL, w->k = NULL;
+}
+
 /* A whole frame on a device that takes one (cuda: device/cuda/vpolar.cu): the host builds what
  * depends on the screen size and the gaze (the on-screen mask above, the radial table, the blur's
  * kernels) and receives the film and the counts; the grid, the denoiser's history coordinates,
  * SVGF's buffers and history and the mipmaps stay on the device (the host's copies of the grid stay
- * unused). The stage times are the device's (events). */
-static fv_status render_whole(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, const fv_vp_trace_job *job,
-                              const fv_space_view *view, fv_kit_progress *prog, fv_error *err)
+ * unused). whole_prepare builds the frame, fv_vp_device_frames renders it (with the other eye's, for
+ * a stereo pair), whole_finish takes its result. The stage times are the device's (events). */
+static fv_status whole_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, const fv_vp_trace_job *job,
+                               const fv_space_view *view, whole_frame *w, fv_error *err)
 {
+    memset(w, 0, sizeof *w);
     const fv_grid *g = fv_space_grid(p->space);
     const bool polar = fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN;
     fv_cuda_vp_frame f;
@@ -423,11 +440,16 @@ static fv_status render_whole(fv_vp_pipeline *p, const fv_frame *frame, fv_film 
         f.blur_table = (fv_kblur_table){p->sw, p->sh, (p->sw > p->sh ? p->sw : p->sh) - 1, nq, off, k};
         f.blur_nk = nk;
     }
-    const fv_film_views out = fv_film_views_of(film);
-    fv_cuda_vp_result r;
-    fv_status s = fv_vp_device_frame(p->dev, &f, &out, &r, err);
-    free(off), free(k);
-    if (s != FV_OK) return s;
+    w->f = f;
+    w->out = fv_film_views_of(film);
+    w->off = off, w->k = k;
+    return FV_OK;
+}
+
+static fv_status whole_finish(fv_vp_pipeline *p, const fv_frame *frame, fv_stats *stats, const fv_vp_trace_job *job, const fv_space_view *view,
+                              const fv_cuda_vp_result *res, fv_kit_progress *prog, fv_error *err)
+{
+    const fv_cuda_vp_result r = *res;
     static const char *const stage[5] = {"trace", "denoise", "mip", "map", "blur"};
     for (int i = 0; i < 5; i++) fv_stats_add_ms(stats, stage[i], r.stage_ms[i]);
     fv_stats_add_ms(stats, "kernel", r.kernel_ms);
@@ -447,47 +469,87 @@ static fv_status render_whole(fv_vp_pipeline *p, const fv_frame *frame, fv_film 
     return fv_kit_phase_end(prog, err);
 }
 
-fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
-{
-    const fv_camera *cam = frame->camera, *prev_cam = frame->prev_camera;
-    const fv_gaze gaze = frame->gaze;
+/* What a frame of one eye starts from, whichever way it is rendered: the camera, the sample
+ * space's view at the gaze, the trace's job and the frame's progress (the job points to it). */
+typedef struct eye_frame {
     fv_camera_basis basis;
-    fv_status s = fv_frame_camera(cam, film, &basis, err);
+    fv_space_view view;
+    fv_vp_trace_job job;
+    fv_kit_progress prog;
+} eye_frame;
+
+/* Sets up p for the frame's screen (buffers rebuilt when its size changed) and fills ef. */
+static fv_status begin_frame(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, eye_frame *ef, fv_error *err)
+{
+    const fv_camera *cam = frame->camera;
+    fv_status s = fv_frame_camera(cam, film, &ef->basis, err);
     if (s != FV_OK) return s;
     fv_eye_model def;
     const fv_eye_model *em = fv_frame_eye_model(frame, cam->width, cam->height, &def);
     if (p->sw != cam->width || p->sh != cam->height) {
         if ((s = setup(p, cam->width, cam->height, em, frame->seed, err)) != FV_OK) return s;
     }
-    const fv_grid *g = fv_space_grid(p->space);
-    fv_space_view view = fv_space_view_at(p->space, gaze);
+    ef->view = fv_space_view_at(p->space, frame->gaze);
 
     /* The cells of a polar grid that no screen pixel can see (its corners reach beyond the screen
      * wherever the gaze is): the trace skips them with offscreen=skip, the denoiser always (they
      * would only cost time and pull the edge's samples towards values nobody sees). The reach
      * covers the map stage's trilinear φ-mip lookup (two levels, one texel each way, a level's
      * texel about one pixel along φ). Kept while the gaze stays. */
-    if (p->onscreen && !(view.gx == p->mask_gx && view.gy == p->mask_gy)) {
-        fv_space_onscreen_mask(&view, MASK_REACH_PX, p->onscreen);
-        p->mask_gx = view.gx, p->mask_gy = view.gy;
+    if (p->onscreen && !(ef->view.gx == p->mask_gx && ef->view.gy == p->mask_gy)) {
+        fv_space_onscreen_mask(&ef->view, MASK_REACH_PX, p->onscreen);
+        p->mask_gx = ef->view.gx, p->mask_gy = ef->view.gy;
     }
 
-    /* 1. trace */
-    fv_vp_trace_job job;
-    trace_job(p, frame, &basis, &view, &job);
+    trace_job(p, frame, &ef->basis, &ef->view, &ef->job);
     /* Progress: the trace is most of a frame; the filters report at their end. */
-    fv_kit_progress prog = {0};
-    fv_kit_phase(&prog, frame, 0.0, 0.8);
-    job.progress = &prog;
-    if (p->dev && fv_vp_device_whole_frame(p->dev)) return render_whole(p, frame, film, stats, &job, &view, &prog, err);
-    job.counters = fv_kit_counters_reuse(&p->counters);
+    memset(&ef->prog, 0, sizeof ef->prog);
+    fv_kit_phase(&ef->prog, frame, 0.0, 0.8);
+    ef->job.progress = &ef->prog;
+    return FV_OK;
+}
+
+/* `eyes` whole frames (1, or a stereo pair: a pipeline, frame, film and eye_frame each) on their
+ * devices, with one host wait for them all; each eye's film, counters and history as if it were
+ * rendered alone, eye 0's stats added before eye 1's. */
+static fv_status render_whole(fv_vp_pipeline *const *p, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, eye_frame *ef,
+                              fv_error *err)
+{
+    whole_frame w[2];
+    memset(w, 0, sizeof w);
+    fv_status s = FV_OK;
+    for (int e = 0; e < eyes && s == FV_OK; e++) s = whole_prepare(p[e], &frames[e], films[e], stats, &ef[e].job, &ef[e].view, &w[e], err);
+    fv_cuda_vp_frame f[2];
+    fv_film_views out[2];
+    fv_cuda_vp_result r[2];
+    fv_vp_device *dev[2];
+    for (int e = 0; e < eyes; e++) f[e] = w[e].f, out[e] = w[e].out, dev[e] = p[e]->dev;
+    if (s == FV_OK) s = fv_vp_device_frames(dev, eyes, f, out, r, err);
+    for (int e = 0; e < eyes; e++) whole_free(&w[e]);
+    for (int e = 0; e < eyes && s == FV_OK; e++) s = whole_finish(p[e], &frames[e], stats, &ef[e].job, &ef[e].view, &r[e], &ef[e].prog, err);
+    return s;
+}
+
+fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+{
+    const fv_camera *prev_cam = frame->prev_camera;
+    eye_frame ef;
+    fv_status s = begin_frame(p, frame, film, &ef, err);
+    if (s != FV_OK) return s;
+    const fv_grid *g = fv_space_grid(p->space);
+    const fv_camera_basis basis = ef.basis;
+    fv_space_view view = ef.view;
+
+    /* 1. trace */
+    if (p->dev && fv_vp_device_whole_frame(p->dev)) return render_whole(&p, 1, frame, &film, stats, &ef, err);
+    ef.job.counters = fv_kit_counters_reuse(&p->counters);
     fv_vp_trace_result tr;
     fv_stage_clock t0 = fv_stage_clock_now();
     bool traced;
     if (p->dev) {
-        if ((s = fv_vp_device_trace(p->dev, &job, &p->g, &tr, &traced, err)) != FV_OK) return s;
+        if ((s = fv_vp_device_trace(p->dev, &ef.job, &p->g, &tr, &traced, err)) != FV_OK) return s;
     } else {
-        traced = fv_vp_trace(&job, &p->g, &tr);
+        traced = fv_vp_trace(&ef.job, &p->g, &tr);
     }
     const fv_stage_clock t1 = fv_stage_clock_now();
     const double t_trace = t1.wall - t0.wall;
@@ -581,8 +643,21 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
         if (s != FV_OK) return s;
     }
     fv_stage_stop(stats, "blur", t0);
-    fv_kit_phase(&prog, frame, 0.8, 0.2);
-    return fv_kit_phase_end(&prog, err);
+    fv_kit_phase(&ef.prog, frame, 0.8, 0.2);
+    return fv_kit_phase_end(&ef.prog, err);
+}
+
+fv_status fv_vp_pipeline_render_pair(fv_vp_pipeline *const *p, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    if (p[0] == p[1] || !p[0]->dev || !p[1]->dev || !fv_vp_device_whole_frame(p[0]->dev) || !fv_vp_device_whole_frame(p[1]->dev)) {
+        fv_status s = fv_vp_pipeline_render(p[0], &frames[0], films[0], stats, err);
+        return s == FV_OK ? fv_vp_pipeline_render(p[1], &frames[1], films[1], stats, err) : s;
+    }
+    eye_frame ef[2];
+    fv_status s;
+    for (int e = 0; e < 2; e++)
+        if ((s = begin_frame(p[e], &frames[e], films[e], &ef[e], err)) != FV_OK) return s;
+    return render_whole(p, 2, frames, films, stats, ef, err);
 }
 
 const fv_space *fv_vp_pipeline_space(const fv_vp_pipeline *p, fv_space_view *view, const float **image, double *px_per_deg)

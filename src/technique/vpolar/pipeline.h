@@ -48,6 +48,10 @@ void fv_vp_pipeline_destroy(fv_vp_pipeline *p);
 
 /* Renders one eye of a frame (its camera and gaze; its previous camera, NULL: no history). */
 fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);
+/* Renders both eyes of a stereo frame, p[e] eye e's pipeline (frames[e] into films[e]): the images,
+ * counters and histories of fv_vp_pipeline_render called for eye 0 then eye 1. On a device that
+ * takes whole frames (cuda) both eyes are queued before one host wait; elsewhere the two calls. */
+fv_status fv_vp_pipeline_render_pair(fv_vp_pipeline *const *p, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err);
 
 /* The last frame's sample space, its view (where the gaze was), the sample-space image (denoised
  * when denoising is on) and the display's pixels per degree, for pictures of the space itself

@@ -259,27 +259,59 @@ static fv_vp_opts full_opts(const fv_vp_opts *o)
     return f;
 }
 
-/* Each eye has its own pipeline: its history follows that eye's camera. */
+/* Each eye has its own pipeline: its history follows that eye's camera. The pipeline for the
+ * frame's eye (*full: cartesian-full's, made here at its first frame) and the frame it renders. */
+static fv_status eye_pipeline(vp_state *st, const fv_frame *frame, fv_vp_pipeline **p, fv_frame *f, bool *full, fv_error *err)
+{
+    const int e = frame->eye;
+    *full = whole_fovea(st, frame);
+    if (*full && !st->full[e]) {
+        const fv_vp_opts fo = full_opts(&st->o);
+        fv_status s = fv_vp_pipeline_create(st->scene, &fo, &st->full[e], err);
+        if (s != FV_OK) return s;
+    }
+    *p = *full ? st->full[e] : st->eye[e];
+    /* The pipeline that did not render this eye's last frame holds an older history: not reused. */
+    *f = *frame;
+    if (*full != st->in_full[e]) f->prev_camera = NULL;
+    return FV_OK;
+}
+
 static fv_status vp_render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
     vp_state *st = state;
-    const int e = frame->eye;
-    const bool full = whole_fovea(st, frame);
-    fv_status s;
-    if (full && !st->full[e]) {
-        const fv_vp_opts fo = full_opts(&st->o);
-        if ((s = fv_vp_pipeline_create(st->scene, &fo, &st->full[e], err)) != FV_OK) return s;
-    }
-    fv_vp_pipeline *p = full ? st->full[e] : st->eye[e];
-    /* The pipeline that did not render this eye's last frame holds an older history: not reused. */
-    fv_frame f = *frame;
-    if (full != st->in_full[e]) f.prev_camera = NULL;
+    fv_vp_pipeline *p;
+    fv_frame f;
+    bool full;
+    fv_status s = eye_pipeline(st, frame, &p, &f, &full, err);
+    if (s != FV_OK) return s;
     s = fv_vp_pipeline_render(p, &f, film, stats, err);
     if (s != FV_OK) return s;
-    st->in_full[e] = full;
+    st->in_full[frame->eye] = full;
     if (st->show == SHOW_SPACE) show_space(p, film);
     if (st->show == SHOW_DENSITY) s = show_density(st, p, film, err);
     return s;
+}
+
+/* A stereo frame: on cuda both eyes' whole frames are queued before one host wait
+ * (fv_vp_pipeline_render_pair, docs/gpu.md), each eye on its own pipeline as vp_render renders it;
+ * on the CPU and the portable backend (whose stages wait for themselves) the two per-eye calls. */
+static fv_status vp_render_pair(void *state, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    vp_state *st = state;
+    fv_status s;
+    if (st->o.device != FV_DEVICE_CUDA || st->show != SHOW_SCREEN) {
+        s = vp_render(state, &frames[0], films[0], stats, err);
+        return s == FV_OK ? vp_render(state, &frames[1], films[1], stats, err) : s;
+    }
+    fv_vp_pipeline *p[2];
+    fv_frame f[2];
+    bool full[2];
+    for (int e = 0; e < 2; e++)
+        if ((s = eye_pipeline(st, &frames[e], &p[e], &f[e], &full[e], err)) != FV_OK) return s;
+    if ((s = fv_vp_pipeline_render_pair(p, f, films, stats, err)) != FV_OK) return s;
+    for (int e = 0; e < 2; e++) st->in_full[e] = full[e];
+    return FV_OK;
 }
 
 static void vp_destroy(void *state)
@@ -426,7 +458,7 @@ const fv_technique_class fv_technique_vpolar = {
     .name = "vpolar",
     .summary = "foveated path tracing in Visual-Polar space: 1 spp on the VP grid, SVGF in VP space, φ-mipmapped mapping, foveated blur",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_vpolar_params), .main = REDUCTION_STEPS,
-    .create = create_vpolar, .create_on = create_vpolar_on, .devices = VP_DEVICES, .render = vp_render, .destroy = vp_destroy,
+    .create = create_vpolar, .create_on = create_vpolar_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
 
@@ -434,7 +466,7 @@ const fv_technique_class fv_technique_cartesian = {
     .name = "cartesian",
     .summary = "uniform screen grid with vpolar's sample count, SVGF, bilinear upscaling (Visual-Polar Sec. 4.3 baseline)",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_cartesian_params), .main = REDUCTION_STEPS,
-    .create = create_cartesian, .create_on = create_cartesian_on, .devices = VP_DEVICES, .render = vp_render, .destroy = vp_destroy,
+    .create = create_cartesian, .create_on = create_cartesian_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp",
 };
 
@@ -442,7 +474,7 @@ const fv_technique_class fv_technique_cartesian_full = {
     .name = "cartesian-full",
     .summary = "1 spp at full resolution with SVGF: the cost reference of Visual-Polar Fig. 12",
     .family = FV_FAMILY_VPOLAR, .baseline = "pt", FV_CLASS_PARAMS(k_cartesian_full_params), .main = BOUNCE_STEPS,
-    .create = create_cartesian_full, .create_on = create_cartesian_full_on, .devices = VP_DEVICES, .render = vp_render, .destroy = vp_destroy,
+    .create = create_cartesian_full, .create_on = create_cartesian_full_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp",
 };
 
@@ -450,7 +482,7 @@ const fv_technique_class fv_technique_linear_falloff = {
     .name = "linear-falloff",
     .summary = "full-resolution launch, paths killed at random outside the fovea (Weier et al. 2016), SVGF, blur",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_linear_falloff_params), .main = BOUNCE_STEPS,
-    .create = create_linear_falloff, .create_on = create_linear_falloff_on, .devices = VP_DEVICES, .render = vp_render, .destroy = vp_destroy,
+    .create = create_linear_falloff, .create_on = create_linear_falloff_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
 
@@ -458,6 +490,6 @@ const fv_technique_class fv_technique_logpolar = {
     .name = "log-polar",
     .summary = "kernel log-polar space (Meng et al. 2018), SVGF in log-polar space, φ-mipmapped mapping",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_logpolar_params), .main = BOUNCE_STEPS,
-    .create = create_logpolar, .create_on = create_logpolar_on, .devices = VP_DEVICES, .render = vp_render, .destroy = vp_destroy,
+    .create = create_logpolar, .create_on = create_logpolar_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
