@@ -39,6 +39,15 @@ static inline void fv_sim_expect(fv_sim_mark since, uint64_t waits, long launche
         fail_msg("%s: %llu kernel launches, expected %ld", what, (unsigned long long)l, launches);
 }
 
+/* Since `since`: exactly `calls` synchronize calls (stream, event or device). The host waits above
+ * are counted with one flag for the whole device, so two synchronizes back to back (a stream each)
+ * read as one wait; this counts each. */
+static inline void fv_sim_expect_sync_calls(fv_sim_mark since, uint64_t calls, const char *what)
+{
+    const uint64_t c = fv_sim_now().syncs - since.syncs;
+    if (c != calls) fail_msg("%s: %llu synchronize calls, expected %llu", what, (unsigned long long)c, (unsigned long long)calls);
+}
+
 static inline void fv_sim_expect_freed(const char *what)
 {
     fv_sim_mark m = fv_sim_now();
@@ -118,6 +127,10 @@ static inline fv_sim_mark fv_sim_now(void) { return 0; }
 static inline void fv_sim_expect(fv_sim_mark since, uint64_t waits, long launches, const char *what)
 {
     (void)since, (void)waits, (void)launches, (void)what;
+}
+static inline void fv_sim_expect_sync_calls(fv_sim_mark since, uint64_t calls, const char *what)
+{
+    (void)since, (void)calls, (void)what;
 }
 static inline void fv_sim_expect_freed(const char *what) { (void)what; }
 #endif

@@ -244,11 +244,17 @@ static void compare_pair(const char *method, const char *params, const char *dev
         fv_stats_clear(&se);
         fv_sim_mark m = fv_sim_now();
         if (fv_technique_render_pair(pair, f, c, &sc, &err) != FV_OK) fail_msg("%s: %s", what, err.msg);
-        if (cuda) fv_sim_expect(m, 1, -1, what); /* what host_syncs reports (checked below) is what the host did */
+        if (cuda) {
+            fv_sim_expect(m, 1, -1, what); /* what host_syncs reports (checked below) is what the host did */
+            fv_sim_expect_sync_calls(m, 1, what); /* one synchronize, not one per eye's stream */
+        }
         m = fv_sim_now();
         for (int e = 0; e < 2; e++)
             if (fv_technique_render(each, &f[e], e1[e], &se, &err) != FV_OK) fail_msg("%s eye %d: %s", what, e, err.msg);
-        if (cuda) fv_sim_expect(m, 2, -1, what);
+        if (cuda) {
+            fv_sim_expect(m, 2, -1, what);
+            fv_sim_expect_sync_calls(m, 2, what);
+        }
         printf("%s: host syncs %g for the pair, %g for two calls; samples %g, history %.4f\n", what, fv_stats_get_count(&sc, "host_syncs"),
                fv_stats_get_count(&se, "host_syncs"), fv_stats_get_count(&sc, "samples"), fv_stats_get_count(&sc, "history_fraction"));
         for (int e = 0; e < 2; e++) {
