@@ -526,7 +526,13 @@ static fv_status render_whole(fv_vp_pipeline *const *p, int eyes, const fv_frame
     for (int e = 0; e < eyes; e++) f[e] = w[e].f, out[e] = w[e].out, dev[e] = p[e]->dev;
     if (s == FV_OK) s = fv_vp_device_frames(dev, eyes, f, out, r, err);
     for (int e = 0; e < eyes; e++) whole_free(&w[e]);
-    for (int e = 0; e < eyes && s == FV_OK; e++) s = whole_finish(p[e], &frames[e], stats, &ef[e].job, &ef[e].view, &r[e], &ef[e].prog, err);
+    if (s != FV_OK) return s;
+    /* Every eye the device rendered takes its result and history, even after eye 0's progress
+     * asked to cancel: the device's history has moved on for both. */
+    for (int e = 0; e < eyes; e++) {
+        const fv_status se = whole_finish(p[e], &frames[e], stats, &ef[e].job, &ef[e].view, &r[e], &ef[e].prog, s == FV_OK ? err : NULL);
+        if (s == FV_OK) s = se;
+    }
     return s;
 }
 
