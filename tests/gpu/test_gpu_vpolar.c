@@ -294,10 +294,10 @@ static void compare_pair(const char *method, const char *params, const char *dev
 static void test_pair(void **st)
 {
     (void)st;
-    compare_pair("vpolar", "", "cuda", 96, 64, 4);
-    compare_pair("linear-falloff", "", "cuda", 96, 64, 3);
-    compare_pair("cartesian", "denoise=false", "cuda", 96, 64, 3);
-    compare_pair("vpolar", "", "portable", 96, 64, 3);
+    compare_pair("vpolar", "", "cuda", 80, 48, 4);
+    compare_pair("linear-falloff", "", "cuda", 64, 48, 3);
+    compare_pair("cartesian", "denoise=false", "cuda", 64, 48, 3);
+    compare_pair("vpolar", "", "portable", 64, 48, 3);
 }
 
 int main(void)
