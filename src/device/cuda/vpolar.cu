@@ -529,8 +529,7 @@ static fv_status check_frame(const fv_cuda_vp_frame *f, fv_error *err)
     return bad ? fv_error_set(err, FV_ERR_INTERNAL, "CUDA: Visual-Polar frame: %s", bad) : FV_OK;
 }
 
-/* Queues one eye's frame on its stream, then the copies of its film's buffers that are set and its
- * counters to the host; nothing waits. */
+/* Queues one eye's frame on its stream; nothing waits. */
 static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_error *err)
 {
     fv_status s;
@@ -608,10 +607,17 @@ static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv
     }
     cudaEventRecord(c->ev[ST_COUNT], st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the Visual-Polar kernels", err);
+    return FV_OK;
+}
 
-    /* What the host receives after the wait: the film's buffers that are set and the counters. */
+/* Queues the copies of one eye's film buffers that are set and its counters to the host, after its
+ * frame on its stream, and marks the stream's end (c->queued). */
+static fv_status read_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_error *err)
+{
+    const size_t ns = (size_t)f->trace.space.sw * (size_t)f->trace.space.sh;
+    cudaStream_t st = c->stream;
     memset(c->counts_host, 0, sizeof c->counts_host);
-    e = fv_cuda_film_read_async(&c->film, out, ns, st);
+    cudaError_t e = fv_cuda_film_read_async(&c->film, out, ns, st);
     if (e == cudaSuccess) e = cudaMemcpyAsync(c->counts_host, c->counts, sizeof c->counts_host, cudaMemcpyDeviceToHost, st);
     if (e == cudaSuccess && f->denoise) e = svgf_read_rows(&c->svgf, st);
     if (e == cudaSuccess) e = cudaEventRecord(c->queued, st);
@@ -647,11 +653,15 @@ extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *const *c, int eyes, const fv_
         if ((s = check_frame(&f[e], err)) != FV_OK) return s;
     }
     if (eyes == 2 && c[0] == c[1]) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: a stereo pair's eyes share their buffers");
-    /* Every eye queued (each on its own stream, so a pair's two eyes may run side by side), then
-     * the one host wait: eye 0's stream, which waits for eye 1's read-back first. A pair thus costs
-     * one round trip, as a single eye does. */
+    /* Every eye's kernels queued (each on its own stream, so a pair's two eyes may run side by
+     * side), then every eye's read-back (a copy into pageable host memory may hold the host until
+     * its stream gets there, so none is queued before the last eye's kernels), then the one host
+     * wait: eye 0's stream, which waits for eye 1's read-back first. A pair thus costs one round
+     * trip, as a single eye does. */
     for (int e = 0; e < eyes; e++)
-        if ((s = launch_frame(c[e], &f[e], &out[e], err)) != FV_OK) {
+        if ((s = launch_frame(c[e], &f[e], &out[e], err)) != FV_OK) return s;
+    for (int e = 0; e < eyes; e++)
+        if ((s = read_frame(c[e], &f[e], &out[e], err)) != FV_OK) {
             /* nothing queued may write into a film after the caller has its error */
             for (int q = 0; q <= e; q++) cudaStreamSynchronize(c[q]->stream);
             return s;
