@@ -222,13 +222,8 @@ static void compare_pair(const char *method, const char *params, const char *dev
     const size_t n = (size_t)w * h;
     for (int i = 0; i < frames; i++) {
         fv_frame f[2];
+        fv_test_stereo_frames(cam, 0.0, i, 7, i > 0, f);
         for (int e = 0; e < 2; e++) {
-            fv_frame_init(&f[e], &cam[e]);
-            f[e].seed = 7;
-            f[e].index = i;
-            f[e].eye = e;
-            f[e].eye_count = 2;
-            f[e].prev_camera = i > 0 ? &cam[e] : NULL;
             f[e].left_camera = e == 1 ? &cam[0] : NULL;
             f[e].gaze.x = gaze[i < ngaze ? i : ngaze - 1][0] + 0.03f * (float)e;
             f[e].gaze.y = gaze[i < ngaze ? i : ngaze - 1][1];

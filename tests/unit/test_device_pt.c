@@ -205,14 +205,7 @@ static void test_pair(void **st)
             const double time = 0.25 * i;
             if (fv_scene_set_time(s, time, &err) != FV_OK) fail_msg("%s", err.msg);
             fv_frame f[2];
-            for (int e = 0; e < 2; e++) {
-                fv_frame_init(&f[e], &cam[e]);
-                f[e].time = time;
-                f[e].index = i;
-                f[e].seed = 9;
-                f[e].eye = e;
-                f[e].eye_count = 2;
-            }
+            fv_test_stereo_frames(cam, time, i, 9, false, f);
             fv_stats sp, se;
             fv_stats_clear(&sp);
             fv_stats_clear(&se);

@@ -314,14 +314,8 @@ static void compare_pair(const char *scene, const char *method, const char *para
         const double time = 0.1 * i;
         if (fv_scene_set_time(s, time, &err) != FV_OK) fail_msg("%s", err.msg);
         fv_frame f[2];
+        fv_test_stereo_frames(cam, time, i, 5, i > 0, f);
         for (int e = 0; e < 2; e++) {
-            fv_frame_init(&f[e], &cam[e]);
-            f[e].time = time;
-            f[e].seed = 5;
-            f[e].index = i;
-            f[e].eye = e;
-            f[e].eye_count = 2;
-            f[e].prev_camera = i > 0 ? &cam[e] : NULL;
             f[e].left_camera = e == 1 ? &cam[0] : NULL;
             f[e].gaze.x = 0.35f + 0.12f * (float)i + 0.04f * (float)e;
             f[e].gaze.y = 0.55f - 0.08f * (float)i;

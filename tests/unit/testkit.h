@@ -10,6 +10,7 @@
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -160,6 +161,21 @@ static inline void fv_test_render_fresh(fv_technique *t, const fv_frame *f, fv_f
     fv_error err;
     fv_stats_clear(stats);
     if (fv_technique_render(t, f, film, stats, &err) != FV_OK) fail_msg("%s: frame %d: %s", fv_technique_name_of(t), f->index, err.msg);
+}
+
+/* Frame `index` of a stereo pair through cam[0] (left) and cam[1] (right) at `time` with `seed`;
+ * `continues`: each eye's previous frame was through the same camera (a still pair's history). */
+static inline void fv_test_stereo_frames(const fv_camera cam[2], double time, int index, uint64_t seed, bool continues, fv_frame f[2])
+{
+    for (int e = 0; e < 2; e++) {
+        fv_frame_init(&f[e], &cam[e]);
+        f[e].time = time;
+        f[e].index = index;
+        f[e].seed = seed;
+        f[e].eye = e;
+        f[e].eye_count = 2;
+        f[e].prev_camera = continues ? &cam[e] : NULL;
+    }
 }
 
 /* One frame (index 0, `seed`) of `method` with the parameters `list` (as fv_test_params_str) in
