@@ -295,6 +295,33 @@ static void test_pair(void **st)
     compare_pair("vpolar", "", "portable", 64, 48, 3);
 }
 
+/* The diagnostics that draw the sample grid need its host copy, which cuda does not keep: refused in
+ * one line at creation, before anything is allocated on the GPU. */
+static void test_refusals(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    assert_int_equal(fv_test_load("cornell", &s, &v), 0);
+    const struct {
+        const char *method, *params, *needle;
+    } cases[] = {
+        {"vpolar", "device=cuda show=space", "parameter show=space: device cuda renders the image only (devices cpu and portable draw diagnostics)"},
+        {"log-polar", "device=cuda show=density", "parameter show=density: device cuda renders the image only (devices cpu and portable draw diagnostics)"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        fv_params *p = fv_test_params_str(cases[i].params);
+        fv_technique *t = NULL;
+        fv_error err;
+        fv_test_expect_fail(fv_technique_create(cases[i].method, s, p, NULL, &t, &err), &err, FV_ERR_INVALID, cases[i].needle, cases[i].params);
+        assert_null(t);
+        fv_params_destroy(p);
+        fv_sim_expect_freed(cases[i].method);
+    }
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+
 int main(void)
 {
     char why[256];
@@ -304,6 +331,7 @@ int main(void)
     }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_vpolar),         cmocka_unit_test(test_cartesian), cmocka_unit_test(test_cartesian_full),
                                        cmocka_unit_test(test_linear_falloff), cmocka_unit_test(test_logpolar),  cmocka_unit_test(test_svgf_passes),
-                                       cmocka_unit_test(test_moving),         cmocka_unit_test(test_pair)};
+                                       cmocka_unit_test(test_moving),         cmocka_unit_test(test_pair),
+                                       cmocka_unit_test(test_refusals)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
