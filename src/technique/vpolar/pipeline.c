@@ -112,34 +112,44 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
     if (s != FV_OK) return s;
     const fv_grid *g = fv_space_grid(p->space);
     size_t n = (size_t)g->w * g->h, ns = (size_t)sw * sh;
-    p->g.color = fv_alloc_array(n, 3 * sizeof(float));
-    p->g.albedo = fv_alloc_array(n, 3 * sizeof(float));
-    p->g.reflectance = fv_alloc_array(n, 3 * sizeof(float));
-    p->g.normal = fv_alloc_array(n, 3 * sizeof(float));
-    p->g.position = fv_alloc_array(n, 3 * sizeof(float));
-    p->g.depth = fv_alloc_array(n, sizeof(float));
-    p->g.id = fv_alloc_array(n, sizeof(uint32_t));
-    p->g.sampled = fv_alloc_array(n, 1);
+    /* A device that renders whole frames (cuda) keeps the grid on the GPU: the host's copy would be
+     * written once here and never read (69 bytes a cell; some 300 MB for a stereo pair of
+     * cartesian-full at 1440x1600). Its history coordinates and sigma are still allocated, as the
+     * frame's description points to them, but never touched, so they cost no memory. */
+    const bool host_grid = !(p->dev && fv_vp_device_whole_frame(p->dev));
+    if (host_grid) {
+        p->g.color = fv_alloc_array(n, 3 * sizeof(float));
+        p->g.albedo = fv_alloc_array(n, 3 * sizeof(float));
+        p->g.reflectance = fv_alloc_array(n, 3 * sizeof(float));
+        p->g.normal = fv_alloc_array(n, 3 * sizeof(float));
+        p->g.position = fv_alloc_array(n, 3 * sizeof(float));
+        p->g.depth = fv_alloc_array(n, sizeof(float));
+        p->g.id = fv_alloc_array(n, sizeof(uint32_t));
+        p->g.sampled = fv_alloc_array(n, 1);
+    }
     p->prev_coord = fv_alloc_array(n, 2 * sizeof(float));
     p->sigma = fv_alloc_array(ns, sizeof(float));
     /* The largest radius from any gaze is the diagonal. */
     p->nlut = (int)(sqrt((double)sw * sw + (double)sh * sh) / LUT_STEP) + 3;
     p->lut = fv_alloc_array((size_t)p->nlut, 3 * sizeof(float));
-    if (!p->g.color || !p->g.albedo || !p->g.reflectance || !p->g.normal || !p->g.position || !p->g.depth || !p->g.id || !p->g.sampled ||
+    if ((host_grid && (!p->g.color || !p->g.albedo || !p->g.reflectance || !p->g.normal || !p->g.position || !p->g.depth || !p->g.id ||
+                       !p->g.sampled)) ||
         !p->prev_coord || !p->sigma || !p->lut) {
         free_buffers(p);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d sample grid", g->w, g->h);
     }
     /* "No surface, not sampled" everywhere: the rows beyond a column's height keep it for good,
      * since the trace stage writes only the valid cells. */
-    memset(p->g.color, 0, n * 3 * sizeof(float));
-    memset(p->g.albedo, 0, n * 3 * sizeof(float));
-    memset(p->g.reflectance, 0, n * 3 * sizeof(float));
-    memset(p->g.normal, 0, n * 3 * sizeof(float));
-    memset(p->g.position, 0, n * 3 * sizeof(float));
-    memset(p->g.id, 0, n * sizeof(uint32_t));
-    memset(p->g.sampled, 0, n);
-    for (size_t i = 0; i < n; i++) p->g.depth[i] = INFINITY;
+    if (host_grid) {
+        memset(p->g.color, 0, n * 3 * sizeof(float));
+        memset(p->g.albedo, 0, n * 3 * sizeof(float));
+        memset(p->g.reflectance, 0, n * 3 * sizeof(float));
+        memset(p->g.normal, 0, n * 3 * sizeof(float));
+        memset(p->g.position, 0, n * 3 * sizeof(float));
+        memset(p->g.id, 0, n * sizeof(uint32_t));
+        memset(p->g.sampled, 0, n);
+        for (size_t i = 0; i < n; i++) p->g.depth[i] = INFINITY;
+    }
     if (fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
         if (!(p->onscreen = fv_alloc_array(n, 1))) {
             free_buffers(p);
@@ -384,8 +394,8 @@ static void whole_free(whole_frame *w)
 /* A whole frame on a device that takes one (cuda: device/cuda/vpolar.cu): the host builds what
  * depends on the screen size and the gaze (the on-screen mask above, the radial table, the blur's
  * kernels) and receives the film and the counts; the grid, the denoiser's history coordinates,
- * SVGF's buffers and history and the mipmaps stay on the device (the host's copies of the grid stay
- * unused). whole_prepare builds the frame, fv_vp_device_frames renders it (with the other eye's, for
+ * SVGF's buffers and history and the mipmaps stay on the device (the host keeps no copy of the
+ * grid: setup). whole_prepare builds the frame, fv_vp_device_frames renders it (with the other eye's, for
  * a stereo pair), whole_finish takes its result. The stage times are the device's (events). */
 static fv_status whole_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, const fv_vp_trace_job *job,
                                const fv_space_view *view, whole_frame *w, fv_error *err)
