@@ -150,9 +150,12 @@ FV_API bool fv_gaze_missing_from_name(const char *name, fv_gaze_missing *out);
 /* ---- importing eye-tracker recordings (docs/gaze.md, "Importing") ---- */
 
 typedef enum fv_gaze_format {
-    FV_GAZE_FORMAT_AUTO = 0,     /* from the extension (a trailing .gz aside): .asc EyeLink, .csv Pupil Labs */
+    FV_GAZE_FORMAT_AUTO = 0,     /* from the extension (a trailing .gz aside): .asc EyeLink, .csv Pupil Labs, .tsv
+                                    Tobii Pro Lab (from its header); a .csv or .tsv with a column mapping: TABLE */
     FV_GAZE_FORMAT_EYELINK_ASC,  /* EyeLink sample file (edf2asc) */
-    FV_GAZE_FORMAT_PUPIL_CSV     /* Pupil Labs gaze_positions.csv (Pupil Player export) */
+    FV_GAZE_FORMAT_PUPIL_CSV,    /* Pupil Labs gaze_positions.csv (Pupil Player export) */
+    FV_GAZE_FORMAT_TABLE,        /* any delimited table (CSV, TSV, semicolons) under fv_gaze_table_opts' mapping */
+    FV_GAZE_FORMAT_TOBII         /* Tobii Pro Lab data export (.tsv): the table reader with Tobii's columns */
 } fv_gaze_format;
 
 /* Which eye's gaze a recording of both eyes becomes (docs/gaze.md, "Which eye"). */
@@ -164,24 +167,41 @@ typedef enum fv_gaze_eyes {
     FV_GAZE_EYES_EACH         /* each eye its own gaze: a five-column trace (stereo renders) */
 } fv_gaze_eyes;
 
+/* The column mapping of FV_GAZE_FORMAT_TABLE (docs/gaze.md, "Other tables"). A column is named by
+ * its header text (exact, any case) or by its 1-based number (a file without a header line: every
+ * column given by number, and the first line's time field not a number). Either x and y (one
+ * gaze) or the per-eye pairs (either eye or both). Strings are borrowed for the call. */
+typedef struct fv_gaze_table_opts {
+    const char *time, *x, *y;
+    const char *left_x, *left_y, *right_x, *right_y;
+    const char *valid;  /* optional: a row whose value here is not 1, true, valid or yes (any case) is missing */
+    double time_unit;   /* seconds per unit of the time column [0: seconds; Tobii: the header's unit, else µs] */
+    bool pixels;        /* coordinates in pixels of width x height (fv_gaze_import_opts), not normalised */
+    bool bottom_left;   /* the origin is at the bottom left (y up), not the top left */
+} fv_gaze_table_opts;
+
 typedef struct fv_gaze_import_opts {
     fv_gaze_format format;
     double min_confidence; /* Pupil: samples below this confidence are missing [0.6] */
-    int width, height;     /* EyeLink: the screen in pixels, replacing DISPLAY_COORDS (0: from the file) */
+    int width, height;     /* the screen in pixels: EyeLink, replacing DISPLAY_COORDS (0: from the file); a table in
+                              pixels; Tobii, where the export has no recording resolution */
     fv_gaze_eyes eyes;     /* [FV_GAZE_EYES_DEFAULT] */
     uint64_t max_inflated; /* a gzip-compressed recording may inflate to at most this many bytes [1 GiB] */
+    fv_gaze_table_opts table; /* TABLE: the column mapping (all NULL: none); Tobii: time_unit alone */
 } fv_gaze_import_opts;
 
 typedef struct fv_gaze_import_info {
     fv_gaze_format format;
     long samples, missing, dropped; /* written; of those missing; dropped (time not increasing) */
-    double width, height;           /* EyeLink: the screen the coordinates were divided by */
+    double width, height;           /* EyeLink, a table in pixels, Tobii: the screen the coordinates were divided by
+                                       (Tobii: the last row's recording resolution) */
     bool binocular;                 /* a five-column trace was written (each eye its own gaze) */
     fv_gaze_eyes eyes;              /* the choice applied (after a successful import never DEFAULT) */
     bool compressed;                /* the recording was gzip-compressed */
     double rate;                    /* EyeLink: the sample rate in Hz the recording gave (0: none) */
     long gaps;                      /* EyeLink: gaps between recording blocks, written as missing samples */
     long paired;                    /* Pupil: samples made of one row per eye (both, each) */
+    long skipped;                   /* Tobii: rows without eye-tracker data (events, other sensors), left out */
 } fv_gaze_import_info;
 
 FV_API void fv_gaze_import_opts_init(fv_gaze_import_opts *o);

@@ -39,6 +39,7 @@
 #include "core/alloc.h"
 #include "core/fileio.h"
 #include "fovea/gaze.h"
+#include "gaze/import.h"
 
 /* Pupil: rows of the two eyes at most this far apart (s) are one binocular sample. Pupil's eye
  * cameras run at 120-200 Hz (5-8 ms apart), and the two eyes' rows of one moment are well under a
@@ -55,20 +56,8 @@ void fv_gaze_import_opts_init(fv_gaze_import_opts *o)
     o->max_inflated = DEFAULT_MAX_INFLATED;
 }
 
-typedef struct writer {
-    FILE *f;
-    const char *in;
-    fv_gaze_eyes eyes; /* resolved: never DEFAULT */
-    bool binocular;    /* five columns (eyes == EACH) */
-    bool any;
-    long known[2]; /* samples with a known gaze, per column pair */
-    double t0, prev;
-    fv_gaze_import_info *info;
-} writer;
 
-/* The next line of the recording (at most FV_LINE_MAX bytes): true for a line; false at the end,
- * on a read error (ferror tells) or with *st set for a line too long. */
-static bool next_line(FILE *in, const writer *w, char **line, size_t *cap, int lineno, fv_status *st, fv_error *err)
+bool fv_gaze_read_line(FILE *in, const fv_gaze_writer *w, char **line, size_t *cap, int lineno, fv_status *st, fv_error *err)
 {
     long n = fv_file_getline(in, line, cap, FV_LINE_MAX);
     if (n == -1) *st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: line longer than %d bytes", w->in, lineno, FV_LINE_MAX);
@@ -76,11 +65,11 @@ static bool next_line(FILE *in, const writer *w, char **line, size_t *cap, int l
     return n > 0;
 }
 
-static bool on_screen(double x, double y) { return x >= 0.0 && x <= 1.0 && y >= 0.0 && y <= 1.0; }
+bool fv_gaze_on_screen(double x, double y) { return x >= 0.0 && x <= 1.0 && y >= 0.0 && y <= 1.0; }
 
 /* One line of the trace (time in seconds; a pair of coordinates is missing when NaN or off the
  * screen; xr, yr only in a five-column trace). Returns false when dropped (time not increasing). */
-static bool put_sample(writer *w, double t, double xl, double yl, double xr, double yr)
+static bool put_sample(fv_gaze_writer *w, double t, double xl, double yl, double xr, double yr)
 {
     /* The time as written (9 digits) must increase too: a jump to 1e19 s would print equal. */
     char tt[40];
@@ -93,7 +82,7 @@ static bool put_sample(writer *w, double t, double xl, double yl, double xr, dou
     if (!w->any) w->t0 = t;
     w->any = true;
     w->prev = shown;
-    bool ml = !on_screen(xl, yl), mr = !on_screen(xr, yr);
+    bool ml = !fv_gaze_on_screen(xl, yl), mr = !fv_gaze_on_screen(xr, yr);
     w->info->samples++;
     if (ml || (w->binocular && mr)) w->info->missing++;
     fputs(tt, w->f);
@@ -109,11 +98,9 @@ static bool put_sample(writer *w, double t, double xl, double yl, double xr, dou
     return true;
 }
 
-/* One moment's gaze of each eye (NaN, or off the screen: missing or not recorded), written as the
- * eye choice wants it. */
-static bool emit(writer *w, double t, double xl, double yl, double xr, double yr)
+bool fv_gaze_emit(fv_gaze_writer *w, double t, double xl, double yl, double xr, double yr)
 {
-    bool kl = on_screen(xl, yl), kr = on_screen(xr, yr);
+    bool kl = fv_gaze_on_screen(xl, yl), kr = fv_gaze_on_screen(xr, yr);
     switch (w->eyes) {
     case FV_GAZE_EYES_LEFT: return put_sample(w, t, xl, yl, NAN, NAN);
     case FV_GAZE_EYES_RIGHT: return put_sample(w, t, xr, yr, NAN, NAN);
@@ -253,7 +240,7 @@ static double line_rate(const char *line)
     return isfinite(r) && r >= 1.0 && r <= 100000.0 ? r : 0.0;
 }
 
-static fv_status import_asc(FILE *in, writer *w, fv_gaze_eyes want, fv_error *err)
+static fv_status import_asc(FILE *in, fv_gaze_writer *w, fv_gaze_eyes want, fv_error *err)
 {
     char *line = NULL;
     size_t cap = 0;
@@ -263,7 +250,7 @@ static fv_status import_asc(FILE *in, writer *w, fv_gaze_eyes want, fv_error *er
     fv_status st = FV_OK;
     int lineno = 0;
     /* First pass: the screen and the eyes. */
-    while (next_line(in, w, &line, &cap, ++lineno, &st, err)) {
+    while (fv_gaze_read_line(in, w, &line, &cap, ++lineno, &st, err)) {
         const char *d = strstr(line, "DISPLAY_COORDS");
         if (starts_with(line, "MSG") && d && sscanf(d + 14, "%lf %lf %lf %lf", &left, &top, &right, &bottom) == 4) sized = true;
         if (keyword(line, "START") || keyword(line, "SAMPLES")) eyes |= line_eyes(line);
@@ -306,7 +293,7 @@ static fv_status import_asc(FILE *in, writer *w, fv_gaze_eyes want, fv_error *er
     double rate = 0, last = NAN, end_ms = NAN;
     bool gap = false;
     lineno = 0;
-    while (next_line(in, w, &line, &cap, ++lineno, &st, err)) {
+    while (fv_gaze_read_line(in, w, &line, &cap, ++lineno, &st, err)) {
         if (!isdigit((unsigned char)line[0])) {
             char eye = 0;
             double r = line_rate(line);
@@ -357,7 +344,7 @@ static fv_status import_asc(FILE *in, writer *w, fv_gaze_eyes want, fv_error *er
          * period after its last sample) until this sample. */
         if (gap && isfinite(last) && t - last > 1.5 * period) {
             double g = end_ms > last && end_ms < t ? end_ms : last + period;
-            if (emit(w, g / 1000.0, NAN, NAN, NAN, NAN)) w->info->gaps++;
+            if (fv_gaze_emit(w, g / 1000.0, NAN, NAN, NAN, NAN)) w->info->gaps++;
         }
         gap = false;
         end_ms = NAN;
@@ -368,7 +355,7 @@ static fv_status import_asc(FILE *in, writer *w, fv_gaze_eyes want, fv_error *er
         else xl = v[0], yl = v[1];
         if (blink[0]) xl = yl = NAN;
         if (blink[1]) xr = yr = NAN;
-        emit(w, t / 1000.0, (xl - left) / sw, (yl - top) / sh, (xr - left) / sw, (yr - top) / sh);
+        fv_gaze_emit(w, t / 1000.0, (xl - left) / sw, (yl - top) / sh, (xr - left) / sw, (yr - top) / sh);
     }
     free(line);
     return st;
@@ -376,36 +363,63 @@ static fv_status import_asc(FILE *in, writer *w, fv_gaze_eyes want, fv_error *er
 
 /* ---- Pupil Labs gaze_positions.csv ---- */
 
-#define CSV_MAX_FIELDS 256
-
-/* Splits a comma-separated line into at most CSV_MAX_FIELDS fields (a field in double quotes may
- * hold commas; the quotes are left off). Returns the number of fields. */
-static int csv_split(const char *line, const char **f, size_t *len)
+void fv_gaze_fields_free(fv_gaze_fields *fs)
 {
-    int n = 0;
+    free(fs->buf);
+    free(fs->f);
+    free(fs->len);
+    memset(fs, 0, sizeof *fs);
+}
+
+/* Fields are copied into fs->buf (a quoted field's "" becomes one quote), so each is a C string;
+ * a line of L bytes needs at most L + 1 bytes of copies and NULs. Whatever follows a quoted
+ * field's closing quote up to the delimiter is left off, as is the end of line. */
+bool fv_gaze_fields_split(fv_gaze_fields *fs, const char *line, char delim)
+{
+    size_t need = strlen(line) + 2;
+    if (need > fs->bufcap) {
+        char *b = realloc(fs->buf, need);
+        if (!b) return false;
+        fs->buf = b;
+        fs->bufcap = need;
+    }
+    char *o = fs->buf;
     const char *s = line;
+    fs->n = 0;
+    fs->unterminated = false;
     for (;;) {
-        if (n == CSV_MAX_FIELDS) return n;
-        while (*s == ' ') s++;
+        if (fv_grow((void **)&fs->f, &fs->cap, fs->n + 1, sizeof *fs->f) || fv_grow((void **)&fs->len, &fs->lencap, fs->n + 1, sizeof *fs->len))
+            return false;
+        while (*s == ' ' || (*s == '\t' && delim != '\t')) s++;
+        char *start = o;
         if (*s == '"') {
-            const char *q = strchr(s + 1, '"');
-            f[n] = s + 1;
-            len[n] = q ? (size_t)(q - s - 1) : strcspn(s + 1, "\r\n");
-            s = q ? q + 1 : s + 1 + len[n];
-            s += strcspn(s, ",\r\n");
+            s++;
+            for (;;) {
+                if (*s == '\0' || ((*s == '\r' || *s == '\n') && s[strspn(s, "\r\n")] == '\0')) {
+                    fs->unterminated = true;
+                    break;
+                }
+                if (*s == '"' && s[1] == '"') *o++ = '"', s += 2;
+                else if (*s == '"') {
+                    s++;
+                    break;
+                } else *o++ = *s++;
+            }
+            while (*s && *s != delim && *s != '\r' && *s != '\n') s++;
         } else {
-            f[n] = s;
-            len[n] = strcspn(s, ",\r\n");
-            s += len[n];
+            while (*s && *s != delim && *s != '\r' && *s != '\n') *o++ = *s++;
         }
-        while (len[n] && (f[n][len[n] - 1] == ' ' || f[n][len[n] - 1] == '\t')) len[n]--;
-        n++;
-        if (*s != ',') return n;
+        while (o > start && (o[-1] == ' ' || o[-1] == '\t')) o--;
+        *o++ = '\0';
+        fs->f[fs->n] = start;
+        fs->len[fs->n] = (size_t)(o - 1 - start);
+        fs->n++;
+        if (*s != delim) return true;
         s++;
     }
 }
 
-static bool field_number(const char *s, size_t len, double *v)
+bool fv_gaze_field_number(const char *s, size_t len, double *v)
 {
     if (len == 0 || len > 63) return false;
     char tmp[64];
@@ -446,21 +460,27 @@ static int cmp_rows(const void *a, const void *b)
     return (p->index > q->index) - (p->index < q->index);
 }
 
-static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_gaze_eyes want, fv_error *err)
+static fv_status import_pupil(FILE *in, fv_gaze_writer *w, double min_conf, fv_gaze_eyes want, fv_error *err)
 {
     char *line = NULL;
     size_t cap = 0;
     int col_t = -1, col_old_t = -1, col_c = -1, col_x = -1, col_y = -1, col_base = -1, col_id = -1;
     fv_status st = FV_OK;
     int lineno = 0;
-    const char *f[CSV_MAX_FIELDS];
-    size_t len[CSV_MAX_FIELDS];
+    fv_gaze_fields fs = {0};
+    const char **f = NULL;
+    size_t *len = NULL;
     /* The header: the first line that is not blank (an export may start with one). */
-    while (next_line(in, w, &line, &cap, ++lineno, &st, err)) {
+    while (fv_gaze_read_line(in, w, &line, &cap, ++lineno, &st, err)) {
         char *h = line;
         if (!strncmp(h, "\xEF\xBB\xBF", 3)) h += 3; /* a byte order mark */
         if (h[strspn(h, " \t\r\n")] == '\0') continue;
-        int n = csv_split(h, f, len);
+        if (!fv_gaze_fields_split(&fs, h, ',')) {
+            st = fv_error_set(err, FV_ERR_NOMEM, "out of memory reading '%s'", w->in);
+            break;
+        }
+        int n = fs.n;
+        f = fs.f, len = fs.len;
         for (int k = 0; k < n; k++) {
 #define IS(name) (len[k] == strlen(name) && !strncmp(f[k], name, len[k]))
             if (IS("gaze_timestamp")) col_t = k;
@@ -476,24 +496,32 @@ static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_gaze_eyes
     }
     if (st != FV_OK) {
         free(line);
+        fv_gaze_fields_free(&fs);
         return st;
     }
     if (col_t < 0) col_t = col_old_t;
     if (col_t < 0 || col_c < 0 || col_x < 0 || col_y < 0) {
         free(line);
+        fv_gaze_fields_free(&fs);
         return fv_error_set(err, FV_ERR_INVALID,
-                            "%s: the header lacks gaze_timestamp (or timestamp), confidence, norm_pos_x or norm_pos_y (is it Pupil's gaze_positions.csv?)",
+                            "%s: the header lacks gaze_timestamp (or timestamp), confidence, norm_pos_x or norm_pos_y: not Pupil's "
+                            "gaze_positions.csv (for another table: --format table --time COL --x COL --y COL)",
                             w->in);
     }
     const char *tname = col_t == col_old_t ? "timestamp" : "gaze_timestamp";
     pupil_row *rows = NULL;
     int count = 0, rcap = 0;
     long per_eye[3] = {0, 0, 0};
-    while (st == FV_OK && next_line(in, w, &line, &cap, ++lineno, &st, err)) {
+    while (st == FV_OK && fv_gaze_read_line(in, w, &line, &cap, ++lineno, &st, err)) {
         if (line[strspn(line, " \t\r\n")] == '\0') continue;
-        int n = csv_split(line, f, len);
+        if (!fv_gaze_fields_split(&fs, line, ',')) {
+            st = fv_error_set(err, FV_ERR_NOMEM, "out of memory reading '%s'", w->in);
+            break;
+        }
+        int n = fs.n;
+        f = fs.f, len = fs.len;
         double t, c, x, y;
-        if (col_t >= n || col_c >= n || !field_number(f[col_t], len[col_t], &t) || !field_number(f[col_c], len[col_c], &c)) {
+        if (col_t >= n || col_c >= n || !fv_gaze_field_number(f[col_t], len[col_t], &t) || !fv_gaze_field_number(f[col_c], len[col_c], &c)) {
             st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: expected numbers in %s and confidence", w->in, lineno, tname);
             break;
         }
@@ -501,8 +529,8 @@ static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_gaze_eyes
             w->info->dropped++;
             continue;
         }
-        if (col_x >= n || col_y >= n || !field_number(f[col_x], len[col_x], &x) || !field_number(f[col_y], len[col_y], &y) || !(c >= min_conf) ||
-            !on_screen(x, y))
+        if (col_x >= n || col_y >= n || !fv_gaze_field_number(f[col_x], len[col_x], &x) || !fv_gaze_field_number(f[col_y], len[col_y], &y) || !(c >= min_conf) ||
+            !fv_gaze_on_screen(x, y))
             x = y = NAN;
         int eye = row_eye(col_base >= 0 && col_base < n ? f[col_base] : NULL, col_base >= 0 && col_base < n ? len[col_base] : 0,
                           col_id >= 0 && col_id < n ? f[col_id] : NULL, col_id >= 0 && col_id < n ? len[col_id] : 0);
@@ -515,6 +543,7 @@ static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_gaze_eyes
         per_eye[eye]++;
     }
     free(line);
+    fv_gaze_fields_free(&fs);
     if (st != FV_OK) {
         free(rows);
         return st;
@@ -549,22 +578,26 @@ static fv_status import_pupil(FILE *in, writer *w, double min_conf, fv_gaze_eyes
             i++;
             w->info->paired++;
         }
-        emit(w, t, l[0], l[1], rt[0], rt[1]);
+        fv_gaze_emit(w, t, l[0], l[1], rt[0], rt[1]);
     }
     free(rows);
     return FV_OK;
 }
 
-/* The format from the name: .asc EyeLink, .csv Pupil, either with .gz after it. */
-static fv_gaze_format guess_format(const char *path)
+/* The format from the name: .asc EyeLink, .csv Pupil (or a table when a column mapping is given),
+ * .tsv Tobii Pro Lab (a table with a mapping; without one, read as Tobii's when its header is),
+ * any of them with .gz after it. */
+static fv_gaze_format guess_format(const char *path, bool mapping)
 {
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
     size_t n = strlen(base);
     if (n > 3 && strcasecmp(base + n - 3, ".gz") == 0) n -= 3;
     if (n > 4 && strncasecmp(base + n - 4, ".asc", 4) == 0) return FV_GAZE_FORMAT_EYELINK_ASC;
+    if (mapping) return FV_GAZE_FORMAT_TABLE;
     if (n > 4 && strncasecmp(base + n - 4, ".csv", 4) == 0) return FV_GAZE_FORMAT_PUPIL_CSV;
-    return FV_GAZE_FORMAT_AUTO;
+    if (n > 4 && strncasecmp(base + n - 4, ".tsv", 4) == 0) return FV_GAZE_FORMAT_AUTO; /* gaze_table.c looks at the header */
+    return (fv_gaze_format)-1;
 }
 
 fv_status fv_gaze_import(const char *in_path, const char *out_path, const fv_gaze_import_opts *opts, fv_gaze_import_info *info,
@@ -577,7 +610,9 @@ fv_status fv_gaze_import(const char *in_path, const char *out_path, const fv_gaz
     memset(info, 0, sizeof *info);
     info->width = opts->width;
     info->height = opts->height;
-    fv_gaze_format fmt = opts->format != FV_GAZE_FORMAT_AUTO ? opts->format : guess_format(in_path);
+    const fv_gaze_table_opts *m = &opts->table;
+    bool mapping = m->time || m->x || m->y || m->left_x || m->left_y || m->right_x || m->right_y || m->valid;
+    fv_gaze_format fmt = opts->format != FV_GAZE_FORMAT_AUTO ? opts->format : guess_format(in_path, mapping);
     if (!(opts->min_confidence >= 0.0 && opts->min_confidence <= 1.0))
         return fv_error_set(err, FV_ERR_INVALID, "gaze import: confidence threshold %g is outside [0, 1]", opts->min_confidence);
     if ((unsigned)opts->eyes > FV_GAZE_EYES_EACH) return fv_error_set(err, FV_ERR_INVALID, "gaze import: unknown eye choice %d", (int)opts->eyes);
@@ -585,10 +620,19 @@ fv_status fv_gaze_import(const char *in_path, const char *out_path, const fv_gaz
     FILE *in;
     fv_status st = fv_file_open_read(in_path, "recording", &in, err);
     if (st != FV_OK) return st;
-    if (fmt != FV_GAZE_FORMAT_EYELINK_ASC && fmt != FV_GAZE_FORMAT_PUPIL_CSV) {
+    if ((unsigned)fmt > FV_GAZE_FORMAT_TOBII) {
         fclose(in);
-        return fv_error_set(err, FV_ERR_INVALID, "%s: unknown recording format (an EyeLink .asc or Pupil Labs gaze_positions .csv, or either .gz)",
+        return fv_error_set(err, FV_ERR_INVALID,
+                            "%s: unknown recording format (an EyeLink .asc, a Pupil Labs gaze_positions .csv, a Tobii Pro Lab .tsv, any of them "
+                            ".gz; another table: --format table --time COL --x COL --y COL)",
                             in_path);
+    }
+    /* A mapping belongs to a table; Tobii's columns are its own (only its time unit may be given). */
+    bool table_opts = mapping || m->time_unit > 0 || m->pixels || m->bottom_left;
+    if (fmt == FV_GAZE_FORMAT_TOBII ? mapping || m->pixels || m->bottom_left : table_opts && fmt != FV_GAZE_FORMAT_TABLE && fmt != FV_GAZE_FORMAT_AUTO) {
+        fclose(in);
+        return fv_error_set(err, FV_ERR_INVALID, "%s: the column options (--time, --x, --coords, ...) are for --format table%s", in_path,
+                            fmt == FV_GAZE_FORMAT_TOBII ? " (Tobii's columns are found by name; --time-unit alone applies)" : "");
     }
     if ((st = inflate_recording(in_path, opts->max_inflated ? opts->max_inflated : DEFAULT_MAX_INFLATED, &in, &info->compressed, err)) != FV_OK) {
         fclose(in);
@@ -607,9 +651,12 @@ fv_status fv_gaze_import(const char *in_path, const char *out_path, const fv_gaz
         return st;
     }
     info->format = fmt;
-    writer w = {out, in_path, FV_GAZE_EYES_LEFT, false, false, {0, 0}, 0, 0, info};
+    fv_gaze_writer w = {out, in_path, FV_GAZE_EYES_LEFT, false, false, {0, 0}, 0, 0, info};
     fprintf(out, "# gaze trace imported from %s by fovea gaze import (docs/gaze.md)\n", in_path);
-    st = fmt == FV_GAZE_FORMAT_EYELINK_ASC ? import_asc(in, &w, opts->eyes, err) : import_pupil(in, &w, opts->min_confidence, opts->eyes, err);
+    if (fmt == FV_GAZE_FORMAT_EYELINK_ASC) st = import_asc(in, &w, opts->eyes, err);
+    else if (fmt == FV_GAZE_FORMAT_PUPIL_CSV) st = import_pupil(in, &w, opts->min_confidence, opts->eyes, err);
+    else st = fv_gaze_import_table(in, &w, opts, &fmt, err);
+    info->format = fmt;
     if (st == FV_OK && ferror(in)) st = fv_error_set(err, FV_ERR_IO, "cannot read '%s': %s", in_path, strerror(errno));
     fclose(in);
     info->eyes = w.eyes;
