@@ -412,12 +412,339 @@ static void test_eyelink_eyes(void **st)
     assert_non_null(strstr(err.msg, "short.asc:4: expected a sample"));
 }
 
+/* ---- tables (--format table) and Tobii Pro Lab exports (src/gaze/gaze_table.c) ---- */
+
+/* A mapping for one gaze: --time time --x x --y y. */
+static fv_gaze_import_opts table_opts(const char *t, const char *x, const char *y)
+{
+    fv_gaze_import_opts o;
+    fv_gaze_import_opts_init(&o);
+    o.table.time = t;
+    o.table.x = x;
+    o.table.y = y;
+    return o;
+}
+
+/* table_norm.csv: normalised, seconds, a note column first whose quoted fields hold commas (and
+ * ""), found by name in any case (GX as gx). Rows at 10.000 ... 10.060 s: times from the first,
+ * 0 ... 0.06; (0.5,0.5), (0.25,0.75); three missing by each marker (empty, nan/NaN, - and .);
+ * (0.8,0.2); a second row at 10.050 s (dropped); x = 1.2, off the screen (missing). */
+static void test_table_norm(void **st)
+{
+    (void)st;
+    fv_gaze_import_info info;
+    fv_error err;
+    trace tr;
+    fv_gaze_import_opts o = table_opts("TIME", "gx", "gy");
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_OK);
+    assert_int_equal(info.format, FV_GAZE_FORMAT_TABLE); /* a .csv with a mapping is a table */
+    assert_int_equal(tr.n, 7);
+    assert_int_equal(tr.columns, 3);
+    assert_int_equal(info.missing, 4);
+    assert_int_equal(info.dropped, 1);
+    assert_int_equal(info.eyes, FV_GAZE_EYES_BOTH);
+    static const double t[7] = {0, 0.01, 0.02, 0.03, 0.04, 0.05, 0.06}, x[7] = {0.5, 0.25, NAN, NAN, NAN, 0.8, NAN},
+                        y[7] = {0.5, 0.75, NAN, NAN, NAN, 0.2, NAN};
+    for (int k = 0; k < 7; k++) {
+        assert_float_equal(tr.t[k], t[k], 1e-9);
+        if (isnan(x[k])) assert_true(isnan(tr.v[k][0]) && isnan(tr.v[k][1]));
+        else assert_float_equal(tr.v[k][0], x[k], 1e-6), assert_float_equal(tr.v[k][1], y[k], 1e-6);
+    }
+    /* The same y with the origin at the bottom left: 1 - 0.75 = 0.25, 1 - 0.2 = 0.8. */
+    o.table.bottom_left = true;
+    o.format = FV_GAZE_FORMAT_TABLE;
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_OK);
+    assert_float_equal(tr.v[1][1], 0.25, 1e-6);
+    assert_float_equal(tr.v[5][1], 0.8, 1e-6);
+    /* Milliseconds: the 10 ms steps become 10 us. */
+    o.table.time_unit = 1e-3;
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_OK);
+    assert_float_equal(tr.t[1], 1e-5, 1e-12);
+    /* The trace reads back: a blink from 0.02 s to 0.04 s is unknown gaze. */
+    o = table_opts("time", "gx", "gy");
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_OK);
+    fv_gaze_path *p;
+    assert_int_equal(fv_gaze_path_load_csv(tmp_path("trace.csv"), &p, &err), FV_OK);
+    fv_gaze g;
+    assert_true(fv_gaze_path_eval(p, 0.005, &g, NULL));
+    assert_float_equal(g.x, 0.375, 1e-6); /* halfway from 0.5 to 0.25 */
+    assert_false(fv_gaze_path_eval(p, 0.03, &g, NULL));
+    fv_gaze_path_destroy(p);
+}
+
+/* table_px_bottomleft.tsv: tab-separated, ms, pixels of 1920x1080 with the origin at the bottom
+ * left, both eyes, and a validity column (1, true, 0, YES). Left eye at 1000 ms (960,540):
+ * 960/1920 = 0.5, 1 - 540/1080 = 0.5; right (980,560): 0.5104167, 1 - 0.5185185 = 0.4814815.
+ * At 1004 ms left (480,270): 0.25, 0.75; right (500,250): 0.2604167, 0.7685185. At 1008 ms
+ * invalid. At 1012 ms left (1920,0): 1, 1 (the screen's corner); right (1900,20): 0.9895833,
+ * 0.9814815. */
+static void test_table_px_two_eyes(void **st)
+{
+    (void)st;
+    fv_gaze_import_info info;
+    fv_error err;
+    trace tr;
+    fv_gaze_import_opts o;
+    fv_gaze_import_opts_init(&o);
+    o.table = (fv_gaze_table_opts){.time = "time (ms)", .left_x = "LX", .left_y = "LY", .right_x = "RX", .right_y = "RY", .valid = "valid",
+                                   .time_unit = 1e-3, .pixels = true, .bottom_left = true};
+    /* Pixels need their screen. */
+    assert_int_equal(import(DATA "table_px_bottomleft.tsv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "--coords px needs the screen the pixels are of (--screen WxH)"));
+    o.width = 1920, o.height = 1080;
+    assert_int_equal(import(DATA "table_px_bottomleft.tsv", &o, &info, &tr, &err), FV_OK);
+    /* Per-eye columns of one row are one instant: each eye its own gaze by default, as EyeLink. */
+    assert_int_equal(info.eyes, FV_GAZE_EYES_EACH);
+    assert_int_equal(tr.columns, 5);
+    assert_int_equal(tr.n, 4);
+    assert_int_equal(info.missing, 1);
+    assert_float_equal(info.width, 1920, 0);
+    static const double t[4] = {0, 0.004, 0.008, 0.012};
+    static const double v[4][4] = {{0.5, 0.5, 0.5104167, 0.4814815},
+                                   {0.25, 0.75, 0.2604167, 0.7685185},
+                                   {NAN, NAN, NAN, NAN},
+                                   {1.0, 1.0, 0.9895833, 0.9814815}};
+    for (int k = 0; k < 4; k++) {
+        assert_float_equal(tr.t[k], t[k], 1e-9);
+        for (int c = 0; c < 4; c++)
+            if (isnan(v[k][c])) assert_true(isnan(tr.v[k][c]));
+            else assert_float_equal(tr.v[k][c], v[k][c], 1e-6);
+    }
+    /* both: the mean, (0.5 + 0.5104167)/2 = 0.5052083, (0.5 + 0.4814815)/2 = 0.4907407. */
+    o.eyes = FV_GAZE_EYES_BOTH;
+    assert_int_equal(import(DATA "table_px_bottomleft.tsv", &o, &info, &tr, &err), FV_OK);
+    assert_int_equal(tr.columns, 3);
+    assert_float_equal(tr.v[0][0], 0.5052083, 1e-6);
+    assert_float_equal(tr.v[0][1], 0.4907407, 1e-6);
+    o.eyes = FV_GAZE_EYES_RIGHT;
+    assert_int_equal(import(DATA "table_px_bottomleft.tsv", &o, &info, &tr, &err), FV_OK);
+    assert_float_equal(tr.v[3][0], 0.9895833, 1e-6);
+    assert_float_equal(tr.v[3][1], 0.9814815, 1e-6);
+    /* Only the left eye mapped: its trace, and no right eye to ask for. */
+    o.table.right_x = o.table.right_y = NULL;
+    o.eyes = FV_GAZE_EYES_DEFAULT;
+    assert_int_equal(import(DATA "table_px_bottomleft.tsv", &o, &info, &tr, &err), FV_OK);
+    assert_int_equal(info.eyes, FV_GAZE_EYES_LEFT);
+    assert_float_equal(tr.v[1][0], 0.25, 1e-6);
+    o.eyes = FV_GAZE_EYES_RIGHT;
+    assert_int_equal(import(DATA "table_px_bottomleft.tsv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "table_px_bottomleft.tsv: no right-eye columns"));
+}
+
+/* table_semicolon.csv: semicolons, decimal commas, CRLF: 5,000 s (0,5; 0,25), 5,020 s (0,75;
+ * 0,125), 5,040 s missing. table_noheader.csv: no header, columns by number (2: time, 3 and 4:
+ * x, y) at 2.000 ... 2.012 s: (0.1,0.2), (0.3,0.4), missing, (0.5,0.6). */
+static void test_table_delimiters_and_numbers(void **st)
+{
+    (void)st;
+    fv_gaze_import_info info;
+    fv_error err;
+    trace tr;
+    fv_gaze_import_opts o = table_opts("t", "x", "y");
+    assert_int_equal(import(DATA "table_semicolon.csv", &o, &info, &tr, &err), FV_OK);
+    assert_int_equal(tr.n, 3);
+    assert_float_equal(tr.t[1], 0.02, 1e-9);
+    assert_float_equal(tr.v[0][0], 0.5, 1e-9);
+    assert_float_equal(tr.v[0][1], 0.25, 1e-9);
+    assert_float_equal(tr.v[1][0], 0.75, 1e-9);
+    assert_float_equal(tr.v[1][1], 0.125, 1e-9);
+    assert_true(isnan(tr.v[2][0]));
+    o = table_opts("2", "3", "4");
+    assert_int_equal(import(DATA "table_noheader.csv", &o, &info, &tr, &err), FV_OK);
+    assert_int_equal(tr.n, 4); /* the first line is a row */
+    static const double t[4] = {0, 0.004, 0.008, 0.012}, x[4] = {0.1, 0.3, NAN, 0.5}, y[4] = {0.2, 0.4, NAN, 0.6};
+    for (int k = 0; k < 4; k++) {
+        assert_float_equal(tr.t[k], t[k], 1e-9);
+        if (isnan(x[k])) assert_true(isnan(tr.v[k][0]));
+        else assert_float_equal(tr.v[k][0], x[k], 1e-6), assert_float_equal(tr.v[k][1], y[k], 1e-6);
+    }
+    /* Without a header, names mean nothing; numbers past the row do not exist. */
+    o = table_opts("2", "3", "y");
+    assert_int_equal(import(DATA "table_noheader.csv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "--y y: the file has no header line, so its columns are named by number (1 to 4)"));
+    o = table_opts("2", "3", "5");
+    assert_int_equal(import(DATA "table_noheader.csv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "--y 5: the first row has 4 columns"));
+    /* A header and numbers: the time's column 2 holds "time", so the first line is a header. */
+    o = table_opts("2", "3", "4");
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_OK);
+    assert_int_equal(tr.n, 7);
+    assert_float_equal(tr.v[1][0], 0.25, 1e-6);
+}
+
+/* Refusals: one line naming the file (and line and column for a row), nothing written. */
+static void test_table_refusals(void **st)
+{
+    (void)st;
+    fv_gaze_import_info info;
+    fv_error err;
+    trace tr;
+    fv_gaze_import_opts o = table_opts("time", "gz", "gy");
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "table_norm.csv: --x gz: no such column; the header has 'note', 'time', 'GX', 'gy'"));
+    o = table_opts("time", "gx", "GX");
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "table_norm.csv: --x and --y both name column 'GX'"));
+    o = table_opts("gy", "gx", "gy");
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "--time and --y both name column 'gy'"));
+    o = table_opts("time", "gx", NULL);
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "--x needs --y"));
+    o = table_opts("time", "gx", "gy");
+    o.eyes = FV_GAZE_EYES_EACH;
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "--x/--y give one gaze; --eye each needs per-eye columns"));
+    o = table_opts("time", "gx", "gy");
+    o.width = 640, o.height = 480; /* a screen for normalised coordinates: a forgotten --coords px */
+    assert_int_equal(import(DATA "table_norm.csv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "--screen is for a table in pixels"));
+    o = table_opts("time", "gx", "gy");
+    o.format = FV_GAZE_FORMAT_EYELINK_ASC;
+    assert_int_equal(import(DATA "eyelink_mono.asc", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "the column options (--time, --x, --coords, ...) are for --format table"));
+
+    o = table_opts("t", "x", "y");
+    char bad[256]; /* tmp_path's buffers are reused by import() */
+    snprintf(bad, sizeof bad, "%s", tmp_path("bad.csv"));
+    write_file(bad, "", 0);
+    assert_int_equal(import(bad, &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "bad.csv: the file is empty"));
+    const char malformed[] = "t,x,y\n0,0.1,0.2\n\n0.01,0.3,0.4e\n";
+    write_file(bad, malformed, sizeof malformed - 1);
+    assert_int_equal(import(bad, &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "bad.csv:4: column 'y': '0.4e' is not a number"));
+    const char time[] = "t,x,y\n0,0.1,0.2\nsoon,0.3,0.4\n";
+    write_file(bad, time, sizeof time - 1);
+    assert_int_equal(import(bad, &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "bad.csv:3: column 't' (the time): 'soon' is not a number"));
+    /* Out of order: refused, not sorted (a table of one row per moment out of order has a wrong
+     * time column or two recordings pasted together). */
+    const char order[] = "t,x,y\n0,0.1,0.2\n0.02,0.3,0.4\n0.01,0.5,0.6\n";
+    write_file(bad, order, sizeof order - 1);
+    assert_int_equal(import(bad, &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "bad.csv:4: time 0.01 s is before the previous row's 0.02 s"));
+    const char quote[] = "t,x,y,note\n0,0.1,0.2,\"open\n";
+    write_file(bad, quote, sizeof quote - 1);
+    assert_int_equal(import(bad, &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "bad.csv:2: a quoted field is not closed on its line"));
+    /* A .csv that is not Pupil's, named without a mapping: the message says how to map it. */
+    assert_int_equal(import(DATA "table_norm.csv", NULL, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "not Pupil's gaze_positions.csv (for another table: --format table --time COL --x COL --y COL)"));
+    /* A .tsv that is not Tobii's, likewise. */
+    assert_int_equal(import(DATA "table_px_bottomleft.tsv", NULL, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "not a Tobii Pro Lab export"));
+    assert_non_null(strstr(err.msg, "--format table --time COL --x COL --y COL"));
+}
+
+/* tobii_prolab.tsv (Pro Lab's columns, 1920x1080, "Recording timestamp [us]" with the micro
+ * sign): an event row at 1.990 s (RecordingStart) before the first sample at 2.000 s, so times
+ * count from 2.000 s; samples at 2.000000, 2.008333, 2.016667, 2.025000, 2.033333 s and an event
+ * row at 2.010 s (both events skipped). Gaze point (960,540) -> (0.5,0.5); (480,270) -> (0.25,
+ * 0.25); at 2.016667 s the left eye Invalid, the right Valid: Tobii's gaze (1440,810) -> (0.75,
+ * 0.75); at 2.025 s both Invalid, no gaze: missing; (192,108) -> (0.1,0.1). Per eye at 2.000 s:
+ * left (950,530) -> 0.4947917, 0.4907407; right (970,550) -> 0.5052083, 0.5092593. */
+static void test_tobii(void **st)
+{
+    (void)st;
+    fv_gaze_import_info info;
+    fv_error err;
+    trace tr;
+    assert_int_equal(import(DATA "tobii_prolab.tsv", NULL, &info, &tr, &err), FV_OK);
+    assert_int_equal(info.format, FV_GAZE_FORMAT_TOBII); /* from the .tsv's header */
+    assert_int_equal(info.eyes, FV_GAZE_EYES_BOTH);
+    assert_int_equal(info.skipped, 2);
+    assert_int_equal(info.missing, 1);
+    assert_int_equal(tr.n, 5);
+    assert_int_equal(tr.columns, 3);
+    assert_float_equal(info.width, 1920, 0);
+    assert_float_equal(info.height, 1080, 0);
+    static const double t[5] = {0, 0.008333, 0.016667, 0.025, 0.033333}, xy[5] = {0.5, 0.25, 0.75, NAN, 0.1};
+    for (int k = 0; k < 5; k++) {
+        assert_float_equal(tr.t[k], t[k], 1e-9);
+        if (isnan(xy[k])) assert_true(isnan(tr.v[k][0]));
+        else assert_float_equal(tr.v[k][0], xy[k], 1e-6), assert_float_equal(tr.v[k][1], xy[k], 1e-6);
+    }
+    fv_gaze_import_opts o;
+    fv_gaze_import_opts_init(&o);
+    o.eyes = FV_GAZE_EYES_EACH;
+    o.format = FV_GAZE_FORMAT_TOBII;
+    assert_int_equal(import(DATA "tobii_prolab.tsv", &o, &info, &tr, &err), FV_OK);
+    assert_int_equal(tr.columns, 5);
+    assert_int_equal(info.missing, 2); /* 2.016667 s (the left eye) and 2.025 s */
+    assert_float_equal(tr.v[0][0], 0.4947917, 1e-6);
+    assert_float_equal(tr.v[0][1], 0.4907407, 1e-6);
+    assert_float_equal(tr.v[0][2], 0.5052083, 1e-6);
+    assert_float_equal(tr.v[0][3], 0.5092593, 1e-6);
+    assert_true(isnan(tr.v[2][0]));
+    assert_float_equal(tr.v[2][2], 0.75, 1e-6);
+    /* The five-column trace reads back as two eyes' gaze. */
+    fv_gaze_path *p;
+    assert_int_equal(fv_gaze_path_load_csv(tmp_path("trace.csv"), &p, &err), FV_OK);
+    fv_gaze_path_destroy(p);
+    /* A unit of the header's overridden: as if the stamps were ns, 8333 ns apart. */
+    o.eyes = FV_GAZE_EYES_DEFAULT;
+    o.table.time_unit = 1e-9;
+    assert_int_equal(import(DATA "tobii_prolab.tsv", &o, &info, &tr, &err), FV_OK);
+    assert_float_equal(tr.t[1], 8.333e-6, 1e-12);
+    /* Tobii's columns are its own. */
+    o.table.x = "Gaze point X";
+    assert_int_equal(import(DATA "tobii_prolab.tsv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "are for --format table"));
+}
+
+/* tobii_ms.tsv: "Recording timestamp [ms]", Tobii's gaze alone, no validity and no recording
+ * resolution (--screen 640x480): 100.0 ms (320,240) -> (0.5,0.5); 116.5 ms (640,480) -> (1,1);
+ * an event row at 120.0 ms (skipped); 133.0 ms with no gaze and no event: a lost sample, missing;
+ * 149.5 ms (0,0). */
+static void test_tobii_ms(void **st)
+{
+    (void)st;
+    fv_gaze_import_info info;
+    fv_error err;
+    trace tr;
+    fv_gaze_import_opts o;
+    fv_gaze_import_opts_init(&o);
+    assert_int_equal(import(DATA "tobii_ms.tsv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "tobii_ms.tsv:2: gaze in pixels, and no recording resolution in the row (give the screen with --screen WxH)"));
+    o.width = 640, o.height = 480;
+    assert_int_equal(import(DATA "tobii_ms.tsv", &o, &info, &tr, &err), FV_OK);
+    assert_int_equal(tr.n, 4);
+    assert_int_equal(info.skipped, 1);
+    assert_int_equal(info.missing, 1);
+    static const double t[4] = {0, 0.0165, 0.033, 0.0495}, xy[4] = {0.5, 1.0, NAN, 0.0};
+    for (int k = 0; k < 4; k++) {
+        assert_float_equal(tr.t[k], t[k], 1e-9);
+        if (isnan(xy[k])) assert_true(isnan(tr.v[k][0]));
+        else assert_float_equal(tr.v[k][0], xy[k], 1e-6), assert_float_equal(tr.v[k][1], xy[k], 1e-6);
+    }
+    /* No per-eye columns: no eye to choose. */
+    o.eyes = FV_GAZE_EYES_LEFT;
+    assert_int_equal(import(DATA "tobii_ms.tsv", &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "--eye left needs the per-eye columns"));
+    /* A unit fovea does not know, and a .tsv without Tobii's time. */
+    char bad[256];
+    snprintf(bad, sizeof bad, "%s", tmp_path("bad.tsv"));
+    const char minutes[] = "Recording timestamp [min]\tGaze point X\tGaze point Y\n1\t2\t3\n";
+    write_file(bad, minutes, sizeof minutes - 1);
+    o.eyes = FV_GAZE_EYES_DEFAULT;
+    assert_int_equal(import(bad, &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "bad.tsv: the header gives the recording timestamp in [min]"));
+    const char notime[] = "Timestamp\tGaze point X\tGaze point Y\n1\t2\t3\n";
+    write_file(bad, notime, sizeof notime - 1);
+    o.format = FV_GAZE_FORMAT_TOBII;
+    assert_int_equal(import(bad, &o, &info, &tr, &err), FV_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "bad.tsv: no 'Recording timestamp' column"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pupil_blank_first), cmocka_unit_test(test_pupil_old_header), cmocka_unit_test(test_pupil_binocular),
         cmocka_unit_test(test_eyelink_2000hz),    cmocka_unit_test(test_eyelink_gz),       cmocka_unit_test(test_eyelink_trials),
-        cmocka_unit_test(test_eyelink_eyes),
+        cmocka_unit_test(test_eyelink_eyes),      cmocka_unit_test(test_table_norm),       cmocka_unit_test(test_table_px_two_eyes),
+        cmocka_unit_test(test_table_delimiters_and_numbers), cmocka_unit_test(test_table_refusals), cmocka_unit_test(test_tobii),
+        cmocka_unit_test(test_tobii_ms),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
