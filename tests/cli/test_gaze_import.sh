@@ -57,4 +57,49 @@ ls "$TMP" | grep -q 'tmp\.' && fail "temporary files left in $TMP"
 head -n 1 "$SRC/tests/data/pupil_gaze_positions.csv" >"$TMP/gaze_positions.csv"
 expect 2 "no usable gaze sample" -- $FOVEA gaze import "$TMP/gaze_positions.csv" --out "$TMP/empty.csv"
 [ -e "$TMP/empty.csv" ] && fail "a refused import wrote empty.csv"
+# ---- tables (--format table) and Tobii Pro Lab exports ----
+# table_norm.csv: a quoted note with a comma before the time column; rows 10 ms apart
+expect 0 "" -- $G "$D/table_norm.csv" --time time --x gx --y gy --out "$TMP/tab.csv"
+grep -q "7 samples (4 missing, 1 dropped: time not increasing), one gaze for both eyes" "$TMP/err" || fail "table summary: $(cat "$TMP/err")"
+grep -q '^0.01,0.250000,0.750000$' "$TMP/tab.csv" || fail "tab.csv: $(sed -n 2,4p "$TMP/tab.csv")"
+grep -q '^0.02,,$' "$TMP/tab.csv" || fail "tab.csv: the blink is not missing"
+expect 0 "" -- $R --gaze-trace "$TMP/tab.csv" --gaze-missing widen --frames 2 --fps 60 --out "$TMP/tab.png"
+# pixels of 1920x1080 from the bottom left, ms, both eyes: right eye at 1000 ms (980,560) ->
+# 980/1920 = 0.510417, 1 - 560/1080 = 0.481481
+expect 0 "" -- $G "$D/table_px_bottomleft.tsv" --format table --time "Time (ms)" --time-unit ms --left-x LX --left-y LY --right-x RX \
+  --right-y RY --valid Valid --coords px --screen 1920x1080 --origin bottom-left --out "$TMP/px.csv"
+grep -q "4 samples (1 missing), both eyes, screen 1920x1080" "$TMP/err" || fail "px summary: $(cat "$TMP/err")"
+grep -q '^0,0.500000,0.500000,0.510417,0.481481$' "$TMP/px.csv" || fail "px.csv: $(sed -n 2p "$TMP/px.csv")"
+expect 0 "" -- $R --gaze-trace "$TMP/px.csv" --stereo 10 --frames 2 --fps 60 --out "$TMP/px.png"
+expect 2 "--coords px needs the screen" -- $G "$D/table_px_bottomleft.tsv" --time 1 --x 2 --y 3 --coords px --out "$TMP/x.csv"
+expect 2 "table_norm.csv: --x gz: no such column; the header has 'note', 'time', 'GX', 'gy'" -- \
+  $G "$D/table_norm.csv" --time time --x gz --y gy --out "$TMP/x.csv"
+expect 2 "--x and --y both name column 'GX'" -- $G "$D/table_norm.csv" --time time --x gx --y gx --out "$TMP/x.csv"
+printf 't,x,y\n0,0.1,0.2\n0.01,0.3,O.4\n' >"$TMP/typo.csv"
+expect 2 "typo.csv:3: column 'y': 'O.4' is not a number" -- $G "$TMP/typo.csv" --time t --x x --y y --out "$TMP/x.csv"
+: >"$TMP/none.csv"
+expect 2 "none.csv: the file is empty" -- $G "$TMP/none.csv" --time t --x x --y y --out "$TMP/x.csv"
+expect 2 "not Pupil's gaze_positions.csv (for another table: --format table --time COL --x COL --y COL)" -- \
+  $G "$D/table_norm.csv" --out "$TMP/x.csv"
+expect 2 "--time-unit min: expected s, ms, us or ns" -- $G "$D/table_norm.csv" --time time --x gx --y gy --time-unit min --out "$TMP/x.csv"
+expect 2 "--coords cm: expected norm or px" -- $G "$D/table_norm.csv" --time time --x gx --y gy --coords cm --out "$TMP/x.csv"
+expect 2 "--origin centre: expected top-left or bottom-left" -- $G "$D/table_norm.csv" --time time --x gx --y gy --origin centre --out "$TMP/x.csv"
+expect 2 "--format excel: expected eyelink, pupil, tobii or table" -- $G "$D/table_norm.csv" --format excel --out "$TMP/x.csv"
+# Tobii Pro Lab: found by the .tsv's header, also gzip-compressed; events skipped
+expect 0 "" -- $G "$D/tobii_prolab.tsv" --out "$TMP/tobii.csv"
+grep -q "5 samples (1 missing), screen 1920x1080, one gaze for both eyes, 2 rows without gaze data skipped" "$TMP/err" ||
+  fail "tobii summary: $(cat "$TMP/err")"
+grep -q '^0.016667,0.750000,0.750000$' "$TMP/tobii.csv" || fail "tobii.csv: $(sed -n 4p "$TMP/tobii.csv")"
+gzip -c "$D/tobii_prolab.tsv" >"$TMP/prolab.tsv.gz"
+expect 0 "" -- $G "$TMP/prolab.tsv.gz" --out "$TMP/tobiigz.csv"
+diff <(grep -v '^#' "$TMP/tobii.csv") <(grep -v '^#' "$TMP/tobiigz.csv") >/dev/null || fail "the .tsv.gz export gives another trace"
+expect 0 "" -- $G "$D/tobii_prolab.tsv" --eye each --out "$TMP/tobii5.csv"
+grep -q '^0.016667,,,0.750000,0.750000$' "$TMP/tobii5.csv" || fail "tobii --eye each: $(sed -n 4p "$TMP/tobii5.csv")"
+expect 2 "tobii_ms.tsv:2: gaze in pixels, and no recording resolution in the row" -- $G "$D/tobii_ms.tsv" --out "$TMP/x.csv"
+expect 0 "" -- $G "$D/tobii_ms.tsv" --screen 640x480 --out "$TMP/tms.csv"
+grep -q '^0.0165,1.000000,1.000000$' "$TMP/tms.csv" || fail "tms.csv: $(sed -n 3p "$TMP/tms.csv")"
+expect 2 "are for --format table (Tobii's columns are found by name" -- $G "$D/tobii_prolab.tsv" --format tobii --x a --y b --out "$TMP/x.csv"
+expect 2 "table_px_bottomleft.tsv: not a Tobii Pro Lab export" -- $G "$D/table_px_bottomleft.tsv" --out "$TMP/x.csv"
+$FOVEA gaze --help | grep -q -- "--left-x COL" || fail "gaze --help lacks the table options"
+[ -e "$TMP/x.csv" ] && fail "a refused table import left x.csv behind"
 finish
