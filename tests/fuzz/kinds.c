@@ -146,6 +146,26 @@ static fv_status run_import(fv_fuzz_ctx *c, const char *path, fv_error *err)
     return c->note[0] ? FV_ERR_INTERNAL : FV_OK;
 }
 
+/* A delimited table under a mapping by number (time, x, y in columns 2, 3, 4: the seeds'
+ * table_norm.csv, table_noheader.csv), imported like a recording. */
+static fv_status run_table(fv_fuzz_ctx *c, const char *path, fv_error *err)
+{
+    char trace[4200];
+    snprintf(trace, sizeof trace, "%s/trace.csv", c->work);
+    fv_gaze_import_opts o;
+    fv_gaze_import_opts_init(&o);
+    o.format = FV_GAZE_FORMAT_TABLE;
+    o.table.time = "2";
+    o.table.x = "3";
+    o.table.y = "4";
+    fv_status st = fv_gaze_import(path, trace, &o, NULL, err);
+    if (st != FV_OK) return st;
+    fv_error e2;
+    if (run_gaze(c, trace, &e2) != FV_OK && !c->note[0]) snprintf(c->note, sizeof c->note, "imported, then the trace was refused: %s", e2.msg);
+    remove(trace);
+    return c->note[0] ? FV_ERR_INTERNAL : FV_OK;
+}
+
 static const fv_fuzz_kind k_kinds[] = {
     {"scene", ".json", run_scene, {"tests/data", "scenes", "tests/fuzz/seeds"}, NULL, false},
     {"obj", ".obj", run_scene, {"tests/data", "tests/fuzz/seeds", NULL}, NULL, false},
@@ -162,6 +182,8 @@ static const fv_fuzz_kind k_kinds[] = {
     {"exr", ".exr", run_image, {NULL, NULL, NULL}, NULL, true},
     {"eyelink", ".asc", run_import, {"tests/data", NULL, NULL}, NULL, false},
     {"pupil", ".csv", run_import, {"tests/data", NULL, NULL}, "pupil", false},
+    {"tobii", ".tsv", run_import, {"tests/data", NULL, NULL}, "tobii", false},
+    {"table", ".csv", run_table, {"tests/data", NULL, NULL}, "table", false},
 };
 
 int fv_fuzz_kind_count(void) { return (int)(sizeof k_kinds / sizeof k_kinds[0]); }
