@@ -26,6 +26,9 @@
  *
  * Times are written in seconds from the first sample. Samples whose time does not increase are
  * dropped and counted. The output goes through the atomic writer: on any error no file is left.
+ *
+ * Other tables (a column mapping) and Tobii Pro Lab exports are read by gaze_table.c, through the
+ * writer, line reader and field splitter here (import.h).
  */
 #include <ctype.h>
 #include <errno.h>
