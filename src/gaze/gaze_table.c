@@ -444,7 +444,9 @@ fv_status fv_gaze_import_table(FILE *in, fv_gaze_writer *w, const fv_gaze_import
     }
     if (st == FV_OK) {
         t.tobii = *format == FV_GAZE_FORMAT_TOBII;
-        st = t.tobii ? map_tobii(&t, opts, err) : map_table(&t, opts, err);
+        if (t.tobii && (opts->table.pixels || opts->table.bottom_left))
+            st = fv_error_set(err, FV_ERR_INVALID, "%s: --coords and --origin are for --format table (Tobii's units come from its export)", w->in);
+        else st = t.tobii ? map_tobii(&t, opts, err) : map_table(&t, opts, err);
     }
     if (st == FV_OK) st = choose_eyes(&t, opts->eyes, err);
     double prev = 0;
