@@ -32,6 +32,11 @@ static void usage(FILE *f)
            FV_CLI_THREAD_POLICY_HELP
                "  --device D        run every measured method that has device D there (cpu, portable, cuda,\n"
                "                    auto; docs/gpu.md); methods and references naming a device keep theirs\n"
+               "  --progress-every S\n"
+               "                    progress within each long step (a reference's frames, the noise probe,\n"
+               "                    a method's repeat: percentage, frame, ETA) on stderr: on a terminal one\n"
+               "                    line redrawn in place; otherwise a line at most every S seconds of a\n"
+               "                    step still running (0: at every change) [20]\n"
                "  --check           only validate the scenario\n"
                "  --list            list the scenarios found, each with its description's first sentence\n"
                "Without a scenario file (the same harness, cache and reports; docs/bench.md):\n"
@@ -43,10 +48,7 @@ static void usage(FILE *f)
                "  --frames N        frames [1; with a temporal method, its still warm-up before one measured frame]\n"
                "  --size WxH        image size [256x256]\n"
                "  --save-scenario F write the scenario built as a JSON file (to rerun or edit)\n"
-               "  --quiet           no status or progress lines\n"
-               "  --progress-every S  progress within a long step (a reference's frames, the noise probe, a\n"
-               "                    method's repeat): on a terminal one line redrawn in place; otherwise a line\n"
-               "                    at most every S seconds of a step still running [20]\n");
+               "  --quiet           no status or progress lines\n");
 }
 
 static bool is_file(const char *p)
