@@ -28,6 +28,7 @@ static void test_duration(void **st)
     assert_string_equal(dur(3599.4), "59m59s");
     assert_string_equal(dur(3720.0), "1h02m"); /* 62 minutes */
     assert_string_equal(dur(36000.0 + 59 * 60 + 59), "10h59m");
+    assert_string_equal(dur(1e12), "100000h00m"); /* capped: an ETA from almost nothing done */
     assert_string_equal(dur(-3.0), "0s");
     assert_string_equal(dur(NAN), "0s");
 }

@@ -15,7 +15,7 @@
 void fv_cli_duration(double seconds, char *buf, size_t n)
 {
     if (!(seconds >= 0.0)) seconds = 0.0;
-    if (seconds > 360000.0 * 99) seconds = 360000.0 * 99; /* a silly ETA early on stays printable */
+    if (seconds > 3.6e8) seconds = 3.6e8; /* 100000 h: an early ETA's nonsense stays short */
     long s = (long)(seconds + 0.5);
     if (s < 60) snprintf(buf, n, "%lds", s);
     else if (s < 3600) snprintf(buf, n, "%ldm%02lds", s / 60, s % 60);
