@@ -72,7 +72,7 @@ typedef struct fv_bench_options {
     int threads;            /* 0: all */
     int repeats;            /* > 0 overrides the scenario's */
     const fv_log *log;      /* warnings */
-    /* Progress lines ("[2/6] pt-4: repeat 1/3, frame 2/5"); may be NULL. */
+    /* Status lines, one as each step begins ("[2/6] pt-4: repeat 1/3, 5 frame(s)"); may be NULL. */
     void (*status)(void *user, const char *line);
     void *status_user;
     /* "cpu", "portable", "cuda", "auto" or NULL: the device of every measured method that has it
@@ -92,6 +92,13 @@ typedef struct fv_bench_options {
     void (*report)(void *user, const char *json);
     /* NULL: one process; else the run is split over size processes (above). */
     const fv_bench_split *split;
+    /* Progress within the step the last status line began (a reference's frames, the noise probe,
+     * a method's repeat): `done` of the step's `total` frames that this process renders are done,
+     * and the fraction `part` of the next one; may be NULL. Gets status_user; never called from two
+     * threads at once. A reference and the probe report during a frame too (through the driver's
+     * fv_progress_fn, as the technique's work goes on); a measured method only between frames,
+     * after its frame's time is taken: its timed render call is the same with or without this. */
+    void (*progress)(void *user, int done, int total, double part);
 } fv_bench_options;
 
 /* Runs the scenario file at `path`. Bad scenario -> FV_ERR_INVALID naming file and field. Writes

@@ -140,12 +140,14 @@ class MetricReport(Structure):
 
 BENCH_MODES = {"default": 0, "quick": 1, "full": 2}
 LINE_FN = CFUNCTYPE(None, c_void_p, c_char_p)
+BENCH_PROGRESS_FN = CFUNCTYPE(None, c_void_p, c_int, c_int, c_double)
 
 
 class BenchOptions(Structure):
     _fields_ = [("out_dir", c_char_p), ("cache_dir", c_char_p), ("mode", c_int), ("threads", c_int), ("repeats", c_int),
                 ("log", POINTER(Log)), ("status", LINE_FN), ("status_user", c_void_p), ("device", c_char_p),
-                ("table", LINE_FN), ("command", c_char_p), ("report", LINE_FN), ("split", c_void_p)]
+                ("table", LINE_FN), ("command", c_char_p), ("report", LINE_FN), ("split", c_void_p),
+                ("progress", BENCH_PROGRESS_FN)]
 
 # ---- provenance.h ----
 

@@ -101,6 +101,19 @@ static void reference_key(const fv_scenario *sc, const fv_bench_method *m, const
 #undef KEY
 }
 
+/* Progress through the step the last status line began (fv_bench_options.progress): `done` of
+ * `total` frames; `within` also reports during a frame, through the driver's progress callback. */
+typedef struct step_progress {
+    const fv_bench_options *opt;
+    int done, total;
+    bool within;
+} step_progress;
+
+static void step_report(const step_progress *p, double part)
+{
+    if (p && p->opt->progress) p->opt->progress(p->opt->status_user, p->done, p->total, part);
+}
+
 /* Renders frames [first, nframes) of one method with a fresh technique; calls back per frame.
  * The frames come from the sequence driver, as `fovea render` makes them. */
 typedef struct render_job {
@@ -111,6 +124,7 @@ typedef struct render_job {
     const fv_log *log;
     const fv_bench_split *split; /* NULL: one process */
     bool left_only;              /* a stereo scenario's reference: the measured left eye alone */
+    step_progress *step;         /* NULL: the frames report no progress */
 } render_job;
 
 typedef fv_status (*frame_fn)(void *user, int index, fv_film *film, double ms, const fv_stats *stats, fv_error *err);
@@ -120,6 +134,15 @@ static bool keep_going(void *user, double fraction)
     (void)fraction;
     const fv_bench_split *sp = user;
     return !sp->stopped(sp->user);
+}
+
+/* The driver's callback of a frame that reports progress within it (a reference, the probe): the
+ * step's progress, and when split, whether to go on. */
+static bool frame_progress(void *user, double fraction)
+{
+    const render_job *j = user;
+    step_report(j->step, fraction);
+    return !(j->split && j->split->stopped) || keep_going((void *)j->split, fraction);
 }
 
 static fv_status render_sequence(const render_job *j, int first, int nframes, frame_fn on_frame, void *user, fv_error *err)
@@ -138,16 +161,25 @@ static fv_status render_sequence(const render_job *j, int first, int nframes, fr
         fv_stats_clear(&stats);
         fv_film_clear(film);
         if (films[1]) fv_film_clear(films[1]);
-        double t0 = fv_time_ms();
-        /* split over processes: a frame stops early once another rank has failed */
+        /* split over processes: a frame stops early once another rank has failed; a measured
+         * method's frame reports no progress within it (only between frames, below, outside
+         * the timed call) */
         const bool poll = j->split && j->split->stopped;
-        st = fv_driver_render(j->driver, t, i, i > first, films, &stats, poll ? keep_going : NULL, poll ? (void *)j->split : NULL, err);
+        const bool within = j->step && j->step->within && j->step->opt->progress;
+        fv_progress_fn fn = within ? frame_progress : poll ? keep_going : NULL;
+        void *fn_user = within ? (void *)j : poll ? (void *)j->split : NULL;
+        double t0 = fv_time_ms();
+        st = fv_driver_render(j->driver, t, i, i > first, films, &stats, fn, fn_user, err);
         double ms = fv_time_ms() - t0;
         if (st != FV_OK) {
             fv_error_prefix(err, "%s, frame %d: ", j->m->label, i);
             break;
         }
         st = on_frame(user, i, film, ms, &stats, err);
+        if (st == FV_OK && j->step) {
+            j->step->done++;
+            step_report(j->step, 0.0);
+        }
     }
     fv_film_destroy(films[0]);
     fv_film_destroy(films[1]);
@@ -292,14 +324,20 @@ static fv_status load_references(const fv_bench_run_info *info, fv_scene *scene,
         missing[i] = 1;
     }
     st = share_plan(sp, st, missing, n, err);
-    for (int i = first; i < n && st == FV_OK; i++) nmissing += missing[i];
+    int mine = 0; /* the missing frames this rank renders when they are dealt round-robin */
+    for (int i = first; i < n && st == FV_OK; i++) {
+        if (missing[i] && (!sp || nmissing % sp->size == sp->rank)) mine++;
+        nmissing += missing[i];
+    }
     if (st == FV_OK && nmissing > 0) {
         const bool alone = !sp || fv_technique_warmup_frames(fv_technique_index(m->method)) > 0;
         say(info->opt, "%s: rendering %d frame(s) with %s (%d cached)%s", m->label, alone ? n - first : nmissing, m->method, *cached,
             alone ? "" : ", split over the ranks");
         /* References are rendered on their own random stream (core/rng.h). */
-        render_job j = {sc, scene, info->ref_driver, m, info->opt->log, sp, true};
+        step_progress prog = {info->opt, 0, alone ? n - first : mine, true};
+        render_job j = {sc, scene, info->ref_driver, m, info->opt->log, sp, true, &prog};
         ref_ctx c = {frames, (const char *const *)paths, slot, 0.0};
+        step_report(&prog, 0.0);
         if (alone) {
             /* Render the whole measured sequence (a temporal reference needs its history); frames
              * already cached are simply not written again. Frames before measure_from are never
@@ -381,14 +419,18 @@ static fv_status probe_reference(fv_bench_run_info *info, fv_scene *scene, const
     fv_drive_opts o = *dopt;
     o.seed = fv_seed_reference_probe(sc->seed);
     st = fv_driver_create(scene, view, &o, &driver, err);
-    render_job j = {sc, scene, driver, &probe, info->opt->log, sp, true};
+    step_progress prog = {info->opt, 0, 1, true};
+    render_job j = {sc, scene, driver, &probe, info->opt->log, sp, true, &prog};
     bool split = false;
     /* every rank has its driver before any splits the still; a failure there or in the split is
      * already the job's */
     if (sp && ((st = agree(sp, st, err)) != FV_OK || (st = split_still(&j, last, rgb, &split, err)) != FV_OK)) goto compare;
     if (split && rank == 0) st = fv_image_write(path, rgb, sc->width, sc->height, 1.0f, err);
     probe_ctx c = {rgb, path};
-    if (!split && rank == 0) st = render_sequence(&j, last, last + 1, on_probe_frame, &c, err);
+    if (!split && rank == 0) {
+        step_report(&prog, 0.0);
+        st = render_sequence(&j, last, last + 1, on_probe_frame, &c, err);
+    }
     if (st != FV_OK) fv_error_prefix(err, "the reference's noise probe: ");
     st = agree(sp, st, err);
 compare:
@@ -540,7 +582,7 @@ static fv_status method_begin(const fv_bench_run_info *info, fv_scene *scene, fr
     c->last = fv_alloc_array(npix, 3 * sizeof(float));
     if (!res->ms || !mr->stage_per_rep || !mr->frame_ms || !c->flip_map || !c->last) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     fv_stats_clear(&mr->stage_names);
-    mr->j = (render_job){sc, scene, info->driver, res->m, info->opt->log, info->opt->split, false};
+    mr->j = (render_job){sc, scene, info->driver, res->m, info->opt->log, info->opt->split, false, NULL};
     return render_sequence(&mr->j, 0, 1, on_warmup_frame, NULL, err);
 }
 
@@ -564,7 +606,13 @@ static fv_status method_repeat(method_run *mr, int index, int total, int r, fv_e
         if (sc->frames - sc->measure_from > 1 && (st = fv_temporal_create(sc->width, sc->height, &c->mopts, &c->temporal, err)) != FV_OK)
             return st;
     }
-    if ((st = render_sequence(&mr->j, 0, sc->frames, on_method_frame, c, err)) != FV_OK) return st;
+    /* frame k of n, between the frames: nothing within the timed render calls */
+    step_progress prog = {c->info->opt, 0, sc->frames, false};
+    mr->j.step = &prog;
+    step_report(&prog, 0.0);
+    st = render_sequence(&mr->j, 0, sc->frames, on_method_frame, c, err);
+    mr->j.step = NULL;
+    if (st != FV_OK) return st;
     res->ms[r] = c->ms_sum / sc->frames;
     for (int k = 0; k < c->stage_sum.n_stages; k++) {
         fv_stats_add_ms(&mr->stage_names, c->stage_sum.stage[k].name, 0.0);

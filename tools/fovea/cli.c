@@ -218,40 +218,6 @@ fv_log fv_cli_log(bool *quiet)
     return l;
 }
 
-void fv_cli_progress_init(fv_cli_progress *p, bool quiet, int frames)
-{
-    memset(p, 0, sizeof *p);
-    p->enabled = !quiet && isatty(STDERR_FILENO);
-    p->t0 = fv_time_ms();
-    p->frames = frames > 0 ? frames : 1;
-    p->last_percent = -1;
-}
-
-bool fv_cli_progress_frame(void *user, double fraction)
-{
-    fv_cli_progress *p = user;
-    if (g_signal) return false;
-    if (!p->enabled) return true;
-    double total = (p->frame + fraction) / p->frames;
-    int percent = (int)(total * 100.0);
-    if (percent == p->last_percent) return true;
-    p->last_percent = percent;
-    double el = (fv_time_ms() - p->t0) / 1000.0;
-    double eta = total > 0.001 ? el * (1.0 - total) / total : 0.0;
-    char bar[31];
-    int filled = (int)(total * 30.0);
-    for (int i = 0; i < 30; i++) bar[i] = i < filled ? '#' : '.';
-    bar[30] = '\0';
-    fprintf(stderr, "\r[%s] %3d%%  frame %d/%d  %.0fs elapsed, ETA %.0fs ", bar, percent, p->frame + 1, p->frames, el, eta);
-    fflush(stderr);
-    return true;
-}
-
-void fv_cli_progress_done(fv_cli_progress *p)
-{
-    if (p->enabled) fprintf(stderr, "\r%*s\r", 78, "");
-}
-
 int fv_cli_check_method(const char *cmd, const char *method)
 {
     if (fv_technique_index(method) >= 0) return 0;

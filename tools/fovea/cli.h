@@ -85,16 +85,41 @@ int fv_cli_opt_thread_policy(const char *cmd, const char *arg);
 /* One line saying which plan is in effect, for --stats. */
 const char *fv_cli_thread_plan(void);
 
-/* A progress bar with ETA on stderr, drawn only when stderr is a terminal and not quiet. */
+/* ---- the progress line (cli_progress.c) ----
+ *
+ * On stderr: a bar, the percentage, the frame under way, the time so far and the ETA (once a
+ * thousandth of the work is done). On a terminal, one line drawn in place (\r) when its
+ * percentage changes or a second has passed, and cleared when the work or the step ends. Not on a
+ * terminal (a pipe, a CI log) nothing, unless the command asks for lines (init_steps with every_s
+ * >= 0): then a plain line "LABEL: 42%, frame 2/3, 1m12s elapsed, ETA 1m40s" when the percentage
+ * has changed and every_s seconds have passed since the step began and since its last line (a
+ * step shorter than that adds nothing to the log). quiet: nothing at all. */
 typedef struct fv_cli_progress {
-    bool enabled;
-    double t0;
-    int frame, frames;
+    bool enabled;     /* anything is shown */
+    bool tty;         /* stderr is a terminal */
+    double every_ms;  /* not a terminal: the least time between two lines; < 0: no lines */
+    double t0;        /* the work's (the step's) start, fv_time_ms */
+    double last_ms;   /* the last line drawn, else t0 */
+    int frame, frames; /* the frame under way (0-based) of how many: set by the caller */
     int last_percent;
+    int shown;        /* characters of the terminal's line now drawn (0: none) */
+    char label[160];  /* the step, leading a line that is not a terminal's */
 } fv_cli_progress;
+/* One run of frames (`fovea render`): the bar on a terminal only. */
 void fv_cli_progress_init(fv_cli_progress *p, bool quiet, int frames);
+/* A command of several steps (`fovea bench`): the bar on a terminal, else lines (every_s). */
+void fv_cli_progress_init_steps(fv_cli_progress *p, bool quiet, double every_s);
+/* Ends the step shown (fv_cli_progress_done) and begins the next: its label, its frames, its clock. */
+void fv_cli_progress_step(fv_cli_progress *p, const char *label, int frames);
 bool fv_cli_progress_frame(void *user, double fraction); /* fv_progress_fn; cancels once interrupted */
+/* Clears the terminal's line, if drawn (again: nothing). */
 void fv_cli_progress_done(fv_cli_progress *p);
+/* The rules, for the tests: whether a line showing `percent` is due at now_ms; the line for
+ * `total` (0..1) of the work at now_ms into buf (snprintf's return); a duration as "42s",
+ * "3m05s", "1h02m" (whole seconds, rounded). */
+bool fv_cli_progress_due(const fv_cli_progress *p, int percent, double now_ms);
+int fv_cli_progress_format(const fv_cli_progress *p, double total, double now_ms, char *buf, size_t n);
+void fv_cli_duration(double seconds, char *buf, size_t n);
 
 /* The method check every rendering command makes before loading anything: an unknown name fails
  * with the library's message listing the methods. Returns 0 or the exit code (message printed). */

@@ -32,6 +32,11 @@ static void usage(FILE *f)
            FV_CLI_THREAD_POLICY_HELP
                "  --device D        run every measured method that has device D there (cpu, portable, cuda,\n"
                "                    auto; docs/gpu.md); methods and references naming a device keep theirs\n"
+               "  --progress-every S\n"
+               "                    progress within each long step (a reference's frames, the noise probe,\n"
+               "                    a method's repeat: percentage, frame, ETA) on stderr: on a terminal one\n"
+               "                    line redrawn in place; otherwise a line at most every S seconds of a\n"
+               "                    step still running (0: at every change) [20]\n"
                "  --check           only validate the scenario\n"
                "  --list            list the scenarios found, each with its description's first sentence\n"
                "Without a scenario file (the same harness, cache and reports; docs/bench.md):\n"
@@ -43,7 +48,7 @@ static void usage(FILE *f)
                "  --frames N        frames [1; with a temporal method, its still warm-up before one measured frame]\n"
                "  --size WxH        image size [256x256]\n"
                "  --save-scenario F write the scenario built as a JSON file (to rerun or edit)\n"
-               "  --quiet           no progress lines\n");
+               "  --quiet           no status or progress lines\n");
 }
 
 static bool is_file(const char *p)
@@ -167,18 +172,59 @@ static void list_scenarios(void)
     }
 }
 
+/* What the run says on stderr: a line as each step begins, and the progress within it on the
+ * CLI's progress line (cli.h), which a warning or the table first clears. */
+typedef struct bench_say {
+    fv_cli_progress bar;
+    fv_log log; /* the CLI's warning sink */
+} bench_say;
+
 /* The result table on stdout, whatever --quiet says: it is the command's output. */
 static void on_table(void *user, const char *text)
 {
-    (void)user;
+    fv_cli_progress_done(&((bench_say *)user)->bar);
     fputs(text, stdout);
     fflush(stdout);
 }
 
 static void on_status(void *user, const char *line)
 {
-    (void)user;
-    fprintf(stderr, "fovea bench: %s\n", line);
+    bench_say *b = user;
+    char label[sizeof b->bar.label];
+    snprintf(label, sizeof label, "fovea bench: %s", line);
+    fv_cli_progress_step(&b->bar, label, 1);
+    fprintf(stderr, "%s\n", label);
+}
+
+static void on_progress(void *user, int done, int total, double part)
+{
+    bench_say *b = user;
+    b->bar.frames = total > 0 ? total : 1;
+    b->bar.frame = done;
+    fv_cli_progress_frame(&b->bar, part);
+    if (done >= total) fv_cli_progress_done(&b->bar); /* the step's frames are all done */
+}
+
+static void on_warning(void *user, const char *msg)
+{
+    bench_say *b = user;
+    fv_cli_progress_done(&b->bar);
+    b->log.warn(b->log.user, msg);
+}
+
+/* The run's callbacks on opt (on the process that speaks) and its warnings into *log. */
+static void bench_say_init(bench_say *b, bool quiet, double every_s, bool speaks, fv_bench_options *opt, bool *quiet_flag, fv_log *log)
+{
+    fv_cli_progress_init_steps(&b->bar, quiet || !speaks, every_s);
+    b->log = fv_cli_log(quiet_flag);
+    *log = (fv_log){on_warning, b};
+    opt->log = log;
+    opt->status_user = b;
+    if (!quiet && speaks) {
+        opt->status = on_status;
+        opt->progress = on_progress;
+    }
+    if (speaks) opt->table = on_table;
 }
 
 #ifdef FOVEA_HAVE_MPI
@@ -264,17 +310,17 @@ static void command_line(int argc, char **argv, char *out, size_t n)
     }
 }
 
-static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check, bool quiet, fv_bench_options *opt, const bench_dist *bd)
+static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check, bool quiet, double every_s, fv_bench_options *opt,
+                       const bench_dist *bd)
 {
     const char *cmd = "bench";
     char *json = NULL, label[128];
     int rc = fv_bench_cmdline_json(cmd, cl, &json, label, sizeof label);
     if (rc) return rc;
-    fv_log log = fv_cli_log(&quiet);
-    opt->log = &log;
     const bool speaks = !opt->split || opt->split->rank == 0;
-    if (!quiet && speaks) opt->status = on_status;
-    if (speaks) opt->table = on_table;
+    bench_say say;
+    fv_log log;
+    bench_say_init(&say, quiet, every_s, speaks, opt, &quiet, &log);
     fv_error err;
     fv_error_clear(&err);
     /* Relative paths in the JSON are already absolute (bench_cmdline.c): "." is only a fallback. */
@@ -282,6 +328,7 @@ static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check,
     if (s == FV_OK && save && speaks) s = fv_file_write_atomic(save, json, strlen(json), &err);
     if (s == FV_OK && !check) s = fv_bench_run_text(json, label, ".", opt, &err);
     free(json);
+    fv_cli_progress_done(&say.bar);
     if (s != FV_OK) return bench_fail(bd, s, err.msg);
     if (check && speaks) printf("%s: ok\n", save ? save : label);
     else if (!quiet && speaks) fprintf(stderr, "fovea bench: wrote %s/\n", opt->out_dir);
@@ -293,14 +340,14 @@ static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check,
 static int bench(int argc, char **argv, bench_dist *bd, const fv_bench_split *split)
 {
     enum { O_OUT = 256, O_DEVICE, O_CACHE, O_QUICK, O_FULL, O_REPEATS, O_THREADS, O_TPOLICY, O_CHECK, O_LIST, O_QUIET, O_HELP, O_SCENE,
-           O_METHODS, O_REFERENCE, O_GAZE, O_GAZE_TRACE, O_FRAMES, O_SIZE, O_SAVE };
+           O_METHODS, O_REFERENCE, O_GAZE, O_GAZE_TRACE, O_FRAMES, O_SIZE, O_SAVE, O_EVERY };
     static const struct option longs[] = {{"out", 1, 0, O_OUT},       {"device", 1, 0, O_DEVICE},   {"cache", 1, 0, O_CACHE},     {"quick", 0, 0, O_QUICK},
                                           {"full", 0, 0, O_FULL},     {"repeats", 1, 0, O_REPEATS}, {"threads", 1, 0, O_THREADS}, {"thread-policy", 1, 0, O_TPOLICY},
                                           {"check", 0, 0, O_CHECK},   {"list", 0, 0, O_LIST},       {"quiet", 0, 0, O_QUIET},
                                           {"help", 0, 0, O_HELP},     {"scene", 1, 0, O_SCENE},     {"methods", 1, 0, O_METHODS},
                                           {"reference", 1, 0, O_REFERENCE}, {"gaze", 1, 0, O_GAZE}, {"gaze-trace", 1, 0, O_GAZE_TRACE},
                                           {"frames", 1, 0, O_FRAMES}, {"size", 1, 0, O_SIZE},       {"save-scenario", 1, 0, O_SAVE},
-                                          {0, 0, 0, 0}};
+                                          {"progress-every", 1, 0, O_EVERY}, {0, 0, 0, 0}};
     const char *cmd = "bench";
     fv_bench_options opt;
     memset(&opt, 0, sizeof opt);
@@ -316,6 +363,8 @@ static int bench(int argc, char **argv, bench_dist *bd, const fv_bench_split *sp
     fv_bench_cmdline cl;
     memset(&cl, 0, sizeof cl);
     const char *save = NULL;
+    /* not on a terminal: a line at most this often (docs/bench.md) */
+    double every_s = 20.0;
     int rc;
     long l;
     opterr = 0;
@@ -359,6 +408,10 @@ static int bench(int argc, char **argv, bench_dist *bd, const fv_bench_split *sp
             cmdline = true;
             break;
         case O_SAVE: save = optarg, cmdline = true; break;
+        case O_EVERY:
+            if (!fv_cli_parse_float(optarg, &every_s) || every_s < 0.0 || every_s > 86400.0)
+                return fv_cli_usage_error(cmd, "--progress-every %s: expected seconds in [0, 86400]", optarg);
+            break;
         case O_CHECK: check = true; break;
         case O_LIST: list = true; break;
         case O_QUIET: quiet = true; break;
@@ -373,23 +426,23 @@ static int bench(int argc, char **argv, bench_dist *bd, const fv_bench_split *sp
     }
     if (cl.scene) {
         if (optind != argc) return fv_cli_usage_error(cmd, "--scene builds the scenario: give no SCENARIO file ('%s')", argv[optind]);
-        return run_cmdline(&cl, save, check, quiet, &opt, bd);
+        return run_cmdline(&cl, save, check, quiet, every_s, &opt, bd);
     }
     if (cmdline) return fv_cli_usage_error(cmd, "--methods, --reference, --gaze, --gaze-trace, --frames, --size and --save-scenario need --scene");
     if (optind != argc - 1) return fv_cli_usage_error(cmd, optind >= argc ? "missing SCENARIO (try fovea bench --list)" : "too many arguments");
     char path[4096];
     if (!resolve(argv[optind], path, sizeof path))
         return fv_cli_usage_error(cmd, "unknown scenario '%s' (try fovea bench --list)", argv[optind]);
-    fv_log log = fv_cli_log(&quiet);
-    opt.log = &log;
-    if (!quiet && speaks) opt.status = on_status;
-    if (speaks) opt.table = on_table;
+    bench_say say;
+    fv_log log;
+    bench_say_init(&say, quiet, every_s, speaks, &opt, &quiet, &log);
     fv_error err;
     fv_error_clear(&err);
     /* A regular file only: the JSON reader opens it by name, and a FIFO would block it. */
     fv_status s = fv_file_check_read(path, "scenario", &err);
     if (s != FV_OK) return fv_cli_fail(cmd, s, err.msg);
     s = check ? fv_bench_check(path, opt.mode, &err) : fv_bench_run(path, &opt, &err);
+    fv_cli_progress_done(&say.bar);
     if (s != FV_OK) return bench_fail(bd, s, err.msg);
     if (check && speaks) printf("%s: ok\n", path);
     else if (!quiet && speaks) fprintf(stderr, "fovea bench: wrote %s/\n", opt.out_dir);

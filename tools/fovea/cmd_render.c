@@ -392,7 +392,7 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
     fv_cli_progress_init(&bar, o->quiet || rank != 0, o->frames);
     /* Launchers give a rank a terminal for stdout, not for stderr: rank 0 draws the bar when
      * the job's output is a terminal. */
-    if (rank == 0 && !o->quiet) bar.enabled = isatty(STDOUT_FILENO);
+    if (rank == 0 && !o->quiet) bar.enabled = bar.tty = isatty(STDOUT_FILENO);
     dist_progress dp = {d, NULL, &bar, 0.0, 1.0};
     double t0 = fv_time_ms();
     fv_stats stats;
