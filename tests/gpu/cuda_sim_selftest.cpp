@@ -4,7 +4,8 @@
  *   cuda_sim_selftest          every thread of every block runs once with its own indices; a block
  *                              reduction in shared memory with several __syncthreads per thread
  *                              gives the hand-computed sums; an impossible launch shape is an error
- *                              for cudaGetLastError and runs nothing; host waits are counted only
+ *                              for cudaGetLastError and runs nothing, a failed call's error is
+ *                              kept there too (out of memory); host waits are counted only
  *                              when work was queued; events time; everything freed.
  *   cuda_sim_selftest CASE     one misuse the simulator must abort on with its message (ctest
  *                              matches the message: tests/CMakeLists.txt).
@@ -114,11 +115,21 @@ static int selftest(void)
     CHECK(cudaMemcpy(&h, hits, sizeof h, cudaMemcpyDeviceToHost) == cudaSuccess);
     CHECK(h == 0);
 
+    /* any call that fails leaves its error for cudaGetLastError, as CUDA does: an allocation out of
+     * memory too (so a backend clears it before the launches it checks, device/cuda/common.h) */
+    void *none = &h;
+    fv_cuda_sim_fail_allocation(0);
+    CHECK(cudaMalloc(&none, 16) == cudaErrorMemoryAllocation && none == nullptr);
+    CHECK(cudaPeekAtLastError() == cudaErrorMemoryAllocation);
+    CHECK(cudaGetLastError() == cudaErrorMemoryAllocation);
+    CHECK(cudaGetLastError() == cudaSuccess);
+
     /* events: unrecorded is an error, recorded ones time */
     cudaEvent_t a, b;
     CHECK(cudaEventCreate(&a) == cudaSuccess && cudaEventCreate(&b) == cudaSuccess);
     float ms = -1.0f;
     CHECK(cudaEventElapsedTime(&ms, a, b) == cudaErrorInvalidResourceHandle);
+    CHECK(cudaGetLastError() == cudaErrorInvalidResourceHandle);
     CHECK(cudaEventRecord(a, st) == cudaSuccess && cudaEventRecord(b, st) == cudaSuccess);
     CHECK(cudaEventSynchronize(b) == cudaSuccess);
     CHECK(cudaEventElapsedTime(&ms, a, b) == cudaSuccess && ms >= 0.0f);
@@ -128,6 +139,7 @@ static int selftest(void)
     CHECK(cudaGetDeviceCount(&count) == cudaSuccess && count == 1);
     CHECK(cudaGetDeviceProperties(&p, 0) == cudaSuccess && p.major == 9 && strstr(p.name, "simulator"));
     CHECK(cudaGetDeviceProperties(&p, 1) == cudaErrorInvalidDevice);
+    CHECK(cudaGetLastError() == cudaErrorInvalidDevice);
 
     CHECK(cudaEventDestroy(a) == cudaSuccess && cudaEventDestroy(b) == cudaSuccess);
     CHECK(cudaStreamDestroy(st) == cudaSuccess);

@@ -10,7 +10,8 @@
  * whose host side lies in device memory), an unknown or destroyed stream or event, threads of a
  * block that reach __syncthreads a different number of times, a launch from inside a kernel, and
  * at exit any device allocation, stream or event never freed. A launch of an impossible shape sets
- * cudaErrorInvalidConfiguration for cudaGetLastError, as CUDA does. Device memory is host memory
+ * cudaErrorInvalidConfiguration for cudaGetLastError, and any call that fails (a cudaMalloc out of
+ * memory included) leaves its error there too, as CUDA does. Device memory is host memory
  * (malloc, filled with 0xff bytes as CUDA does not clear it), so AddressSanitizer sees a kernel's
  * out-of-bounds access.
  *

@@ -253,7 +253,7 @@ public:
     std::map<uintptr_t, Allocation> allocs; /* by base address */
     std::set<const fv_cuda_sim_stream *> streams;
     std::set<const fv_cuda_sim_event *> events;
-    cudaError_t last = cudaSuccess; /* for cudaGetLastError */
+    cudaError_t last = cudaSuccess; /* for cudaGetLastError: set by every call that fails, as CUDA's */
     bool queued = false;            /* work was queued since the host last waited */
     int64_t fail_in = -1;           /* fv_cuda_sim_fail_allocation */
     fv_cuda_sim_counts counts = {};
@@ -301,6 +301,15 @@ public:
         if (!e || !events.count(e)) die(nullptr, 0, "%s: event %p was not created or is destroyed", what, (void *)e);
     }
 
+    /* A call's error, kept for cudaGetLastError as CUDA keeps it (a failed cudaMalloc included):
+     * a backend that checks cudaGetLastError after its launches sees what an earlier failure left
+     * unless it cleared it. Called with m held. */
+    cudaError_t fail(cudaError_t e)
+    {
+        last = e;
+        return e;
+    }
+
     /* The host waits here for what was queued, if anything was. */
     void host_wait()
     {
@@ -313,6 +322,14 @@ Device &device()
 {
     static Device d;
     return d;
+}
+
+/* Device::fail for a call that does not hold the device's lock. */
+cudaError_t fail_unlocked(cudaError_t e)
+{
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    return d.fail(e);
 }
 
 } // namespace
@@ -348,15 +365,15 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
 
 cudaError_t cudaGetDeviceCount(int *count)
 {
-    if (!count) return cudaErrorInvalidValue;
+    if (!count) return fail_unlocked(cudaErrorInvalidValue);
     *count = 1;
     return cudaSuccess;
 }
 
 cudaError_t cudaGetDeviceProperties(cudaDeviceProp *prop, int dev)
 {
-    if (!prop) return cudaErrorInvalidValue;
-    if (dev != 0) return cudaErrorInvalidDevice;
+    if (!prop) return fail_unlocked(cudaErrorInvalidValue);
+    if (dev != 0) return fail_unlocked(cudaErrorInvalidDevice);
     memset(prop, 0, sizeof *prop);
     snprintf(prop->name, sizeof prop->name, "fovea CUDA simulator");
     /* an H100's shape: compute capability 9.0, the limits the launch checks use */
@@ -415,7 +432,7 @@ cudaError_t cudaDeviceSynchronize(void)
 
 cudaError_t cudaStreamCreate(cudaStream_t *s)
 {
-    if (!s) return cudaErrorInvalidValue;
+    if (!s) return fail_unlocked(cudaErrorInvalidValue);
     Device &d = device();
     std::lock_guard<std::mutex> l(d.m);
     *s = new fv_cuda_sim_stream();
@@ -448,7 +465,7 @@ cudaError_t cudaStreamWaitEvent(cudaStream_t s, cudaEvent_t e, unsigned int flag
     std::lock_guard<std::mutex> l(d.m);
     d.check_stream(s, "cudaStreamWaitEvent", nullptr, 0);
     d.check_event(e, "cudaStreamWaitEvent");
-    if (flags != 0) return cudaErrorInvalidValue;
+    if (flags != 0) return d.fail(cudaErrorInvalidValue);
     /* the work before the event has run already (launches run when queued): the stream need not
      * wait, and the host does not */
     return cudaSuccess;
@@ -456,7 +473,7 @@ cudaError_t cudaStreamWaitEvent(cudaStream_t s, cudaEvent_t e, unsigned int flag
 
 cudaError_t cudaEventCreate(cudaEvent_t *e)
 {
-    if (!e) return cudaErrorInvalidValue;
+    if (!e) return fail_unlocked(cudaErrorInvalidValue);
     Device &d = device();
     std::lock_guard<std::mutex> l(d.m);
     *e = new fv_cuda_sim_event();
@@ -502,25 +519,25 @@ cudaError_t cudaEventElapsedTime(float *ms, cudaEvent_t start, cudaEvent_t end)
     std::lock_guard<std::mutex> l(d.m);
     d.check_event(start, "cudaEventElapsedTime");
     d.check_event(end, "cudaEventElapsedTime");
-    if (!ms) return cudaErrorInvalidValue;
-    if (!start->recorded || !end->recorded) return cudaErrorInvalidResourceHandle; /* as CUDA: an event never recorded */
+    if (!ms) return d.fail(cudaErrorInvalidValue);
+    if (!start->recorded || !end->recorded) return d.fail(cudaErrorInvalidResourceHandle); /* as CUDA: an event never recorded */
     *ms = std::chrono::duration<float, std::milli>(end->t - start->t).count();
     return cudaSuccess;
 }
 
 cudaError_t fv_cuda_sim_malloc(void **p, size_t bytes, const char *file, int line)
 {
-    if (!p) return cudaErrorInvalidValue;
+    if (!p) return fail_unlocked(cudaErrorInvalidValue);
     *p = nullptr;
     if (bytes == 0) return cudaSuccess;
     Device &d = device();
     std::lock_guard<std::mutex> l(d.m);
     if (d.fail_in >= 0 && d.fail_in-- == 0) {
         d.counts.injected_failures++;
-        return cudaErrorMemoryAllocation;
+        return d.fail(cudaErrorMemoryAllocation);
     }
     void *q = malloc(bytes);
-    if (!q) return cudaErrorMemoryAllocation;
+    if (!q) return d.fail(cudaErrorMemoryAllocation);
     /* CUDA does not clear new memory: NaN floats and all-ones integers make a read before a write show */
     memset(q, 0xff, bytes);
     d.allocs[(uintptr_t)q] = Allocation{bytes, file, line};
@@ -557,7 +574,7 @@ cudaError_t fv_cuda_sim_memcpy(void *dst, const void *src, size_t bytes, cudaMem
     std::lock_guard<std::mutex> l(d.m);
     d.check_stream(s, what, file, line);
     if (bytes == 0) return cudaSuccess;
-    if (!dst || !src) return cudaErrorInvalidValue;
+    if (!dst || !src) return d.fail(cudaErrorInvalidValue);
     bool dst_dev = d.find(dst) != nullptr, src_dev = d.find(src) != nullptr;
     switch (kind) {
     case cudaMemcpyHostToHost: break;
@@ -565,7 +582,7 @@ cudaError_t fv_cuda_sim_memcpy(void *dst, const void *src, size_t bytes, cudaMem
     case cudaMemcpyDeviceToHost: src_dev = true; break;
     case cudaMemcpyDeviceToDevice: dst_dev = src_dev = true; break;
     case cudaMemcpyDefault: break;
-    default: return cudaErrorInvalidValue;
+    default: return d.fail(cudaErrorInvalidValue);
     }
     static const char *const kinds[] = {"host to host", "host to device", "device to host", "device to device", "default"};
     if (dst_dev) d.check_range(dst, bytes, what, file, line);
