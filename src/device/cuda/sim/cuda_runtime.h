@@ -16,7 +16,8 @@
  * out-of-bounds access.
  *
  * Execution: a launch runs at once and to completion (one device, in-order streams): block after
- * block, the threads of a block concurrently on a pool of OS threads, __syncthreads a barrier among
+ * block (first to last, then last to first on the kernel's next launch: CUDA promises no order),
+ * the threads of a block concurrently on a pool of OS threads, __syncthreads a barrier among
  * them; __shared__ variables are function statics, which is right because one block runs at a time.
  * Host waits are counted: a synchronize, a synchronous cudaMemcpy or a cudaFree that comes after
  * work was queued (a launch or an async copy or memset) is one wait of the host for the device

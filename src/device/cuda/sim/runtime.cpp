@@ -18,6 +18,7 @@
 #include <map>
 #include <mutex>
 #include <set>
+#include <string>
 #include <vector>
 #include "cuda_runtime.h"
 #include "fv_cuda_sim.h"
@@ -102,6 +103,7 @@ struct Job {
     unsigned threads; /* of a block */
     void (*body)(void *);
     void *ctx;
+    bool reverse;     /* the blocks last to first */
 };
 
 class Pool;
@@ -109,7 +111,7 @@ thread_local Pool *t_pool;  /* set on the pool's threads: they are running a ker
 thread_local unsigned t_id; /* the thread's index in its block */
 
 /* The threads that run a launch: as many as the largest block so far, each running one thread of
- * every block, the blocks one after another. */
+ * every block, the blocks one after another (in the order the launch's Job says). */
 class Pool {
     std::mutex m;
     std::condition_variable start_cv, done_cv;
@@ -178,10 +180,13 @@ class Pool {
         t_block_dim = j.block;
         t_grid_dim = j.grid;
         t_thread_idx = uint3{id % j.block.x, id / j.block.x % j.block.y, id / (j.block.x * j.block.y)};
-        for (unsigned z = 0; z < j.grid.z; z++)
-            for (unsigned y = 0; y < j.grid.y; y++)
-                for (unsigned x = 0; x < j.grid.x; x++) {
-                    t_block_idx = uint3{x, y, z};
+        for (unsigned bz = 0; bz < j.grid.z; bz++)
+            for (unsigned by = 0; by < j.grid.y; by++)
+                for (unsigned bx = 0; bx < j.grid.x; bx++) {
+                    if (j.reverse)
+                        t_block_idx = uint3{j.grid.x - 1 - bx, j.grid.y - 1 - by, j.grid.z - 1 - bz};
+                    else
+                        t_block_idx = uint3{bx, by, bz};
                     j.body(j.ctx);
                     sync.leave();
                     block_end.wait([&] { end_block(j); });
@@ -254,6 +259,7 @@ public:
     std::set<const fv_cuda_sim_stream *> streams;
     std::set<const fv_cuda_sim_event *> events;
     cudaError_t last = cudaSuccess; /* for cudaGetLastError: set by every call that fails, as CUDA's */
+    std::map<std::string, unsigned long long> launches_of; /* by kernel name: odd ones run their blocks reversed */
     bool queued = false;            /* work was queued since the host last waited */
     int64_t fail_in = -1;           /* fv_cuda_sim_fail_allocation */
     fv_cuda_sim_counts counts = {};
@@ -344,6 +350,7 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
 {
     if (t_pool) die(file, line, "kernel %s launched from inside a kernel (dynamic parallelism is not simulated)", kernel);
     Device &d = device();
+    bool reverse = false;
     {
         std::lock_guard<std::mutex> l(d.m);
         d.check_stream(s, kernel, file, line);
@@ -355,9 +362,13 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
         }
         d.counts.launches++;
         d.queued = true;
+        /* CUDA runs a launch's blocks in no order: every other launch of a kernel runs them last
+         * to first, so a kernel that reads what another block of its launch writes finds it
+         * unwritten one way or the other (a race on a GPU), and a test comparing images sees it. */
+        reverse = d.launches_of[kernel]++ % 2 == 1;
     }
     std::lock_guard<std::mutex> one(d.launch_m);
-    Job j = {kernel, file, line, grid, block, block.x * block.y * block.z, body, ctx};
+    Job j = {kernel, file, line, grid, block, block.x * block.y * block.z, body, ctx, reverse};
     const unsigned long long blocks = d.pool.run(j);
     std::lock_guard<std::mutex> l(d.m);
     d.counts.blocks += blocks;
