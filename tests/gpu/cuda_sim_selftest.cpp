@@ -3,8 +3,10 @@
  *
  *   cuda_sim_selftest          every thread of every block runs once with its own indices; a block
  *                              reduction in shared memory with several __syncthreads per thread
- *                              gives the hand-computed sums; an impossible launch shape is an error
- *                              for cudaGetLastError and runs nothing; host waits are counted only
+ *                              gives the hand-computed sums; a kernel's launches alternate the
+ *                              order of their blocks; an impossible launch shape is an error
+ *                              for cudaGetLastError and runs nothing, a failed call's error is
+ *                              kept there too (out of memory); host waits are counted only
  *                              when work was queued; events time; everything freed.
  *   cuda_sim_selftest CASE     one misuse the simulator must abort on with its message (ctest
  *                              matches the message: tests/CMakeLists.txt).
@@ -47,6 +49,12 @@ __global__ void block_sum(const unsigned *in, unsigned long long *out)
         __syncthreads();
     }
     if (t == 0) out[blockIdx.x] = part[0];
+}
+
+/* The order the blocks ran in: block b's turn, from a counter thread 0 of each block takes. */
+__global__ void turn(unsigned *next, unsigned *order)
+{
+    if (threadIdx.x == 0) order[blockIdx.x] = atomicAdd(next, 1u);
 }
 
 /* Misuse: threads of one block reach __syncthreads unequally. */
@@ -114,11 +122,33 @@ static int selftest(void)
     CHECK(cudaMemcpy(&h, hits, sizeof h, cudaMemcpyDeviceToHost) == cudaSuccess);
     CHECK(h == 0);
 
+    /* a kernel's launches run their blocks first to last, then last to first, and so on (CUDA
+     * promises no order: a block that reads what another of its launch writes is caught) */
+    unsigned order[4], *dorder = nullptr;
+    CHECK(cudaMalloc((void **)&dorder, sizeof order) == cudaSuccess);
+    for (unsigned run = 0; run < 2; run++) {
+        CHECK(cudaMemset(hits, 0, sizeof(unsigned)) == cudaSuccess);
+        FV_CUDA_LAUNCH(turn, 4, 32, 0)(hits, dorder);
+        CHECK(cudaMemcpy(order, dorder, sizeof order, cudaMemcpyDeviceToHost) == cudaSuccess);
+        for (unsigned b = 0; b < 4; b++) CHECK(order[b] == (run == 0 ? b : 3 - b));
+    }
+    CHECK(cudaFree(dorder) == cudaSuccess);
+
+    /* any call that fails leaves its error for cudaGetLastError, as CUDA does: an allocation out of
+     * memory too (so a backend clears it before the launches it checks, device/cuda/common.h) */
+    void *none = &h;
+    fv_cuda_sim_fail_allocation(0);
+    CHECK(cudaMalloc(&none, 16) == cudaErrorMemoryAllocation && none == nullptr);
+    CHECK(cudaPeekAtLastError() == cudaErrorMemoryAllocation);
+    CHECK(cudaGetLastError() == cudaErrorMemoryAllocation);
+    CHECK(cudaGetLastError() == cudaSuccess);
+
     /* events: unrecorded is an error, recorded ones time */
     cudaEvent_t a, b;
     CHECK(cudaEventCreate(&a) == cudaSuccess && cudaEventCreate(&b) == cudaSuccess);
     float ms = -1.0f;
     CHECK(cudaEventElapsedTime(&ms, a, b) == cudaErrorInvalidResourceHandle);
+    CHECK(cudaGetLastError() == cudaErrorInvalidResourceHandle);
     CHECK(cudaEventRecord(a, st) == cudaSuccess && cudaEventRecord(b, st) == cudaSuccess);
     CHECK(cudaEventSynchronize(b) == cudaSuccess);
     CHECK(cudaEventElapsedTime(&ms, a, b) == cudaSuccess && ms >= 0.0f);
@@ -128,6 +158,7 @@ static int selftest(void)
     CHECK(cudaGetDeviceCount(&count) == cudaSuccess && count == 1);
     CHECK(cudaGetDeviceProperties(&p, 0) == cudaSuccess && p.major == 9 && strstr(p.name, "simulator"));
     CHECK(cudaGetDeviceProperties(&p, 1) == cudaErrorInvalidDevice);
+    CHECK(cudaGetLastError() == cudaErrorInvalidDevice);
 
     CHECK(cudaEventDestroy(a) == cudaSuccess && cudaEventDestroy(b) == cudaSuccess);
     CHECK(cudaStreamDestroy(st) == cudaSuccess);
@@ -136,8 +167,8 @@ static int selftest(void)
     fv_cuda_sim_counts e;
     fv_cuda_sim_counts_get(&e);
     CHECK(e.live_allocations == 0 && e.live_bytes == 0 && e.live_streams == 0 && e.live_events == 0);
-    CHECK(e.launches == c0.launches + 2);  /* the two impossible ones are not launches */
-    CHECK(e.blocks == c0.blocks + 30 + 6);
+    CHECK(e.launches == c0.launches + 4);  /* the two impossible ones are not launches */
+    CHECK(e.blocks == c0.blocks + 30 + 6 + 2 * 4);
     printf("CUDA simulator self-test: passed\n");
     return 0;
 }

@@ -322,6 +322,28 @@ static void test_refusals(void **st)
     fv_scene_destroy(s);
 }
 
+#ifdef FOVEA_CUDA_SIM
+/* The simulator only: every device allocation of vpolar's backend (the scene at create; the grid,
+ * SVGF's buffers, the mipmaps, the blur's and the film's buffers and the host's tables at the first
+ * frame; the moving scene's update and the history's reprojection at the second) failing in turn,
+ * as on a full GPU: each run ends in a one-line CUDA error with nothing left on the device, and the
+ * run after it, in the same process, succeeds (CUDA keeps a failed call's error for
+ * cudaGetLastError: a frame must not report it as its own launch's). */
+static void test_out_of_memory(void **st)
+{
+    (void)st;
+    fv_scene *s = NULL;
+    fv_view *v = NULL;
+    if (fv_test_load("cornell-fpm", &s, &v) != 0) fail_msg("cannot load cornell-fpm");
+    fv_camera cam;
+    fv_view_camera(v, s, 0.7, 32, 24, &cam);
+    fv_sim_frames r = {s, &cam, "vpolar", "device=cuda", 2, 0.7};
+    if (fv_sim_walk_allocation_failures(fv_sim_run_frames, &r, "vpolar") < 30) fail_msg("vpolar: fewer device allocations than its buffers");
+    fv_view_destroy(v);
+    fv_scene_destroy(s);
+}
+#endif
+
 int main(void)
 {
     char why[256];
@@ -332,6 +354,10 @@ int main(void)
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_vpolar),         cmocka_unit_test(test_cartesian), cmocka_unit_test(test_cartesian_full),
                                        cmocka_unit_test(test_linear_falloff), cmocka_unit_test(test_logpolar),  cmocka_unit_test(test_svgf_passes),
                                        cmocka_unit_test(test_moving),         cmocka_unit_test(test_pair),
-                                       cmocka_unit_test(test_refusals)};
+                                       cmocka_unit_test(test_refusals),
+#ifdef FOVEA_CUDA_SIM
+                                       cmocka_unit_test(test_out_of_memory)
+#endif
+    };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -20,6 +20,14 @@ static inline fv_status fv_cuda_fail(cudaError_t e, const char *what, fv_error *
     return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %s while %s", cudaGetErrorString(e), what);
 }
 
+/* Forgets the error an earlier failed call left for cudaGetLastError. CUDA keeps the last error of
+ * any runtime call, a cudaMalloc out of memory included, until cudaGetLastError reads it; a frame
+ * checks cudaGetLastError after its launches, so without this the frame after a failed one (a
+ * retry once memory was freed, the next method of a bench) would report the old failure as its
+ * launch's. Every render calls it before its first CUDA call; what that failure was has been
+ * returned already. A sticky error (the context lost) is not forgotten: every later call returns it. */
+static inline void fv_cuda_forget_error(void) { (void)cudaGetLastError(); }
+
 /* A device array that grows and is refilled from the host when what it holds changed. */
 typedef struct fv_cuda_mirror {
     void *p;

@@ -101,6 +101,7 @@ extern "C" fv_status fv_cuda_pt_render(fv_cuda_pt *c, int eyes, const fv_kpt_fra
 {
     *syncs = 0;
     if (eyes < 1 || eyes > 2) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %d eyes", eyes);
+    fv_cuda_forget_error();
     /* every eye's film first: nothing between the launches but launches */
     size_t n[2];
     fv_film_views dv[2];

@@ -210,6 +210,7 @@ extern "C" fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const fv_ksdf_world *w, 
 {
     *syncs = 0;
     if (eyes < 1 || eyes > 2) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %d eyes", eyes);
+    fv_cuda_forget_error();
     fv_ksdf_world dw;
     fv_status s = upload_world(c, w, &dw, err);
     if (s != FV_OK) return s;
@@ -506,6 +507,7 @@ extern "C" fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const fv_ksdf_wo
 {
     *syncs = 0;
     if (eyes < 1 || eyes > 2) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: %d eyes", eyes);
+    fv_cuda_forget_error();
     fv_ksdf_world dw;
     fv_status s = upload_world(c, w, &dw, err);
     if (s != FV_OK) return s;

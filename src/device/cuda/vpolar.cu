@@ -653,6 +653,7 @@ extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *const *c, int eyes, const fv_
         if ((s = check_frame(&f[e], err)) != FV_OK) return s;
     }
     if (eyes == 2 && c[0] == c[1]) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: a stereo pair's eyes share their buffers");
+    fv_cuda_forget_error();
     /* Every eye's kernels queued (each on its own stream, so a pair's two eyes may run side by
      * side), then every eye's read-back (a copy into pageable host memory may hold the host until
      * its stream gets there, so none is queued before the last eye's kernels), then the one host

@@ -10,12 +10,14 @@
  * whose host side lies in device memory), an unknown or destroyed stream or event, threads of a
  * block that reach __syncthreads a different number of times, a launch from inside a kernel, and
  * at exit any device allocation, stream or event never freed. A launch of an impossible shape sets
- * cudaErrorInvalidConfiguration for cudaGetLastError, as CUDA does. Device memory is host memory
+ * cudaErrorInvalidConfiguration for cudaGetLastError, and any call that fails (a cudaMalloc out of
+ * memory included) leaves its error there too, as CUDA does. Device memory is host memory
  * (malloc, filled with 0xff bytes as CUDA does not clear it), so AddressSanitizer sees a kernel's
  * out-of-bounds access.
  *
  * Execution: a launch runs at once and to completion (one device, in-order streams): block after
- * block, the threads of a block concurrently on a pool of OS threads, __syncthreads a barrier among
+ * block (first to last, then last to first on the kernel's next launch: CUDA promises no order),
+ * the threads of a block concurrently on a pool of OS threads, __syncthreads a barrier among
  * them; __shared__ variables are function statics, which is right because one block runs at a time.
  * Host waits are counted: a synchronize, a synchronous cudaMemcpy or a cudaFree that comes after
  * work was queued (a launch or an async copy or memset) is one wait of the host for the device

@@ -18,6 +18,7 @@
 #include <map>
 #include <mutex>
 #include <set>
+#include <string>
 #include <vector>
 #include "cuda_runtime.h"
 #include "fv_cuda_sim.h"
@@ -102,6 +103,7 @@ struct Job {
     unsigned threads; /* of a block */
     void (*body)(void *);
     void *ctx;
+    bool reverse;     /* the blocks last to first */
 };
 
 class Pool;
@@ -109,7 +111,7 @@ thread_local Pool *t_pool;  /* set on the pool's threads: they are running a ker
 thread_local unsigned t_id; /* the thread's index in its block */
 
 /* The threads that run a launch: as many as the largest block so far, each running one thread of
- * every block, the blocks one after another. */
+ * every block, the blocks one after another (in the order the launch's Job says). */
 class Pool {
     std::mutex m;
     std::condition_variable start_cv, done_cv;
@@ -178,10 +180,13 @@ class Pool {
         t_block_dim = j.block;
         t_grid_dim = j.grid;
         t_thread_idx = uint3{id % j.block.x, id / j.block.x % j.block.y, id / (j.block.x * j.block.y)};
-        for (unsigned z = 0; z < j.grid.z; z++)
-            for (unsigned y = 0; y < j.grid.y; y++)
-                for (unsigned x = 0; x < j.grid.x; x++) {
-                    t_block_idx = uint3{x, y, z};
+        for (unsigned bz = 0; bz < j.grid.z; bz++)
+            for (unsigned by = 0; by < j.grid.y; by++)
+                for (unsigned bx = 0; bx < j.grid.x; bx++) {
+                    if (j.reverse)
+                        t_block_idx = uint3{j.grid.x - 1 - bx, j.grid.y - 1 - by, j.grid.z - 1 - bz};
+                    else
+                        t_block_idx = uint3{bx, by, bz};
                     j.body(j.ctx);
                     sync.leave();
                     block_end.wait([&] { end_block(j); });
@@ -253,7 +258,8 @@ public:
     std::map<uintptr_t, Allocation> allocs; /* by base address */
     std::set<const fv_cuda_sim_stream *> streams;
     std::set<const fv_cuda_sim_event *> events;
-    cudaError_t last = cudaSuccess; /* for cudaGetLastError */
+    cudaError_t last = cudaSuccess; /* for cudaGetLastError: set by every call that fails, as CUDA's */
+    std::map<std::string, unsigned long long> launches_of; /* by kernel name: odd ones run their blocks reversed */
     bool queued = false;            /* work was queued since the host last waited */
     int64_t fail_in = -1;           /* fv_cuda_sim_fail_allocation */
     fv_cuda_sim_counts counts = {};
@@ -301,6 +307,15 @@ public:
         if (!e || !events.count(e)) die(nullptr, 0, "%s: event %p was not created or is destroyed", what, (void *)e);
     }
 
+    /* A call's error, kept for cudaGetLastError as CUDA keeps it (a failed cudaMalloc included):
+     * a backend that checks cudaGetLastError after its launches sees what an earlier failure left
+     * unless it cleared it. Called with m held. */
+    cudaError_t fail(cudaError_t e)
+    {
+        last = e;
+        return e;
+    }
+
     /* The host waits here for what was queued, if anything was. */
     void host_wait()
     {
@@ -315,6 +330,14 @@ Device &device()
     return d;
 }
 
+/* Device::fail for a call that does not hold the device's lock. */
+cudaError_t fail_unlocked(cudaError_t e)
+{
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    return d.fail(e);
+}
+
 } // namespace
 
 void fv_cuda_sim_syncthreads(void)
@@ -327,6 +350,7 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
 {
     if (t_pool) die(file, line, "kernel %s launched from inside a kernel (dynamic parallelism is not simulated)", kernel);
     Device &d = device();
+    bool reverse = false;
     {
         std::lock_guard<std::mutex> l(d.m);
         d.check_stream(s, kernel, file, line);
@@ -338,9 +362,13 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
         }
         d.counts.launches++;
         d.queued = true;
+        /* CUDA runs a launch's blocks in no order: every other launch of a kernel runs them last
+         * to first, so a kernel that reads what another block of its launch writes finds it
+         * unwritten one way or the other (a race on a GPU), and a test comparing images sees it. */
+        reverse = d.launches_of[kernel]++ % 2 == 1;
     }
     std::lock_guard<std::mutex> one(d.launch_m);
-    Job j = {kernel, file, line, grid, block, block.x * block.y * block.z, body, ctx};
+    Job j = {kernel, file, line, grid, block, block.x * block.y * block.z, body, ctx, reverse};
     const unsigned long long blocks = d.pool.run(j);
     std::lock_guard<std::mutex> l(d.m);
     d.counts.blocks += blocks;
@@ -348,15 +376,15 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
 
 cudaError_t cudaGetDeviceCount(int *count)
 {
-    if (!count) return cudaErrorInvalidValue;
+    if (!count) return fail_unlocked(cudaErrorInvalidValue);
     *count = 1;
     return cudaSuccess;
 }
 
 cudaError_t cudaGetDeviceProperties(cudaDeviceProp *prop, int dev)
 {
-    if (!prop) return cudaErrorInvalidValue;
-    if (dev != 0) return cudaErrorInvalidDevice;
+    if (!prop) return fail_unlocked(cudaErrorInvalidValue);
+    if (dev != 0) return fail_unlocked(cudaErrorInvalidDevice);
     memset(prop, 0, sizeof *prop);
     snprintf(prop->name, sizeof prop->name, "fovea CUDA simulator");
     /* an H100's shape: compute capability 9.0, the limits the launch checks use */
@@ -415,7 +443,7 @@ cudaError_t cudaDeviceSynchronize(void)
 
 cudaError_t cudaStreamCreate(cudaStream_t *s)
 {
-    if (!s) return cudaErrorInvalidValue;
+    if (!s) return fail_unlocked(cudaErrorInvalidValue);
     Device &d = device();
     std::lock_guard<std::mutex> l(d.m);
     *s = new fv_cuda_sim_stream();
@@ -448,7 +476,7 @@ cudaError_t cudaStreamWaitEvent(cudaStream_t s, cudaEvent_t e, unsigned int flag
     std::lock_guard<std::mutex> l(d.m);
     d.check_stream(s, "cudaStreamWaitEvent", nullptr, 0);
     d.check_event(e, "cudaStreamWaitEvent");
-    if (flags != 0) return cudaErrorInvalidValue;
+    if (flags != 0) return d.fail(cudaErrorInvalidValue);
     /* the work before the event has run already (launches run when queued): the stream need not
      * wait, and the host does not */
     return cudaSuccess;
@@ -456,7 +484,7 @@ cudaError_t cudaStreamWaitEvent(cudaStream_t s, cudaEvent_t e, unsigned int flag
 
 cudaError_t cudaEventCreate(cudaEvent_t *e)
 {
-    if (!e) return cudaErrorInvalidValue;
+    if (!e) return fail_unlocked(cudaErrorInvalidValue);
     Device &d = device();
     std::lock_guard<std::mutex> l(d.m);
     *e = new fv_cuda_sim_event();
@@ -502,25 +530,25 @@ cudaError_t cudaEventElapsedTime(float *ms, cudaEvent_t start, cudaEvent_t end)
     std::lock_guard<std::mutex> l(d.m);
     d.check_event(start, "cudaEventElapsedTime");
     d.check_event(end, "cudaEventElapsedTime");
-    if (!ms) return cudaErrorInvalidValue;
-    if (!start->recorded || !end->recorded) return cudaErrorInvalidResourceHandle; /* as CUDA: an event never recorded */
+    if (!ms) return d.fail(cudaErrorInvalidValue);
+    if (!start->recorded || !end->recorded) return d.fail(cudaErrorInvalidResourceHandle); /* as CUDA: an event never recorded */
     *ms = std::chrono::duration<float, std::milli>(end->t - start->t).count();
     return cudaSuccess;
 }
 
 cudaError_t fv_cuda_sim_malloc(void **p, size_t bytes, const char *file, int line)
 {
-    if (!p) return cudaErrorInvalidValue;
+    if (!p) return fail_unlocked(cudaErrorInvalidValue);
     *p = nullptr;
     if (bytes == 0) return cudaSuccess;
     Device &d = device();
     std::lock_guard<std::mutex> l(d.m);
     if (d.fail_in >= 0 && d.fail_in-- == 0) {
         d.counts.injected_failures++;
-        return cudaErrorMemoryAllocation;
+        return d.fail(cudaErrorMemoryAllocation);
     }
     void *q = malloc(bytes);
-    if (!q) return cudaErrorMemoryAllocation;
+    if (!q) return d.fail(cudaErrorMemoryAllocation);
     /* CUDA does not clear new memory: NaN floats and all-ones integers make a read before a write show */
     memset(q, 0xff, bytes);
     d.allocs[(uintptr_t)q] = Allocation{bytes, file, line};
@@ -557,7 +585,7 @@ cudaError_t fv_cuda_sim_memcpy(void *dst, const void *src, size_t bytes, cudaMem
     std::lock_guard<std::mutex> l(d.m);
     d.check_stream(s, what, file, line);
     if (bytes == 0) return cudaSuccess;
-    if (!dst || !src) return cudaErrorInvalidValue;
+    if (!dst || !src) return d.fail(cudaErrorInvalidValue);
     bool dst_dev = d.find(dst) != nullptr, src_dev = d.find(src) != nullptr;
     switch (kind) {
     case cudaMemcpyHostToHost: break;
@@ -565,7 +593,7 @@ cudaError_t fv_cuda_sim_memcpy(void *dst, const void *src, size_t bytes, cudaMem
     case cudaMemcpyDeviceToHost: src_dev = true; break;
     case cudaMemcpyDeviceToDevice: dst_dev = src_dev = true; break;
     case cudaMemcpyDefault: break;
-    default: return cudaErrorInvalidValue;
+    default: return d.fail(cudaErrorInvalidValue);
     }
     static const char *const kinds[] = {"host to host", "host to device", "device to host", "device to device", "default"};
     if (dst_dev) d.check_range(dst, bytes, what, file, line);
