@@ -27,7 +27,8 @@ static inline fv_sim_mark fv_sim_now(void)
     return m;
 }
 
-/* Since `since`: exactly `waits` host waits, and `launches` kernel launches (< 0: any number, > 0). */
+/* Since `since`: exactly `waits` host waits, `launches` kernel launches (< 0: any number, > 0), and
+ * no upload queued behind a kernel of its stream (the simulator's uploads_behind_kernels). */
 static inline void fv_sim_expect(fv_sim_mark since, uint64_t waits, long launches, const char *what)
 {
     fv_sim_mark now = fv_sim_now();
@@ -35,6 +36,8 @@ static inline void fv_sim_expect(fv_sim_mark since, uint64_t waits, long launche
     printf("%s: CUDA simulator: %llu host waits, %llu launches, %llu blocks\n", what, (unsigned long long)w, (unsigned long long)l,
            (unsigned long long)(now.blocks - since.blocks));
     if (w != waits) fail_msg("%s: the host waited for the device %llu times, expected %llu", what, (unsigned long long)w, (unsigned long long)waits);
+    const uint64_t u = now.uploads_behind_kernels - since.uploads_behind_kernels;
+    if (u) fail_msg("%s: %llu host-to-device copies queued behind a kernel of their stream (a hidden host wait mid-frame)", what, (unsigned long long)u);
     if (launches >= 0 ? l != (uint64_t)launches : l == 0)
         fail_msg("%s: %llu kernel launches, expected %ld", what, (unsigned long long)l, launches);
 }

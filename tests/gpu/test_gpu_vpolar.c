@@ -88,13 +88,15 @@ static void compare(const char *scene, const char *method, const char *params, i
             f.gaze.x = gaze[i][0] + 0.03f * (float)e;
             f.gaze.y = gaze[i][1];
             fv_stats sp, sn, sc, sc2;
+            char what[256];
+            snprintf(what, sizeof what, "%s [%s] %s %dx%d frame %d eye %d", method, params, scene, w, h, i, e);
             fv_test_render_fresh(tp, &f, p, &sp);
+            const fv_sim_mark m = fv_sim_now();
             fv_test_render_fresh(tc, &f, c1, &sc);
+            fv_sim_expect(m, 1, -1, what); /* one wait, and no upload behind a kernel (a hidden one) */
             fv_test_render_fresh(tc2, &f, c2, &sc2);
             f.seed = 8;
             fv_test_render_fresh(tn, &f, n2, &sn);
-            char what[256];
-            snprintf(what, sizeof what, "%s [%s] %s %dx%d frame %d eye %d", method, params, scene, w, h, i, e);
             const float *a = fv_film_color_const(p), *b = fv_film_color_const(c1);
             for (size_t k = 0; k < 3 * n; k++)
                 if (!isfinite(a[k]) || !isfinite(b[k])) fail_msg("%s: value %zu not finite (portable %g, cuda %g)", what, k, a[k], b[k]);

@@ -303,11 +303,18 @@ __global__ void fv_cuda_pyr_level(fv_ksdf_world w, fv_ksdf_frame f, fv_kpyr k, i
 }
 
 /* Pass 2's sky: the farthest finite depth of the tip (depths are >= 0, so their bits order as
- * unsigned integers do). */
+ * unsigned integers do). Each block takes its maximum in shared memory first, then one atomic per
+ * block meets the others': millions of atomics on one global address would queue behind each
+ * other. A maximum does not depend on the order, so the bits are the same. */
 __global__ void fv_cuda_pyr_far(const float *depth, int n, unsigned *far)
 {
+    __shared__ unsigned block_far;
+    if (threadIdx.x == 0) block_far = 0u;
+    __syncthreads();
     const int i = (int)(blockIdx.x * blockDim.x + threadIdx.x);
-    if (i < n && isfinite(depth[i]) && depth[i] > 0.0f) atomicMax(far, __float_as_uint(depth[i]));
+    if (i < n && isfinite(depth[i]) && depth[i] > 0.0f) atomicMax(&block_far, __float_as_uint(depth[i]));
+    __syncthreads();
+    if (threadIdx.x == 0 && block_far) atomicMax(far, block_far);
 }
 
 __global__ void fv_cuda_pyr_sobel(fv_kpyr k, const unsigned *far, float threshold)

@@ -14,9 +14,10 @@
  * levels, the blur's sigma and scratch image and the film keep their GPU buffers between frames, reallocated only when a size
  * changes. What the host builds per screen size or per gaze (column heights, the on-screen mask,
  * the mipmaps' shape, the radial table, the blur's kernels) goes through fv_cuda_mirror, copied only
- * when its bytes changed; the scene only when its time moved. The radial table is copied after the
- * reprojection is queued: until then the GPU's copy is the previous frame's, which is the table the
- * reprojection needs (the previous view's), so one buffer serves both in stream order.
+ * when its bytes changed; the scene only when its time moved. The radial table has two buffers
+ * used in turn: the reprojection reads the previous frame's (the previous view's), the map this
+ * frame's. Every copy from the host is queued before the frame's first kernel, so none waits for a
+ * kernel (a copy from pageable memory may make the host wait for its stream's queued work).
  *
  * The host waits once a frame, at the end, for the film's buffers that are set and the counters
  * (the trace's, and SVGF's per row: res->syncs = 1). A stereo pair (fv_cuda_vp_render with two
@@ -81,7 +82,9 @@ struct fv_cuda_vp {
     float *mip_img[FV_KPHI_MAX_LEVELS];
     float *shape_host;            /* the shape packed for one copy: per level rows, rowsf, inv_src */
     size_t shape_cap;             /* floats */
-    fv_cuda_mirror col_h, onscreen, shape, lut, blur_off, blur_k;
+    fv_cuda_mirror col_h, onscreen, shape, blur_off, blur_k;
+    fv_cuda_mirror lut[2];        /* the radial tables: this frame's and the previous one's, in turn */
+    int lut_prev;                 /* which of them the previous frame mapped with */
     unsigned long long *counts;   /* rays, paths, non-finite paths */
     unsigned long long counts_host[3]; /* their copy, read back with the film (a pair reads both eyes' before its one wait) */
     cudaEvent_t queued;           /* after the frame's read-back: a pair's eye 1 joins eye 0's stream here */
@@ -471,7 +474,8 @@ extern "C" void fv_cuda_vp_destroy(fv_cuda_vp *c)
     fv_cuda_mirror_free(&c->col_h);
     fv_cuda_mirror_free(&c->onscreen);
     fv_cuda_mirror_free(&c->shape);
-    fv_cuda_mirror_free(&c->lut);
+    fv_cuda_mirror_free(&c->lut[0]);
+    fv_cuda_mirror_free(&c->lut[1]);
     fv_cuda_mirror_free(&c->blur_off);
     fv_cuda_mirror_free(&c->blur_k);
     cudaFree(c->counts);
@@ -544,13 +548,21 @@ static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv
     const uint8_t *mask = f->onscreen;
     fv_kphi_mips dm;
     memset(&dm, 0, sizeof dm);
-    if ((s = grid_ensure(c, gw, gh, err)) != FV_OK || (s = screen_ensure(c, sw, sh, err)) != FV_OK ||
-        (s = fv_cuda_film_prepare(&c->film, out, ns, &dv, err)) != FV_OK || (s = fv_cuda_scene_update(&c->scene, f->scene, st, err)) != FV_OK ||
+    /* Every copy from the host first, the radial table included (into the buffer the previous
+     * frame did not map with, which the reprojection still reads), then what launches (the grid's
+     * first clear): a copy from pageable memory queued behind a kernel of its stream may make the
+     * host wait for that kernel, and a pair's second eye would then be queued only once the first
+     * eye's trace had run. The simulator counts such copies (uploads_behind_kernels). */
+    const int lut_now = c->lut_prev ^ 1;
+    if ((s = fv_cuda_scene_update(&c->scene, f->scene, st, err)) != FV_OK ||
         (f->trace.col_h && (s = fv_cuda_mirror_fill(&c->col_h, f->trace.col_h, (size_t)gw * sizeof(int), st, "the column heights", err)) != FV_OK) ||
         (mask && (s = fv_cuda_mirror_fill(&c->onscreen, mask, n, st, "the on-screen mask", err)) != FV_OK) ||
-        (f->mips && (s = mips_ensure(c, f, &dm, err)) != FV_OK) || (f->denoise && (s = svgf_ensure(c, gw, gh, err)) != FV_OK) ||
+        (f->mips && (s = mips_ensure(c, f, &dm, err)) != FV_OK) ||
         (f->blur && ((s = fv_cuda_mirror_fill(&c->blur_off, f->blur_table.off, (size_t)f->blur_table.nq * sizeof(int), st, "the blur's kernels", err)) != FV_OK ||
-                     (s = fv_cuda_mirror_fill(&c->blur_k, f->blur_table.k, f->blur_nk * sizeof(float), st, "the blur's kernels", err)) != FV_OK)))
+                     (s = fv_cuda_mirror_fill(&c->blur_k, f->blur_table.k, f->blur_nk * sizeof(float), st, "the blur's kernels", err)) != FV_OK)) ||
+        (s = fv_cuda_mirror_fill(&c->lut[lut_now], f->map.lut, (size_t)f->map.nlut * 3 * sizeof(float), st, "the radial table", err)) != FV_OK ||
+        (s = grid_ensure(c, gw, gh, err)) != FV_OK || (s = screen_ensure(c, sw, sh, err)) != FV_OK ||
+        (s = fv_cuda_film_prepare(&c->film, out, ns, &dv, err)) != FV_OK || (f->denoise && (s = svgf_ensure(c, gw, gh, err)) != FV_OK))
         return s;
     const int *dcol_h = f->trace.col_h ? (const int *)c->col_h.p : NULL;
     const uint8_t *dmask = mask ? (const uint8_t *)c->onscreen.p : NULL;
@@ -569,7 +581,7 @@ static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv
         fv_kvp_reproject_frame rf = f->reproject;
         rf.g = c->g;
         rf.onscreen = f->reproject.onscreen ? dmask : NULL;
-        rf.prev_lut = c->lut.p ? (const float *)c->lut.p : NULL;
+        rf.prev_lut = c->lut[c->lut_prev].p ? (const float *)c->lut[c->lut_prev].p : NULL;
         if (!rf.prev_lut && rf.space.kind != FV_KVP_CARTESIAN)
             return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: a history without the previous frame's radial table");
         FV_CUDA_LAUNCH(fv_cuda_vp_reproject, blocks_of(n), FV_CUDA_VP_THREADS, st)(rf, c->prev_coord);
@@ -585,14 +597,13 @@ static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv
             FV_CUDA_LAUNCH(fv_cuda_vp_halve, tiles_of(dm.w, f->mip_h[k]), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(dm, k, f->mip_h[k]);
     }
 
-    /* 4. map: this frame's radial table replaces the previous one (the reprojection is queued) */
+    /* 4. map, with this frame's radial table */
     cudaEventRecord(c->ev[ST_MAP], st);
-    if ((s = fv_cuda_mirror_fill(&c->lut, f->map.lut, (size_t)f->map.nlut * 3 * sizeof(float), st, "the radial table", err)) != FV_OK) return s;
     fv_kvp_map_frame mf = f->map;
     mf.col_h = dcol_h;
     mf.g = c->g;
     mf.mips = dm;
-    mf.lut = (const float *)c->lut.p;
+    mf.lut = (const float *)c->lut[lut_now].p;
     mf.sigma = f->blur ? c->sigma : NULL;
     FV_CUDA_LAUNCH(fv_cuda_vp_map, tiles_of(sw, sh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(mf, dv);
 
@@ -607,6 +618,7 @@ static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv
     }
     cudaEventRecord(c->ev[ST_COUNT], st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the Visual-Polar kernels", err);
+    c->lut_prev = lut_now; /* the next frame's reprojection reads it */
     return FV_OK;
 }
 

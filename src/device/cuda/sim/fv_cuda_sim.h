@@ -21,6 +21,9 @@ typedef struct fv_cuda_sim_counts {
     uint64_t live_bytes;
     uint64_t live_streams, live_events;
     uint64_t injected_failures; /* allocations failed by fv_cuda_sim_fail_allocation */
+    uint64_t uploads_behind_kernels; /* cudaMemcpyAsync host to device queued behind a kernel launched on
+                                      * its stream since the host last waited: from pageable memory
+                                      * CUDA may make the host wait for that kernel first */
 } fv_cuda_sim_counts;
 
 /* The counts since the process started (the live ones: now). */

@@ -261,6 +261,7 @@ public:
     cudaError_t last = cudaSuccess; /* for cudaGetLastError: set by every call that fails, as CUDA's */
     std::map<std::string, unsigned long long> launches_of; /* by kernel name: odd ones run their blocks reversed */
     bool queued = false;            /* work was queued since the host last waited */
+    std::set<cudaStream_t> launched; /* streams a kernel was launched on since the host last waited */
     int64_t fail_in = -1;           /* fv_cuda_sim_fail_allocation */
     fv_cuda_sim_counts counts = {};
     Pool pool;
@@ -321,6 +322,7 @@ public:
     {
         if (queued) counts.host_waits++;
         queued = false;
+        launched.clear();
     }
 };
 
@@ -362,6 +364,7 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
         }
         d.counts.launches++;
         d.queued = true;
+        d.launched.insert(s);
         /* CUDA runs a launch's blocks in no order: every other launch of a kernel runs them last
          * to first, so a kernel that reads what another block of its launch writes finds it
          * unwritten one way or the other (a race on a GPU), and a test comparing images sees it. */
@@ -600,6 +603,11 @@ cudaError_t fv_cuda_sim_memcpy(void *dst, const void *src, size_t bytes, cudaMem
     else if (d.find(dst)) die(file, line, "%s %s: the destination %p is device memory", what, kinds[kind], dst);
     if (src_dev) d.check_range(src, bytes, what, file, line);
     else if (d.find(src)) die(file, line, "%s %s: the source %p is device memory", what, kinds[kind], src);
+    /* A copy from pageable host memory to the device may wait for its stream's queued work before
+     * it starts (CUDA stages it through pinned memory): behind a kernel of its stream (or any, on
+     * the legacy stream 0, which waits for the others) the host would wait mid-frame, unseen. */
+    if (async && dst_dev && !src_dev && (s ? d.launched.count(s) || d.launched.count(nullptr) : !d.launched.empty()))
+        d.counts.uploads_behind_kernels++;
     memmove(dst, src, bytes);
     if (async) d.queued = true;
     else if (src_dev || dst_dev) d.host_wait(); /* a synchronous copy waits for the work before it */
