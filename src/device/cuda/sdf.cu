@@ -175,10 +175,10 @@ static fv_status upload_world(fv_cuda_sdf *c, const fv_ksdf_world *w, fv_ksdf_wo
 {
     *dw = *w;
     fv_status s;
-    if ((s = fv_cuda_mirror_fill(&c->ops, w->ops, (size_t)w->nops * sizeof(fv_sdf_op), 0, "the world", err)) != FV_OK ||
-        (s = fv_cuda_mirror_fill(&c->objs, w->objs, (size_t)w->count * sizeof(fv_ksdf_object), 0, "the world", err)) != FV_OK ||
-        (s = fv_cuda_mirror_fill(&c->lights, w->lights, (size_t)w->nlights * sizeof(fv_ksdf_light), 0, "the world", err)) != FV_OK ||
-        (s = fv_cuda_mirror_fill(&c->mats, w->mats, (size_t)w->nmat * sizeof(fv_material), 0, "the world", err)) != FV_OK)
+    if ((s = fv_cuda_mirror_fill(&c->ops, w->ops, (size_t)w->nops * sizeof(fv_sdf_op), c->stream, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->objs, w->objs, (size_t)w->count * sizeof(fv_ksdf_object), c->stream, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->lights, w->lights, (size_t)w->nlights * sizeof(fv_ksdf_light), c->stream, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->mats, w->mats, (size_t)w->nmat * sizeof(fv_material), c->stream, "the world", err)) != FV_OK)
         return s;
     dw->ops = (const fv_sdf_op *)c->ops.p;
     dw->objs = (const fv_ksdf_object *)c->objs.p;
@@ -496,8 +496,8 @@ static fv_status blur_ensure(fv_cuda_sdf *c, int w, int h, float smax, fv_kblur_
         b->w = w, b->h = h, b->smax = smax;
     }
     fv_status s;
-    if ((s = fv_cuda_mirror_fill(&b->off, b->host_off, (size_t)b->nq * sizeof(int), 0, "fipr's blur kernels", err)) != FV_OK ||
-        (s = fv_cuda_mirror_fill(&b->k, b->host_k, b->nk * sizeof(float), 0, "fipr's blur kernels", err)) != FV_OK)
+    if ((s = fv_cuda_mirror_fill(&b->off, b->host_off, (size_t)b->nq * sizeof(int), c->stream, "fipr's blur kernels", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&b->k, b->host_k, b->nk * sizeof(float), c->stream, "fipr's blur kernels", err)) != FV_OK)
         return s;
     t->w = w;
     t->h = h;
