@@ -29,6 +29,7 @@
  * most FV_LINE_MAX bytes.
  */
 #include <ctype.h>
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -55,6 +56,12 @@ typedef struct table {
     int res_w, res_h;           /* Tobii: the recording resolution (-1: none) */
     int event, sensor;          /* Tobii: what a row without gaze is (-1: none) */
     double scale;               /* seconds per unit of time */
+    /* The first row's time, which the others are taken relative to before scaling: an integer
+     * time (a count of ns or µs since an epoch, some 1.7e18 ns) is subtracted as an integer, as a
+     * double holds such a count only to a few hundred ns. */
+    bool have_origin, origin_is_int;
+    long long origin_i;
+    double origin_d;
     bool bottom_left;
     bool tobii;
 } table;
@@ -87,6 +94,40 @@ static bool number(const table *t, const char *s, double *v)
     memcpy(tmp, s, len + 1);
     tmp[c - s] = '.';
     return fv_gaze_field_number(tmp, len, v);
+}
+
+/* A whole number that a long long holds (a sign, digits, nothing else): *v gets it. */
+static bool integer(const char *s, long long *v)
+{
+    const char *d = *s == '-' || *s == '+' ? s + 1 : s;
+    size_t n = strspn(d, "0123456789");
+    if (n == 0 || n > 19 || d[n] != '\0') return false;
+    errno = 0;
+    *v = strtoll(s, NULL, 10);
+    return errno == 0;
+}
+
+/* A row's time relative to the first row's, in the table's unit (t->origin*: set by the first). */
+static bool row_time(table *t, const char *s, double *v)
+{
+    long long i = 0;
+    const bool is_int = integer(s, &i);
+    double d = 0.0;
+    if (!is_int && !number(t, s, &d)) return false;
+    if (!is_int && !isfinite(d)) {
+        *v = d; /* dropped by the caller; not an origin */
+        return true;
+    }
+    if (!t->have_origin) {
+        t->have_origin = true;
+        t->origin_is_int = is_int;
+        t->origin_i = i;
+        t->origin_d = d;
+    }
+    long long diff;
+    if (is_int && t->origin_is_int && !__builtin_sub_overflow(i, t->origin_i, &diff)) *v = (double)diff;
+    else *v = (is_int ? (double)i : d) - (t->origin_is_int ? (double)t->origin_i : t->origin_d);
+    return true;
 }
 
 /* A coordinate: a number, NaN for a missing marker (empty, nan, -, .), false for anything else. */
@@ -335,7 +376,7 @@ static fv_status row(table *t, const fv_gaze_fields *fs, const fv_gaze_import_op
     }
     double tm;
     const char *ft = field(fs, t->time);
-    if (!number(t, ft, &tm))
+    if (!row_time(t, ft, &tm))
         return fv_error_set(err, FV_ERR_INVALID, "%s:%d: column %s (the time): '%s' is not a number", w->in, lineno, col_name(t, t->time, nb, sizeof nb),
                             ft);
     if (!isfinite(tm)) {

@@ -573,6 +573,39 @@ static void test_table_delimiters_and_numbers(void **st)
 }
 
 /* Refusals: one line naming the file (and line and column for a row), nothing written. */
+/* Nanoseconds since 1970 (Pupil Cloud's gaze.csv: some 1.7e18, beyond what a double holds to the
+ * nanosecond; its ulp there is 256 ns): rows 5 ms apart must come out 0.005 s apart, not 0.005 s
+ * give or take a few hundred ns. Pixels of a 1600x1200 scene camera: 800/1600 = 0.5,
+ * 816/1600 = 0.51, 612/1200 = 0.51, 400/1600 = 0.25, 300/1200 = 0.25; `worn` 0 is missing. */
+static void test_table_ns_epoch(void **st)
+{
+    (void)st;
+    const char *path = tmp_path("neon.csv");
+    const char neon[] = "section id,timestamp [ns],gaze x [px],gaze y [px],worn\n"
+                        "a,1700000000000000000,800.0,600.0,1\n"
+                        "a,1700000000005000000,816.0,612.0,1\n"
+                        "a,1700000000010000000,,,0\n"
+                        "a,1700000000015000000,400.0,300.0,1\n";
+    write_file(path, neon, sizeof neon - 1);
+    fv_gaze_import_opts o = table_opts("timestamp [ns]", "gaze x [px]", "gaze y [px]");
+    o.table.time_unit = 1e-9;
+    o.table.pixels = true;
+    o.table.valid = "worn";
+    o.width = 1600, o.height = 1200;
+    fv_gaze_import_info info;
+    fv_error err;
+    trace tr;
+    assert_int_equal(import(path, &o, &info, &tr, &err), FV_OK);
+    assert_int_equal(tr.n, 4);
+    assert_int_equal(info.missing, 1);
+    static const double t[4] = {0, 0.005, 0.01, 0.015}, x[4] = {0.5, 0.51, NAN, 0.25}, y[4] = {0.5, 0.51, NAN, 0.25};
+    for (int k = 0; k < 4; k++) {
+        assert_float_equal(tr.t[k], t[k], 1e-12);
+        if (isnan(x[k])) assert_true(isnan(tr.v[k][0]) && isnan(tr.v[k][1]));
+        else assert_float_equal(tr.v[k][0], x[k], 1e-6), assert_float_equal(tr.v[k][1], y[k], 1e-6);
+    }
+}
+
 static void test_table_refusals(void **st)
 {
     (void)st;
@@ -743,7 +776,7 @@ int main(void)
         cmocka_unit_test(test_pupil_blank_first), cmocka_unit_test(test_pupil_old_header), cmocka_unit_test(test_pupil_binocular),
         cmocka_unit_test(test_eyelink_2000hz),    cmocka_unit_test(test_eyelink_gz),       cmocka_unit_test(test_eyelink_trials),
         cmocka_unit_test(test_eyelink_eyes),      cmocka_unit_test(test_table_norm),       cmocka_unit_test(test_table_px_two_eyes),
-        cmocka_unit_test(test_table_delimiters_and_numbers), cmocka_unit_test(test_table_refusals), cmocka_unit_test(test_tobii),
+        cmocka_unit_test(test_table_delimiters_and_numbers), cmocka_unit_test(test_table_refusals), cmocka_unit_test(test_table_ns_epoch), cmocka_unit_test(test_tobii),
         cmocka_unit_test(test_tobii_ms),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
