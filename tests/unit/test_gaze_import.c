@@ -415,6 +415,17 @@ static void test_eyelink_eyes(void **st)
 /* ---- tables (--format table) and Tobii Pro Lab exports (src/gaze/gaze_table.c) ---- */
 
 /* A mapping for one gaze: --time time --x x --y y. */
+/* The first n samples of a three-column trace: times within t_tol of t[], gazes within 1e-6 of
+ * (x[], y[]), a NaN x meaning a missing sample (both fields empty). */
+static void expect_samples(const trace *tr, int n, const double *t, double t_tol, const double *x, const double *y)
+{
+    for (int k = 0; k < n; k++) {
+        assert_float_equal(tr->t[k], t[k], t_tol);
+        if (isnan(x[k])) assert_true(isnan(tr->v[k][0]) && isnan(tr->v[k][1]));
+        else assert_float_equal(tr->v[k][0], x[k], 1e-6), assert_float_equal(tr->v[k][1], y[k], 1e-6);
+    }
+}
+
 static fv_gaze_import_opts table_opts(const char *t, const char *x, const char *y)
 {
     fv_gaze_import_opts o;
@@ -445,11 +456,7 @@ static void test_table_norm(void **st)
     assert_int_equal(info.eyes, FV_GAZE_EYES_BOTH);
     static const double t[7] = {0, 0.01, 0.02, 0.03, 0.04, 0.05, 0.06}, x[7] = {0.5, 0.25, NAN, NAN, NAN, 0.8, NAN},
                         y[7] = {0.5, 0.75, NAN, NAN, NAN, 0.2, NAN};
-    for (int k = 0; k < 7; k++) {
-        assert_float_equal(tr.t[k], t[k], 1e-9);
-        if (isnan(x[k])) assert_true(isnan(tr.v[k][0]) && isnan(tr.v[k][1]));
-        else assert_float_equal(tr.v[k][0], x[k], 1e-6), assert_float_equal(tr.v[k][1], y[k], 1e-6);
-    }
+    expect_samples(&tr, 7, t, 1e-9, x, y);
     /* The same y with the origin at the bottom left: 1 - 0.75 = 0.25, 1 - 0.2 = 0.8. */
     o.table.bottom_left = true;
     o.format = FV_GAZE_FORMAT_TABLE;
@@ -553,11 +560,7 @@ static void test_table_delimiters_and_numbers(void **st)
     assert_int_equal(import(DATA "table_noheader.csv", &o, &info, &tr, &err), FV_OK);
     assert_int_equal(tr.n, 4); /* the first line is a row */
     static const double t[4] = {0, 0.004, 0.008, 0.012}, x[4] = {0.1, 0.3, NAN, 0.5}, y[4] = {0.2, 0.4, NAN, 0.6};
-    for (int k = 0; k < 4; k++) {
-        assert_float_equal(tr.t[k], t[k], 1e-9);
-        if (isnan(x[k])) assert_true(isnan(tr.v[k][0]));
-        else assert_float_equal(tr.v[k][0], x[k], 1e-6), assert_float_equal(tr.v[k][1], y[k], 1e-6);
-    }
+    expect_samples(&tr, 4, t, 1e-9, x, y);
     /* Without a header, names mean nothing; numbers past the row do not exist. */
     o = table_opts("2", "3", "y");
     assert_int_equal(import(DATA "table_noheader.csv", &o, &info, &tr, &err), FV_ERR_INVALID);
@@ -599,11 +602,7 @@ static void test_table_ns_epoch(void **st)
     assert_int_equal(tr.n, 4);
     assert_int_equal(info.missing, 1);
     static const double t[4] = {0, 0.005, 0.01, 0.015}, x[4] = {0.5, 0.51, NAN, 0.25}, y[4] = {0.5, 0.51, NAN, 0.25};
-    for (int k = 0; k < 4; k++) {
-        assert_float_equal(tr.t[k], t[k], 1e-12);
-        if (isnan(x[k])) assert_true(isnan(tr.v[k][0]) && isnan(tr.v[k][1]));
-        else assert_float_equal(tr.v[k][0], x[k], 1e-6), assert_float_equal(tr.v[k][1], y[k], 1e-6);
-    }
+    expect_samples(&tr, 4, t, 1e-12, x, y);
 }
 
 static void test_table_refusals(void **st)
@@ -693,11 +692,7 @@ static void test_tobii(void **st)
     assert_float_equal(info.width, 1920, 0);
     assert_float_equal(info.height, 1080, 0);
     static const double t[5] = {0, 0.008333, 0.016667, 0.025, 0.033333}, xy[5] = {0.5, 0.25, 0.75, NAN, 0.1};
-    for (int k = 0; k < 5; k++) {
-        assert_float_equal(tr.t[k], t[k], 1e-9);
-        if (isnan(xy[k])) assert_true(isnan(tr.v[k][0]));
-        else assert_float_equal(tr.v[k][0], xy[k], 1e-6), assert_float_equal(tr.v[k][1], xy[k], 1e-6);
-    }
+    expect_samples(&tr, 5, t, 1e-9, xy, xy);
     fv_gaze_import_opts o;
     fv_gaze_import_opts_init(&o);
     o.eyes = FV_GAZE_EYES_EACH;
@@ -746,11 +741,7 @@ static void test_tobii_ms(void **st)
     assert_int_equal(info.skipped, 1);
     assert_int_equal(info.missing, 1);
     static const double t[4] = {0, 0.0165, 0.033, 0.0495}, xy[4] = {0.5, 1.0, NAN, 0.0};
-    for (int k = 0; k < 4; k++) {
-        assert_float_equal(tr.t[k], t[k], 1e-9);
-        if (isnan(xy[k])) assert_true(isnan(tr.v[k][0]));
-        else assert_float_equal(tr.v[k][0], xy[k], 1e-6), assert_float_equal(tr.v[k][1], xy[k], 1e-6);
-    }
+    expect_samples(&tr, 4, t, 1e-9, xy, xy);
     /* No per-eye columns: no eye to choose. */
     o.eyes = FV_GAZE_EYES_LEFT;
     assert_int_equal(import(DATA "tobii_ms.tsv", &o, &info, &tr, &err), FV_ERR_INVALID);
