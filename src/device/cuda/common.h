@@ -112,24 +112,6 @@ static inline fv_status fv_cuda_film_prepare(fv_cuda_film *f, const fv_film_view
     return FV_OK;
 }
 
-/* Copies the device film's n pixels into host's buffers that are set. */
-static inline fv_status fv_cuda_film_read(const fv_cuda_film *f, const fv_film_views *host, size_t n, fv_error *err)
-{
-    struct {
-        void *host;
-        const void *dev;
-        size_t bytes;
-    } back[6] = {{host->color, f->color, 3 * n * sizeof(float)},       {host->depth, f->depth, n * sizeof(float)},
-                 {host->normal, f->normal, 3 * n * sizeof(float)},     {host->albedo, f->albedo, 3 * n * sizeof(float)},
-                 {host->position, f->position, 3 * n * sizeof(float)}, {host->id, f->id, n * sizeof(uint32_t)}};
-    for (int i = 0; i < 6; i++) {
-        cudaError_t e;
-        if (back[i].host && (e = cudaMemcpy(back[i].host, back[i].dev, back[i].bytes, cudaMemcpyDeviceToHost)) != cudaSuccess)
-            return fv_cuda_fail(e, "reading the film back", err);
-    }
-    return FV_OK;
-}
-
 /* Queues the copies of the device film's n pixels into host's buffers that are set on stream st; the
  * caller waits for the stream once, after whatever else it reads back. */
 static inline cudaError_t fv_cuda_film_read_async(const fv_cuda_film *f, const fv_film_views *host, size_t n, cudaStream_t st)
