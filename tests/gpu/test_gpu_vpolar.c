@@ -312,12 +312,7 @@ static void test_refusals(void **st)
         {"log-polar", "device=cuda show=density", "parameter show=density: device cuda renders the image only (devices cpu and portable draw diagnostics)"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        fv_params *p = fv_test_params_str(cases[i].params);
-        fv_technique *t = NULL;
-        fv_error err;
-        fv_test_expect_fail(fv_technique_create(cases[i].method, s, p, NULL, &t, &err), &err, FV_ERR_INVALID, cases[i].needle, cases[i].params);
-        assert_null(t);
-        fv_params_destroy(p);
+        fv_test_expect_refusal(cases[i].method, cases[i].params, s, cases[i].needle);
         fv_sim_expect_freed(cases[i].method);
     }
     fv_view_destroy(v);

@@ -151,6 +151,20 @@ static inline fv_technique *fv_test_technique(const char *method, const char *li
     return t;
 }
 
+/* Creating `method` in scene s with the parameters `list` must be refused: FV_ERR_INVALID, a
+ * one-line message naming `needle`, and no technique. */
+static inline void fv_test_expect_refusal(const char *method, const char *list, const fv_scene *s, const char *needle)
+{
+    fv_params *p = fv_test_params_str(list);
+    fv_technique *t = NULL;
+    fv_error err;
+    char what[256];
+    snprintf(what, sizeof what, "%s %s", method, list);
+    fv_test_expect_fail(fv_technique_create(method, s, p, NULL, &t, &err), &err, FV_ERR_INVALID, needle, what);
+    if (t) fail_msg("%s: refused, yet a technique was made", what);
+    fv_params_destroy(p);
+}
+
 /* One frame of t into film, its colour set to NaN first so that a pixel the technique does not
  * write cannot pass a comparison; *stats (cleared first) receives the frame's costs. */
 static inline void fv_test_render_fresh(fv_technique *t, const fv_frame *f, fv_film *film, fv_stats *stats)
