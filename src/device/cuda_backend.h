@@ -30,6 +30,27 @@ struct fv_ksdf_pyr_counts;
 struct fv_kpyr;
 struct fv_kpyr_fovea;
 
+/* What a CUDA backend asked of the runtime, counted by the backend's own calls (device/cuda/
+ * common.h), so that a real GPU and the simulator report the same figures: what decides a frame's
+ * cost besides its kernels. A host wait is a call that holds the host until the device is done: a
+ * synchronize after queued work, a synchronous copy, a cudaFree after queued work, and every copy
+ * between the device and pageable host memory (CUDA stages it through a pinned buffer of its own
+ * while the host waits; cudaPointerGetAttributes says which memory is pageable). Techniques report
+ * a frame's difference as --stats-json counters (fv_cuda_calls_report). */
+typedef struct fv_cuda_calls {
+    uint64_t launches;
+    uint64_t syncs;           /* synchronize calls */
+    uint64_t host_waits;
+    uint64_t pageable_copies; /* copies between the device and pageable host memory */
+    uint64_t bytes_h2d, bytes_d2h;
+    uint64_t allocations, frees; /* device memory taken and given back */
+} fv_cuda_calls;
+
+/* Adds after - before to stats as the counters launches, host_waits, pageable_copies, h2d_bytes,
+ * d2h_bytes, device_allocs and device_frees (device/device.c). */
+struct fv_stats;
+void fv_cuda_calls_report(struct fv_stats *stats, const fv_cuda_calls *before, const fv_cuda_calls *after);
+
 /* True when a CUDA device can run our kernels; else false with the reason in why. */
 bool fv_cuda_probe(char *why, size_t why_len);
 
@@ -46,6 +67,8 @@ fv_status fv_cuda_pt_update(fv_cuda_pt *c, const struct fv_kscene *host, fv_erro
 fv_status fv_cuda_pt_render(fv_cuda_pt *c, int eyes, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays, uint64_t *nan_samples,
                             double *kernel_ms, int *syncs, fv_error *err);
 void fv_cuda_pt_destroy(fv_cuda_pt *c);
+/* What c has asked of the runtime since it was created. */
+void fv_cuda_pt_calls(const fv_cuda_pt *c, fv_cuda_calls *out);
 
 /* The sphere-tracing family (kernel/sdf_pixel.h, kernel/sdf_pyramid.h): the GPU's buffers for the
  * world, the films, the pyramid and fipr's history, kept between frames and grown when a frame
@@ -78,6 +101,7 @@ fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const struct fv_ksdf_world 
                                      const struct fv_kpyr_fovea *fov, const fv_cuda_pyr_opts *po, const fv_film_views *out,
                                      struct fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err);
 void fv_cuda_sdf_destroy(fv_cuda_sdf *c);
+void fv_cuda_sdf_calls(const fv_cuda_sdf *c, fv_cuda_calls *out);
 
 /* The Visual-Polar family (vpolar, cartesian, cartesian-full, linear-falloff, log-polar; technique/
  * vpolar/pipeline.c): a whole frame of one eye on the GPU. The sample grid's buffers, the history's
@@ -89,6 +113,7 @@ typedef struct fv_cuda_vp fv_cuda_vp;
 /* Copies the flat scene (host memory) to the GPU. */
 fv_status fv_cuda_vp_create(const struct fv_kscene *host, fv_cuda_vp **out, fv_error *err);
 void fv_cuda_vp_destroy(fv_cuda_vp *c);
+void fv_cuda_vp_calls(const fv_cuda_vp *c, fv_cuda_calls *out);
 
 /* One frame of one eye, every pointer host memory (the GPU's copies are the backend's). */
 typedef struct fv_cuda_vp_frame {
@@ -129,6 +154,7 @@ typedef struct fv_cuda_vp_result {
     double kernel_ms;          /* the frame's launches, first to last (events) */
     double stage_ms[5];        /* trace, denoise, mip, map, blur (events) */
     int syncs;                 /* host waits in the frame: 1 (the end; 0 for a pair's eye 1) */
+    fv_cuda_calls calls;       /* what the eye's backend asked of the runtime in the frame */
 } fv_cuda_vp_result;
 
 /* Renders `eyes` frames (1, or 2: a stereo pair, one backend, frame, film and result per eye, each

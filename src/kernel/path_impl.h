@@ -23,6 +23,7 @@
  * and fv_hit, fv_material, the BSDFs (kernel/bsdf.h), the light kernels (kernel/light.h) and the
  * path types (kernel/path.h) must be visible. The macros are undefined at the end.
  */
+#include "kernel/simt.h" /* guarded: the probes of the bounce loop */
 
 /* Radiance arriving at o from direction d (unit). pre, when not NULL, is the first hit already
  * traced (pre_ok false: the ray missed), as for camera rays traced in packets. first (optional)
@@ -36,6 +37,7 @@ FV_PATH_QUAL fv_vec3 FV_PATH_FN(const FV_PATH_SCENE *s, const fv_path_opts *opt,
     fv_vec3 p_prev = o;
     uint64_t nrays = 0;
     for (int depth = 1; depth <= opt->max_depth; depth++) {
+        FV_SIMT_STEP(FV_SIMT_BOUNCE);
         fv_hit h;
         nrays++;
         if (depth == 1 && pre) h = *pre;

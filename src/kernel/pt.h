@@ -18,6 +18,7 @@
 #include "kernel/light.h"
 #include "kernel/material.h"
 #include "kernel/path.h"
+#include "kernel/simt.h"
 #include "kernel/traverse.h"
 
 #define FV_PATH_FN fv_kpath_trace_from
@@ -44,6 +45,7 @@ FV_HD static inline void fv_kpt_pixel(const fv_kscene *s, const fv_kpt_frame *f,
     first.p = first.n = first.albedo = first.reflectance = fv_v3s(0.0f);
     first.obj = 0;
     for (int k = 0; k < f->opt.spp; k++) {
+        FV_SIMT_STEP(FV_SIMT_SAMPLE);
         fv_rng rng = fv_rng_stream(f->seed, FV_STREAM_CAMERA, (uint64_t)pix * 2 + (uint64_t)f->eye, (uint64_t)k, (uint64_t)f->frame);
         float jx = fv_rng_next(&rng), jy = fv_rng_next(&rng);
         fv_vec3 d = fv_camera_dir(&f->cam, (float)x + jx, (float)y + jy);

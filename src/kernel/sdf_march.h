@@ -27,6 +27,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 #include "kernel/sdf_world.h"
+#include "kernel/simt.h"
 
 typedef struct fv_march_opts {
     int max_steps;  /* evaluations per ray (the paper's heat maps stop at 256) */
@@ -154,6 +155,7 @@ FV_HD static inline void fv_kmarch_one(const fv_ksdf_world *w, int max_steps, fl
     fv_kmarch_lane l;
     if (!fv_kmarch_start(&l, r, out, 0, relax)) return;
     for (;;) {
+        FV_SIMT_STEP(FV_SIMT_MARCH);
         fv_vec3 p = fv_madd(r->o, r->d, l.t);
         int m = 0;
         float d = fv_ksdf_world_eval1(w, p.x, p.y, p.z, &m);

@@ -20,6 +20,7 @@
 #include "kernel/path.h"
 #include "kernel/sdf_pyramid.h"
 #include "kernel/sdf_shade.h"
+#include "kernel/simt.h"
 
 /* What a frame's pixels share. */
 typedef struct fv_ksdf_frame {
@@ -81,6 +82,7 @@ FV_HD static inline void fv_ksdf_level_cell(const fv_ksdf_world *w, const fv_ksd
     fv_march_ray r;
     fv_march_hit h;
     fv_ksdf_camera_ray(w, f, sx, sy, &r);
+    FV_SIMT_STEP(FV_SIMT_SAMPLE);
     if (k > 0) r.t0 = fmaxf(r.t0, fv_kpyr_start(py->depth[k - 1], &py->lv[k - 1], x >> 1, y >> 1, py->min_filter != 0));
     fv_kmarch_one(w, f->march.max_steps, f->march.relax, &r, false, &h);
     c->rays++;
@@ -125,6 +127,7 @@ FV_HD static inline void fv_ksdf_target_pixel(const fv_ksdf_world *w, const fv_k
     fv_vec3 sum = fv_v3s(0.0f);
     for (int b = 0; b < S; b++)
         for (int a = 0; a < S; a++) {
+            FV_SIMT_STEP(FV_SIMT_SAMPLE);
             fv_march_ray r;
             fv_march_hit h;
             const int sx = x * S + a, sy = y * S + b;

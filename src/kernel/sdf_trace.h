@@ -19,6 +19,7 @@
 #include "core/ray_box.h"
 #include "fovea/math.h"
 #include "kernel/scene.h"
+#include "kernel/simt.h"
 
 #ifdef FV_K_WIDE
 #error "kernel/sdf_trace.h builds the scalar SDF kernel: include it in a unit without another sdf/kernel.h"
@@ -100,6 +101,7 @@ FV_HD static inline bool fv_sdf_trace_field(const fv_sdf *f, float eps, fv_vec3 
     int step = 0;
     if (t0 == tnear && fabsf(dist) < eps) {
         while (fabsf(dist) < eps) {
+            FV_SIMT_STEP(FV_SIMT_MARCH);
             t += fmaxf(fabsf(dist), eps) * inv_dl;
             if (t > t1 || ++step >= FV_KSDF_TRACE_STEPS) return false;
             dist = fv_ksdf_distance(f, fv_madd(o, d, t), 0);
@@ -110,6 +112,7 @@ FV_HD static inline bool fv_sdf_trace_field(const fv_sdf *f, float eps, fv_vec3 
      * crossed. */
     float side = dist >= 0.0f ? 1.0f : -1.0f;
     for (; step < FV_KSDF_TRACE_STEPS; step++) {
+        FV_SIMT_STEP(FV_SIMT_MARCH);
         float ds = side * dist;
         if (ds < eps) {
             for (int k = 0; k < FV_KSDF_REFINE; k++) {

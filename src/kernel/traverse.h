@@ -25,6 +25,7 @@
 #include "kernel/hit.h"
 #include "kernel/scene.h"
 #include "kernel/sdf_trace.h"
+#include "kernel/simt.h"
 
 /* A box test's far distance is scaled up by 1 + 2 gamma(3) so rounding in the slab arithmetic
  * never loses a box that a ray only touches (a wall's flat box, a triangle in a box face). */
@@ -170,6 +171,7 @@ FV_HD static inline bool fv_kblas(const fv_kscene *s, int root, fv_vec3 o, fv_ve
         bool ha, hb;
         int32_t ca, cb;
         float ta, tb;
+        FV_SIMT_STEP(FV_SIMT_TRAVERSE);
         fv_knode_children(&s->nodes[ni], o, inv, b->t, &ha, &hb, &ca, &cb, &ta, &tb);
         if (ha && ca < 0) {
             if (fv_kleaf_tris(s, ca, o, d, any, b)) return true;
@@ -232,6 +234,7 @@ FV_HD static inline bool fv_ktlas(const fv_kscene *s, fv_vec3 o, fv_vec3 d, bool
         bool ha, hb;
         int32_t ca, cb;
         float ta, tb;
+        FV_SIMT_STEP(FV_SIMT_TRAVERSE);
         fv_knode_children(&s->tnodes[ni], o, inv, b->t, &ha, &hb, &ca, &cb, &ta, &tb);
         if (ha && ca < 0) {
             if (fv_kleaf_inst(s, ca, o, d, any, b)) return true;

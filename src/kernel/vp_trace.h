@@ -113,10 +113,13 @@ FV_HD static inline void fv_kvp_trace_sample(const fv_kscene *s, const fv_kvp_tr
     first.t = 0.0f;
     first.p = first.n = first.albedo = first.reflectance = fv_v3s(0.0f);
     first.obj = 0;
+    FV_SIMT_STEP(FV_SIMT_SAMPLE);
     fv_vec3 L = fv_path_guard(fv_kpath_trace_from(s, &f->pt, f->cam.pos, dir, NULL, false, &rng, &first, &c->rays), &c->nan_paths);
     /* spp > 1: more paths through the same camera ray, averaged. */
-    for (int n = 1; n < f->pt.spp; n++)
+    for (int n = 1; n < f->pt.spp; n++) {
+        FV_SIMT_STEP(FV_SIMT_SAMPLE);
         L = fv_add(L, fv_path_guard(fv_kpath_trace_from(s, &f->pt, f->cam.pos, dir, NULL, false, &rng, NULL, &c->rays), &c->nan_paths));
+    }
     if (f->pt.spp > 1) L = fv_scale(L, 1.0f / (float)f->pt.spp);
     fv_kvp_store_sample(g, i, L, &first);
     c->paths++;

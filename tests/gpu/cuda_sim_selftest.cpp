@@ -6,15 +6,20 @@
  *                              gives the hand-computed sums; a kernel's launches alternate the
  *                              order of their blocks; an impossible launch shape is an error
  *                              for cudaGetLastError and runs nothing, a failed call's error is
- *                              kept there too (out of memory); host waits are counted only
- *                              when work was queued; events time; everything freed.
+ *                              kept there too (out of memory); host waits are counted as CUDA
+ *                              makes the host wait (a synchronize after queued work, every copy
+ *                              with pageable memory; pinned memory's copies are queued), and the
+ *                              backends' own count agrees; SIMT efficiency of a kernel worked by
+ *                              hand; events time; everything freed.
  *   cuda_sim_selftest CASE     one misuse the simulator must abort on with its message (ctest
  *                              matches the message: tests/CMakeLists.txt).
  */
 #include <stdio.h>
 #include <string.h>
 #include "cuda_runtime.h"
+#include "device/cuda/common.h"
 #include "device/cuda/launch.h"
+#include "kernel/simt.h"
 #include "device/cuda/sim/fv_cuda_sim.h"
 
 #define CHECK(cond)                                                                  \
@@ -65,8 +70,17 @@ __global__ void divergent_barrier(int *x)
     x[threadIdx.x] = 1;
 }
 
+/* Lane t of a block counts t % 32 sphere-tracing steps in its first warp and 4 in the others. */
+__global__ void simt_steps(void)
+{
+    const unsigned t = threadIdx.x;
+    const unsigned n = t < 32 ? t : 4;
+    for (unsigned i = 0; i < n; i++) FV_SIMT_STEP(FV_SIMT_MARCH);
+}
+
 static int selftest(void)
 {
+    fv_cuda_tally tally = {};
     fv_cuda_sim_counts c0;
     fv_cuda_sim_counts_get(&c0);
 
@@ -76,7 +90,7 @@ static int selftest(void)
     CHECK(cudaMalloc((void **)&cell, n * sizeof(unsigned)) == cudaSuccess);
     CHECK(cudaMalloc((void **)&hits, sizeof(unsigned)) == cudaSuccess);
     CHECK(cudaMemset(hits, 0, sizeof(unsigned)) == cudaSuccess);
-    FV_CUDA_LAUNCH(whoami, dim3(5, 3, 2), dim3(4, 3, 2), 0)(cell, hits, n);
+    FV_CUDA_LAUNCH(&tally, whoami, dim3(5, 3, 2), dim3(4, 3, 2), 0)(cell, hits, n);
     CHECK(cudaGetLastError() == cudaSuccess);
     static unsigned host[700];
     unsigned h = 0;
@@ -96,11 +110,20 @@ static int selftest(void)
     cudaStream_t st;
     CHECK(cudaStreamCreate(&st) == cudaSuccess);
     CHECK(cudaMemcpyAsync(din, in, sizeof in, cudaMemcpyHostToDevice, st) == cudaSuccess);
-    FV_CUDA_LAUNCH(block_sum, blocks, 256, st)(din, dout);
-    unsigned long long sums[6];
-    CHECK(cudaMemcpyAsync(sums, dout, sizeof sums, cudaMemcpyDeviceToHost, st) == cudaSuccess);
+    FV_CUDA_LAUNCH(&tally, block_sum, blocks, 256, st)(din, dout);
+    /* into pinned memory the copy is queued: the synchronize is the wait */
+    unsigned long long *sums = nullptr;
+    CHECK(cudaHostAlloc((void **)&sums, 6 * sizeof *sums, cudaHostAllocDefault) == cudaSuccess);
+    cudaPointerAttributes pa;
+    CHECK(cudaPointerGetAttributes(&pa, sums + 1) == cudaSuccess && pa.type == cudaMemoryTypeHost);
+    CHECK(cudaPointerGetAttributes(&pa, in) == cudaSuccess && pa.type == cudaMemoryTypeUnregistered);
+    CHECK(cudaPointerGetAttributes(&pa, dout) == cudaSuccess && pa.type == cudaMemoryTypeDevice);
+    CHECK(cudaMemcpyAsync(sums, dout, 6 * sizeof *sums, cudaMemcpyDeviceToHost, st) == cudaSuccess);
     fv_cuda_sim_counts c1;
     fv_cuda_sim_counts_get(&c1);
+    /* whoami's two read-backs and the upload of in, all pageable: three waits */
+    CHECK(c1.host_waits == c0.host_waits + 3 && c1.pageable_copies == c0.pageable_copies + 3);
+    CHECK(c1.bytes_h2d == c0.bytes_h2d + sizeof in && c1.bytes_d2h == c0.bytes_d2h + n * sizeof(unsigned) + sizeof h + 6 * sizeof *sums);
     CHECK(cudaStreamSynchronize(st) == cudaSuccess);
     fv_cuda_sim_counts c2;
     fv_cuda_sim_counts_get(&c2);
@@ -109,14 +132,54 @@ static int selftest(void)
     fv_cuda_sim_counts c3;
     fv_cuda_sim_counts_get(&c3);
     CHECK(c3.host_waits == c2.host_waits && c3.syncs == c2.syncs + 1); /* nothing queued: no wait */
+    /* into pageable memory the copy itself is a wait, queued work or not, and leaves none queued */
+    unsigned long long pageable[6];
+    FV_CUDA_LAUNCH(&tally, block_sum, blocks, 256, st)(din, dout);
+    CHECK(cudaMemcpyAsync(pageable, dout, sizeof pageable, cudaMemcpyDeviceToHost, st) == cudaSuccess);
+    CHECK(cudaMemcpyAsync(pageable, dout, sizeof pageable, cudaMemcpyDeviceToHost, st) == cudaSuccess);
+    CHECK(cudaStreamSynchronize(st) == cudaSuccess);
+    fv_cuda_sim_counts c4;
+    fv_cuda_sim_counts_get(&c4);
+    CHECK(c4.host_waits == c3.host_waits + 2 && c4.pageable_copies == c3.pageable_copies + 2 && c4.syncs == c3.syncs + 1);
+    CHECK(memcmp(pageable, sums, sizeof pageable) == 0);
+    /* the backends' own count (device/cuda/common.h) follows the same rules */
+    const fv_cuda_calls t0 = tally.n;
+    FV_CUDA_LAUNCH(&tally, block_sum, blocks, 256, st)(din, dout);
+    CHECK(fv_cuda_copy(&tally, pageable, dout, sizeof pageable, cudaMemcpyDeviceToHost, st) == cudaSuccess);
+    CHECK(fv_cuda_copy(&tally, sums, dout, 6 * sizeof *sums, cudaMemcpyDeviceToHost, st) == cudaSuccess);
+    CHECK(fv_cuda_wait(&tally, st) == cudaSuccess);
+    fv_cuda_sim_counts c5;
+    fv_cuda_sim_counts_get(&c5);
+    CHECK(tally.n.launches == t0.launches + 1 && tally.n.pageable_copies == t0.pageable_copies + 1 && tally.n.syncs == t0.syncs + 1);
+    CHECK(tally.n.host_waits - t0.host_waits == c5.host_waits - c4.host_waits && tally.n.host_waits == t0.host_waits + 2);
+    CHECK(tally.n.bytes_d2h - t0.bytes_d2h == c5.bytes_d2h - c4.bytes_d2h);
     for (unsigned b = 0; b < blocks; b++) CHECK(sums[b] == 65536ull * b + 32640ull);
+    CHECK(cudaFreeHost(sums) == cudaSuccess);
+    /* registered memory is pinned until unregistered */
+    CHECK(cudaHostRegister(pageable, sizeof pageable, cudaHostRegisterDefault) == cudaSuccess);
+    CHECK(cudaPointerGetAttributes(&pa, pageable + 5) == cudaSuccess && pa.type == cudaMemoryTypeHost);
+    CHECK(cudaHostUnregister(pageable) == cudaSuccess);
+    CHECK(cudaPointerGetAttributes(&pa, pageable) == cudaSuccess && pa.type == cudaMemoryTypeUnregistered);
+
+    /* SIMT efficiency, worked by hand: a block of 40 threads is a full warp whose lanes count 0..31
+     * steps (496 useful, 32 x 31 = 992 paid) and a warp of 8 lanes counting 4 each (32 useful, the
+     * warp's 32 lanes x 4 = 128 paid): 528 / 1120 in all */
+    fv_cuda_sim_simt_reset();
+    FV_CUDA_LAUNCH(&tally, simt_steps, 1, 40, 0)();
+    FV_CUDA_LAUNCH(&tally, simt_steps, 2, 40, 0)();
+    fv_cuda_sim_simt sr[4];
+    CHECK(fv_cuda_sim_simt_get(sr, 4) == 1 && !strcmp(sr[0].kernel, "simt_steps") && sr[0].launches == 2 && sr[0].threads_per_block == 40);
+    CHECK(sr[0].warps == 6 && sr[0].lane_total == 3 * 528 && sr[0].warp_total == 3 * 1120);
+    CHECK(sr[0].lane_steps[FV_SIMT_MARCH] == 3 * 528 && sr[0].warp_steps[FV_SIMT_MARCH] == 3 * 1120 && sr[0].warp_steps[FV_SIMT_TRAVERSE] == 0);
+    fv_cuda_sim_simt_reset();
+    CHECK(fv_cuda_sim_simt_get(sr, 4) == 0);
 
     /* an impossible shape: an error for cudaGetLastError (then cleared), and nothing runs */
     CHECK(cudaMemset(hits, 0, sizeof(unsigned)) == cudaSuccess);
-    FV_CUDA_LAUNCH(whoami, 1, 2048, 0)(cell, hits, n);
+    FV_CUDA_LAUNCH(&tally, whoami, 1, 2048, 0)(cell, hits, n);
     CHECK(cudaGetLastError() == cudaErrorInvalidConfiguration);
     CHECK(cudaGetLastError() == cudaSuccess);
-    FV_CUDA_LAUNCH(whoami, 0, 64, 0)(cell, hits, n);
+    FV_CUDA_LAUNCH(&tally, whoami, 0, 64, 0)(cell, hits, n);
     CHECK(cudaPeekAtLastError() == cudaErrorInvalidConfiguration);
     CHECK(cudaGetLastError() == cudaErrorInvalidConfiguration);
     CHECK(cudaMemcpy(&h, hits, sizeof h, cudaMemcpyDeviceToHost) == cudaSuccess);
@@ -128,7 +191,7 @@ static int selftest(void)
     CHECK(cudaMalloc((void **)&dorder, sizeof order) == cudaSuccess);
     for (unsigned run = 0; run < 2; run++) {
         CHECK(cudaMemset(hits, 0, sizeof(unsigned)) == cudaSuccess);
-        FV_CUDA_LAUNCH(turn, 4, 32, 0)(hits, dorder);
+        FV_CUDA_LAUNCH(&tally, turn, 4, 32, 0)(hits, dorder);
         CHECK(cudaMemcpy(order, dorder, sizeof order, cudaMemcpyDeviceToHost) == cudaSuccess);
         for (unsigned b = 0; b < 4; b++) CHECK(order[b] == (run == 0 ? b : 3 - b));
     }
@@ -166,9 +229,10 @@ static int selftest(void)
     CHECK(cudaFree(nullptr) == cudaSuccess);
     fv_cuda_sim_counts e;
     fv_cuda_sim_counts_get(&e);
-    CHECK(e.live_allocations == 0 && e.live_bytes == 0 && e.live_streams == 0 && e.live_events == 0);
-    CHECK(e.launches == c0.launches + 4);  /* the two impossible ones are not launches */
-    CHECK(e.blocks == c0.blocks + 30 + 6 + 2 * 4);
+    CHECK(e.live_allocations == 0 && e.live_bytes == 0 && e.live_streams == 0 && e.live_events == 0 && e.live_pinned == 0);
+    CHECK(e.launches == c0.launches + 8);  /* the two impossible ones are not launches */
+    CHECK(e.blocks == c0.blocks + 30 + 3 * 6 + 2 * 4 + 1 + 2);
+    CHECK(e.allocations == c0.allocations + 5 && e.frees == c0.frees + 5); /* cell, hits, din, dout, dorder */
     printf("CUDA simulator self-test: passed\n");
     return 0;
 }
@@ -176,6 +240,7 @@ static int selftest(void)
 /* Each misuse case; the simulator aborts in it (returning is a failure). */
 static int misuse(const char *what)
 {
+    fv_cuda_tally tally = {};
     void *p = nullptr;
     char host[128];
     if (cudaMalloc(&p, 64) != cudaSuccess) return 1;
@@ -189,7 +254,7 @@ static int misuse(const char *what)
         cudaFree(p);
     } else if (!strcmp(what, "free-offset")) cudaFree((char *)p + 8);
     else if (!strcmp(what, "leak")) return 0; /* p is never freed: the check at exit aborts */
-    else if (!strcmp(what, "divergent-barrier")) FV_CUDA_LAUNCH(divergent_barrier, 1, 16, 0)((int *)p);
+    else if (!strcmp(what, "divergent-barrier")) FV_CUDA_LAUNCH(&tally, divergent_barrier, 1, 16, 0)((int *)p);
     else if (!strcmp(what, "destroyed-stream")) {
         cudaStream_t s;
         cudaStreamCreate(&s);

@@ -1,6 +1,7 @@
 /* fovea — what tests/gpu check beyond their images when they run on the CUDA simulator (their
  * sim_test_* build, FOVEA_CUDA_SIM; docs/gpu.md "The CUDA simulator"), where nothing else can
- * count them: the host's waits for the device and the kernels launched over a stretch of work, that
+ * count them: the host's synchronizes and the kernels launched over a stretch of work, that the
+ * backend's own count of its runtime calls is what the simulator saw, that
  * destroying the techniques freed every device allocation, stream and event, and that every
  * allocation's failure is handled (a GPU that is full). On a real GPU (or without CUDA) the checks
  * compile to nothing. Include after <cmocka.h> and fovea/fovea.h.
@@ -27,19 +28,45 @@ static inline fv_sim_mark fv_sim_now(void)
     return m;
 }
 
-/* Since `since`: exactly `waits` host waits, `launches` kernel launches (< 0: any number, > 0), and
- * no upload queued behind a kernel of its stream (the simulator's uploads_behind_kernels). */
-static inline void fv_sim_expect(fv_sim_mark since, uint64_t waits, long launches, const char *what)
+/* Since `since`: exactly `syncs` synchronize calls (the frame's designed waits: one a frame or a
+ * pair), `launches` kernel launches (< 0: any number, > 0), and no upload from pageable memory
+ * queued behind a kernel of its stream. The other waits CUDA makes (every copy between the device
+ * and pageable memory) are checked against what the backend reports (fv_sim_expect_reported) and
+ * per family in test_gpu_counts. */
+static inline void fv_sim_expect(fv_sim_mark since, uint64_t syncs, long launches, const char *what)
 {
     fv_sim_mark now = fv_sim_now();
-    uint64_t w = now.host_waits - since.host_waits, l = now.launches - since.launches;
-    printf("%s: CUDA simulator: %llu host waits, %llu launches, %llu blocks\n", what, (unsigned long long)w, (unsigned long long)l,
-           (unsigned long long)(now.blocks - since.blocks));
-    if (w != waits) fail_msg("%s: the host waited for the device %llu times, expected %llu", what, (unsigned long long)w, (unsigned long long)waits);
+    uint64_t c = now.syncs - since.syncs, l = now.launches - since.launches;
+    printf("%s: CUDA simulator: %llu synchronizes, %llu host waits, %llu launches, %llu blocks\n", what, (unsigned long long)c,
+           (unsigned long long)(now.host_waits - since.host_waits), (unsigned long long)l, (unsigned long long)(now.blocks - since.blocks));
+    if (c != syncs) fail_msg("%s: the host synchronized %llu times, expected %llu", what, (unsigned long long)c, (unsigned long long)syncs);
     const uint64_t u = now.uploads_behind_kernels - since.uploads_behind_kernels;
     if (u) fail_msg("%s: %llu host-to-device copies queued behind a kernel of their stream (a hidden host wait mid-frame)", what, (unsigned long long)u);
     if (launches >= 0 ? l != (uint64_t)launches : l == 0)
         fail_msg("%s: %llu kernel launches, expected %ld", what, (unsigned long long)l, launches);
+}
+
+/* Since `since`, what the simulator counted equals what the backend reported in `stats` (its own
+ * count of its calls, fv_cuda_calls: the figures --stats-json shows on a GPU): launches, host waits,
+ * pageable copies, bytes each way, device allocations and frees. So no runtime call escapes the
+ * backend's count, and its count follows CUDA's rules as the simulator does. */
+static inline void fv_sim_expect_reported(fv_sim_mark since, const fv_stats *stats, const char *what)
+{
+    const fv_sim_mark now = fv_sim_now();
+    const struct {
+        const char *key;
+        uint64_t sim;
+    } c[] = {{"launches", now.launches - since.launches},
+             {"host_waits", now.host_waits - since.host_waits},
+             {"pageable_copies", now.pageable_copies - since.pageable_copies},
+             {"h2d_bytes", now.bytes_h2d - since.bytes_h2d},
+             {"d2h_bytes", now.bytes_d2h - since.bytes_d2h},
+             {"device_allocs", now.allocations - since.allocations},
+             {"device_frees", now.frees - since.frees}};
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++)
+        if (fv_stats_get_count(stats, c[i].key) != (double)c[i].sim)
+            fail_msg("%s: the backend reports %s %g, the simulator counted %llu", what, c[i].key, fv_stats_get_count(stats, c[i].key),
+                     (unsigned long long)c[i].sim);
 }
 
 /* Since `since`: exactly `calls` synchronize calls (stream, event or device). The host waits above
@@ -127,9 +154,13 @@ static inline fv_status fv_sim_run_frames(void *ctx, fv_error *err)
 #define FV_GPU_TEST_NO_DEVICE 77 /* ctest: skipped */
 typedef int fv_sim_mark;
 static inline fv_sim_mark fv_sim_now(void) { return 0; }
-static inline void fv_sim_expect(fv_sim_mark since, uint64_t waits, long launches, const char *what)
+static inline void fv_sim_expect(fv_sim_mark since, uint64_t syncs, long launches, const char *what)
 {
-    (void)since, (void)waits, (void)launches, (void)what;
+    (void)since, (void)syncs, (void)launches, (void)what;
+}
+static inline void fv_sim_expect_reported(fv_sim_mark since, const fv_stats *stats, const char *what)
+{
+    (void)since, (void)stats, (void)what;
 }
 static inline void fv_sim_expect_sync_calls(fv_sim_mark since, uint64_t calls, const char *what)
 {

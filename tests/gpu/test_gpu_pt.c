@@ -31,7 +31,7 @@ static void compare_scene(const char *name, int w, int h, double time, int frame
     fv_film *p = fv_test_render_pt(s, &cam, "spp=4 device=portable", time, frames, 11);
     fv_sim_mark m = fv_sim_now();
     fv_film *c1 = fv_test_render_pt(s, &cam, "spp=4 device=cuda", time, frames, 11);
-    fv_sim_expect(m, (uint64_t)frames, frames, name); /* a frame: one launch, one wait (then the copies back) */
+    fv_sim_expect(m, (uint64_t)frames, frames, name); /* a frame: one launch, one synchronize (after the copies back) */
     fv_sim_expect_freed(name);
     fv_film *c2 = fv_test_render_pt(s, &cam, "spp=4 device=cuda", time, frames, 11);
     fv_test_agreement r = fv_test_agree(p, c1, 1e-3);
@@ -114,7 +114,9 @@ static void test_pair(void **st)
         fv_stats sp, se;
         fv_stats_clear(&sp);
         fv_stats_clear(&se);
+        const fv_sim_mark m = fv_sim_now();
         if (fv_technique_render_pair(pair, f, b, &sp, &err) != FV_OK) fail_msg("pair %d: %s", i, err.msg);
+        fv_sim_expect_reported(m, &sp, "pt pair");
         for (int e = 0; e < 2; e++)
             if (fv_technique_render(each, &f[e], a[e], &se, &err) != FV_OK) fail_msg("frame %d eye %d: %s", i, e, err.msg);
         printf("pt cornell-fpm stereo frame %d: rays %g (per eye %g), host syncs %g (per eye %g)\n", i, fv_stats_get_count(&sp, "rays"),

@@ -66,7 +66,7 @@ static void compare(const char *scene, const char *method, int w, int h, int spp
     fv_film *p = render(method, pp, s, &cam, &sp);
     fv_sim_mark m = fv_sim_now();
     fv_film *c1 = render(method, pc, s, &cam, &sc);
-    fv_sim_expect(m, 1, 1, method); /* one launch, one wait */
+    fv_sim_expect(m, 1, 1, method); /* one launch, one synchronize */
     fv_sim_expect_freed(method);
     fv_film *c2 = render(method, pc, s, &cam, &sc2);
     fv_test_agreement r = fv_test_agree(p, c1, 1e-4);
@@ -130,6 +130,7 @@ static void compare_pyramid(const char *scene, const char *method, const char *p
             fv_sim_mark m = fv_sim_now();
             fv_test_render_fresh(tc, &f, c1, &sc);
             fv_sim_expect(m, 1, -1, method); /* what host_syncs reports (checked below) is what the host did */
+            fv_sim_expect_reported(m, &sc, method);
             fv_test_render_fresh(tc2, &f, c2, &sc2);
             fv_test_agreement r = fv_test_agree(p, c1, 1e-4);
             const float *a = fv_film_color_const(p), *b = fv_film_color_const(c1);

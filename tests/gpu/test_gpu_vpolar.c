@@ -93,7 +93,8 @@ static void compare(const char *scene, const char *method, const char *params, i
             fv_test_render_fresh(tp, &f, p, &sp);
             const fv_sim_mark m = fv_sim_now();
             fv_test_render_fresh(tc, &f, c1, &sc);
-            fv_sim_expect(m, 1, -1, what); /* one wait, and no upload behind a kernel (a hidden one) */
+            fv_sim_expect(m, 1, -1, what); /* one synchronize, and no upload behind a kernel (a hidden wait) */
+            fv_sim_expect_reported(m, &sc, what);
             fv_test_render_fresh(tc2, &f, c2, &sc2);
             f.seed = 8;
             fv_test_render_fresh(tn, &f, n2, &sn);
@@ -244,6 +245,7 @@ static void compare_pair(const char *method, const char *params, const char *dev
         if (cuda) {
             fv_sim_expect(m, 1, -1, what); /* what host_syncs reports (checked below) is what the host did */
             fv_sim_expect_sync_calls(m, 1, what); /* one synchronize, not one per eye's stream */
+            fv_sim_expect_reported(m, &sc, what);
         }
         m = fv_sim_now();
         for (int e = 0; e < 2; e++)
@@ -251,6 +253,7 @@ static void compare_pair(const char *method, const char *params, const char *dev
         if (cuda) {
             fv_sim_expect(m, 2, -1, what);
             fv_sim_expect_sync_calls(m, 2, what);
+            fv_sim_expect_reported(m, &se, what);
         }
         printf("%s: host syncs %g for the pair, %g for two calls; samples %g, history %.4f\n", what, fv_stats_get_count(&sc, "host_syncs"),
                fv_stats_get_count(&se, "host_syncs"), fv_stats_get_count(&sc, "samples"), fv_stats_get_count(&sc, "history_fraction"));

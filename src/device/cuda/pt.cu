@@ -23,6 +23,7 @@
 #define FV_CUDA_BLOCK 8
 
 struct fv_cuda_pt {
+    fv_cuda_tally calls;     /* what it asked of the runtime (device/cuda/common.h) */
     fv_cuda_scene scene;     /* the flat scene on the GPU (device/cuda/scene.h) */
     fv_cuda_film film[2];    /* per eye (a stereo pair is read back after both ran), kept between frames of one size */
     unsigned long long *counts; /* rays, non-finite estimates */
@@ -53,29 +54,31 @@ extern "C" bool fv_cuda_probe(char *why, size_t why_len)
 
 extern "C" fv_status fv_cuda_pt_update(fv_cuda_pt *c, const fv_kscene *h, fv_error *err)
 {
-    return fv_cuda_scene_update(&c->scene, h, 0, err);
+    return fv_cuda_scene_update(&c->calls, &c->scene, h, 0, err);
 }
 
 extern "C" void fv_cuda_pt_destroy(fv_cuda_pt *c)
 {
     if (!c) return;
-    fv_cuda_scene_free(&c->scene);
-    fv_cuda_film_free(&c->film[0]);
-    fv_cuda_film_free(&c->film[1]);
-    cudaFree(c->counts);
+    fv_cuda_scene_free(&c->calls, &c->scene);
+    fv_cuda_film_free(&c->calls, &c->film[0]);
+    fv_cuda_film_free(&c->calls, &c->film[1]);
+    fv_cuda_release(&c->calls, c->counts);
     if (c->start) cudaEventDestroy(c->start);
     if (c->stop) cudaEventDestroy(c->stop);
     free(c);
 }
+
+extern "C" void fv_cuda_pt_calls(const fv_cuda_pt *c, fv_cuda_calls *out) { *out = c->calls.n; }
 
 extern "C" fv_status fv_cuda_pt_create(const fv_kscene *host, fv_cuda_pt **out, fv_error *err)
 {
     *out = NULL;
     fv_cuda_pt *c = (fv_cuda_pt *)calloc(1, sizeof *c);
     if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    fv_status s = fv_cuda_scene_upload(&c->scene, host, err);
+    fv_status s = fv_cuda_scene_upload(&c->calls, &c->scene, host, err);
     cudaError_t e;
-    if (s == FV_OK && (e = cudaMalloc((void **)&c->counts, 2 * sizeof(unsigned long long))) != cudaSuccess) s = fv_cuda_fail(e, "allocating counters", err);
+    if (s == FV_OK && (e = fv_cuda_alloc(&c->calls, (void **)&c->counts, 2 * sizeof(unsigned long long))) != cudaSuccess) s = fv_cuda_fail(e, "allocating counters", err);
     if (s == FV_OK && ((e = cudaEventCreate(&c->start)) != cudaSuccess || (e = cudaEventCreate(&c->stop)) != cudaSuccess))
         s = fv_cuda_fail(e, "creating events", err);
     if (s != FV_OK) {
@@ -108,24 +111,24 @@ extern "C" fv_status fv_cuda_pt_render(fv_cuda_pt *c, int eyes, const fv_kpt_fra
     fv_status s;
     for (int i = 0; i < eyes; i++) {
         n[i] = (size_t)f[i].cam.width * (size_t)f[i].cam.height;
-        if ((s = fv_cuda_film_prepare(&c->film[i], &out[i], n[i], &dv[i], err)) != FV_OK) return s;
+        if ((s = fv_cuda_film_prepare(&c->calls, &c->film[i], &out[i], n[i], &dv[i], err)) != FV_OK) return s;
     }
     cudaStream_t st = 0;
     cudaError_t e;
-    if ((e = cudaMemsetAsync(c->counts, 0, 2 * sizeof(unsigned long long), st)) != cudaSuccess) return fv_cuda_fail(e, "clearing counters", err);
+    if ((e = fv_cuda_clear(&c->calls, c->counts, 0, 2 * sizeof(unsigned long long), st)) != cudaSuccess) return fv_cuda_fail(e, "clearing counters", err);
     dim3 block(FV_CUDA_BLOCK, FV_CUDA_BLOCK);
     cudaEventRecord(c->start, st);
     for (int i = 0; i < eyes; i++) {
         dim3 grid((unsigned)((f[i].cam.width + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK), (unsigned)((f[i].cam.height + FV_CUDA_BLOCK - 1) / FV_CUDA_BLOCK));
-        FV_CUDA_LAUNCH(fv_cuda_pt_kernel, grid, block, st)(c->scene.dev, f[i], dv[i], c->counts);
+        FV_CUDA_LAUNCH(&c->calls, fv_cuda_pt_kernel, grid, block, st)(c->scene.dev, f[i], dv[i], c->counts);
     }
     cudaEventRecord(c->stop, st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the pt kernel", err);
     /* what the host receives, enqueued behind the kernels, then its one wait */
     unsigned long long counts[2];
-    for (int i = 0; i < eyes && e == cudaSuccess; i++) e = fv_cuda_film_read_async(&c->film[i], &out[i], n[i], st);
-    if (e == cudaSuccess) e = cudaMemcpyAsync(counts, c->counts, sizeof counts, cudaMemcpyDeviceToHost, st);
-    if (e == cudaSuccess) e = cudaStreamSynchronize(st);
+    for (int i = 0; i < eyes && e == cudaSuccess; i++) e = fv_cuda_film_read_async(&c->calls, &c->film[i], &out[i], n[i], st);
+    if (e == cudaSuccess) e = fv_cuda_copy(&c->calls, counts, c->counts, sizeof counts, cudaMemcpyDeviceToHost, st);
+    if (e == cudaSuccess) e = fv_cuda_wait(&c->calls, st);
     *syncs = 1;
     if (e != cudaSuccess) return fv_cuda_fail(e, "running the pt kernel", err);
     float ms = 0.0f;

@@ -8,6 +8,7 @@
 #define FV_DEVICE_CUDA_SCENE_H
 
 #include <cuda_runtime.h>
+#include "device/cuda/common.h"
 #include "fovea/status.h"
 #include "kernel/scene.h"
 
@@ -20,10 +21,10 @@ typedef struct fv_cuda_scene {
 
 /* Copies host (host memory) into c (zeroed by the caller). On failure what was allocated stays in c
  * for fv_cuda_scene_free. */
-fv_status fv_cuda_scene_upload(fv_cuda_scene *c, const fv_kscene *host, fv_error *err);
+fv_status fv_cuda_scene_upload(fv_cuda_tally *k, fv_cuda_scene *c, const fv_kscene *host, fv_error *err);
 /* Brings c to host's time (the same scene exported earlier): nothing when the time is the one
  * copied, else the arrays time changes, queued on stream st (0: the legacy stream). */
-fv_status fv_cuda_scene_update(fv_cuda_scene *c, const fv_kscene *host, cudaStream_t st, fv_error *err);
-void fv_cuda_scene_free(fv_cuda_scene *c);
+fv_status fv_cuda_scene_update(fv_cuda_tally *k, fv_cuda_scene *c, const fv_kscene *host, cudaStream_t st, fv_error *err);
+void fv_cuda_scene_free(fv_cuda_tally *k, fv_cuda_scene *c);
 
 #endif

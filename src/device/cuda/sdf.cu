@@ -61,6 +61,7 @@ typedef struct dev_blur {
 } dev_blur;
 
 struct fv_cuda_sdf {
+    fv_cuda_tally calls;        /* what it asked of the runtime (device/cuda/common.h) */
     fv_cuda_mirror ops, objs, lights, mats;
     fv_cuda_film film[2];       /* per eye: a stereo pair is read back after both eyes ran */
     unsigned long long *counts; /* FV_CUDA_PYR_COUNTS */
@@ -77,29 +78,29 @@ struct fv_cuda_sdf {
 static void pyramid_free(fv_cuda_sdf *c)
 {
     for (int i = 0; i < FV_PYRAMID_MAX_LEVELS; i++) {
-        cudaFree(c->k.depth[i]);
-        cudaFree(c->k.steps[i]);
+        fv_cuda_release(&c->calls, c->k.depth[i]);
+        fv_cuda_release(&c->calls, c->k.steps[i]);
     }
-    cudaFree(c->k.need);
-    cudaFree(c->k.edge);
-    cudaFree(c->k.mask);
-    cudaFree(c->k.vis);
+    fv_cuda_release(&c->calls, c->k.need);
+    fv_cuda_release(&c->calls, c->k.edge);
+    fv_cuda_release(&c->calls, c->k.mask);
+    fv_cuda_release(&c->calls, c->k.vis);
     memset(&c->k, 0, sizeof c->k);
 }
 
-static void history_free(dev_history *h)
+static void history_free(fv_cuda_tally *k, dev_history *h)
 {
-    cudaFree(h->color);
-    cudaFree(h->stamp);
+    fv_cuda_release(k, h->color);
+    fv_cuda_release(k, h->stamp);
     memset(h, 0, sizeof *h);
 }
 
-static void blur_free(dev_blur *b)
+static void blur_free(fv_cuda_tally *k, dev_blur *b)
 {
-    cudaFree(b->sigma);
-    cudaFree(b->tmp);
-    fv_cuda_mirror_free(&b->off);
-    fv_cuda_mirror_free(&b->k);
+    fv_cuda_release(k, b->sigma);
+    fv_cuda_release(k, b->tmp);
+    fv_cuda_mirror_free(k, &b->off);
+    fv_cuda_mirror_free(k, &b->k);
     free(b->host_off);
     free(b->host_k);
     memset(b, 0, sizeof *b);
@@ -108,23 +109,25 @@ static void blur_free(dev_blur *b)
 extern "C" void fv_cuda_sdf_destroy(fv_cuda_sdf *c)
 {
     if (!c) return;
-    fv_cuda_mirror_free(&c->ops);
-    fv_cuda_mirror_free(&c->objs);
-    fv_cuda_mirror_free(&c->lights);
-    fv_cuda_mirror_free(&c->mats);
-    fv_cuda_film_free(&c->film[0]);
-    fv_cuda_film_free(&c->film[1]);
-    blur_free(&c->blur);
+    fv_cuda_mirror_free(&c->calls, &c->ops);
+    fv_cuda_mirror_free(&c->calls, &c->objs);
+    fv_cuda_mirror_free(&c->calls, &c->lights);
+    fv_cuda_mirror_free(&c->calls, &c->mats);
+    fv_cuda_film_free(&c->calls, &c->film[0]);
+    fv_cuda_film_free(&c->calls, &c->film[1]);
+    blur_free(&c->calls, &c->blur);
     pyramid_free(c);
-    history_free(&c->hist[0]);
-    history_free(&c->hist[1]);
-    cudaFree(c->far);
+    history_free(&c->calls, &c->hist[0]);
+    history_free(&c->calls, &c->hist[1]);
+    fv_cuda_release(&c->calls, c->far);
     if (c->stream) cudaStreamDestroy(c->stream);
-    cudaFree(c->counts);
+    fv_cuda_release(&c->calls, c->counts);
     if (c->start) cudaEventDestroy(c->start);
     if (c->stop) cudaEventDestroy(c->stop);
     free(c);
 }
+
+extern "C" void fv_cuda_sdf_calls(const fv_cuda_sdf *c, fv_cuda_calls *out) { *out = c->calls.n; }
 
 extern "C" fv_status fv_cuda_sdf_create(fv_cuda_sdf **out, fv_error *err)
 {
@@ -133,8 +136,8 @@ extern "C" fv_status fv_cuda_sdf_create(fv_cuda_sdf **out, fv_error *err)
     if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     cudaError_t e;
     fv_status s = FV_OK;
-    if ((e = cudaMalloc((void **)&c->counts, FV_CUDA_PYR_COUNTS * sizeof(unsigned long long))) != cudaSuccess ||
-        (e = cudaMalloc((void **)&c->far, sizeof(unsigned))) != cudaSuccess)
+    if ((e = fv_cuda_alloc(&c->calls, (void **)&c->counts, FV_CUDA_PYR_COUNTS * sizeof(unsigned long long))) != cudaSuccess ||
+        (e = fv_cuda_alloc(&c->calls, (void **)&c->far, sizeof(unsigned))) != cudaSuccess)
         s = fv_cuda_fail(e, "allocating counters", err);
     if (s == FV_OK && (e = cudaStreamCreate(&c->stream)) != cudaSuccess) s = fv_cuda_fail(e, "creating a stream", err);
     if (s == FV_OK && ((e = cudaEventCreate(&c->start)) != cudaSuccess || (e = cudaEventCreate(&c->stop)) != cudaSuccess))
@@ -175,10 +178,10 @@ static fv_status upload_world(fv_cuda_sdf *c, const fv_ksdf_world *w, fv_ksdf_wo
 {
     *dw = *w;
     fv_status s;
-    if ((s = fv_cuda_mirror_fill(&c->ops, w->ops, (size_t)w->nops * sizeof(fv_sdf_op), c->stream, "the world", err)) != FV_OK ||
-        (s = fv_cuda_mirror_fill(&c->objs, w->objs, (size_t)w->count * sizeof(fv_ksdf_object), c->stream, "the world", err)) != FV_OK ||
-        (s = fv_cuda_mirror_fill(&c->lights, w->lights, (size_t)w->nlights * sizeof(fv_ksdf_light), c->stream, "the world", err)) != FV_OK ||
-        (s = fv_cuda_mirror_fill(&c->mats, w->mats, (size_t)w->nmat * sizeof(fv_material), c->stream, "the world", err)) != FV_OK)
+    if ((s = fv_cuda_mirror_fill(&c->calls, &c->ops, w->ops, (size_t)w->nops * sizeof(fv_sdf_op), c->stream, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->calls, &c->objs, w->objs, (size_t)w->count * sizeof(fv_ksdf_object), c->stream, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->calls, &c->lights, w->lights, (size_t)w->nlights * sizeof(fv_ksdf_light), c->stream, "the world", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->calls, &c->mats, w->mats, (size_t)w->nmat * sizeof(fv_material), c->stream, "the world", err)) != FV_OK)
         return s;
     dw->ops = (const fv_sdf_op *)c->ops.p;
     dw->objs = (const fv_ksdf_object *)c->objs.p;
@@ -194,9 +197,9 @@ static fv_status finish(fv_cuda_sdf *c, int eyes, const fv_film_views *out, cons
 {
     cudaStream_t st = c->stream;
     cudaError_t e = cudaSuccess;
-    for (int i = 0; i < eyes && e == cudaSuccess; i++) e = fv_cuda_film_read_async(&c->film[i], &out[i], n[i], st);
-    if (e == cudaSuccess) e = cudaMemcpyAsync(kc, c->counts, (size_t)ncounts * sizeof *kc, cudaMemcpyDeviceToHost, st);
-    if (e == cudaSuccess) e = cudaStreamSynchronize(st);
+    for (int i = 0; i < eyes && e == cudaSuccess; i++) e = fv_cuda_film_read_async(&c->calls, &c->film[i], &out[i], n[i], st);
+    if (e == cudaSuccess) e = fv_cuda_copy(&c->calls, kc, c->counts, (size_t)ncounts * sizeof *kc, cudaMemcpyDeviceToHost, st);
+    if (e == cudaSuccess) e = fv_cuda_wait(&c->calls, st);
     *syncs = 1;
     if (e != cudaSuccess) return fv_cuda_fail(e, what, err);
     float ms = 0.0f;
@@ -219,18 +222,18 @@ extern "C" fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const fv_ksdf_world *w, 
     fv_film_views dv[2];
     for (int i = 0; i < eyes; i++) {
         n[i] = (size_t)f[i].cam.width * (size_t)f[i].cam.height;
-        if ((s = fv_cuda_film_prepare(&c->film[i], &out[i], n[i], &dv[i], err)) != FV_OK) return s;
+        if ((s = fv_cuda_film_prepare(&c->calls, &c->film[i], &out[i], n[i], &dv[i], err)) != FV_OK) return s;
     }
     cudaStream_t st = c->stream;
     cudaError_t e;
-    if ((e = cudaMemsetAsync(c->counts, 0, FV_CUDA_SDF_COUNTS * sizeof(unsigned long long), st)) != cudaSuccess)
+    if ((e = fv_cuda_clear(&c->calls, c->counts, 0, FV_CUDA_SDF_COUNTS * sizeof(unsigned long long), st)) != cudaSuccess)
         return fv_cuda_fail(e, "clearing counters", err);
     dim3 block(FV_CUDA_SDF_BLOCK, FV_CUDA_SDF_BLOCK);
     cudaEventRecord(c->start, st);
     for (int i = 0; i < eyes; i++) {
         dim3 grid((unsigned)((f[i].cam.width + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK),
                   (unsigned)((f[i].cam.height + FV_CUDA_SDF_BLOCK - 1) / FV_CUDA_SDF_BLOCK));
-        FV_CUDA_LAUNCH(fv_cuda_sdf_kernel, grid, block, st)(dw, f[i], dv[i], c->counts);
+        FV_CUDA_LAUNCH(&c->calls, fv_cuda_sdf_kernel, grid, block, st)(dw, f[i], dv[i], c->counts);
     }
     cudaEventRecord(c->stop, st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the sphere-tracing kernel", err);
@@ -400,13 +403,14 @@ static fv_status pyramid_ensure(fv_cuda_sdf *c, const fv_kpyr *shape, bool fipr,
     cudaError_t e = cudaSuccess;
     for (int i = 0; i + 1 < L && e == cudaSuccess; i++) {
         size_t n = (size_t)k->lv[i].w * k->lv[i].h;
-        if ((e = cudaMalloc((void **)&k->depth[i], n * sizeof(float))) == cudaSuccess) e = cudaMalloc((void **)&k->steps[i], n * sizeof(uint16_t));
+        if ((e = fv_cuda_alloc(&c->calls, (void **)&k->depth[i], n * sizeof(float))) == cudaSuccess)
+            e = fv_cuda_alloc(&c->calls, (void **)&k->steps[i], n * sizeof(uint16_t));
     }
     const size_t nmid = L > 1 ? (size_t)k->lv[L - 2].w * k->lv[L - 2].h : 0;
-    if (e == cudaSuccess && vis) e = cudaMalloc((void **)&k->vis, nmid * sizeof(uint32_t));
-    if (e == cudaSuccess && fipr) e = cudaMalloc((void **)&k->need, nmid);
-    if (e == cudaSuccess && fipr) e = cudaMalloc((void **)&k->edge, (size_t)k->lv[0].w * k->lv[0].h);
-    if (e == cudaSuccess && fipr) e = cudaMalloc((void **)&k->mask, (size_t)k->w * k->h);
+    if (e == cudaSuccess && vis) e = fv_cuda_alloc(&c->calls, (void **)&k->vis, nmid * sizeof(uint32_t));
+    if (e == cudaSuccess && fipr) e = fv_cuda_alloc(&c->calls, (void **)&k->need, nmid);
+    if (e == cudaSuccess && fipr) e = fv_cuda_alloc(&c->calls, (void **)&k->edge, (size_t)k->lv[0].w * k->lv[0].h);
+    if (e == cudaSuccess && fipr) e = fv_cuda_alloc(&c->calls, (void **)&k->mask, (size_t)k->w * k->h);
     if (e != cudaSuccess) {
         pyramid_free(c);
         return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for a %dx%d pyramid", shape->w, shape->h)
@@ -424,19 +428,19 @@ static fv_status history_ensure(fv_cuda_sdf *c, int eye, int index, fv_error *er
     fv_kpyr *k = &c->k;
     const size_t n = (size_t)k->lv[k->L - 2].w * k->lv[k->L - 2].h;
     if (h->sw != k->sw || h->sh != k->sh || !h->color) {
-        history_free(h);
+        history_free(&c->calls, h);
         cudaError_t e;
-        if ((e = cudaMalloc((void **)&h->color, 3 * n * sizeof(float))) != cudaSuccess ||
-            (e = cudaMalloc((void **)&h->stamp, n * sizeof(int))) != cudaSuccess ||
-            (e = cudaMemsetAsync(h->color, 0, 3 * n * sizeof(float), c->stream)) != cudaSuccess) {
-            history_free(h);
+        if ((e = fv_cuda_alloc(&c->calls, (void **)&h->color, 3 * n * sizeof(float))) != cudaSuccess ||
+            (e = fv_cuda_alloc(&c->calls, (void **)&h->stamp, n * sizeof(int))) != cudaSuccess ||
+            (e = fv_cuda_clear(&c->calls, h->color, 0, 3 * n * sizeof(float), c->stream)) != cudaSuccess) {
+            history_free(&c->calls, h);
             return fv_cuda_fail(e, "allocating fipr's history", err);
         }
         h->sw = k->sw;
         h->sh = k->sh;
         index = 0;
     }
-    if (index == 0) FV_CUDA_LAUNCH(fv_cuda_pyr_forget, blocks_of(n), 256, c->stream)(h->stamp, (int)n);
+    if (index == 0) FV_CUDA_LAUNCH(&c->calls, fv_cuda_pyr_forget, blocks_of(n), 256, c->stream)(h->stamp, (int)n);
     k->hist_color = h->color;
     k->hist_stamp = h->stamp;
     return FV_OK;
@@ -470,12 +474,12 @@ static fv_status blur_ensure(fv_cuda_sdf *c, int w, int h, float smax, fv_kblur_
     const size_t n = (size_t)w * h;
     cudaError_t e;
     if (b->pixels != n) {
-        cudaFree(b->sigma);
-        cudaFree(b->tmp);
+        fv_cuda_release(&c->calls, b->sigma);
+        fv_cuda_release(&c->calls, b->tmp);
         b->sigma = b->tmp = NULL;
         b->pixels = 0;
-        if ((e = cudaMalloc((void **)&b->sigma, n * sizeof(float))) != cudaSuccess ||
-            (e = cudaMalloc((void **)&b->tmp, 3 * n * sizeof(float))) != cudaSuccess)
+        if ((e = fv_cuda_alloc(&c->calls, (void **)&b->sigma, n * sizeof(float))) != cudaSuccess ||
+            (e = fv_cuda_alloc(&c->calls, (void **)&b->tmp, 3 * n * sizeof(float))) != cudaSuccess)
             return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for fipr's blur")
                                                   : fv_cuda_fail(e, "allocating fipr's blur", err);
         b->pixels = n;
@@ -496,8 +500,8 @@ static fv_status blur_ensure(fv_cuda_sdf *c, int w, int h, float smax, fv_kblur_
         b->w = w, b->h = h, b->smax = smax;
     }
     fv_status s;
-    if ((s = fv_cuda_mirror_fill(&b->off, b->host_off, (size_t)b->nq * sizeof(int), c->stream, "fipr's blur kernels", err)) != FV_OK ||
-        (s = fv_cuda_mirror_fill(&b->k, b->host_k, b->nk * sizeof(float), c->stream, "fipr's blur kernels", err)) != FV_OK)
+    if ((s = fv_cuda_mirror_fill(&c->calls, &b->off, b->host_off, (size_t)b->nq * sizeof(int), c->stream, "fipr's blur kernels", err)) != FV_OK ||
+        (s = fv_cuda_mirror_fill(&c->calls, &b->k, b->host_k, b->nk * sizeof(float), c->stream, "fipr's blur kernels", err)) != FV_OK)
         return s;
     t->w = w;
     t->h = h;
@@ -525,12 +529,12 @@ extern "C" fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const fv_ksdf_wo
     const size_t ns[2] = {n, n};
     fv_film_views dv[2];
     for (int i = 0; i < eyes; i++)
-        if ((s = fv_cuda_film_prepare(&c->film[i], &out[i], n, &dv[i], err)) != FV_OK) return s;
+        if ((s = fv_cuda_film_prepare(&c->calls, &c->film[i], &out[i], n, &dv[i], err)) != FV_OK) return s;
     fv_kblur_table bt;
     if (blurred && (s = blur_ensure(c, shape->w, shape->h, po->blur_sigma, &bt, err)) != FV_OK) return s;
     cudaStream_t st = c->stream;
     cudaError_t e;
-    if ((e = cudaMemsetAsync(c->counts, 0, FV_CUDA_PYR_COUNTS * sizeof(unsigned long long), st)) != cudaSuccess)
+    if ((e = fv_cuda_clear(&c->calls, c->counts, 0, FV_CUDA_PYR_COUNTS * sizeof(unsigned long long), st)) != cudaSuccess)
         return fv_cuda_fail(e, "clearing counters", err);
     fv_kpyr *k = &c->k;
     const dim3 block(FV_CUDA_SDF_BLOCK, FV_CUDA_SDF_BLOCK);
@@ -543,22 +547,22 @@ extern "C" fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const fv_ksdf_wo
         /* the levels traced whole (fipr: all but the middle, which the mask decides) */
         const int full_below = fipr ? L - 2 : L - 1;
         for (int l = 0; l < full_below; l++)
-            FV_CUDA_LAUNCH(fv_cuda_pyr_level, grid_of(k->lv[l].w, k->lv[l].h), block, st)(dw, f[i], *k, l, index, c->counts);
+            FV_CUDA_LAUNCH(&c->calls, fv_cuda_pyr_level, grid_of(k->lv[l].w, k->lv[l].h), block, st)(dw, f[i], *k, l, index, c->counts);
         if (fipr) {
             const size_t ntip = (size_t)k->lv[0].w * k->lv[0].h;
-            cudaMemsetAsync(c->far, 0, sizeof(unsigned), st);
-            FV_CUDA_LAUNCH(fv_cuda_pyr_far, blocks_of(ntip), 256, st)(k->depth[0], (int)ntip, c->far);
-            FV_CUDA_LAUNCH(fv_cuda_pyr_sobel, grid_of(k->lv[0].w, k->lv[0].h), block, st)(*k, c->far, po->edge);
-            FV_CUDA_LAUNCH(fv_cuda_pyr_mask, grid_of(k->w, k->h), block, st)(*k, fov[i], c->counts);
-            FV_CUDA_LAUNCH(fv_cuda_pyr_need, grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, st)(*k, fov[i], c->counts);
-            FV_CUDA_LAUNCH(fv_cuda_pyr_level, grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, st)(dw, f[i], *k, L - 2, index, c->counts);
+            fv_cuda_clear(&c->calls, c->far, 0, sizeof(unsigned), st);
+            FV_CUDA_LAUNCH(&c->calls, fv_cuda_pyr_far, blocks_of(ntip), 256, st)(k->depth[0], (int)ntip, c->far);
+            FV_CUDA_LAUNCH(&c->calls, fv_cuda_pyr_sobel, grid_of(k->lv[0].w, k->lv[0].h), block, st)(*k, c->far, po->edge);
+            FV_CUDA_LAUNCH(&c->calls, fv_cuda_pyr_mask, grid_of(k->w, k->h), block, st)(*k, fov[i], c->counts);
+            FV_CUDA_LAUNCH(&c->calls, fv_cuda_pyr_need, grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, st)(*k, fov[i], c->counts);
+            FV_CUDA_LAUNCH(&c->calls, fv_cuda_pyr_level, grid_of(k->lv[L - 2].w, k->lv[L - 2].h), block, st)(dw, f[i], *k, L - 2, index, c->counts);
         }
-        FV_CUDA_LAUNCH(fv_cuda_pyr_target, grid_of(k->w, k->h), block, st)(dw, f[i], *k, dv[i], c->counts);
+        FV_CUDA_LAUNCH(&c->calls, fv_cuda_pyr_target, grid_of(k->w, k->h), block, st)(dw, f[i], *k, dv[i], c->counts);
         if (blurred) {
             /* pass 5 on this eye's colour, in place through the scratch image */
-            FV_CUDA_LAUNCH(fv_cuda_pyr_sigma, grid_of(k->w, k->h), block, st)(k->mask, k->w, k->h, po->blur_sigma, c->blur.sigma);
-            FV_CUDA_LAUNCH(fv_cuda_blur_h, grid_of(k->w, k->h), block, st)(bt, c->blur.sigma, dv[i].color, c->blur.tmp);
-            FV_CUDA_LAUNCH(fv_cuda_blur_v, grid_of(k->w, k->h), block, st)(bt, c->blur.sigma, c->blur.tmp, dv[i].color);
+            FV_CUDA_LAUNCH(&c->calls, fv_cuda_pyr_sigma, grid_of(k->w, k->h), block, st)(k->mask, k->w, k->h, po->blur_sigma, c->blur.sigma);
+            FV_CUDA_LAUNCH(&c->calls, fv_cuda_blur_h, grid_of(k->w, k->h), block, st)(bt, c->blur.sigma, dv[i].color, c->blur.tmp);
+            FV_CUDA_LAUNCH(&c->calls, fv_cuda_blur_v, grid_of(k->w, k->h), block, st)(bt, c->blur.sigma, c->blur.tmp, dv[i].color);
         }
     }
     cudaEventRecord(c->stop, st);

@@ -65,6 +65,7 @@ typedef struct dev_svgf {
 } dev_svgf;
 
 struct fv_cuda_vp {
+    fv_cuda_tally calls;          /* what it asked of the runtime (device/cuda/common.h) */
     fv_cuda_scene scene;
     cudaStream_t stream;
     cudaEvent_t ev[ST_COUNT + 1]; /* before each stage, and after the last */
@@ -208,8 +209,8 @@ __global__ void fv_cuda_vp_svgf_rows(fv_ksvgf k)
 static void grid_free(fv_cuda_vp *c)
 {
     fv_kvp_gbuf *g = &c->g;
-    cudaFree(g->color), cudaFree(g->albedo), cudaFree(g->normal), cudaFree(g->depth), cudaFree(g->position);
-    cudaFree(g->reflectance), cudaFree(g->id), cudaFree(g->sampled), cudaFree(c->prev_coord);
+    void *const bufs[] = {g->color, g->albedo, g->normal, g->depth, g->position, g->reflectance, g->id, g->sampled, c->prev_coord};
+    for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++) fv_cuda_release(&c->calls, bufs[i]);
     memset(g, 0, sizeof *g);
     c->prev_coord = NULL;
     c->gw = c->gh = 0;
@@ -225,27 +226,27 @@ static fv_status grid_ensure(fv_cuda_vp *c, int gw, int gh, fv_error *err)
     fv_kvp_gbuf *g = &c->g;
     cudaStream_t st = c->stream;
     cudaError_t e;
-    if ((e = cudaMalloc((void **)&g->color, 3 * n * sizeof(float))) != cudaSuccess ||
-        (e = cudaMalloc((void **)&g->albedo, 3 * n * sizeof(float))) != cudaSuccess ||
-        (e = cudaMalloc((void **)&g->reflectance, 3 * n * sizeof(float))) != cudaSuccess ||
-        (e = cudaMalloc((void **)&g->normal, 3 * n * sizeof(float))) != cudaSuccess ||
-        (e = cudaMalloc((void **)&g->position, 3 * n * sizeof(float))) != cudaSuccess ||
-        (e = cudaMalloc((void **)&g->depth, n * sizeof(float))) != cudaSuccess ||
-        (e = cudaMalloc((void **)&g->id, n * sizeof(uint32_t))) != cudaSuccess ||
-        (e = cudaMalloc((void **)&g->sampled, n)) != cudaSuccess ||
-        (e = cudaMalloc((void **)&c->prev_coord, 2 * n * sizeof(float))) != cudaSuccess ||
-        (e = cudaMemsetAsync(g->color, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
-        (e = cudaMemsetAsync(g->albedo, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
-        (e = cudaMemsetAsync(g->reflectance, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
-        (e = cudaMemsetAsync(g->normal, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
-        (e = cudaMemsetAsync(g->position, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
-        (e = cudaMemsetAsync(g->id, 0, n * sizeof(uint32_t), st)) != cudaSuccess ||
-        (e = cudaMemsetAsync(g->sampled, 0, n, st)) != cudaSuccess) {
+    if ((e = fv_cuda_alloc(&c->calls, (void **)&g->color, 3 * n * sizeof(float))) != cudaSuccess ||
+        (e = fv_cuda_alloc(&c->calls, (void **)&g->albedo, 3 * n * sizeof(float))) != cudaSuccess ||
+        (e = fv_cuda_alloc(&c->calls, (void **)&g->reflectance, 3 * n * sizeof(float))) != cudaSuccess ||
+        (e = fv_cuda_alloc(&c->calls, (void **)&g->normal, 3 * n * sizeof(float))) != cudaSuccess ||
+        (e = fv_cuda_alloc(&c->calls, (void **)&g->position, 3 * n * sizeof(float))) != cudaSuccess ||
+        (e = fv_cuda_alloc(&c->calls, (void **)&g->depth, n * sizeof(float))) != cudaSuccess ||
+        (e = fv_cuda_alloc(&c->calls, (void **)&g->id, n * sizeof(uint32_t))) != cudaSuccess ||
+        (e = fv_cuda_alloc(&c->calls, (void **)&g->sampled, n)) != cudaSuccess ||
+        (e = fv_cuda_alloc(&c->calls, (void **)&c->prev_coord, 2 * n * sizeof(float))) != cudaSuccess ||
+        (e = fv_cuda_clear(&c->calls, g->color, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
+        (e = fv_cuda_clear(&c->calls, g->albedo, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
+        (e = fv_cuda_clear(&c->calls, g->reflectance, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
+        (e = fv_cuda_clear(&c->calls, g->normal, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
+        (e = fv_cuda_clear(&c->calls, g->position, 0, 3 * n * sizeof(float), st)) != cudaSuccess ||
+        (e = fv_cuda_clear(&c->calls, g->id, 0, n * sizeof(uint32_t), st)) != cudaSuccess ||
+        (e = fv_cuda_clear(&c->calls, g->sampled, 0, n, st)) != cudaSuccess) {
         grid_free(c);
         return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for a %dx%d sample grid", gw, gh)
                                               : fv_cuda_fail(e, "allocating the sample grid", err);
     }
-    FV_CUDA_LAUNCH(fv_cuda_vp_fill, blocks_of(n), FV_CUDA_VP_THREADS, st)(g->depth, n, INFINITY);
+    FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_fill, blocks_of(n), FV_CUDA_VP_THREADS, st)(g->depth, n, INFINITY);
     c->gw = gw, c->gh = gh;
     return FV_OK;
 }
@@ -277,12 +278,12 @@ static int svgf_buffers(dev_svgf *d, size_t n, size_t h, void ***ptr, size_t *by
     return m;
 }
 
-static void svgf_free(dev_svgf *d)
+static void svgf_free(fv_cuda_tally *k, dev_svgf *d)
 {
     void **ptr[SVGF_MAX_BUFFERS];
     size_t bytes[SVGF_MAX_BUFFERS];
     const int m = svgf_buffers(d, 0, 0, ptr, bytes);
-    for (int i = 0; i < m; i++) cudaFree(*ptr[i]);
+    for (int i = 0; i < m; i++) fv_cuda_release(k, *ptr[i]);
     free(d->row_surface), free(d->row_hist), free(d->row_holes), free(d->row_len);
     memset(d, 0, sizeof *d);
 }
@@ -293,22 +294,22 @@ static fv_status svgf_ensure(fv_cuda_vp *c, int gw, int gh, fv_error *err)
 {
     dev_svgf *d = &c->svgf;
     if (d->w == gw && d->h == gh && d->k.surf) return FV_OK;
-    svgf_free(d);
+    svgf_free(&c->calls, d);
     const size_t n = (size_t)gw * (size_t)gh, h = (size_t)gh;
     void **ptr[SVGF_MAX_BUFFERS];
     size_t bytes[SVGF_MAX_BUFFERS];
     const int m = svgf_buffers(d, n, h, ptr, bytes);
     cudaError_t e = cudaSuccess;
     for (int i = 0; i < m && e == cudaSuccess; i++)
-        if ((e = cudaMalloc(ptr[i], bytes[i])) == cudaSuccess) e = cudaMemsetAsync(*ptr[i], 0, bytes[i], c->stream);
+        if ((e = fv_cuda_alloc(&c->calls, ptr[i], bytes[i])) == cudaSuccess) e = fv_cuda_clear(&c->calls, *ptr[i], 0, bytes[i], c->stream);
     if (e != cudaSuccess) {
-        svgf_free(d);
+        svgf_free(&c->calls, d);
         return e == cudaErrorMemoryAllocation ? fv_error_set(err, FV_ERR_NOMEM, "CUDA: out of GPU memory for SVGF on a %dx%d grid", gw, gh)
                                               : fv_cuda_fail(e, "allocating SVGF's buffers", err);
     }
     if (!(d->row_surface = (long *)calloc(h, sizeof(long))) || !(d->row_hist = (long *)calloc(h, sizeof(long))) ||
         !(d->row_holes = (long *)calloc(h, sizeof(long))) || !(d->row_len = (double *)calloc(h, sizeof(double)))) {
-        svgf_free(d);
+        svgf_free(&c->calls, d);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     }
     fv_ksvgf *k = &d->k;
@@ -345,13 +346,13 @@ static void svgf_launch(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const int *dco
     k->active = dmask;
     k->history = d->have_history && f->history;
     const dim3 tiles = tiles_of(c->gw, c->gh), block(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK);
-    FV_CUDA_LAUNCH(fv_cuda_vp_svgf_step, tiles, block, st)(*k, SV_ACCUMULATE, 0);
-    FV_CUDA_LAUNCH(fv_cuda_vp_svgf_rows, blocks_of((size_t)c->gh), FV_CUDA_VP_THREADS, st)(*k);
-    FV_CUDA_LAUNCH(fv_cuda_vp_svgf_step, tiles, block, st)(*k, SV_VARIANCE, 0);
+    FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_svgf_step, tiles, block, st)(*k, SV_ACCUMULATE, 0);
+    FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_svgf_rows, blocks_of((size_t)c->gh), FV_CUDA_VP_THREADS, st)(*k);
+    FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_svgf_step, tiles, block, st)(*k, SV_VARIANCE, 0);
     for (int pass = 0; pass < k->iterations; pass++)
-        FV_CUDA_LAUNCH(fv_cuda_vp_svgf_step, tiles, block, st)(*k, pass == k->iterations - 1 ? SV_LAST_PASS : SV_PASS, pass);
-    if (k->iterations == 0) FV_CUDA_LAUNCH(fv_cuda_vp_svgf_step, tiles, block, st)(*k, SV_FINISH, 0);
-    FV_CUDA_LAUNCH(fv_cuda_vp_svgf_step, tiles, block, st)(*k, SV_HOLES, 0);
+        FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_svgf_step, tiles, block, st)(*k, pass == k->iterations - 1 ? SV_LAST_PASS : SV_PASS, pass);
+    if (k->iterations == 0) FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_svgf_step, tiles, block, st)(*k, SV_FINISH, 0);
+    FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_svgf_step, tiles, block, st)(*k, SV_HOLES, 0);
     /* this frame's features become the next frame's history (pointers only: the launches above
      * already hold their copies of the struct) */
     fv_ksvgf_swap(k);
@@ -359,21 +360,21 @@ static void svgf_launch(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const int *dco
 }
 
 /* Queues the copies of the rows' counters to the host (the frame's end). */
-static cudaError_t svgf_read_rows(dev_svgf *d, cudaStream_t st)
+static cudaError_t svgf_read_rows(fv_cuda_tally *t, dev_svgf *d, cudaStream_t st)
 {
     const size_t h = (size_t)d->h;
     const fv_ksvgf *k = &d->k;
     cudaError_t e;
-    if ((e = cudaMemcpyAsync(d->row_surface, k->row_surface, h * sizeof(long), cudaMemcpyDeviceToHost, st)) != cudaSuccess ||
-        (e = cudaMemcpyAsync(d->row_hist, k->row_hist, h * sizeof(long), cudaMemcpyDeviceToHost, st)) != cudaSuccess ||
-        (e = cudaMemcpyAsync(d->row_holes, k->row_holes, h * sizeof(long), cudaMemcpyDeviceToHost, st)) != cudaSuccess)
+    if ((e = fv_cuda_copy(t, d->row_surface, k->row_surface, h * sizeof(long), cudaMemcpyDeviceToHost, st)) != cudaSuccess ||
+        (e = fv_cuda_copy(t, d->row_hist, k->row_hist, h * sizeof(long), cudaMemcpyDeviceToHost, st)) != cudaSuccess ||
+        (e = fv_cuda_copy(t, d->row_holes, k->row_holes, h * sizeof(long), cudaMemcpyDeviceToHost, st)) != cudaSuccess)
         return e;
-    return cudaMemcpyAsync(d->row_len, k->row_len, h * sizeof(double), cudaMemcpyDeviceToHost, st);
+    return fv_cuda_copy(t, d->row_len, k->row_len, h * sizeof(double), cudaMemcpyDeviceToHost, st);
 }
 
 static void screen_free(fv_cuda_vp *c)
 {
-    cudaFree(c->sigma), cudaFree(c->blur_tmp);
+    fv_cuda_release(&c->calls, c->sigma), fv_cuda_release(&c->calls, c->blur_tmp);
     c->sigma = c->blur_tmp = NULL;
     c->sw = c->sh = 0;
 }
@@ -384,8 +385,8 @@ static fv_status screen_ensure(fv_cuda_vp *c, int sw, int sh, fv_error *err)
     screen_free(c);
     const size_t n = (size_t)sw * (size_t)sh;
     cudaError_t e;
-    if ((e = cudaMalloc((void **)&c->sigma, n * sizeof(float))) != cudaSuccess ||
-        (e = cudaMalloc((void **)&c->blur_tmp, 3 * n * sizeof(float))) != cudaSuccess) {
+    if ((e = fv_cuda_alloc(&c->calls, (void **)&c->sigma, n * sizeof(float))) != cudaSuccess ||
+        (e = fv_cuda_alloc(&c->calls, (void **)&c->blur_tmp, 3 * n * sizeof(float))) != cudaSuccess) {
         screen_free(c);
         return fv_cuda_fail(e, "allocating the blur's buffers", err);
     }
@@ -395,7 +396,7 @@ static fv_status screen_ensure(fv_cuda_vp *c, int sw, int sh, fv_error *err)
 
 static void mips_free(fv_cuda_vp *c)
 {
-    for (int k = 0; k < FV_KPHI_MAX_LEVELS; k++) cudaFree(c->mip_img[k]), c->mip_img[k] = NULL;
+    for (int k = 0; k < FV_KPHI_MAX_LEVELS; k++) fv_cuda_release(&c->calls, c->mip_img[k]), c->mip_img[k] = NULL;
     c->mip_levels = c->mip_w = 0;
     memset(c->mip_h, 0, sizeof c->mip_h);
 }
@@ -417,8 +418,8 @@ static fv_status mips_ensure(fv_cuda_vp *c, const fv_cuda_vp_frame *f, fv_kphi_m
         for (int k = 0; k < L; k++) {
             /* 3 floats a pixel on w columns, one float of padding (filter/phi_mips.c's layout) */
             const size_t floats = 3 * (size_t)w * (size_t)f->mip_h[k] + 1;
-            if ((e = cudaMalloc((void **)&c->mip_img[k], floats * sizeof(float))) != cudaSuccess ||
-                (e = cudaMemsetAsync(c->mip_img[k], 0, floats * sizeof(float), c->stream)) != cudaSuccess) {
+            if ((e = fv_cuda_alloc(&c->calls, (void **)&c->mip_img[k], floats * sizeof(float))) != cudaSuccess ||
+                (e = fv_cuda_clear(&c->calls, c->mip_img[k], 0, floats * sizeof(float), c->stream)) != cudaSuccess) {
                 mips_free(c);
                 return fv_cuda_fail(e, "allocating the φ-mipmaps", err);
             }
@@ -445,7 +446,7 @@ static fv_status mips_ensure(fv_cuda_vp *c, const fv_cuda_vp_frame *f, fv_kphi_m
         else
             memset(o + 2 * w, 0, (size_t)w * sizeof(float));
     }
-    fv_status s = fv_cuda_mirror_fill(&c->shape, c->shape_host, words * sizeof(float), c->stream, "the φ-mipmaps' shape", err);
+    fv_status s = fv_cuda_mirror_fill(&c->calls, &c->shape, c->shape_host, words * sizeof(float), c->stream, "the φ-mipmaps' shape", err);
     if (s != FV_OK) return s;
     memset(dm, 0, sizeof *dm);
     dm->levels = L, dm->w = w, dm->wrap = m->wrap;
@@ -463,22 +464,22 @@ static fv_status mips_ensure(fv_cuda_vp *c, const fv_cuda_vp_frame *f, fv_kphi_m
 extern "C" void fv_cuda_vp_destroy(fv_cuda_vp *c)
 {
     if (!c) return;
-    if (c->stream) cudaStreamSynchronize(c->stream); /* nothing queued may outlive its buffers */
-    fv_cuda_scene_free(&c->scene);
+    if (c->stream) fv_cuda_wait(&c->calls, c->stream); /* nothing queued may outlive its buffers */
+    fv_cuda_scene_free(&c->calls, &c->scene);
     grid_free(c);
     screen_free(c);
     mips_free(c);
-    svgf_free(&c->svgf);
+    svgf_free(&c->calls, &c->svgf);
     free(c->shape_host);
-    fv_cuda_film_free(&c->film);
-    fv_cuda_mirror_free(&c->col_h);
-    fv_cuda_mirror_free(&c->onscreen);
-    fv_cuda_mirror_free(&c->shape);
-    fv_cuda_mirror_free(&c->lut[0]);
-    fv_cuda_mirror_free(&c->lut[1]);
-    fv_cuda_mirror_free(&c->blur_off);
-    fv_cuda_mirror_free(&c->blur_k);
-    cudaFree(c->counts);
+    fv_cuda_film_free(&c->calls, &c->film);
+    fv_cuda_mirror_free(&c->calls, &c->col_h);
+    fv_cuda_mirror_free(&c->calls, &c->onscreen);
+    fv_cuda_mirror_free(&c->calls, &c->shape);
+    fv_cuda_mirror_free(&c->calls, &c->lut[0]);
+    fv_cuda_mirror_free(&c->calls, &c->lut[1]);
+    fv_cuda_mirror_free(&c->calls, &c->blur_off);
+    fv_cuda_mirror_free(&c->calls, &c->blur_k);
+    fv_cuda_release(&c->calls, c->counts);
     for (int i = 0; i <= ST_COUNT; i++)
         if (c->ev[i]) cudaEventDestroy(c->ev[i]);
     if (c->queued) cudaEventDestroy(c->queued);
@@ -486,18 +487,20 @@ extern "C" void fv_cuda_vp_destroy(fv_cuda_vp *c)
     free(c);
 }
 
+extern "C" void fv_cuda_vp_calls(const fv_cuda_vp *c, fv_cuda_calls *out) { *out = c->calls.n; }
+
 extern "C" fv_status fv_cuda_vp_create(const fv_kscene *host, fv_cuda_vp **out, fv_error *err)
 {
     *out = NULL;
     fv_cuda_vp *c = (fv_cuda_vp *)calloc(1, sizeof *c);
     if (!c) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
-    fv_status s = fv_cuda_scene_upload(&c->scene, host, err);
+    fv_status s = fv_cuda_scene_upload(&c->calls, &c->scene, host, err);
     cudaError_t e = cudaSuccess;
     if (s == FV_OK && (e = cudaStreamCreate(&c->stream)) != cudaSuccess) s = fv_cuda_fail(e, "creating a stream", err);
     for (int i = 0; s == FV_OK && i <= ST_COUNT; i++)
         if ((e = cudaEventCreate(&c->ev[i])) != cudaSuccess) s = fv_cuda_fail(e, "creating events", err);
     if (s == FV_OK && (e = cudaEventCreate(&c->queued)) != cudaSuccess) s = fv_cuda_fail(e, "creating events", err);
-    if (s == FV_OK && (e = cudaMalloc((void **)&c->counts, 3 * sizeof(unsigned long long))) != cudaSuccess)
+    if (s == FV_OK && (e = fv_cuda_alloc(&c->calls, (void **)&c->counts, 3 * sizeof(unsigned long long))) != cudaSuccess)
         s = fv_cuda_fail(e, "allocating counters", err);
     if (s != FV_OK) {
         fv_cuda_vp_destroy(c);
@@ -554,26 +557,26 @@ static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv
      * host wait for that kernel, and a pair's second eye would then be queued only once the first
      * eye's trace had run. The simulator counts such copies (uploads_behind_kernels). */
     const int lut_now = c->lut_prev ^ 1;
-    if ((s = fv_cuda_scene_update(&c->scene, f->scene, st, err)) != FV_OK ||
-        (f->trace.col_h && (s = fv_cuda_mirror_fill(&c->col_h, f->trace.col_h, (size_t)gw * sizeof(int), st, "the column heights", err)) != FV_OK) ||
-        (mask && (s = fv_cuda_mirror_fill(&c->onscreen, mask, n, st, "the on-screen mask", err)) != FV_OK) ||
+    if ((s = fv_cuda_scene_update(&c->calls, &c->scene, f->scene, st, err)) != FV_OK ||
+        (f->trace.col_h && (s = fv_cuda_mirror_fill(&c->calls, &c->col_h, f->trace.col_h, (size_t)gw * sizeof(int), st, "the column heights", err)) != FV_OK) ||
+        (mask && (s = fv_cuda_mirror_fill(&c->calls, &c->onscreen, mask, n, st, "the on-screen mask", err)) != FV_OK) ||
         (f->mips && (s = mips_ensure(c, f, &dm, err)) != FV_OK) ||
-        (f->blur && ((s = fv_cuda_mirror_fill(&c->blur_off, f->blur_table.off, (size_t)f->blur_table.nq * sizeof(int), st, "the blur's kernels", err)) != FV_OK ||
-                     (s = fv_cuda_mirror_fill(&c->blur_k, f->blur_table.k, f->blur_nk * sizeof(float), st, "the blur's kernels", err)) != FV_OK)) ||
-        (s = fv_cuda_mirror_fill(&c->lut[lut_now], f->map.lut, (size_t)f->map.nlut * 3 * sizeof(float), st, "the radial table", err)) != FV_OK ||
+        (f->blur && ((s = fv_cuda_mirror_fill(&c->calls, &c->blur_off, f->blur_table.off, (size_t)f->blur_table.nq * sizeof(int), st, "the blur's kernels", err)) != FV_OK ||
+                     (s = fv_cuda_mirror_fill(&c->calls, &c->blur_k, f->blur_table.k, f->blur_nk * sizeof(float), st, "the blur's kernels", err)) != FV_OK)) ||
+        (s = fv_cuda_mirror_fill(&c->calls, &c->lut[lut_now], f->map.lut, (size_t)f->map.nlut * 3 * sizeof(float), st, "the radial table", err)) != FV_OK ||
         (s = grid_ensure(c, gw, gh, err)) != FV_OK || (s = screen_ensure(c, sw, sh, err)) != FV_OK ||
-        (s = fv_cuda_film_prepare(&c->film, out, ns, &dv, err)) != FV_OK || (f->denoise && (s = svgf_ensure(c, gw, gh, err)) != FV_OK))
+        (s = fv_cuda_film_prepare(&c->calls, &c->film, out, ns, &dv, err)) != FV_OK || (f->denoise && (s = svgf_ensure(c, gw, gh, err)) != FV_OK))
         return s;
     const int *dcol_h = f->trace.col_h ? (const int *)c->col_h.p : NULL;
     const uint8_t *dmask = mask ? (const uint8_t *)c->onscreen.p : NULL;
-    if ((e = cudaMemsetAsync(c->counts, 0, 3 * sizeof(unsigned long long), st)) != cudaSuccess) return fv_cuda_fail(e, "clearing counters", err);
+    if ((e = fv_cuda_clear(&c->calls, c->counts, 0, 3 * sizeof(unsigned long long), st)) != cudaSuccess) return fv_cuda_fail(e, "clearing counters", err);
 
     /* 1. trace */
     cudaEventRecord(c->ev[ST_TRACE], st);
     fv_kvp_trace_frame tf = f->trace;
     tf.col_h = dcol_h;
     tf.onscreen = f->trace.onscreen ? dmask : NULL;
-    FV_CUDA_LAUNCH(fv_cuda_vp_trace, tiles_of(gw, gh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(c->scene.dev, tf, c->g, c->counts);
+    FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_trace, tiles_of(gw, gh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(c->scene.dev, tf, c->g, c->counts);
 
     /* 2. the denoiser: the history's coordinates, then SVGF's launches */
     cudaEventRecord(c->ev[ST_DENOISE], st);
@@ -584,17 +587,17 @@ static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv
         rf.prev_lut = c->lut[c->lut_prev].p ? (const float *)c->lut[c->lut_prev].p : NULL;
         if (!rf.prev_lut && rf.space.kind != FV_KVP_CARTESIAN)
             return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: a history without the previous frame's radial table");
-        FV_CUDA_LAUNCH(fv_cuda_vp_reproject, blocks_of(n), FV_CUDA_VP_THREADS, st)(rf, c->prev_coord);
+        FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_reproject, blocks_of(n), FV_CUDA_VP_THREADS, st)(rf, c->prev_coord);
     }
     if (f->denoise) svgf_launch(c, f, dcol_h, dmask);
 
     /* 3. φ-mipmaps: level 0 the grid's colour, then each level from the one before */
     cudaEventRecord(c->ev[ST_MIP], st);
     if (f->mips) {
-        if ((e = cudaMemcpyAsync(dm.img[0], c->g.color, 3 * n * sizeof(float), cudaMemcpyDeviceToDevice, st)) != cudaSuccess)
+        if ((e = fv_cuda_copy(&c->calls, dm.img[0], c->g.color, 3 * n * sizeof(float), cudaMemcpyDeviceToDevice, st)) != cudaSuccess)
             return fv_cuda_fail(e, "copying the φ-mipmaps' level 0", err);
         for (int k = 1; k < dm.levels; k++)
-            FV_CUDA_LAUNCH(fv_cuda_vp_halve, tiles_of(dm.w, f->mip_h[k]), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(dm, k, f->mip_h[k]);
+            FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_halve, tiles_of(dm.w, f->mip_h[k]), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(dm, k, f->mip_h[k]);
     }
 
     /* 4. map, with this frame's radial table */
@@ -605,7 +608,7 @@ static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv
     mf.mips = dm;
     mf.lut = (const float *)c->lut[lut_now].p;
     mf.sigma = f->blur ? c->sigma : NULL;
-    FV_CUDA_LAUNCH(fv_cuda_vp_map, tiles_of(sw, sh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(mf, dv);
+    FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_map, tiles_of(sw, sh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(mf, dv);
 
     /* 5. the foveated blur, in place in the film's colour through the scratch image */
     cudaEventRecord(c->ev[ST_BLUR], st);
@@ -613,8 +616,8 @@ static fv_status launch_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv
         fv_kblur_table bt = f->blur_table;
         bt.off = (const int *)c->blur_off.p;
         bt.k = (const float *)c->blur_k.p;
-        FV_CUDA_LAUNCH(fv_cuda_vp_blur_h, tiles_of(sw, sh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(bt, c->sigma, dv.color, c->blur_tmp);
-        FV_CUDA_LAUNCH(fv_cuda_vp_blur_v, tiles_of(sw, sh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(bt, c->sigma, c->blur_tmp, dv.color);
+        FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_blur_h, tiles_of(sw, sh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(bt, c->sigma, dv.color, c->blur_tmp);
+        FV_CUDA_LAUNCH(&c->calls, fv_cuda_vp_blur_v, tiles_of(sw, sh), dim3(FV_CUDA_VP_BLOCK, FV_CUDA_VP_BLOCK), st)(bt, c->sigma, c->blur_tmp, dv.color);
     }
     cudaEventRecord(c->ev[ST_COUNT], st);
     if ((e = cudaGetLastError()) != cudaSuccess) return fv_cuda_fail(e, "launching the Visual-Polar kernels", err);
@@ -629,9 +632,9 @@ static fv_status read_frame(fv_cuda_vp *c, const fv_cuda_vp_frame *f, const fv_f
     const size_t ns = (size_t)f->trace.space.sw * (size_t)f->trace.space.sh;
     cudaStream_t st = c->stream;
     memset(c->counts_host, 0, sizeof c->counts_host);
-    cudaError_t e = fv_cuda_film_read_async(&c->film, out, ns, st);
-    if (e == cudaSuccess) e = cudaMemcpyAsync(c->counts_host, c->counts, sizeof c->counts_host, cudaMemcpyDeviceToHost, st);
-    if (e == cudaSuccess && f->denoise) e = svgf_read_rows(&c->svgf, st);
+    cudaError_t e = fv_cuda_film_read_async(&c->calls, &c->film, out, ns, st);
+    if (e == cudaSuccess) e = fv_cuda_copy(&c->calls, c->counts_host, c->counts, sizeof c->counts_host, cudaMemcpyDeviceToHost, st);
+    if (e == cudaSuccess && f->denoise) e = svgf_read_rows(&c->calls, &c->svgf, st);
     if (e == cudaSuccess) e = cudaEventRecord(c->queued, st);
     return e == cudaSuccess ? FV_OK : fv_cuda_fail(e, "reading the Visual-Polar frame back", err);
 }
@@ -666,6 +669,8 @@ extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *const *c, int eyes, const fv_
     }
     if (eyes == 2 && c[0] == c[1]) return fv_error_set(err, FV_ERR_INTERNAL, "CUDA: a stereo pair's eyes share their buffers");
     fv_cuda_forget_error();
+    fv_cuda_calls before[2];
+    for (int e = 0; e < eyes; e++) before[e] = c[e]->calls.n;
     /* Every eye's kernels queued (each on its own stream, so a pair's two eyes may run side by
      * side), then every eye's read-back (a copy into pageable host memory may hold the host until
      * its stream gets there, so none is queued before the last eye's kernels), then the one host
@@ -676,13 +681,22 @@ extern "C" fv_status fv_cuda_vp_render(fv_cuda_vp *const *c, int eyes, const fv_
     for (int e = 0; e < eyes; e++)
         if ((s = read_frame(c[e], &f[e], &out[e], err)) != FV_OK) {
             /* nothing queued may write into a film after the caller has its error */
-            for (int q = 0; q <= e; q++) cudaStreamSynchronize(c[q]->stream);
+            for (int q = 0; q <= e; q++) fv_cuda_wait(&c[q]->calls, c[q]->stream);
             return s;
         }
     cudaError_t ce = eyes == 2 ? cudaStreamWaitEvent(c[0]->stream, c[1]->queued, 0) : cudaSuccess;
-    if (ce == cudaSuccess) ce = cudaStreamSynchronize(c[0]->stream);
+    if (ce == cudaSuccess) ce = fv_cuda_wait(&c[0]->calls, c[0]->stream);
+    if (eyes == 2) c[1]->calls.queued = false; /* eye 1's work was waited for through eye 0's stream */
     res[0].syncs = 1;
     if (ce != cudaSuccess) return fv_cuda_fail(ce, "running the Visual-Polar kernels", err);
-    for (int e = 0; e < eyes; e++) frame_result(c[e], &f[e], &res[e]);
+    for (int e = 0; e < eyes; e++) {
+        frame_result(c[e], &f[e], &res[e]);
+        const fv_cuda_calls *a = &c[e]->calls.n, *b = &before[e];
+        fv_cuda_calls *d = &res[e].calls;
+        d->launches = a->launches - b->launches, d->syncs = a->syncs - b->syncs, d->host_waits = a->host_waits - b->host_waits;
+        d->pageable_copies = a->pageable_copies - b->pageable_copies;
+        d->bytes_h2d = a->bytes_h2d - b->bytes_h2d, d->bytes_d2h = a->bytes_d2h - b->bytes_d2h;
+        d->allocations = a->allocations - b->allocations, d->frees = a->frees - b->frees;
+    }
     return FV_OK;
 }

@@ -172,6 +172,8 @@ static fv_status pt_render_flat(pt_state *st, int eyes, const fv_frame *frames, 
     for (int e = 0; e < eyes; e++)
         if ((s = fv_frame_camera(frames[e].camera, films[e], &j[e].f.cam, err)) != FV_OK) return s;
     fv_stage_clock t0 = fv_stage_clock_now();
+    fv_cuda_calls before;
+    if (st->cuda) fv_cuda_pt_calls(st->cuda, &before);
     if ((s = fv_scene_export_update(st->flat, st->scene, err)) != FV_OK) return s;
     if (st->cuda && (s = fv_cuda_pt_update(st->cuda, fv_scene_export_view(st->flat), err)) != FV_OK) return s;
     fv_stage_stop(stats, "scene", t0);
@@ -201,6 +203,9 @@ static fv_status pt_render_flat(pt_state *st, int eyes, const fv_frame *frames, 
         fv_stats_add_count(stats, "rays", (double)rays);
         fv_stats_add_count(stats, "nan_samples", (double)bad);
         fv_stats_add_count(stats, "host_syncs", (double)syncs);
+        fv_cuda_calls after;
+        fv_cuda_pt_calls(st->cuda, &after);
+        fv_cuda_calls_report(stats, &before, &after);
         return FV_OK;
     }
     for (int e = 0; e < eyes; e++) {

@@ -322,6 +322,8 @@ static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
     if (d->cuda) {
         double kernel_ms = 0.0;
         int syncs = 0;
+        fv_cuda_calls before, after;
+        fv_cuda_sdf_calls(d->cuda, &before);
         if (!pyramid) {
             s = fv_cuda_sdf_render(d->cuda, &world->k, eyes, f, out, &c.all, &kernel_ms, &syncs, err);
             c.level_rays[0] = c.all.rays;
@@ -344,6 +346,8 @@ static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
         }
         fv_stats_add_ms(stats, "kernel", kernel_ms);
         fv_stats_add_count(stats, "host_syncs", (double)syncs);
+        fv_cuda_sdf_calls(d->cuda, &after);
+        fv_cuda_calls_report(stats, &before, &after);
     } else {
         for (int e = 0; e < eyes && s == FV_OK; e++) {
             if (!pyramid) {

@@ -464,6 +464,8 @@ static fv_status whole_finish(fv_vp_pipeline *p, const fv_frame *frame, fv_stats
     for (int i = 0; i < 5; i++) fv_stats_add_ms(stats, stage[i], r.stage_ms[i]);
     fv_stats_add_ms(stats, "kernel", r.kernel_ms);
     fv_stats_add_count(stats, "host_syncs", (double)r.syncs);
+    const fv_cuda_calls none = {0};
+    fv_cuda_calls_report(stats, &none, &r.calls);
     fv_stats_add_count(stats, "rays", (double)r.rays);
     fv_stats_add_count(stats, "samples", (double)r.paths);
     fv_stats_add_count(stats, "grid_samples", (double)fv_space_sample_count(p->space));

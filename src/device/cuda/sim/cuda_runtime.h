@@ -19,9 +19,14 @@
  * block (first to last, then last to first on the kernel's next launch: CUDA promises no order),
  * the threads of a block concurrently on a pool of OS threads, __syncthreads a barrier among
  * them; __shared__ variables are function statics, which is right because one block runs at a time.
- * Host waits are counted: a synchronize, a synchronous cudaMemcpy or a cudaFree that comes after
- * work was queued (a launch or an async copy or memset) is one wait of the host for the device
- * (device/cuda/sim/fv_cuda_sim.h reads the counts).
+ * Host waits are counted as CUDA makes the host wait (its "API synchronization behavior"): a
+ * synchronize or a cudaFree that comes after work was queued (a launch, an async copy or memset) is
+ * one wait of the host for the device; so is every synchronous cudaMemcpy, and every copy, async or
+ * not, between the device and pageable host memory (host memory not from cudaHostAlloc or
+ * cudaHostRegister), which CUDA stages through a pinned buffer while the host waits. An async copy
+ * to or from pinned memory is queued like a kernel. Bytes each way, allocations and frees, and per
+ * kernel the SIMT efficiency of its warps (kernel/simt.h) are counted too (device/cuda/sim/
+ * fv_cuda_sim.h reads the counts).
  */
 #ifndef FV_CUDA_SIM_RUNTIME_H
 #define FV_CUDA_SIM_RUNTIME_H
@@ -51,6 +56,20 @@ typedef enum cudaError {
     cudaErrorInvalidResourceHandle = 400,
     cudaErrorNotReady = 600
 } cudaError_t;
+
+/* What cudaPointerGetAttributes says a pointer is (CUDA's values): host memory that is neither
+ * pinned (cudaHostAlloc) nor registered (cudaHostRegister) is "unregistered", pageable. */
+enum cudaMemoryType { cudaMemoryTypeUnregistered = 0, cudaMemoryTypeHost = 1, cudaMemoryTypeDevice = 2, cudaMemoryTypeManaged = 3 };
+
+struct cudaPointerAttributes {
+    cudaMemoryType type;
+    int device;
+    void *devicePointer;
+    void *hostPointer;
+};
+
+#define cudaHostAllocDefault 0u
+#define cudaHostRegisterDefault 0u
 
 enum cudaMemcpyKind {
     cudaMemcpyHostToHost = 0,
@@ -170,7 +189,21 @@ cudaError_t cudaEventRecord(cudaEvent_t e, cudaStream_t s = 0);
 cudaError_t cudaEventSynchronize(cudaEvent_t e);
 cudaError_t cudaEventElapsedTime(float *ms, cudaEvent_t start, cudaEvent_t end);
 
-/* Memory calls carry their call site into the simulator's messages. */
+cudaError_t cudaPointerGetAttributes(cudaPointerAttributes *attr, const void *p);
+
+/* Memory calls carry their call site into the simulator's messages. Pinned host memory (cudaHostAlloc,
+ * cudaMallocHost, cudaHostRegister) is host memory the simulator remembers as pinned: a copy between
+ * it and the device is queued like a kernel; a copy between the device and any other host memory
+ * (pageable) blocks the host until it is done, as CUDA stages it through a pinned buffer of its own. */
+cudaError_t fv_cuda_sim_host_alloc(void **p, size_t bytes, unsigned flags, const char *file, int line);
+cudaError_t fv_cuda_sim_host_free(void *p, const char *file, int line);
+cudaError_t fv_cuda_sim_host_register(void *p, size_t bytes, unsigned flags, const char *file, int line);
+cudaError_t fv_cuda_sim_host_unregister(void *p, const char *file, int line);
+#define cudaHostAlloc(p, bytes, flags) fv_cuda_sim_host_alloc((void **)(p), (bytes), (flags), __FILE__, __LINE__)
+#define cudaMallocHost(p, bytes) fv_cuda_sim_host_alloc((void **)(p), (bytes), 0u, __FILE__, __LINE__)
+#define cudaFreeHost(p) fv_cuda_sim_host_free((p), __FILE__, __LINE__)
+#define cudaHostRegister(p, bytes, flags) fv_cuda_sim_host_register((p), (bytes), (flags), __FILE__, __LINE__)
+#define cudaHostUnregister(p) fv_cuda_sim_host_unregister((p), __FILE__, __LINE__)
 cudaError_t fv_cuda_sim_malloc(void **p, size_t bytes, const char *file, int line);
 cudaError_t fv_cuda_sim_free(void *p, const char *file, int line);
 cudaError_t fv_cuda_sim_memcpy(void *dst, const void *src, size_t bytes, cudaMemcpyKind kind, bool async, cudaStream_t s, const char *file,

@@ -12,6 +12,7 @@
 #include <unistd.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -109,6 +110,15 @@ struct Job {
 class Pool;
 thread_local Pool *t_pool;  /* set on the pool's threads: they are running a kernel */
 thread_local unsigned t_id; /* the thread's index in its block */
+typedef std::array<uint64_t, FV_SIMT_KINDS> Steps;
+thread_local Steps t_steps; /* kernel/simt.h: this thread's iterations in its current block */
+
+/* A launch's SIMT sums (fv_cuda_sim_simt without the name). */
+struct Simt {
+    uint64_t warps = 0;
+    Steps lane{}, warp{};
+    uint64_t lane_total = 0, warp_total = 0;
+};
 
 /* The threads that run a launch: as many as the largest block so far, each running one thread of
  * every block, the blocks one after another (in the order the launch's Job says). */
@@ -123,6 +133,8 @@ class Pool {
     Barrier sync;      /* __syncthreads */
     Barrier block_end; /* every thread of the block has returned */
     std::vector<unsigned> sync_calls; /* per thread of the running block */
+    std::vector<Steps> lane_steps;    /* per thread of the running block: its SIMT counts */
+    Simt simt;                        /* the running launch's */
     unsigned long long blocks_run = 0;
 
     struct Start {
@@ -187,7 +199,9 @@ class Pool {
                         t_block_idx = uint3{j.grid.x - 1 - bx, j.grid.y - 1 - by, j.grid.z - 1 - bz};
                     else
                         t_block_idx = uint3{bx, by, bz};
+                    t_steps.fill(0);
                     j.body(j.ctx);
+                    lane_steps[id] = t_steps; /* read by end_block, after the barrier below */
                     sync.leave();
                     block_end.wait([&] { end_block(j); });
                 }
@@ -205,7 +219,33 @@ class Pool {
                     j.kernel, t_block_idx.x, t_block_idx.y, t_block_idx.z, i, sync_calls[i], sync_calls[0]);
         sync_calls.assign(j.threads, 0);
         sync.reset(j.threads);
+        count_warps(j.threads);
         blocks_run++;
+    }
+
+    /* The block's threads in warps of 32 by their linear index, as the hardware groups them (the
+     * last warp of a block whose size is not a multiple of 32 has idle lanes too): each warp pays
+     * for 32 lanes times its busiest lane's iterations. */
+    void count_warps(unsigned threads)
+    {
+        for (unsigned w0 = 0; w0 < threads; w0 += 32) {
+            const unsigned w1 = w0 + 32 < threads ? w0 + 32 : threads;
+            Steps most{};
+            uint64_t most_total = 0;
+            for (unsigned i = w0; i < w1; i++) {
+                uint64_t total = 0;
+                for (int k = 0; k < FV_SIMT_KINDS; k++) {
+                    simt.lane[k] += lane_steps[i][k];
+                    if (lane_steps[i][k] > most[k]) most[k] = lane_steps[i][k];
+                    total += lane_steps[i][k];
+                }
+                simt.lane_total += total;
+                if (total > most_total) most_total = total;
+            }
+            for (int k = 0; k < FV_SIMT_KINDS; k++) simt.warp[k] += 32 * most[k];
+            simt.warp_total += 32 * most_total;
+            simt.warps++;
+        }
     }
 
 public:
@@ -219,13 +259,15 @@ public:
         for (pthread_t t : workers) pthread_join(t, nullptr);
     }
 
-    /* Runs j to completion; returns the blocks it ran. */
-    unsigned long long run(const Job &j)
+    /* Runs j to completion; returns the blocks it ran, and its SIMT sums in *out. */
+    unsigned long long run(const Job &j, Simt *out)
     {
         grow(j.threads);
         sync.reset(j.threads);
         block_end.reset(j.threads);
         sync_calls.assign(j.threads, 0);
+        lane_steps.assign(j.threads, Steps{});
+        simt = Simt();
         const unsigned long long before = blocks_run;
         std::unique_lock<std::mutex> l(m);
         job = &j;
@@ -234,6 +276,7 @@ public:
         start_cv.notify_all();
         done_cv.wait(l, [&] { return busy == 0; });
         job = nullptr;
+        *out = simt;
         return blocks_run - before;
     }
 
@@ -256,6 +299,9 @@ public:
     std::mutex m;          /* everything below but the pool */
     std::mutex launch_m;   /* one launch at a time: a kernel's __shared__ statics are its block's */
     std::map<uintptr_t, Allocation> allocs; /* by base address */
+    std::map<uintptr_t, Allocation> pinned; /* pinned or registered host ranges, by base address */
+    std::set<uintptr_t> pinned_owned;       /* those cudaHostAlloc made (cudaFreeHost frees them) */
+    std::map<std::string, fv_cuda_sim_simt> simt; /* by kernel name */
     std::set<const fv_cuda_sim_stream *> streams;
     std::set<const fv_cuda_sim_event *> events;
     cudaError_t last = cudaSuccess; /* for cudaGetLastError: set by every call that fails, as CUDA's */
@@ -268,24 +314,35 @@ public:
 
     ~Device()
     {
-        if (allocs.empty() && streams.empty() && events.empty()) return;
+        if (allocs.empty() && streams.empty() && events.empty() && pinned.empty()) return;
         for (const auto &a : allocs)
             fprintf(stderr, "fovea CUDA simulator: %s:%d: %zu bytes of device memory allocated here were never freed\n", a.second.file,
                     a.second.line, a.second.bytes);
+        for (const auto &a : pinned)
+            fprintf(stderr, "fovea CUDA simulator: %s:%d: %zu bytes of host memory pinned here were never freed or unregistered\n",
+                    a.second.file, a.second.line, a.second.bytes);
         if (!streams.empty()) fprintf(stderr, "fovea CUDA simulator: %zu streams were never destroyed\n", streams.size());
         if (!events.empty()) fprintf(stderr, "fovea CUDA simulator: %zu events were never destroyed\n", events.size());
         fflush(stderr);
         abort();
     }
 
-    /* The allocation holding address p, or null. */
-    const std::pair<const uintptr_t, Allocation> *find(const void *p) const
+    /* The range of table t holding address p, or null. */
+    static const std::pair<const uintptr_t, Allocation> *find_in(const std::map<uintptr_t, Allocation> &t, const void *p)
     {
         const uintptr_t a = (uintptr_t)p;
-        auto it = allocs.upper_bound(a);
-        if (it == allocs.begin()) return nullptr;
+        auto it = t.upper_bound(a);
+        if (it == t.begin()) return nullptr;
         --it;
         return a < it->first + it->second.bytes ? &*it : nullptr;
+    }
+    /* The device allocation holding address p, or null. */
+    const std::pair<const uintptr_t, Allocation> *find(const void *p) const { return find_in(allocs, p); }
+    /* Whether [p, p + bytes) lies in one pinned or registered host range. */
+    bool is_pinned(const void *p, size_t bytes) const
+    {
+        const auto *a = find_in(pinned, p);
+        return a && (uintptr_t)p + bytes <= a->first + a->second.bytes;
     }
 
     /* Checks that [p, p + bytes) lies inside one device allocation. */
@@ -317,10 +374,11 @@ public:
         return e;
     }
 
-    /* The host waits here for what was queued, if anything was. */
-    void host_wait()
+    /* The host waits here for what was queued, if anything was; with `always`, for the call's own
+     * transfer too (a copy that blocks), so it is a wait even with nothing queued. */
+    void host_wait(bool always = false)
     {
-        if (queued) counts.host_waits++;
+        if (queued || always) counts.host_waits++;
         queued = false;
         launched.clear();
     }
@@ -372,9 +430,26 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
     }
     std::lock_guard<std::mutex> one(d.launch_m);
     Job j = {kernel, file, line, grid, block, block.x * block.y * block.z, body, ctx, reverse};
-    const unsigned long long blocks = d.pool.run(j);
+    Simt simt;
+    const unsigned long long blocks = d.pool.run(j, &simt);
     std::lock_guard<std::mutex> l(d.m);
     d.counts.blocks += blocks;
+    fv_cuda_sim_simt &r = d.simt[kernel];
+    if (!r.kernel[0]) snprintf(r.kernel, sizeof r.kernel, "%s", kernel);
+    r.launches++;
+    r.threads_per_block = j.threads;
+    r.warps += simt.warps;
+    for (int k = 0; k < FV_SIMT_KINDS; k++) {
+        r.lane_steps[k] += simt.lane[k];
+        r.warp_steps[k] += simt.warp[k];
+    }
+    r.lane_total += simt.lane_total;
+    r.warp_total += simt.warp_total;
+}
+
+void fv_cuda_sim_simt_step(int kind)
+{
+    if (t_pool && kind >= 0 && kind < FV_SIMT_KINDS) t_steps[kind]++;
 }
 
 cudaError_t cudaGetDeviceCount(int *count)
@@ -555,6 +630,7 @@ cudaError_t fv_cuda_sim_malloc(void **p, size_t bytes, const char *file, int lin
     /* CUDA does not clear new memory: NaN floats and all-ones integers make a read before a write show */
     memset(q, 0xff, bytes);
     d.allocs[(uintptr_t)q] = Allocation{bytes, file, line};
+    d.counts.allocations++;
     d.counts.live_allocations++;
     d.counts.live_bytes += bytes;
     *p = q;
@@ -573,6 +649,7 @@ cudaError_t fv_cuda_sim_free(void *p, const char *file, int line)
                    a->second.file, a->second.line);
         die(file, line, "cudaFree of %p, which is not device memory (never allocated, or freed already)", p);
     }
+    d.counts.frees++;
     d.counts.live_allocations--;
     d.counts.live_bytes -= it->second.bytes;
     d.allocs.erase(it);
@@ -603,14 +680,28 @@ cudaError_t fv_cuda_sim_memcpy(void *dst, const void *src, size_t bytes, cudaMem
     else if (d.find(dst)) die(file, line, "%s %s: the destination %p is device memory", what, kinds[kind], dst);
     if (src_dev) d.check_range(src, bytes, what, file, line);
     else if (d.find(src)) die(file, line, "%s %s: the source %p is device memory", what, kinds[kind], src);
-    /* A copy from pageable host memory to the device may wait for its stream's queued work before
-     * it starts (CUDA stages it through pinned memory): behind a kernel of its stream (or any, on
-     * the legacy stream 0, which waits for the others) the host would wait mid-frame, unseen. */
-    if (async && dst_dev && !src_dev && (s ? d.launched.count(s) || d.launched.count(nullptr) : !d.launched.empty()))
+    if (dst_dev && !src_dev) d.counts.bytes_h2d += bytes;
+    if (src_dev && !dst_dev) d.counts.bytes_d2h += bytes;
+    /* Between the device and pageable host memory CUDA stages the copy through a pinned buffer of
+     * its own, and the host takes part: such a copy, async or not, returns only once its stream's
+     * work before it and (device to host) the copy itself are done, or (host to device) the bytes
+     * are staged. Either way the host waits, mid-frame if kernels are queued: a wait of its own,
+     * even with nothing queued. An upload behind a kernel of its stream (or any, on the legacy
+     * stream 0, which waits for the others) is the worst of these: the host waits for the kernel
+     * before it can queue the rest of the frame. */
+    const bool host_side = src_dev != dst_dev;
+    const bool pageable = host_side && !d.is_pinned(src_dev ? dst : src, bytes);
+    if (pageable && dst_dev && (s ? d.launched.count(s) || d.launched.count(nullptr) : !d.launched.empty()))
         d.counts.uploads_behind_kernels++;
     memmove(dst, src, bytes);
-    if (async) d.queued = true;
-    else if (src_dev || dst_dev) d.host_wait(); /* a synchronous copy waits for the work before it */
+    if (pageable) {
+        d.counts.pageable_copies++;
+        d.host_wait(true);
+    } else if (async) {
+        if (src_dev || dst_dev) d.queued = true; /* pinned memory, or device to device: queued like a kernel */
+    } else if (src_dev || dst_dev) {
+        d.host_wait(true); /* a synchronous copy waits for the work before it and for itself */
+    }
     return cudaSuccess;
 }
 
@@ -627,6 +718,75 @@ cudaError_t fv_cuda_sim_memset(void *p, int value, size_t bytes, bool async, cud
     return cudaSuccess;
 }
 
+cudaError_t cudaPointerGetAttributes(cudaPointerAttributes *attr, const void *p)
+{
+    if (!attr) return fail_unlocked(cudaErrorInvalidValue);
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    memset(attr, 0, sizeof *attr);
+    if (d.find(p)) {
+        attr->type = cudaMemoryTypeDevice;
+        attr->devicePointer = const_cast<void *>(p);
+    } else if (Device::find_in(d.pinned, p)) {
+        attr->type = cudaMemoryTypeHost;
+        attr->hostPointer = attr->devicePointer = const_cast<void *>(p); /* mapped, as CUDA's unified addressing has it */
+    } else {
+        attr->type = cudaMemoryTypeUnregistered; /* as CUDA 11 on: pageable memory is no error */
+        attr->device = -2;
+    }
+    return cudaSuccess;
+}
+
+cudaError_t fv_cuda_sim_host_alloc(void **p, size_t bytes, unsigned flags, const char *file, int line)
+{
+    if (!p) return fail_unlocked(cudaErrorInvalidValue);
+    *p = nullptr;
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    if (flags != 0) return d.fail(cudaErrorInvalidValue); /* the flags fovea would use: none */
+    void *q = malloc(bytes ? bytes : 1);
+    if (!q) return d.fail(cudaErrorMemoryAllocation);
+    d.pinned[(uintptr_t)q] = Allocation{bytes ? bytes : 1, file, line};
+    d.pinned_owned.insert((uintptr_t)q);
+    *p = q;
+    return cudaSuccess;
+}
+
+cudaError_t fv_cuda_sim_host_free(void *p, const char *file, int line)
+{
+    if (!p) return cudaSuccess;
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    if (!d.pinned_owned.erase((uintptr_t)p)) die(file, line, "cudaFreeHost of %p, which cudaHostAlloc did not return (or was freed)", p);
+    d.pinned.erase((uintptr_t)p);
+    free(p);
+    d.host_wait(); /* as cudaFree: it waits for the device */
+    return cudaSuccess;
+}
+
+cudaError_t fv_cuda_sim_host_register(void *p, size_t bytes, unsigned flags, const char *file, int line)
+{
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    if (!p || bytes == 0 || flags != 0) return d.fail(cudaErrorInvalidValue);
+    if (d.find(p)) die(file, line, "cudaHostRegister of %p, which is device memory", p);
+    const auto *a = Device::find_in(d.pinned, p);
+    const auto next = d.pinned.lower_bound((uintptr_t)p);
+    if (a || (next != d.pinned.end() && next->first < (uintptr_t)p + bytes))
+        die(file, line, "cudaHostRegister of %zu bytes at %p overlaps host memory already pinned", bytes, p);
+    d.pinned[(uintptr_t)p] = Allocation{bytes, file, line};
+    return cudaSuccess;
+}
+
+cudaError_t fv_cuda_sim_host_unregister(void *p, const char *file, int line)
+{
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    if (d.pinned_owned.count((uintptr_t)p) || !d.pinned.erase((uintptr_t)p))
+        die(file, line, "cudaHostUnregister of %p, which cudaHostRegister did not register", p);
+    return cudaSuccess;
+}
+
 extern "C" void fv_cuda_sim_counts_get(fv_cuda_sim_counts *out)
 {
     Device &d = device();
@@ -634,6 +794,26 @@ extern "C" void fv_cuda_sim_counts_get(fv_cuda_sim_counts *out)
     *out = d.counts;
     out->live_streams = d.streams.size();
     out->live_events = d.events.size();
+    out->live_pinned = d.pinned.size();
+}
+
+extern "C" size_t fv_cuda_sim_simt_get(fv_cuda_sim_simt *out, size_t n)
+{
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    size_t i = 0;
+    for (const auto &r : d.simt) {
+        if (i < n) out[i] = r.second;
+        i++;
+    }
+    return d.simt.size();
+}
+
+extern "C" void fv_cuda_sim_simt_reset(void)
+{
+    Device &d = device();
+    std::lock_guard<std::mutex> l(d.m);
+    d.simt.clear();
 }
 
 extern "C" void fv_cuda_sim_fail_allocation(int64_t n)
