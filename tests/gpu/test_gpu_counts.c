@@ -48,6 +48,7 @@ typedef struct family {
  * from pageable memory every frame. */
 static const family k_families[] = {
     {"pt", "cornell", "spp=1", 64.0f, false, 2, 3, 3, 0, FILM + 2 * 8},
+    {"pt", "city", "spp=1", 0.064f, false, 2, 3, 3, 0, FILM + 2 * 8},
     {"pt", "cornell-fpm", "spp=1", 64.0f, true, 2, 7, 7, 1152, FILM + 2 * 8},
     {"sdf-gt", "sdf-temple", "spp=1", 0.064f, false, 2, 3, 3, 0, FILM + 7 * 8},
     {"fipr", "sdf-temple", "spp=1", 0.064f, false, 14, 3, 3, 0, FILM + 22 * 8},

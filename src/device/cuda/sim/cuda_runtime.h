@@ -26,7 +26,9 @@
  * cudaHostRegister), which CUDA stages through a pinned buffer while the host waits. An async copy
  * to or from pinned memory is queued like a kernel. Bytes each way, allocations and frees, and per
  * kernel the SIMT efficiency of its warps (kernel/simt.h) are counted too (device/cuda/sim/
- * fv_cuda_sim.h reads the counts).
+ * fv_cuda_sim.h reads the counts). With FOVEA_CUDA_SIM_CALLS_ONLY=1 in the environment launches are
+ * counted but run nothing: the host's calls at a size whose kernels the simulator could not run in
+ * time (test_gpu_counts' FOVEA_GPU_FIGURES).
  */
 #ifndef FV_CUDA_SIM_RUNTIME_H
 #define FV_CUDA_SIM_RUNTIME_H

@@ -309,6 +309,10 @@ public:
     bool queued = false;            /* work was queued since the host last waited */
     std::set<cudaStream_t> launched; /* streams a kernel was launched on since the host last waited */
     int64_t fail_in = -1;           /* fv_cuda_sim_fail_allocation */
+    /* FOVEA_CUDA_SIM_CALLS_ONLY=1: launches are checked and counted but run nothing, so the host's
+     * calls of a frame can be counted at a size whose kernels would take the simulator hours (the
+     * headset's 1440x1600); what the kernels would have written is left as it was. */
+    const bool calls_only = getenv("FOVEA_CUDA_SIM_CALLS_ONLY") && *getenv("FOVEA_CUDA_SIM_CALLS_ONLY") == '1';
     fv_cuda_sim_counts counts = {};
     Pool pool;
 
@@ -427,6 +431,7 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
          * to first, so a kernel that reads what another block of its launch writes finds it
          * unwritten one way or the other (a race on a GPU), and a test comparing images sees it. */
         reverse = d.launches_of[kernel]++ % 2 == 1;
+        if (d.calls_only) return;
     }
     std::lock_guard<std::mutex> one(d.launch_m);
     Job j = {kernel, file, line, grid, block, block.x * block.y * block.z, body, ctx, reverse};
