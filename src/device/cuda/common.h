@@ -1,5 +1,6 @@
 /* fovea — what the CUDA backends share (device/cuda/pt.cu, sdf.cu, vpolar.cu): the launch macro
- * (device/cuda/launch.h, FV_CUDA_LAUNCH), the error line of a failed CUDA call, a device array
+ * (device/cuda/launch.h, FV_CUDA_LAUNCH), the runtime calls through wrappers that count them
+ * (fv_cuda_tally: what --stats-json reports), the error line of a failed CUDA call, a device array
  * refilled from the host only when its bytes changed, and a film on the GPU, its buffers kept
  * between frames of one size and read back into the host film's buffers that are set. Host code
  * only; included by .cu files.
@@ -67,8 +68,13 @@ static inline cudaError_t fv_cuda_copy(fv_cuda_tally *k, void *dst, const void *
 {
     if (bytes == 0) return cudaSuccess;
     bool pageable = false;
-    if (kind == cudaMemcpyHostToDevice) k->n.bytes_h2d += bytes, pageable = fv_cuda_pageable(src);
-    if (kind == cudaMemcpyDeviceToHost) k->n.bytes_d2h += bytes, pageable = fv_cuda_pageable(dst);
+    if (kind == cudaMemcpyHostToDevice) {
+        k->n.bytes_h2d += bytes;
+        pageable = fv_cuda_pageable(src);
+    } else if (kind == cudaMemcpyDeviceToHost) {
+        k->n.bytes_d2h += bytes;
+        pageable = fv_cuda_pageable(dst);
+    }
     cudaError_t e = cudaMemcpyAsync(dst, src, bytes, kind, st);
     if (pageable) {
         k->n.pageable_copies++;
@@ -84,8 +90,13 @@ static inline cudaError_t fv_cuda_copy_now(fv_cuda_tally *k, void *dst, const vo
 {
     if (bytes == 0) return cudaSuccess;
     bool pageable = false;
-    if (kind == cudaMemcpyHostToDevice) k->n.bytes_h2d += bytes, pageable = fv_cuda_pageable(src);
-    if (kind == cudaMemcpyDeviceToHost) k->n.bytes_d2h += bytes, pageable = fv_cuda_pageable(dst);
+    if (kind == cudaMemcpyHostToDevice) {
+        k->n.bytes_h2d += bytes;
+        pageable = fv_cuda_pageable(src);
+    } else if (kind == cudaMemcpyDeviceToHost) {
+        k->n.bytes_d2h += bytes;
+        pageable = fv_cuda_pageable(dst);
+    }
     cudaError_t e = cudaMemcpy(dst, src, bytes, kind);
     if (pageable) k->n.pageable_copies++;
     fv_cuda_waited(k, true);
