@@ -116,7 +116,8 @@ static void test_sdf_scene(void **st)
 static void test_sdf_union_81(void **st)
 {
     (void)st;
-    compare_scene(FOVEA_SOURCE_DIR "/scenes/sdf-grid81.json", 48, 27, 0.0, 1, "max_depth=3");
+    char path[512];
+    compare_scene(fv_test_source("scenes/sdf-grid81.json", path, sizeof path), 48, 27, 0.0, 1, "max_depth=3");
 }
 
 /* Devices a method or the build lacks are refused in one line, before anything renders. */

@@ -113,6 +113,19 @@ static inline const char *fv_test_data(const char *rel, char *buf, size_t n)
     return buf;
 }
 
+/* The path of `rel` under the source tree (scenes/..., bench/...): $FOVEA_SOURCE_DIR when set (the
+ * bundle scripts/gpu-check unpacks on another machine mirrors those folders), else the tree the
+ * test was built from, else the current folder. */
+static inline const char *fv_test_source(const char *rel, char *buf, size_t n)
+{
+    const char *dir = getenv("FOVEA_SOURCE_DIR");
+#ifdef FOVEA_SOURCE_DIR
+    if (!dir) dir = FOVEA_SOURCE_DIR;
+#endif
+    snprintf(buf, n, "%s/%s", dir ? dir : ".", rel);
+    return buf;
+}
+
 /* ---- rendering by hand ---- */
 
 /* Renders frames 0 .. n-1 of t into film from the template `first` (camera, seed, threads, gaze,
