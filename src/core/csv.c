@@ -65,6 +65,7 @@ fv_status fv_csv_read(const char *path, const char *what, int max, const char *e
                            : fv_error_set(err, FV_ERR_NOMEM, "out of memory reading '%s'", path);
             break;
         }
+        if (lineno == 1) fv_file_strip_bom(line, len);
         int n = 0;
         fv_csv_kind kind = fv_csv_line(line, before, v, max, &n);
         if (kind == FV_CSV_SKIP) continue;

@@ -105,6 +105,14 @@ long fv_file_getline(FILE *f, char **line, size_t *cap, size_t max)
     }
 }
 
+long fv_file_strip_bom(char *line, long len)
+{
+    /* EF BB BF: what Windows tools (Notepad, Excel's "CSV UTF-8") put before the first line. */
+    if (len < 3 || memcmp(line, "\xEF\xBB\xBF", 3) != 0) return len;
+    memmove(line, line + 3, (size_t)(len - 3) + 1);
+    return len - 3;
+}
+
 /* ---- outputs ---- */
 
 /* dest = target with its symbolic links followed (at most 40 of them, as the kernel allows); the
@@ -129,6 +137,29 @@ static fv_status follow_links(const char *target, char *dest, size_t n, fv_error
     }
 }
 
+/* An existing file about to be replaced (sb: its stat): a regular file that may be written. A file
+ * with no write bit at all is refused even where access() would let this user (root) write it:
+ * whoever made it read-only meant it to stay. */
+static fv_status check_replace(const char *target, const char *dest, const struct stat *sb, fv_error *err)
+{
+    /* Renaming over a device or FIFO would replace the node with a regular file. */
+    if (!S_ISREG(sb->st_mode)) return fv_error_set(err, FV_ERR_IO, "cannot write '%s': not a regular file (%s)", target, kind_of(sb->st_mode));
+    if ((sb->st_mode & 0222) == 0)
+        return fv_error_set(err, FV_ERR_IO, "cannot write '%s': the file is read-only (mode %04o)", target, (unsigned)(sb->st_mode & 07777));
+    if (access(dest, W_OK) != 0) return fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", target, strerror(errno));
+    return FV_OK;
+}
+
+fv_status fv_file_check_write(const char *path, fv_error *err)
+{
+    if (!path || !path[0]) return fv_error_set(err, FV_ERR_IO, "cannot write '': empty file name");
+    char dest[4096];
+    fv_status st = follow_links(path, dest, sizeof dest, err);
+    struct stat sb;
+    if (st == FV_OK && stat(dest, &sb) == 0) st = check_replace(path, dest, &sb, err);
+    return st;
+}
+
 /* The temporary name is made here rather than by mkstemp: mkstemp creates its file 0600, and the
  * only way to learn the umask to fix that is to change it, which races with every other thread
  * creating files. O_EXCL gives the same no-clobber guarantee, and mode 0666 lets the kernel apply
@@ -142,10 +173,9 @@ fv_status fv_atomic_file_begin(const char *target, fv_atomic_file *out, fv_error
         return fv_error_set(err, FV_ERR_IO, "cannot write '%s': path too long", target);
     fv_status st = follow_links(target, out->dest, sizeof out->dest, err);
     if (st != FV_OK) return st;
-    /* Renaming over a device or FIFO would replace the node with a regular file. */
     struct stat sb;
-    if (stat(out->dest, &sb) == 0 && !S_ISREG(sb.st_mode))
-        return fv_error_set(err, FV_ERR_IO, "cannot write '%s': not a regular file (%s)", target, kind_of(sb.st_mode));
+    const bool replaces = stat(out->dest, &sb) == 0;
+    if (replaces && (st = check_replace(target, out->dest, &sb, err)) != FV_OK) return st;
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     uint64_t h = fv_hash_combine(fv_hash_combine(fv_hash64((uint64_t)getpid()), (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec),
@@ -155,6 +185,20 @@ fv_status fv_atomic_file_begin(const char *target, fv_atomic_file *out, fv_error
         snprintf(out->path, sizeof out->path, "%s.tmp.%06x", out->dest, (unsigned)(h & 0xffffffu));
         int fd = open(out->path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
         if (fd >= 0) {
+            /* The replaced file's owner and mode carry over (a private 0600 file stays private).
+             * Changing the owner takes privileges most users lack: then the file is theirs, as
+             * any file they write. chown first, since it may clear set-id bits. */
+            if (replaces) {
+                int r = fchown(fd, sb.st_uid, sb.st_gid);
+                if (r != 0) r = fchown(fd, (uid_t)-1, sb.st_gid); /* a group of this user's */
+                (void)r;                                         /* not permitted: it stays ours */
+                if (fchmod(fd, sb.st_mode & 07777) != 0) {
+                    int e = errno;
+                    close(fd);
+                    unlink(out->path);
+                    return fv_error_set(err, FV_ERR_IO, "cannot write '%s': %s", target, strerror(e));
+                }
+            }
             out->fd = fd;
             out->active = true;
             return FV_OK;

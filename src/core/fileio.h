@@ -30,6 +30,11 @@ fv_status fv_file_check_read(const char *path, const char *what, fv_error *err);
  * error (ferror tells which), or -1 for a line longer than max (not read further). */
 long fv_file_getline(FILE *f, char **line, size_t *cap, size_t max);
 
+/* A UTF-8 byte order mark at the start of line (len bytes, NUL-terminated) is removed in place: a
+ * text file's first line may carry one, which says nothing to a reader of ASCII formats. Returns
+ * the new length. */
+long fv_file_strip_bom(char *line, long len);
+
 /* ---- outputs ----
  *
  * A file written whole or not at all: the data goes to a temporary file next to the target (same
@@ -38,7 +43,9 @@ long fv_file_getline(FILE *f, char **line, size_t *cap, size_t max);
  * A target that is a symbolic link is written through: the temporary file goes next to the file
  * the link (or chain of links) points to, which is replaced, and the link stays. An existing target
  * that is not a regular file (a device, FIFO, socket or directory) is refused before anything is
- * written: "cannot write '<path>': not a regular file (a character device)". A failed write, close
+ * written: "cannot write '<path>': not a regular file (a character device)", and so is one that
+ * is read-only (no write bit, or no permission for this user). A replaced file's mode (and owner,
+ * where the user may set it) carries over to the new one. A failed write, close
  * or rename names the target and keeps the system's reason ("No space left on device").
  *
  * After a successful fv_atomic_file_begin the caller ends with fv_atomic_file_commit or
@@ -55,7 +62,7 @@ typedef struct fv_atomic_file {
     bool active;       /* between begin and commit/abort */
 } fv_atomic_file;
 
-/* Creates the temporary file for target (mode 0666 less the umask). Errors name target. The
+/* Creates the temporary file for target (mode 0666 less the umask; a replaced file's own mode). Errors name target. The
  * structure must stay where it is until commit or abort (its stream refers to it). */
 fv_status fv_atomic_file_begin(const char *target, fv_atomic_file *out, fv_error *err);
 /* The temporary file as a stdio stream (it takes over the descriptor; commit closes it). */
@@ -77,6 +84,12 @@ void fv_atomic_file_abort(fv_atomic_file *af);
  * /proc/self/fd; elsewhere it removes nothing and returns 0). The library installs no handler. */
 int fv_atomic_file_remove_open_temps(void);
 
+/* Whether path could be replaced by an atomic write, checked before the work that makes its
+ * content: a path that does not exist yet passes (its folder is the caller's to check); an
+ * existing one must be a regular file (after its links) with write permission, else the message
+ * fv_atomic_file_begin would give ("cannot write 'x': not a regular file (a FIFO)", "...: the
+ * file is read-only (mode 0444)"). */
+fv_status fv_file_check_write(const char *path, fv_error *err);
 /* Writes len bytes to path whole or not at all (an fv_atomic_file). */
 fv_status fv_file_write_atomic(const char *path, const void *data, size_t len, fv_error *err);
 /* mkdir -p. */

@@ -65,6 +65,7 @@ bool fv_gaze_read_line(FILE *in, const fv_gaze_writer *w, char **line, size_t *c
     long n = fv_file_getline(in, line, cap, FV_LINE_MAX);
     if (n == -1) *st = fv_error_set(err, FV_ERR_INVALID, "%s:%d: line longer than %d bytes", w->in, lineno, FV_LINE_MAX);
     else if (n < 0) *st = fv_error_set(err, FV_ERR_NOMEM, "out of memory reading '%s'", w->in);
+    if (n > 0 && lineno == 1) fv_file_strip_bom(*line, n); /* every format's first line (also on a second pass) */
     return n > 0;
 }
 

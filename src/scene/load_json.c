@@ -255,6 +255,7 @@ typedef struct sdf_build {
     fv_sdf_node *n;
     char **path;
     int count, cap_n, cap_path;
+    int widest; /* the most children of an n-ary operator so far: for the node limit's message */
 } sdf_build;
 
 #define SDF_WHERE 512
@@ -297,8 +298,17 @@ static fv_status sdf_vec(const cJSON *o, const char *key, bool required, int con
 
 static fv_status sdf_push(sdf_build *b, const fv_sdf_node *n, const char *where, int *id, fv_error *err)
 {
-    if (b->count >= FV_SDF_MAX_NODES)
-        return fv_error_set(err, FV_ERR_INVALID, "%s: %s: more than %d sdf nodes", b->c->file, where, FV_SDF_MAX_NODES);
+    /* Said in what the file shows: compiled nodes are not the shapes a user counts (an n-way
+     * union folds into n - 1 binary ones, a transform is a node of its own). */
+    if (b->count >= FV_SDF_MAX_NODES) {
+        if (b->widest > 2)
+            return fv_error_set(err, FV_ERR_INVALID,
+                                "%s: %s: the sdf compiles to more than %d nodes (each shape and transform is one, and an operator "
+                                "of n children n - 1: its largest, of %d children, %d): split it over several objects",
+                                b->c->file, where, FV_SDF_MAX_NODES, b->widest, b->widest - 1);
+        return fv_error_set(err, FV_ERR_INVALID, "%s: %s: the sdf compiles to more than %d nodes (each shape, transform and operator is one): "
+                            "split it over several objects", b->c->file, where, FV_SDF_MAX_NODES);
+    }
     if (fv_grow((void **)&b->n, &b->cap_n, b->count + 1, sizeof *b->n) ||
         fv_grow((void **)&b->path, &b->cap_path, b->count + 1, sizeof *b->path))
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
@@ -329,6 +339,7 @@ static fv_status sdf_children(sdf_build *b, const cJSON *arr, const char *where,
 {
     if (!cJSON_IsArray(arr) || cJSON_GetArraySize(arr) < 2)
         return fv_error_set(err, FV_ERR_INVALID, "%s: %s: expected an array of at least 2 nodes", b->c->file, where);
+    if (cJSON_GetArraySize(arr) > b->widest) b->widest = cJSON_GetArraySize(arr);
     int acc = -1, i = 0;
     fv_status st = FV_OK;
     for (const cJSON *e = arr->child; e; e = e->next, i++) {
@@ -501,7 +512,7 @@ static fv_status parse_sdf_object(const cJSON *o, const json_ctx *c, const char 
                                   fv_error *err)
 {
     static const char *const tkeys[] = {"translate", "rotate_deg", "rotate_quat", "scale", NULL};
-    sdf_build b = {c, NULL, NULL, 0, 0, 0};
+    sdf_build b = {c, NULL, NULL, 0, 0, 0, 0};
     char w[SDF_WHERE];
     snprintf(w, sizeof w, "%s.sdf", where);
     int root = -1;

@@ -142,6 +142,14 @@ int fv_cli_usage_error(const char *cmd, const char *fmt, ...)
     return FV_EXIT_USAGE;
 }
 
+int fv_cli_check_output(const char *cmd, const fv_inputs *in, const char *path, const char *what)
+{
+    fv_error err;
+    fv_error_clear(&err);
+    fv_status s = fv_inputs_check_output(in, path, what, &err);
+    return s == FV_OK ? 0 : fv_cli_fail(cmd, s, err.msg);
+}
+
 bool fv_cli_parse_int(const char *s, long lo, long hi, long *out)
 {
     char *end;

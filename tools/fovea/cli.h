@@ -5,6 +5,7 @@
 
 #include <stdbool.h>
 #include <stdio.h>
+#include "core/inputs.h"
 #include "fovea/fovea.h"
 
 /* Exit statuses of every subcommand. */
@@ -16,6 +17,11 @@ int fv_cli_exit_code(fv_status s);
 int fv_cli_fail(const char *cmd, fv_status s, const char *msg);
 /* Prints "fovea <cmd>: <printf...>" on stderr and returns FV_EXIT_USAGE. */
 int fv_cli_usage_error(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Before any work, for each file a command will write: refused (one line, exit 2) when it is one
+ * of the command's inputs, or an existing device, FIFO, folder or read-only file (core/inputs.h).
+ * what names the output in the message ("--out"). Returns 0 or the exit code. */
+int fv_cli_check_output(const char *cmd, const fv_inputs *in, const char *path, const char *what);
 
 /* Parsers for option values; false with a message in err when malformed. */
 bool fv_cli_parse_int(const char *s, long lo, long hi, long *out);

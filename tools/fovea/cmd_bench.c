@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "bench/scenario.h"
 #include "bench_cmdline.h"
 #include "cli.h"
 #include "core/json_util.h"
@@ -298,6 +299,22 @@ static int bench_fail(const bench_dist *bd, fv_status s, const char *msg)
     return fv_cli_fail("bench", s, msg);
 }
 
+/* The files the run writes that a person names (--save-scenario, the report's DIR/NAME.json and
+ * DIR/NAME.md; reports only when it runs), checked against the files it reads before anything is
+ * rendered or written: 0 or the exit code. The images and the cache are named by the harness. */
+static int check_outputs(const fv_inputs *in, const char *save, const char *out_dir, const char *name, bool reports)
+{
+    int rc = save ? fv_cli_check_output("bench", in, save, "--save-scenario") : 0;
+    static const char *const ext[2] = {"json", "md"};
+    for (int k = 0; k < 2 && reports && rc == 0; k++) {
+        char path[4096], what[4096 + 32];
+        snprintf(path, sizeof path, "%s/%s.%s", out_dir, name, ext[k]);
+        snprintf(what, sizeof what, "--out %s: the report", out_dir);
+        rc = fv_cli_check_output("bench", in, path, what);
+    }
+    return rc;
+}
+
 /* --scene: the scenario built from the command line is checked first, then saved (--save-scenario:
  * nothing is written for bad input), then run as a scenario file would be. */
 /* argv as one line for the reports: "fovea bench ARG..." (arguments with spaces quoted). */
@@ -317,6 +334,17 @@ static int run_cmdline(const fv_bench_cmdline *cl, const char *save, bool check,
     char *json = NULL, label[128];
     int rc = fv_bench_cmdline_json(cmd, cl, &json, label, sizeof label);
     if (rc) return rc;
+    fv_inputs in;
+    fv_inputs_init(&in);
+    fv_inputs_add(&in, cl->scene, "scene file");
+    fv_inputs_add(&in, cl->gaze_trace, "gaze trace");
+    char name[sizeof label];
+    snprintf(name, sizeof name, "%.*s", (int)strlen(label) - 5, label); /* NAME.json: the report's NAME */
+    rc = check_outputs(&in, save, opt->out_dir, name, !check);
+    if (rc) {
+        free(json);
+        return rc;
+    }
     const bool speaks = !opt->split || opt->split->rank == 0;
     bench_say say;
     fv_log log;
@@ -441,6 +469,21 @@ static int bench(int argc, char **argv, bench_dist *bd, const fv_bench_split *sp
     /* A regular file only: the JSON reader opens it by name, and a FIFO would block it. */
     fv_status s = fv_file_check_read(path, "scenario", &err);
     if (s != FV_OK) return fv_cli_fail(cmd, s, err.msg);
+    if (!check) {
+        /* The report's name and the scene are the scenario's: read here for the check alone (a
+         * scenario that does not load is left to the run, which says why). */
+        fv_scenario *sc = NULL;
+        if (fv_scenario_load(path, opt.mode, &sc, &err) == FV_OK) {
+            fv_inputs in;
+            fv_inputs_init(&in);
+            fv_inputs_add(&in, path, "scenario");
+            fv_inputs_add(&in, sc->scene, "scene file");
+            rc = check_outputs(&in, NULL, opt.out_dir, sc->name, true);
+            fv_scenario_destroy(sc);
+            if (rc) return rc;
+        }
+        fv_error_clear(&err);
+    }
     s = check ? fv_bench_check(path, opt.mode, &err) : fv_bench_run(path, &opt, &err);
     fv_cli_progress_done(&say.bar);
     if (s != FV_OK) return bench_fail(bd, s, err.msg);

@@ -180,6 +180,14 @@ int fv_cmd_compare(int argc, char **argv)
     const char *ref_path = argv[optind], *test_path = argv[optind + 1];
     if (heat && fv_image_format_from_path(heat) != FV_IMG_PNG) return fv_cli_usage_error(cmd, "--heatmap %s: the heat map is a .png file", heat);
     if (heat_max > 0 && !heat) return fv_cli_usage_error(cmd, "--heatmap-max: only with --heatmap FILE");
+    if (heat) {
+        fv_inputs in;
+        fv_inputs_init(&in);
+        fv_inputs_add(&in, ref_path, "reference image");
+        fv_inputs_add(&in, test_path, "test image");
+        int crc = fv_cli_check_output(cmd, &in, heat, "--heatmap");
+        if (crc) return crc;
+    }
     fv_error err;
     fv_image ref, test;
     fv_status s = load(ref_path, &ref, &err);

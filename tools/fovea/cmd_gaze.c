@@ -119,6 +119,10 @@ int fv_cmd_gaze(int argc, char **argv)
     }
     if (optind != argc - 1) return fv_cli_usage_error(cmd, optind >= argc ? "missing RECORDING" : "too many arguments");
     if (!out) return fv_cli_usage_error(cmd, "--out TRACE.csv is required");
+    fv_inputs in;
+    fv_inputs_init(&in);
+    fv_inputs_add(&in, argv[optind], "recording");
+    if ((rc = fv_cli_check_output(cmd, &in, out, "--out"))) return rc;
     fv_error err;
     fv_error_clear(&err);
     fv_gaze_import_info info;

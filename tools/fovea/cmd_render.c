@@ -161,6 +161,22 @@ static fv_status warm_up(const render_opts *o, const fv_frame_meta_run *rec, fv_
  * sequence; each written whole or not at all, and each saying how it was made (method,
  * parameters, camera, gaze of its eye, ...; docs/metrics.md) unless --no-metadata; with
  * --overlay, the eye model drawn over it for its eye's gaze and the `overlay` key in any case. */
+static void frame_path(const render_opts *o, int neyes, int f, int e, char path[4096])
+{
+    char tmp[4096];
+    snprintf(path, 4096, "%s", o->out);
+    if (neyes == 2) {
+        tagged_path(o->out, e ? "_right" : "_left", tmp, sizeof tmp);
+        snprintf(path, 4096, "%s", tmp);
+    }
+    if (o->frames > 1) {
+        char tag[32];
+        snprintf(tag, sizeof tag, "_%04d", f);
+        tagged_path(path, tag, tmp, sizeof tmp);
+        snprintf(path, 4096, "%s", tmp);
+    }
+}
+
 static fv_status write_frame(const render_opts *o, const fv_frame_meta_run *rec, fv_driver *driver, fv_film *const *film, int neyes,
                              int f, double ms, fv_error *err)
 {
@@ -168,18 +184,8 @@ static fv_status write_frame(const render_opts *o, const fv_frame_meta_run *rec,
     fv_driver_views(driver, f, &views);
     fv_status s = FV_OK;
     for (int e = 0; e < neyes && s == FV_OK; e++) {
-        char path[4096], tmp[4096];
-        snprintf(path, sizeof path, "%s", o->out);
-        if (neyes == 2) {
-            tagged_path(o->out, e ? "_right" : "_left", tmp, sizeof tmp);
-            snprintf(path, sizeof path, "%s", tmp);
-        }
-        if (o->frames > 1) {
-            char tag[32];
-            snprintf(tag, sizeof tag, "_%04d", f);
-            tagged_path(path, tag, tmp, sizeof tmp);
-            snprintf(path, sizeof path, "%s", tmp);
-        }
+        char path[4096];
+        frame_path(o, neyes, f, e, path);
         fv_params *meta = NULL;
         if (!o->no_meta) s = fv_frame_meta(rec, f, &views, e, ms, &meta, err);
         else if (o->overlay) s = fv_params_create(&meta, err); /* the overlay mark alone (frame_meta.h) */
@@ -318,6 +324,16 @@ static int parse(int argc, char **argv, render_opts *o, fv_params *params)
 
 #ifdef FOVEA_HAVE_MPI
 /* ---- over MPI ranks (docs/distributed.md; the split itself is src/dist's) ---- */
+
+/* What a split sequence writes beside its frames: OUT without its extension + "_ranks.json". */
+static void ranks_path(const char *out, char path[4096])
+{
+    char noext[4096 - 16];
+    snprintf(noext, sizeof noext, "%s", out);
+    char *dot = strrchr(noext, '.'), *slash = strrchr(noext, '/');
+    if (dot && (!slash || dot > slash)) *dot = '\0';
+    snprintf(path, 4096, "%s_ranks.json", noext);
+}
 
 /* Every rank's progress through its own work (base + span x the render's fraction) goes to the
  * job's bar (src/dist/progress.h), which rank 0 alone draws. */
@@ -467,17 +483,44 @@ static int render_dist(fv_dist *d, const render_opts *o, const fv_frame_meta_run
     if (rank != 0) return FV_EXIT_OK;
     /* What was split how, beside the frames: OUT_ranks.json. */
     char path[4096];
-    char noext[4096 - 16];
-    snprintf(noext, sizeof noext, "%s", o->out);
-    char *dot = strrchr(noext, '.'), *slash = strrchr(noext, '/');
-    if (dot && (!slash || dot > slash)) *dot = '\0';
-    snprintf(path, sizeof path, "%s_ranks.json", noext);
+    ranks_path(o->out, path);
     if ((s = fv_dist_frames_manifest(path, o->method, o->frames, size, warmup, &err)) != FV_OK) return fv_cli_fail("render", s, err.msg);
     if (!o->quiet)
         fprintf(stderr, "mpi: %d ranks wrote %d frames (%d warm-up frames per block; %s)\n", size, o->frames, warmup, path);
     return FV_EXIT_OK;
 }
 #endif
+
+/* Every file the command will write (frames, eyes, --stats-json, a split sequence's manifest),
+ * checked against the files it reads before anything is loaded (core/inputs.h): 0 or the exit
+ * code. A sequence of a million frames costs as many stat calls, a second at most. */
+static int check_outputs(const render_opts *o, bool dist)
+{
+    const char *cmd = "render";
+    fv_inputs in;
+    fv_inputs_init(&in);
+    fv_inputs_add(&in, o->scene, "scene file");
+    fv_inputs_add(&in, o->gaze_trace, "gaze trace");
+    fv_inputs_add(&in, o->camera_trace, "camera trace");
+    int rc = o->stats_json ? fv_cli_check_output(cmd, &in, o->stats_json, "--stats-json") : 0;
+    const int neyes = o->stereo > 0 ? 2 : 1;
+    for (int f = 0; f < o->frames && rc == 0; f++)
+        for (int e = 0; e < neyes && rc == 0; e++) {
+            char path[4096];
+            frame_path(o, neyes, f, e, path);
+            rc = fv_cli_check_output(cmd, &in, path, "--out");
+        }
+#ifdef FOVEA_HAVE_MPI
+    if (rc == 0 && dist && o->frames > 1) {
+        char path[4096];
+        ranks_path(o->out, path);
+        rc = fv_cli_check_output(cmd, &in, path, "--out's manifest");
+    }
+#else
+    (void)dist;
+#endif
+    return rc;
+}
 
 /* dist: the MPI job (fv_dist *) when launched over several ranks, else NULL. */
 static int render(int argc, char **argv, void *dist)
@@ -544,6 +587,7 @@ static int render(int argc, char **argv, void *dist)
         rc = fv_cli_usage_error(cmd, "--stats-json %s: cannot write there (%s)", o.stats_json, o.stats_json[0] ? strerror(errno) : "empty path");
         goto done;
     }
+    if ((rc = check_outputs(&o, dist != NULL)) != 0) goto done;
     if ((rc = fv_cli_check_method(cmd, o.method)) != 0) goto done;
     if (o.device) {
         fv_device dev;
