@@ -65,8 +65,9 @@ static void help(void)
            "  --stats-json FILE     write every frame's stage timings and counters, with the method, its\n"
            "                        parameters and the build, as JSON (written whole at the end)\n"
            "  --quiet               no progress bar, warnings or per-frame lines\n"
-           "Exit status: 0 ok, 1 internal error, 2 bad input (the message names it), 130/143 interrupted by\n"
-           "SIGINT/SIGTERM (frames already written stay; no partial or temporary file).\n");
+           "Exit status: 0 ok, 1 internal error, 2 bad input (the message names it), 128+N interrupted by\n"
+           "signal N (130 SIGINT, 143 SIGTERM; also HUP, PIPE, QUIT, USR1, USR2, ALRM: frames already written\n"
+           "stay; no partial or temporary file).\n");
 }
 
 /* "dir/name.ext" + tag -> "dir/name<tag>.ext" */
