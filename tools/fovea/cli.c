@@ -132,6 +132,19 @@ int fv_cli_interrupt_exit(void)
     return 128 + sig;
 }
 
+int fv_cli_interrupt_exit_as(int sig, bool say)
+{
+    /* The line whole: a signal that comes meanwhile (the launcher's, once a rank exits) waits for
+     * it, then finds it said and ends the process without another. */
+    sigset_t all, was;
+    handled_set(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &was);
+    if (say) say_interrupted(sig);
+    g_said = 1;
+    pthread_sigmask(SIG_SETMASK, &was, NULL);
+    return 128 + sig;
+}
+
 int fv_cli_exit_code(fv_status s)
 {
     switch (s) {

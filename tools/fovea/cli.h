@@ -70,6 +70,9 @@ int fv_cli_interrupt_exit(void);
  * the job): a signal from now on ends it without a line of its own. For an MPI job, whose
  * launcher signals the other ranks once a failed rank exits (docs/distributed.md). */
 void fv_cli_interrupt_mute(void);
+/* An MPI job interrupted by signal sig on some rank (fv_dist_signal): this rank says the job's line
+ * when say (the one rank the agreement chose), is muted either way, and returns 128 + sig. */
+int fv_cli_interrupt_exit_as(int sig, bool say);
 
 /* ---- the thread policy (cli_threads.c, docs/threads.md) ----
  *
