@@ -94,6 +94,16 @@ def test_write_and_read_image(tmp_path):
     assert fovea.read_metadata(tmp_path / "a.png") == {"note": "hello"}
 
 
+def test_read_metadata_of_a_malformed_exr_says_nothing(tmp_path, capfd):
+    # A header cut inside the channel list: one FoveaError, and none of OpenEXR's own lines on
+    # stderr (issue 42, item 5).
+    bad = tmp_path / "cut.exr"
+    bad.write_bytes(b"v/1\x01\x02\x00\x00\x00channels\x00chlist\x00\x05")
+    with pytest.raises(fovea.FoveaError):
+        fovea.read_metadata(bad)
+    assert capfd.readouterr().err == ""
+
+
 def test_set_gaze_and_scene_queries(cornell):
     with cornell.renderer("fpm", size=SIZE, params={"photons": 2000}) as r:
         r.set_gaze((0.2, 0.8))

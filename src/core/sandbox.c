@@ -59,12 +59,16 @@ fv_status fv_sandbox_start(fv_sandbox_fn fn, void *user, size_t mem_bytes, int c
 #else
         (void)parent;
 #endif
-        /* The parent's signal handlers are not the child's business: an interrupt from the
-         * terminal reaches the child too and simply ends it (an ignored signal stays ignored). */
-        const int sigs[2] = {SIGINT, SIGTERM};
-        for (int i = 0; i < 2; i++) {
+        /* The parent's signal handlers are not the child's business (they serve the parent's
+         * main thread, which the child does not have): an interrupt from the terminal reaches the
+         * child too and simply ends it. Every caught signal goes back to its default, whichever
+         * the parent catches (the CLI's SIGINT ... SIGALRM, an embedding program's); an ignored
+         * signal stays ignored. */
+        for (int sig = 1; sig < NSIG; sig++) {
             struct sigaction was;
-            if (sigaction(sigs[i], NULL, &was) == 0 && was.sa_handler != SIG_IGN) signal(sigs[i], SIG_DFL);
+            if (sigaction(sig, NULL, &was) == 0 && !(was.sa_flags & SA_SIGINFO) && (was.sa_handler == SIG_IGN || was.sa_handler == SIG_DFL))
+                continue;
+            signal(sig, SIG_DFL);
         }
         /* The library's own prints would add lines to our one-line messages; the parent reports. */
         int null = open("/dev/null", O_WRONLY);

@@ -12,6 +12,8 @@
 enum { TAG_FAIL = 7001, TAG_DATA = 7002, TAG_NOTE = 7003 };
 /* What a rank contributes to an agreement. */
 enum { AGREE_OK = 0, AGREE_STOPPED = 1, AGREE_FAILED = 2 };
+/* The contribution: what the rank did, its status, and the signal that stopped it (0 none). */
+enum { AGREE_INTS = 3 };
 
 struct fv_dist {
     int rank, size;
@@ -25,6 +27,8 @@ struct fv_dist {
     double note_out_buf[FV_DIST_NOTE_MAX], note_in_buf[FV_DIST_NOTE_MAX];
     bool note_out_busy, note_in_posted;
     int bars; /* progress bars started (fv_dist_bar_next) */
+    int (*signal_of)(void); /* fv_dist_set_signal_source */
+    int job_signal;         /* the signal that interrupted the job (the last agreement's), 0 none */
     void (*idle)(void *user);
     void *idle_user;
 };
@@ -156,13 +160,23 @@ bool fv_dist_poll(fv_dist *d)
     return d->peer_failed;
 }
 
-/* Every rank's pair of ints. A rank that arrives early waits without spinning (MPI's blocking
+void fv_dist_set_signal_source(fv_dist *d, int (*signal_of)(void))
+{
+    d->signal_of = signal_of;
+}
+
+int fv_dist_signal(const fv_dist *d)
+{
+    return d->job_signal;
+}
+
+/* Every rank's AGREE_INTS ints. A rank that arrives early waits without spinning (MPI's blocking
  * collectives busy-poll, which takes a core from a rank still rendering on the same host): the
  * non-blocking gather is tested every millisecond (running the idle hook between tests). */
-static int wait_all(fv_dist *d, int mine[2], int *all)
+static int wait_all(fv_dist *d, int mine[AGREE_INTS], int *all)
 {
     MPI_Request q;
-    int rc = MPI_Iallgather(mine, 2, MPI_INT, all, 2, MPI_INT, MPI_COMM_WORLD, &q);
+    int rc = MPI_Iallgather(mine, AGREE_INTS, MPI_INT, all, AGREE_INTS, MPI_INT, MPI_COMM_WORLD, &q);
     int done = 0;
     while (rc == MPI_SUCCESS && !done) {
         rc = MPI_Test(&q, &done, MPI_STATUS_IGNORE);
@@ -177,12 +191,16 @@ static int wait_all(fv_dist *d, int mine[2], int *all)
 fv_status fv_dist_agree(fv_dist *d, fv_status s, bool *print_it, bool *name_rank, fv_error *err)
 {
     *print_it = *name_rank = false;
-    int mine[2] = {AGREE_OK, (int)s};
+    d->job_signal = 0;
+    /* A cancelled rank says whether a signal cancelled it: an interrupted job ends as one
+     * interrupted process does, not as a failure of the rank that happened to be signalled. */
+    const int sig = s == FV_ERR_CANCELLED && d->signal_of ? d->signal_of() : 0;
+    int mine[AGREE_INTS] = {AGREE_OK, (int)s, sig};
     if (s != FV_OK) {
         mine[0] = s == FV_ERR_CANCELLED && fv_dist_poll(d) && !d->told ? AGREE_STOPPED : AGREE_FAILED;
         if (mine[0] == AGREE_FAILED) fv_dist_tell_failure(d);
     }
-    int *all = malloc(sizeof(int) * 2 * (size_t)d->size);
+    int *all = malloc(sizeof(int) * AGREE_INTS * (size_t)d->size);
     double t0 = fv_time_ms();
     int rc = all ? wait_all(d, mine, all) : MPI_ERR_NO_MEM;
     d->wait_s += (fv_time_ms() - t0) * 1e-3;
@@ -195,13 +213,14 @@ fv_status fv_dist_agree(fv_dist *d, fv_status s, bool *print_it, bool *name_rank
     }
     int first = -1, failed = 0, stopped = -1;
     for (int r = 0; r < d->size; r++) {
-        if (all[2 * r] == AGREE_FAILED) {
+        if (all[AGREE_INTS * r] == AGREE_FAILED) {
             failed++;
             if (first < 0) first = r;
-        } else if (all[2 * r] == AGREE_STOPPED && stopped < 0) stopped = r;
+        } else if (all[AGREE_INTS * r] == AGREE_STOPPED && stopped < 0) stopped = r;
     }
     if (first < 0) first = stopped;
-    fv_status job = first < 0 ? FV_OK : (fv_status)all[2 * first + 1];
+    fv_status job = first < 0 ? FV_OK : (fv_status)all[AGREE_INTS * first + 1];
+    if (job == FV_ERR_CANCELLED) d->job_signal = all[AGREE_INTS * first + 2];
     free(all);
     if (job == FV_OK) {
         release_hold(d, d->rank == 0, false);

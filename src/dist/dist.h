@@ -43,6 +43,14 @@ fv_status fv_dist_hold(fv_dist *d, fv_error *err);
  * printing rank on failure (its lines prefixed likewise). err is set only when MPI itself fails. */
 fv_status fv_dist_agree(fv_dist *d, fv_status s, bool *print_it, bool *name_rank, fv_error *err);
 
+/* Interrupts (docs/distributed.md): signal_of() returns the signal that stopped this rank, 0 when
+ * none (the CLI's fv_cli_interrupted). A rank whose status is FV_ERR_CANCELLED passes it to the
+ * agreement, so a job stopped by a signal, on any rank, is known as interrupted on every rank. */
+void fv_dist_set_signal_source(fv_dist *d, int (*signal_of)(void));
+/* After an agreement whose job status is FV_ERR_CANCELLED: the signal that stopped the rank the
+ * agreement chose, 0 when no signal did. Every rank gets the same. */
+int fv_dist_signal(const fv_dist *d);
+
 /* Tells the other ranks this one failed (their fv_dist_poll turns true). */
 void fv_dist_tell_failure(fv_dist *d);
 /* True once another rank has failed; cheap enough to call from a progress callback. */

@@ -59,10 +59,27 @@ static fv_status png_meta(const char *path, FILE *f, fv_params *out, fv_error *e
     return st;
 }
 
+/* OpenEXR's default error handler prints every detail on stderr, a line each (2 to 4 for a
+ * malformed header): ours keeps the last, the most specific, for fovea's one line. */
+typedef struct exr_meta_msg {
+    char text[256];
+} exr_meta_msg;
+
+static void exr_meta_on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
+{
+    void *ud = NULL;
+    if (exr_get_user_data(ctxt, &ud) != EXR_ERR_SUCCESS || !ud) return;
+    exr_meta_msg *m = ud;
+    snprintf(m->text, sizeof m->text, "%s", msg ? msg : exr_get_error_code_as_string(code));
+}
+
 static fv_status exr_meta(const char *path, fv_params *out, fv_error *err)
 {
     exr_context_t ctxt = NULL;
+    exr_meta_msg m = {{0}};
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = exr_meta_on_error;
+    init.user_data = &m;
     exr_result_t r = exr_start_read(&ctxt, path, &init);
     int32_t n = 0;
     if (r == EXR_ERR_SUCCESS) r = exr_get_attribute_count(ctxt, 0, &n);
@@ -78,7 +95,7 @@ static fv_status exr_meta(const char *path, fv_params *out, fv_error *err)
     }
     if (ctxt) exr_finish(&ctxt);
     if (r != EXR_ERR_SUCCESS && st == FV_OK)
-        st = fv_error_set(err, r == EXR_ERR_FILE_ACCESS ? FV_ERR_IO : FV_ERR_INVALID, "cannot read '%s': %s", path, exr_get_error_code_as_string(r));
+        st = fv_error_set(err, r == EXR_ERR_FILE_ACCESS ? FV_ERR_IO : FV_ERR_INVALID, "cannot read '%s': %s", path, m.text[0] ? m.text : exr_get_error_code_as_string(r));
     return st;
 }
 

@@ -41,4 +41,11 @@ expect 2 "expected two images" -- $C "$TMP/ref.pfm"
 printf 'not an image' > "$TMP/junk.png"
 expect 2 "junk.png" -- $C "$TMP/ref.pfm" "$TMP/junk.png"
 expect 2 "--heatmap" -- $C "$TMP/ref.pfm" "$TMP/a.pfm" --heatmap "$TMP/heat.jpg"
+# A malformed EXR (its header cut inside the channel list, or not an EXR version at all): fovea's
+# one line, without OpenEXR's own messages (which its default handler printed, 2 to 4 lines, when
+# the metadata was read; issue 42, item 5).
+printf 'v/1\001\002\000\000\000channels\000chlist\000\005' >"$TMP/cut.exr"
+expect 2 "cut.exr" -- $C "$TMP/cut.exr" "$TMP/cut.exr"
+printf 'v/1\001garbage' >"$TMP/garbage.exr"
+expect 2 "garbage.exr" -- $C "$TMP/ref.pfm" "$TMP/garbage.exr"
 finish

@@ -1,4 +1,5 @@
-# fovea CLI: SIGINT and SIGTERM (issue 25, item 9). An interrupted command prints one line
+# fovea CLI: SIGINT and SIGTERM (issue 25, item 9), and SIGHUP, SIGPIPE, SIGQUIT, SIGUSR1, SIGUSR2 and
+# SIGALRM handled alike (issue 42, item 3; 128 + the signal's number). An interrupted command prints one line
 # ("fovea render: interrupted (SIGINT)"), exits 130 (SIGINT) or 143 (SIGTERM), leaves no
 # temporary file of the atomic writer (*.tmp.*) and no partial output, and no child process (a
 # mesh import's sandbox child dies with it). tools/fovea/cli.h describes the two ways a command
@@ -23,11 +24,11 @@ started() {
   PID=$!
 }
 
-# ended SIG WHAT: waits for PID, which was sent SIG (INT or TERM); checks the exit status and the
-# one line on stderr.
+# ended SIG WHAT: waits for PID, which was sent SIG (INT, TERM, HUP, ...); checks the exit status
+# (128 + the signal's number) and the one line on stderr.
 ended() {
-  local sig=$1 what=$2 want=130 got
-  [ "$sig" = TERM ] && want=143
+  local sig=$1 what=$2 want got
+  want=$((128 + $(kill -l "$sig")))
   wait "$PID"
   got=$?
   [ "$got" = "$want" ] || fail "$what: exit status $got after SIG$sig, expected $want; stderr: $(head -c 400 "$TMP/err")"
@@ -96,6 +97,51 @@ else
   fail "the EXR's temporary file never appeared"
 fi
 
+# ---- the other signals that ask a process to stop, during a write ----
+# Each handled as SIGTERM is: sent twice while the EXR is written (the second stops at once), one
+# line, 128 + the signal, no temporary. Before issue 42 each killed fovea by its default action,
+# silently, leaving o.exr.tmp.XXXXXX.
+W1="${W/2048x2048/1024x1024}"
+for sig in HUP PIPE QUIT USR1 USR2 ALRM; do
+  rm -rf "${D:?}"/*
+  started $W1 --out "$D/o.exr"
+  if wait_for 10 temp_of "$D/o.exr"; then
+    kill -$sig $PID
+    sleep 0.02
+    kill -$sig $PID 2>/dev/null
+    ended $sig "SIG$sig during a write"
+    no_temps "$D" "SIG$sig during a write"
+  else
+    kill -KILL $PID
+    wait $PID
+    fail "SIG$sig: the EXR's temporary file never appeared"
+  fi
+done
+
+# ---- a write to a closed pipe ----
+# fovea's output goes to a reader that has already left: SIGPIPE ends it as above (the line on a
+# stderr that is still open). env restores SIGPIPE's default where the test runs with it ignored
+# (which fovea would respect: the write then fails instead).
+dflt=()
+env --default-signal=PIPE true 2>/dev/null && dflt=(env --default-signal=PIPE)
+{
+  sleep 0.5
+  exec "${dflt[@]}" $FOVEA methods 2>"$TMP/err"
+} | true
+got=${PIPESTATUS[0]}
+[ "$got" = 141 ] || fail "methods into a closed pipe: exit status $got, expected 141: $(head -c 400 "$TMP/err")"
+[ "$(cat "$TMP/err")" = "fovea methods: interrupted (SIGPIPE)" ] || fail "methods into a closed pipe: stderr is not the one line: $(head -c 400 "$TMP/err")"
+# The per-frame lines of a sequence, on a stderr whose reader has left: the render stops after the
+# frame (as a deferred signal does), 141, no temporary.
+rm -rf "${D:?}"/*
+{
+  sleep 0.5
+  exec "${dflt[@]}" $FOVEA render cornell --method pt --spp 1 --size 32x32 --frames 4 --threads 2 --out "$D/s.png" 2>&1 >/dev/null
+} | true
+got=${PIPESTATUS[0]}
+[ "$got" = 141 ] || fail "a render's progress into a closed pipe: exit status $got, expected 141"
+no_temps "$D" "a render's progress into a closed pipe"
+
 # ---- SIGTERM during a mesh import: the importer's child ends with fovea ----
 # About a million triangles: assimp parses them for a second or more in its sandbox child.
 awk 'BEGIN { n = 720
@@ -129,7 +175,7 @@ cat >"$TMP/slow.json" <<'EOF'
  "gaze": {"fixed": [0.5, 0.5]}, "reference": {"method": "pt", "params": {"spp": 512}},
  "methods": [{"label": "pt-4", "method": "pt", "params": {"spp": 4}}, {"label": "pt-256", "method": "pt", "params": {"spp": 256}}]}
 EOF
-for sig in INT TERM; do
+for sig in INT TERM HUP; do
   rm -rf "${D:?}"/*
   started $FOVEA bench "$TMP/slow.json" --quiet --threads 2 --out "$D"
   sleep 1

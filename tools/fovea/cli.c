@@ -15,20 +15,46 @@
  *
  * The only mutable globals of fovea: what the signal handler needs, which cannot be passed to it.
  * The lines and the main thread are set before the handler is installed and only read after. */
-static volatile sig_atomic_t g_signal; /* the first SIGINT/SIGTERM received, 0 none */
+
+/* The signals that end a command as SIGTERM does: each asks the process to stop (a closed
+ * terminal, a closed pipe, a quit key, a timer, a user's signal a job manager sends), and each
+ * would otherwise end it by the default action, mid-write, leaving the atomic writer's temporary
+ * file and no message. */
+#define NSIGS 8
+static const int k_sigs[NSIGS] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM};
+static const char *const k_sig_names[NSIGS] = {"SIGINT", "SIGTERM", "SIGHUP", "SIGPIPE", "SIGQUIT", "SIGUSR1", "SIGUSR2", "SIGALRM"};
+
+static volatile sig_atomic_t g_signal; /* the first handled signal received, 0 none */
 static volatile sig_atomic_t g_defer;  /* 1: the command stops at its next cancellation point */
 static volatile sig_atomic_t g_said;   /* 1: the line has been printed */
-static char g_line[2][160];            /* "fovea <cmd>: interrupted (SIGINT)\n", (SIGTERM) */
-static size_t g_line_len[2];
+static char g_line[NSIGS][160];        /* "fovea <cmd>: interrupted (SIGINT)\n", one per signal */
+static size_t g_line_len[NSIGS];
 static pthread_t g_main;
+
+/* Async-signal-safe: a loop over a constant table. */
+static int sig_index(int sig)
+{
+    for (int k = 0; k < NSIGS; k++)
+        if (k_sigs[k] == sig) return k;
+    return 0;
+}
+
+/* Every handled signal: blocked while the handler runs, and once the command only returns. */
+static void handled_set(sigset_t *set)
+{
+    sigemptyset(set);
+    for (int k = 0; k < NSIGS; k++) sigaddset(set, k_sigs[k]);
+}
 
 static void say_interrupted(int sig)
 {
     if (g_said) return;
     g_said = 1;
-    int k = sig == SIGTERM;
+    int k = sig_index(sig);
     const char *p = g_line[k];
     size_t n = g_line_len[k];
+    /* A closed stderr (the SIGPIPE case) fails the write with EPIPE: the signal it raises is
+     * blocked here (handler or fv_cli_interrupt_exit), so the process still ends by its status. */
     while (n > 0) {
         ssize_t w = write(STDERR_FILENO, p, n);
         if (w < 0 && errno == EINTR) continue;
@@ -61,9 +87,8 @@ static void on_signal(int sig)
 
 void fv_cli_interrupt_install(const char *cmd)
 {
-    static const char *names[2] = {"SIGINT", "SIGTERM"};
-    for (int k = 0; k < 2; k++) {
-        int n = snprintf(g_line[k], sizeof g_line[k], "fovea %.100s: interrupted (%s)\n", cmd, names[k]);
+    for (int k = 0; k < NSIGS; k++) {
+        int n = snprintf(g_line[k], sizeof g_line[k], "fovea %.100s: interrupted (%s)\n", cmd, k_sig_names[k]);
         g_line_len[k] = n > 0 && (size_t)n < sizeof g_line[k] ? (size_t)n : strlen(g_line[k]);
     }
     g_main = pthread_self();
@@ -72,14 +97,11 @@ void fv_cli_interrupt_install(const char *cmd)
     sa.sa_handler = on_signal;
     /* Restarted system calls: a deferred signal must not fail a write in progress. */
     sa.sa_flags = SA_RESTART;
-    sigemptyset(&sa.sa_mask);
-    sigaddset(&sa.sa_mask, SIGINT);
-    sigaddset(&sa.sa_mask, SIGTERM);
-    const int sigs[2] = {SIGINT, SIGTERM};
-    for (int k = 0; k < 2; k++) {
+    handled_set(&sa.sa_mask);
+    for (int k = 0; k < NSIGS; k++) {
         struct sigaction was;
-        if (sigaction(sigs[k], NULL, &was) == 0 && was.sa_handler == SIG_IGN) continue;
-        sigaction(sigs[k], &sa, NULL);
+        if (sigaction(k_sigs[k], NULL, &was) == 0 && was.sa_handler == SIG_IGN) continue;
+        sigaction(k_sigs[k], &sa, NULL);
     }
 }
 
@@ -103,12 +125,23 @@ int fv_cli_interrupt_exit(void)
     int sig = g_signal ? g_signal : SIGINT;
     /* From here on the command only returns: a further signal waits (blocked), so the handler
      * cannot cut this line short or end the process without it. */
-    sigset_t both;
-    sigemptyset(&both);
-    sigaddset(&both, SIGINT);
-    sigaddset(&both, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &both, NULL);
+    sigset_t all;
+    handled_set(&all);
+    pthread_sigmask(SIG_BLOCK, &all, NULL);
     say_interrupted(sig);
+    return 128 + sig;
+}
+
+int fv_cli_interrupt_exit_as(int sig, bool say)
+{
+    /* The line whole: a signal that comes meanwhile (the launcher's, once a rank exits) waits for
+     * it, then finds it said and ends the process without another. */
+    sigset_t all, was;
+    handled_set(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &was);
+    if (say) say_interrupted(sig);
+    g_said = 1;
+    pthread_sigmask(SIG_SETMASK, &was, NULL);
     return 128 + sig;
 }
 

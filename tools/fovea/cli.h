@@ -45,12 +45,13 @@ bool fv_cli_parse_size(const char *s, int *w, int *h);      /* "WxH" */
 /* Warning sink printing "fovea: warning: ..." on stderr (silenced when quiet). */
 fv_log fv_cli_log(bool *quiet);
 
-/* ---- interruption (SIGINT, SIGTERM) ----
+/* ---- interruption (SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM) ----
  *
- * The CLI, not the library, handles the two signals (the library installs no handler and keeps no
- * state). A command ends at once with one line on stderr, "fovea <cmd>: interrupted (SIGINT)",
- * and exit status 128 + the signal (130, 143), leaving no temporary file of an unfinished write
- * and no child process:
+ * The CLI, not the library, handles these signals, every one as SIGTERM (the library installs no
+ * handler and keeps no state). A command ends at once with one line on stderr, "fovea <cmd>:
+ * interrupted (SIGINT)", and exit status 128 + the signal (130 INT, 143 TERM, 129 HUP, 141 PIPE,
+ * 131 QUIT, 138 USR1, 140 USR2, 142 ALRM), leaving no temporary file of an unfinished write and no
+ * child process (a write to a closed pipe, `fovea methods | head -1`, ends the same way):
  *  - at once by default: the handler runs on the main thread (another thread that receives the
  *    signal passes it there), removes the temporary files of the atomic writes the process has
  *    open (fv_atomic_file_remove_open_temps: whatever the main thread was doing, it never
@@ -67,7 +68,7 @@ fv_log fv_cli_log(bool *quiet);
 void fv_cli_interrupt_install(const char *cmd);
 /* Deferred (on) or at once (off, the default). */
 void fv_cli_interrupt_defer(bool on);
-/* The signal received (SIGINT or SIGTERM), 0 when none. */
+/* The signal received (one of the above), 0 when none. */
 int fv_cli_interrupted(void);
 /* Prints the interruption line (once) and returns the exit status, 128 + the signal. */
 int fv_cli_interrupt_exit(void);
@@ -75,6 +76,9 @@ int fv_cli_interrupt_exit(void);
  * the job): a signal from now on ends it without a line of its own. For an MPI job, whose
  * launcher signals the other ranks once a failed rank exits (docs/distributed.md). */
 void fv_cli_interrupt_mute(void);
+/* An MPI job interrupted by signal sig on some rank (fv_dist_signal): this rank says the job's line
+ * when say (the one rank the agreement chose), is muted either way, and returns 128 + sig. */
+int fv_cli_interrupt_exit_as(int sig, bool say);
 
 /* ---- the thread policy (cli_threads.c, docs/threads.md) ----
  *

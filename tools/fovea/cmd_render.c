@@ -65,8 +65,9 @@ static void help(void)
            "  --stats-json FILE     write every frame's stage timings and counters, with the method, its\n"
            "                        parameters and the build, as JSON (written whole at the end)\n"
            "  --quiet               no progress bar, warnings or per-frame lines\n"
-           "Exit status: 0 ok, 1 internal error, 2 bad input (the message names it), 130/143 interrupted by\n"
-           "SIGINT/SIGTERM (frames already written stay; no partial or temporary file).\n");
+           "Exit status: 0 ok, 1 internal error, 2 bad input (the message names it), 128+N interrupted by\n"
+           "signal N (130 SIGINT, 143 SIGTERM; also HUP, PIPE, QUIT, USR1, USR2, ALRM: frames already written\n"
+           "stay; no partial or temporary file).\n");
 }
 
 /* "dir/name.ext" + tag -> "dir/name<tag>.ext" */
@@ -387,6 +388,10 @@ static void unsplit_note(const char *method, const fv_params *params, int size, 
  * not every rank failed (as the held messages of the set-up are replayed), else as one process. */
 static int dist_fail(fv_dist *d, fv_status s, bool print_it, bool name_rank, const char *msg)
 {
+    /* Interrupted (a signal on any rank): as one process, "fovea render: interrupted (SIGTERM)"
+     * without a rank, 128 + the signal on every rank, not a failure of the signalled rank. */
+    const int sig = s == FV_ERR_CANCELLED ? fv_dist_signal(d) : 0;
+    if (sig) return fv_cli_interrupt_exit_as(sig, print_it);
     fv_cli_interrupt_mute(); /* the launcher may now signal this rank: the job's line is said once */
     if (print_it) {
         if (name_rank) fprintf(stderr, "rank %d: ", fv_dist_rank(d));
@@ -750,6 +755,7 @@ int fv_cmd_render(int argc, char **argv)
         fv_error_clear(&err);
         fv_status s = fv_dist_start(NULL, NULL, &d, &err);
         if (s != FV_OK) return fv_cli_fail("render", s, err.msg);
+        fv_dist_set_signal_source(d, fv_cli_interrupted);
         if (fv_dist_size(d) > 1 && (s = fv_dist_hold(d, &err)) != FV_OK) {
             fv_dist_end(d);
             return fv_cli_fail("render", s, err.msg);

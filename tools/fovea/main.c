@@ -27,8 +27,9 @@ static void usage(FILE *f)
     for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
         fprintf(f, "  %-9s %s\n", k_commands[i].name, k_commands[i].summary);
     fprintf(f, "\nfovea renders global illumination where the effort follows the viewer's gaze.\n"
-               "Exit status: 0 success, 1 internal error, 2 bad input (the message names it), 130/143 interrupted\n"
-               "(SIGINT/SIGTERM: no temporary or partial file is left).\n");
+               "Exit status: 0 success, 1 internal error, 2 bad input (the message names it), 128+N interrupted\n"
+               "by signal N (130 SIGINT, 143 SIGTERM; also HUP, PIPE, QUIT, USR1, USR2, ALRM: no temporary or partial\n"
+               "file is left).\n");
 }
 
 int main(int argc, char **argv)
@@ -50,7 +51,7 @@ int main(int argc, char **argv)
     }
     for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
         if (!strcmp(argv[1], k_commands[i].name)) {
-            /* SIGINT/SIGTERM end any command in one line with 130/143 and leave no temporary
+            /* SIGINT, SIGTERM and the like end any command in one line with 128 + N and leave no temporary
              * file or child behind (cli.h); the line names the command as its errors do. */
             bool import = !strcmp(argv[1], "gaze") && argc > 2 && !strcmp(argv[2], "import");
             /* Commands that render run under the thread policy: before anything else, since it
