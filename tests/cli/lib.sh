@@ -34,3 +34,21 @@ finish() {
   fi
   echo "all checks passed"
 }
+
+# For the MPI tests (test_mpi.sh, test_mpi_interrupt.sh): skips (exit 77) where fovea was built
+# without MPI or mpirun is missing; lets OpenMPI run as root (CI does: it refuses unless told
+# twice); sets MPIENV, the command prefix of the ranks: under the sanitizers (scripts/test),
+# OpenMPI's own allocations, made by components it unloads at MPI_Finalize, are reported as leaks
+# LeakSanitizer cannot attribute or suppress by library, so the ranks run with leak detection off
+# (AddressSanitizer and UBSan stay on); one-process renders keep it.
+fv_mpi_setup() {
+  if [ "${FV_HAVE_MPI:-OFF}" != ON ] || ! command -v mpirun >/dev/null; then
+    echo "skipped: fovea built without MPI (FOVEA_MPI) or no mpirun"
+    exit 77
+  fi
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+  MPIENV=()
+  if [ "${FOVEA_SANITIZED:-0}" = 1 ]; then
+    MPIENV=(env "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0")
+  fi
+}

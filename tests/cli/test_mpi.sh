@@ -6,20 +6,7 @@
 # bench's report, and the reference cache it splits over the ranks, equal a one-process run's.
 # Skipped (exit 77) where fovea was built without MPI or mpirun is missing.
 . "$(dirname "$0")/lib.sh"
-if [ "${FV_HAVE_MPI:-OFF}" != ON ] || ! command -v mpirun >/dev/null; then
-  echo "skipped: fovea built without MPI (FOVEA_MPI) or no mpirun"
-  exit 77
-fi
-# CI runs as root; OpenMPI refuses root unless told twice.
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-MPIENV=()
-# Under the sanitizers (scripts/test), OpenMPI's own allocations, made by components it unloads
-# at MPI_Finalize, are reported as leaks LeakSanitizer cannot attribute or suppress by library: the
-# ranks run with leak detection off (AddressSanitizer and UBSan stay on); the one-process renders
-# here keep it.
-if [ "${FOVEA_SANITIZED:-0}" = 1 ]; then
-  MPIENV=(env "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0")
-fi
+fv_mpi_setup
 # Images are compared byte for byte, so written without metadata (which holds render times).
 # Ranks on whatever cores there are; -q keeps mpirun's own banners out of the messages checked.
 MPI="${MPIENV[*]} mpirun -q --oversubscribe --bind-to none"

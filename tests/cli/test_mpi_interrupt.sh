@@ -4,16 +4,7 @@
 # "rank 1: fovea render: render cancelled"), every rank exiting 128 + the signal, no temporary.
 # Skipped (exit 77) where fovea was built without MPI or mpirun is missing.
 . "$(dirname "$0")/lib.sh"
-if [ "${FV_HAVE_MPI:-OFF}" != ON ] || ! command -v mpirun >/dev/null; then
-  echo "skipped: fovea built without MPI (FOVEA_MPI) or no mpirun"
-  exit 77
-fi
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-MPIENV=()
-# As in test_mpi.sh: OpenMPI's own allocations are leaks LeakSanitizer cannot attribute.
-if [ "${FOVEA_SANITIZED:-0}" = 1 ]; then
-  MPIENV=(env "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0")
-fi
+fv_mpi_setup
 # Job control: the launcher and its ranks keep SIGINT (a background job of a shell without it
 # starts with SIGINT ignored, which fovea respects).
 set -m

@@ -101,29 +101,40 @@ static inline int fv_test_load(const char *name, fv_scene **scene, fv_view **vie
     return -1;
 }
 
-/* The path of test data file `rel` (under tests/data): $FOVEA_TEST_DATA when set (a test binary
- * carried to another machine, scripts/gpu-check), else the source tree's folder it was built with. */
-static inline const char *fv_test_data(const char *rel, char *buf, size_t n)
+/* rel under the folder the environment variable `var` names when set (a test binary carried to
+ * another machine, scripts/gpu-check), else under `built` (the folder compiled in; NULL: none),
+ * else under `fallback`. */
+static inline const char *fv_test_path_in(const char *var, const char *built, const char *fallback, const char *rel, char *buf, size_t n)
 {
-    const char *dir = getenv("FOVEA_TEST_DATA");
-#ifdef FOVEA_TEST_DATA
-    if (!dir) dir = FOVEA_TEST_DATA;
-#endif
-    snprintf(buf, n, "%s/%s", dir ? dir : "tests/data", rel);
+    const char *dir = getenv(var);
+    if (!dir) dir = built ? built : fallback;
+    snprintf(buf, n, "%s/%s", dir, rel);
     return buf;
 }
 
+#ifndef FOVEA_TEST_DATA
+#define FV_TEST_DATA_BUILT NULL
+#else
+#define FV_TEST_DATA_BUILT FOVEA_TEST_DATA
+#endif
+#ifndef FOVEA_SOURCE_DIR
+#define FV_TEST_SOURCE_BUILT NULL
+#else
+#define FV_TEST_SOURCE_BUILT FOVEA_SOURCE_DIR
+#endif
+
+/* The path of test data file `rel` (under tests/data): $FOVEA_TEST_DATA when set, else the source
+ * tree's folder the test was built with. */
+static inline const char *fv_test_data(const char *rel, char *buf, size_t n)
+{
+    return fv_test_path_in("FOVEA_TEST_DATA", FV_TEST_DATA_BUILT, "tests/data", rel, buf, n);
+}
+
 /* The path of `rel` under the source tree (scenes/..., bench/...): $FOVEA_SOURCE_DIR when set (the
- * bundle scripts/gpu-check unpacks on another machine mirrors those folders), else the tree the
- * test was built from, else the current folder. */
+ * bundle scripts/gpu-check unpacks mirrors those folders), else the tree the test was built from. */
 static inline const char *fv_test_source(const char *rel, char *buf, size_t n)
 {
-    const char *dir = getenv("FOVEA_SOURCE_DIR");
-#ifdef FOVEA_SOURCE_DIR
-    if (!dir) dir = FOVEA_SOURCE_DIR;
-#endif
-    snprintf(buf, n, "%s/%s", dir ? dir : ".", rel);
-    return buf;
+    return fv_test_path_in("FOVEA_SOURCE_DIR", FV_TEST_SOURCE_BUILT, ".", rel, buf, n);
 }
 
 /* ---- rendering by hand ---- */

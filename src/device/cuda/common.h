@@ -63,10 +63,9 @@ static inline void fv_cuda_release(fv_cuda_tally *k, void *p)
     fv_cuda_waited(k, false);
 }
 
-/* cudaMemcpyAsync on st, host to device or device to host (or device to device). */
-static inline cudaError_t fv_cuda_copy(fv_cuda_tally *k, void *dst, const void *src, size_t bytes, enum cudaMemcpyKind kind, cudaStream_t st)
+/* A copy's bytes, each way, and whether its host side is pageable (then it is counted as such). */
+static inline bool fv_cuda_count_copy(fv_cuda_tally *k, void *dst, const void *src, size_t bytes, enum cudaMemcpyKind kind)
 {
-    if (bytes == 0) return cudaSuccess;
     bool pageable = false;
     if (kind == cudaMemcpyHostToDevice) {
         k->n.bytes_h2d += bytes;
@@ -75,9 +74,17 @@ static inline cudaError_t fv_cuda_copy(fv_cuda_tally *k, void *dst, const void *
         k->n.bytes_d2h += bytes;
         pageable = fv_cuda_pageable(dst);
     }
+    if (pageable) k->n.pageable_copies++;
+    return pageable;
+}
+
+/* cudaMemcpyAsync on st, host to device or device to host (or device to device). */
+static inline cudaError_t fv_cuda_copy(fv_cuda_tally *k, void *dst, const void *src, size_t bytes, enum cudaMemcpyKind kind, cudaStream_t st)
+{
+    if (bytes == 0) return cudaSuccess;
+    const bool pageable = fv_cuda_count_copy(k, dst, src, bytes, kind);
     cudaError_t e = cudaMemcpyAsync(dst, src, bytes, kind, st);
     if (pageable) {
-        k->n.pageable_copies++;
         fv_cuda_waited(k, true);
     } else {
         k->queued = true;
@@ -89,16 +96,8 @@ static inline cudaError_t fv_cuda_copy(fv_cuda_tally *k, void *dst, const void *
 static inline cudaError_t fv_cuda_copy_now(fv_cuda_tally *k, void *dst, const void *src, size_t bytes, enum cudaMemcpyKind kind)
 {
     if (bytes == 0) return cudaSuccess;
-    bool pageable = false;
-    if (kind == cudaMemcpyHostToDevice) {
-        k->n.bytes_h2d += bytes;
-        pageable = fv_cuda_pageable(src);
-    } else if (kind == cudaMemcpyDeviceToHost) {
-        k->n.bytes_d2h += bytes;
-        pageable = fv_cuda_pageable(dst);
-    }
+    fv_cuda_count_copy(k, dst, src, bytes, kind);
     cudaError_t e = cudaMemcpy(dst, src, bytes, kind);
-    if (pageable) k->n.pageable_copies++;
     fv_cuda_waited(k, true);
     return e;
 }
