@@ -1,6 +1,6 @@
 # The CUDA simulator (docs/gpu.md, "The CUDA simulator"): where no real CUDA backend is built, the
-# CUDA backend's own sources (src/device/cuda/*.cu) are compiled a second time by the host's C++
-# compiler against a host implementation of the CUDA runtime (src/device/cuda/sim, first on their
+# CUDA backend's own sources (src/**/*.cu) are compiled a second time by the host's C++
+# compiler against a host implementation of the CUDA runtime (tests/cuda_sim, first on their
 # include path) and linked with the library's objects (all but the "built without CUDA" stub) into
 # fovea_sim, a static library only the tests link: tests/CMakeLists.txt builds every tests/gpu test
 # a second time against it as sim_test_* (label cuda_sim). So CI, with no GPU, executes the CUDA host
@@ -26,8 +26,8 @@ if(FV_HAVE_CUDA_SIM)
   find_package(Threads REQUIRED)
   # One C++ file per .cu that includes it, so that the .cu keeps no C++ language property of its own
   # (and a new .cu under src/device/cuda/ joins without an edit here).
-  file(GLOB FV_SIM_CU CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/device/cuda/*.cu)
-  set(FV_SIM_SOURCES ${CMAKE_SOURCE_DIR}/src/device/cuda/sim/runtime.cpp)
+  file(GLOB_RECURSE FV_SIM_CU CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/*.cu)
+  set(FV_SIM_SOURCES ${CMAKE_SOURCE_DIR}/tests/cuda_sim/runtime.cpp)
   foreach(cu ${FV_SIM_CU})
     get_filename_component(name ${cu} NAME_WE)
     file(CONFIGURE OUTPUT ${CMAKE_BINARY_DIR}/cuda_sim/${name}.cpp
@@ -36,7 +36,7 @@ if(FV_HAVE_CUDA_SIM)
   endforeach()
   add_library(fovea_cuda_sim OBJECT ${FV_SIM_SOURCES})
   # the simulator's cuda_runtime.h before any other
-  target_include_directories(fovea_cuda_sim BEFORE PRIVATE ${CMAKE_SOURCE_DIR}/src/device/cuda/sim)
+  target_include_directories(fovea_cuda_sim BEFORE PRIVATE ${CMAKE_SOURCE_DIR}/tests/cuda_sim)
   target_include_directories(fovea_cuda_sim PRIVATE ${CMAKE_SOURCE_DIR}/include ${CMAKE_SOURCE_DIR}/src)
   set_target_properties(fovea_cuda_sim PROPERTIES CXX_STANDARD 17 CXX_STANDARD_REQUIRED ON CXX_EXTENSIONS OFF)
   # The kernels' floats as the C build's (no contraction into FMA, as nvcc's --fmad=false): the
@@ -44,7 +44,14 @@ if(FV_HAVE_CUDA_SIM)
   target_compile_options(fovea_cuda_sim PRIVATE -Wall -Wextra -Wshadow -Wno-unused-parameter -ffp-contract=off -fno-math-errno)
   target_link_libraries(fovea_cuda_sim PRIVATE ${FV_DEPS})
 
-  add_library(fovea_sim STATIC $<TARGET_OBJECTS:fovea_obj> $<TARGET_OBJECTS:fovea_cuda_sim>)
+  # The kernels' descriptors again, now pointing at their (simulated) CUDA launchers.
+  add_library(fovea_sim_kernels OBJECT ${FV_VARIANT_SOURCES})
+  target_include_directories(fovea_sim_kernels PRIVATE ${CMAKE_SOURCE_DIR}/include ${CMAKE_SOURCE_DIR}/src)
+  target_compile_options(fovea_sim_kernels PRIVATE ${FV_WARN})
+  target_compile_definitions(fovea_sim_kernels PRIVATE ${FV_D_DEFS} FOVEA_HAVE_CUDA=1)
+  target_link_libraries(fovea_sim_kernels PRIVATE ${FV_DEPS})
+
+  add_library(fovea_sim STATIC $<TARGET_OBJECTS:fovea_obj> $<TARGET_OBJECTS:fovea_cuda_sim> $<TARGET_OBJECTS:fovea_sim_kernels>)
   target_include_directories(fovea_sim PUBLIC ${CMAKE_SOURCE_DIR}/include ${CMAKE_SOURCE_DIR}/src)
   target_link_libraries(fovea_sim PUBLIC ${FV_DEPS} Threads::Threads)
   set_target_properties(fovea_sim PROPERTIES LINKER_LANGUAGE CXX)

@@ -1,5 +1,6 @@
-/* fovea — the CUDA backend as the rest of the library sees it: plain C declarations, no CUDA
- * header (the .cu files under device/cuda/ implement them with nvcc). In a build without CUDA
+/* fovea — the sphere tracers' and the Visual-Polar family's CUDA frames as the rest of the library
+ * sees them (pt's frame is already written once over device/backend.h; these two follow): plain C
+ * declarations, no CUDA header (device/cuda/sdf.cu and vpolar.cu implement them with nvcc). In a build without CUDA
  * (FOVEA_HAVE_CUDA undefined) device/cuda_stub.c answers instead: "built without CUDA".
  */
 #ifndef FV_DEVICE_CUDA_BACKEND_H
@@ -8,6 +9,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include "device/backend.h"
 #include "fovea/camera.h"
 #include "fovea/film.h"
 #include "filter/svgf.h"
@@ -30,45 +32,9 @@ struct fv_ksdf_pyr_counts;
 struct fv_kpyr;
 struct fv_kpyr_fovea;
 
-/* What a CUDA backend asked of the runtime, counted by the backend's own calls (device/cuda/
- * common.h), so that a real GPU and the simulator report the same figures: what decides a frame's
- * cost besides its kernels. A host wait is a call that holds the host until the device is done: a
- * synchronize after queued work, a synchronous copy, a cudaFree after queued work, and every copy
- * between the device and pageable host memory (CUDA stages it through a pinned buffer of its own
- * while the host waits; cudaPointerGetAttributes says which memory is pageable). Techniques report
- * a frame's difference as --stats-json counters (fv_cuda_calls_report). */
-typedef struct fv_cuda_calls {
-    uint64_t launches;
-    uint64_t syncs;           /* synchronize calls */
-    uint64_t host_waits;
-    uint64_t pageable_copies; /* copies between the device and pageable host memory */
-    uint64_t bytes_h2d, bytes_d2h;
-    uint64_t allocations, frees; /* device memory taken and given back */
-} fv_cuda_calls;
-
-/* Adds after - before to stats as the counters launches, host_waits, pageable_copies, h2d_bytes,
- * d2h_bytes, device_allocs and device_frees (device/device.c). */
-struct fv_stats;
-void fv_cuda_calls_report(struct fv_stats *stats, const fv_cuda_calls *before, const fv_cuda_calls *after);
-
-/* True when a CUDA device can run our kernels; else false with the reason in why. */
-bool fv_cuda_probe(char *why, size_t why_len);
-
-
-typedef struct fv_cuda_pt fv_cuda_pt;
-/* Copies the flat scene (host memory) to the GPU. */
-fv_status fv_cuda_pt_create(const struct fv_kscene *host, fv_cuda_pt **out, fv_error *err);
-/* Brings the GPU's copy to the host snapshot's time: what moves (instances, top level, lights). */
-fv_status fv_cuda_pt_update(fv_cuda_pt *c, const struct fv_kscene *host, fv_error *err);
-/* Renders `eyes` eyes (1, or 2: a stereo pair, f and out one per eye, both kernels launched before
- * the one host wait) into the films' buffers (host memory): colour and whichever auxiliary buffers
- * are set. *rays and *nan_samples receive the counts of all eyes; *kernel_ms the kernels' own time
- * (events); *syncs the host waits (1). */
-fv_status fv_cuda_pt_render(fv_cuda_pt *c, int eyes, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays, uint64_t *nan_samples,
-                            double *kernel_ms, int *syncs, fv_error *err);
-void fv_cuda_pt_destroy(fv_cuda_pt *c);
-/* What c has asked of the runtime since it was created. */
-void fv_cuda_pt_calls(const fv_cuda_pt *c, fv_cuda_calls *out);
+/* What a backend asked of the runtime (device/backend.h), counted by the backend's own calls
+ * (device/cuda/common.h). */
+typedef fv_backend_calls fv_cuda_calls;
 
 /* The sphere-tracing family (kernel/sdf_pixel.h, kernel/sdf_pyramid.h): the GPU's buffers for the
  * world, the films, the pyramid and fipr's history, kept between frames and grown when a frame

@@ -7,34 +7,6 @@
 
 static const char k_no_cuda[] = "fovea was built without CUDA (configure with a CUDA compiler on the PATH, or -DFOVEA_CUDA=ON; docs/gpu.md)";
 
-bool fv_cuda_probe(char *why, size_t why_len)
-{
-    if (why && why_len) snprintf(why, why_len, "%s", k_no_cuda);
-    return false;
-}
-
-fv_status fv_cuda_pt_create(const struct fv_kscene *host, fv_cuda_pt **out, fv_error *err)
-{
-    (void)host;
-    *out = NULL;
-    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
-}
-
-fv_status fv_cuda_pt_update(fv_cuda_pt *c, const struct fv_kscene *host, fv_error *err)
-{
-    (void)c, (void)host;
-    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
-}
-
-fv_status fv_cuda_pt_render(fv_cuda_pt *c, int eyes, const fv_kpt_frame *f, const fv_film_views *out, uint64_t *rays, uint64_t *nan_samples,
-                            double *kernel_ms, int *syncs, fv_error *err)
-{
-    (void)c, (void)eyes, (void)f, (void)out, (void)rays, (void)nan_samples, (void)kernel_ms, (void)syncs;
-    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
-}
-
-void fv_cuda_pt_destroy(fv_cuda_pt *c) { (void)c; }
-
 fv_status fv_cuda_sdf_create(fv_cuda_sdf **out, fv_error *err)
 {
     *out = NULL;
@@ -75,12 +47,6 @@ fv_status fv_cuda_vp_render(fv_cuda_vp *const *c, int eyes, const fv_cuda_vp_fra
 }
 
 /* Nothing is ever created here, so nothing has been asked of a runtime. */
-void fv_cuda_pt_calls(const fv_cuda_pt *c, fv_cuda_calls *out)
-{
-    (void)c;
-    memset(out, 0, sizeof *out);
-}
-
 void fv_cuda_sdf_calls(const fv_cuda_sdf *c, fv_cuda_calls *out)
 {
     (void)c;

@@ -25,7 +25,7 @@ enum fv_simt_kind {
 };
 
 #if defined(FV_CUDA_SIM)
-/* device/cuda/sim/runtime.cpp: adds one to the calling simulated thread's count; nothing outside a
+/* tests/cuda_sim/runtime.cpp: adds one to the calling simulated thread's count; nothing outside a
  * kernel. */
 void fv_cuda_sim_simt_step(int kind);
 #define FV_SIMT_STEP(kind) fv_cuda_sim_simt_step(kind)

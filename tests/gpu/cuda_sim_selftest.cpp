@@ -1,4 +1,4 @@
-/* The CUDA simulator's own checks (src/device/cuda/sim, docs/gpu.md "The CUDA simulator"), so that
+/* The CUDA simulator's own checks (tests/cuda_sim, docs/gpu.md "The CUDA simulator"), so that
  * sim_test_gpu_* can trust it: kernels written as for nvcc and launched with FV_CUDA_LAUNCH.
  *
  *   cuda_sim_selftest          every thread of every block runs once with its own indices; a block
@@ -20,7 +20,7 @@
 #include "device/cuda/common.h"
 #include "device/cuda/launch.h"
 #include "kernel/simt.h"
-#include "device/cuda/sim/fv_cuda_sim.h"
+#include "fv_cuda_sim.h"
 
 #define CHECK(cond)                                                                  \
     do {                                                                             \

@@ -14,7 +14,7 @@
 #include <string.h>
 
 #ifdef FOVEA_CUDA_SIM
-#include "device/cuda/sim/fv_cuda_sim.h"
+#include "fv_cuda_sim.h"
 
 /* The simulator always has its device: a test that finds none fails rather than skips. */
 #define FV_GPU_TEST_NO_DEVICE 1

@@ -47,9 +47,9 @@ typedef struct family {
  * and copies the radial table (and vpolar's on-screen mask and mip shape, which follow the gaze)
  * from pageable memory every frame. */
 static const family k_families[] = {
-    {"pt", "cornell", "spp=1", 64.0f, false, 2, 3, 3, 0, FILM + 2 * 8},
-    {"pt", "city", "spp=1", 0.064f, false, 2, 3, 3, 0, FILM + 2 * 8},
-    {"pt", "cornell-fpm", "spp=1", 64.0f, true, 2, 7, 7, 1152, FILM + 2 * 8},
+    {"pt", "cornell", "spp=1", 64.0f, false, 2, 1, 0, 0, FILM + 4 * 8},
+    {"pt", "city", "spp=1", 0.064f, false, 2, 1, 0, 0, FILM + 4 * 8},
+    {"pt", "cornell-fpm", "spp=1", 64.0f, true, 2, 1, 0, 768, FILM + 4 * 8},
     {"sdf-gt", "sdf-temple", "spp=1", 0.064f, false, 2, 3, 3, 0, FILM + 7 * 8},
     {"fipr", "sdf-temple", "spp=1", 0.064f, false, 14, 3, 3, 0, FILM + 22 * 8},
     {"vpolar", "cornell", "", 64.0f, false, 38, 16, 16, 6516, 75760},

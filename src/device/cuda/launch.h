@@ -13,20 +13,24 @@
 
 #include <cuda_runtime.h>
 
-/* tally: the backend's fv_cuda_tally (device/cuda/common.h), which counts the launch. The count is
+/* FV_CUDA_LAUNCH_PLAIN counts nothing: for the launchers of declared kernels (device/cuda/
+ * kernel_cuda.h), whose backend (device/cuda/backend.cu) counts the launch itself.
+ * tally: the backend's fv_cuda_tally (device/cuda/common.h), which counts the launch. The count is
  * taken in a for statement's first clause that runs its body once, so the macro stays one
  * statement (safe under an if without braces) and nvcc still sees a plain launch. */
 #if defined(__CUDACC__)
+#define FV_CUDA_LAUNCH_PLAIN(kernel, grid, block, stream) kernel<<<(grid), (block), 0, (stream)>>>
 #define FV_CUDA_LAUNCH(tally, kernel, grid, block, stream) \
     for (int fv_launch_once_ = fv_cuda_launching(tally); fv_launch_once_; fv_launch_once_ = 0) kernel<<<(grid), (block), 0, (stream)>>>
 #elif defined(FV_CUDA_SIM)
 /* sim/cuda_runtime.h defines FV_CUDA_SIM and the launcher; the name and call site go into its
  * messages. */
+#define FV_CUDA_LAUNCH_PLAIN(kernel, grid, block, stream) fv_cuda_sim::launch(kernel, #kernel, (grid), (block), (stream), __FILE__, __LINE__)
 #define FV_CUDA_LAUNCH(tally, kernel, grid, block, stream)                                             \
     for (int fv_launch_once_ = fv_cuda_launching(tally); fv_launch_once_; fv_launch_once_ = 0) \
     fv_cuda_sim::launch(kernel, #kernel, (grid), (block), (stream), __FILE__, __LINE__)
 #else
-#error "device/cuda/*.cu are compiled by nvcc or, in the simulator build, with device/cuda/sim first on the include path"
+#error "device/cuda/*.cu are compiled by nvcc or, in the simulator build, with tests/cuda_sim first on the include path"
 #endif
 
 #endif

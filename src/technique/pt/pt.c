@@ -4,7 +4,9 @@
  *  - cpu: pixels eight at a time as Embree ray packets, `spp` jittered samples each;
  *  - portable: the device kernel (kernel/pt.h) on the CPU, a pixel at a time over the flat scene
  *    (scene/export.h), which is how CI tests the GPU's code;
- *  - cuda: the same kernel on an NVIDIA GPU (device/cuda_backend.h).
+ *  - cuda: the same kernel on an NVIDIA GPU.
+ * The portable and cuda devices share one frame (pt_render_device) over the device backend
+ * (device/backend.h), the kernel declared once in technique/pt/pt_kernels.h.
  * All three draw the same random numbers per pixel and sample.
  * On the cpu, more than FV_SAMPLE_BLOCK samples are summed as blocks along core/blocks.h's fixed
  * tree in double, and the parameters block_first/block_count render one range of those blocks,
@@ -15,10 +17,13 @@
 #include <string.h>
 #include "core/stage_time.h"
 #include "core/blocks.h"
-#include "device/cuda_backend.h"
+#include "device/backend.h"
+#include "device/calls_report.h"
+#include "device/film_device.h"
 #include "film/film_sums.h"
-#include "kernel/pt.h"
 #include "scene/export.h"
+#include "scene/export_device.h"
+#include "technique/pt/pt_kernels.h"
 #include "technique/class.h"
 #include "technique/kit.h"
 #include "transport/path.h"
@@ -28,8 +33,12 @@ typedef struct pt_state {
     fv_path_opts opt;
     fv_device device;
     int block_first, block_count; /* the blocks rendered: [first, first + count) of the spp's */
-    fv_scene_export *flat; /* portable and cuda: the flat scene at the frame's time */
-    fv_cuda_pt *cuda;      /* cuda: the GPU's copy of it */
+    /* portable and cuda: */
+    fv_scene_export *flat;     /* the flat scene at the frame's time */
+    fv_backend *backend;
+    fv_scene_device *dscene;   /* its copy on the backend */
+    fv_film_device film[2];    /* per eye: a stereo pair is read back after both ran */
+    fv_buffer counts, counts_host; /* FV_PT_COUNTS per eye, on the device and pinned */
     fv_kit_counters *counters; /* every frame's, kept (fv_kit_counters_reuse) */
 } pt_state;
 
@@ -37,7 +46,13 @@ static void pt_destroy(void *state)
 {
     pt_state *st = state;
     if (!st) return;
-    fv_cuda_pt_destroy(st->cuda);
+    if (st->backend) {
+        fv_scene_device_destroy(st->dscene);
+        for (int e = 0; e < 2; e++) fv_film_device_release(st->backend, &st->film[e]);
+        fv_buffer_release(st->backend, &st->counts);
+        fv_pinned_release(st->backend, &st->counts_host);
+        fv_backend_destroy(st->backend);
+    }
     fv_scene_export_destroy(st->flat);
     fv_kit_counters_destroy(st->counters);
     free(st);
@@ -56,7 +71,8 @@ static fv_status pt_create(const fv_scene *scene, fv_params *params, fv_device d
     if (s == FV_OK && device != FV_DEVICE_CPU && st->block_count != nb)
         s = fv_error_set(err, FV_ERR_INVALID, "parameters block_first/block_count: only the cpu device renders a range of sample blocks");
     if (s == FV_OK && device != FV_DEVICE_CPU) s = fv_scene_export_create(scene, &st->flat, err);
-    if (s == FV_OK && device == FV_DEVICE_CUDA) s = fv_cuda_pt_create(fv_scene_export_view(st->flat), &st->cuda, err);
+    if (s == FV_OK && device != FV_DEVICE_CPU) s = fv_backend_create(device, &st->backend, err);
+    if (s == FV_OK && device != FV_DEVICE_CPU) s = fv_scene_device_create(st->backend, fv_scene_export_view(st->flat), &st->dscene, err);
     if (s != FV_OK) {
         pt_destroy(st);
         return s;
@@ -143,80 +159,73 @@ static void pt_tile(void *ctx, const fv_tile *tile)
     fv_kit_count(j->counters, tile->thread, FV_KIT_NAN, bad);
 }
 
-/* The portable backend: the device kernel, a pixel at a time, on the CPU's threads. */
-typedef struct pt_flat_job {
-    const fv_kscene *scene;
-    fv_kpt_frame f;
-    fv_film_views out;
-    fv_kit_counters *counters;
-} pt_flat_job;
-
-static void pt_flat_tile(void *ctx, const fv_tile *tile)
+/* `eyes` eyes of one frame (1, or both of a stereo pair) on a device backend, the scene brought to
+ * the frame's time once: every eye's launch queued, then the films' and counters' read-back, then
+ * the one wait (on the portable backend each launch runs at once, with progress and cancel). */
+static fv_status pt_render_device(pt_state *st, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
 {
-    pt_flat_job *j = ctx;
-    uint64_t rays = 0, bad = 0;
-    for (int y = tile->y0; y < tile->y1; y++)
-        for (int x = tile->x0; x < tile->x1; x++) fv_kpt_pixel(j->scene, &j->f, x, y, &j->out, &rays, &bad);
-    fv_kit_count(j->counters, tile->thread, FV_KIT_RAYS, rays);
-    fv_kit_count(j->counters, tile->thread, FV_KIT_NAN, bad);
-}
-
-/* `eyes` eyes of one frame (1, or both of a stereo pair) on the flat scene, brought to the frame's
- * time once: on CUDA both eyes' kernels before the one host wait, on the portable backend one eye
- * after the other. */
-static fv_status pt_render_flat(pt_state *st, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
-{
-    pt_flat_job j[2];
-    memset(j, 0, sizeof j);
+    fv_backend *b = st->backend;
+    fv_pt_pixel_args a[2];
+    fv_film_views host[2];
+    size_t n[2];
+    memset(a, 0, sizeof a);
     fv_status s;
     for (int e = 0; e < eyes; e++)
-        if ((s = fv_frame_camera(frames[e].camera, films[e], &j[e].f.cam, err)) != FV_OK) return s;
+        if ((s = fv_frame_camera(frames[e].camera, films[e], &a[e].f.cam, err)) != FV_OK) return s;
+    fv_backend_calls before;
+    fv_backend_calls_get(b, &before);
+    fv_backend_set_threads(b, frames[0].threads);
     fv_stage_clock t0 = fv_stage_clock_now();
-    fv_cuda_calls before;
-    if (st->cuda) fv_cuda_pt_calls(st->cuda, &before);
-    if ((s = fv_scene_export_update(st->flat, st->scene, err)) != FV_OK) return s;
-    if (st->cuda && (s = fv_cuda_pt_update(st->cuda, fv_scene_export_view(st->flat), err)) != FV_OK) return s;
+    if ((s = fv_scene_export_update(st->flat, st->scene, err)) != FV_OK ||
+        (s = fv_scene_device_update(st->dscene, fv_scene_export_view(st->flat), err)) != FV_OK)
+        return s;
     fv_stage_stop(stats, "scene", t0);
-    fv_kpt_frame f[2];
-    fv_film_views out[2];
-    for (int e = 0; e < eyes; e++) {
+    const size_t count_bytes = (size_t)eyes * FV_PT_COUNTS * sizeof(uint64_t);
+    if ((s = fv_buffer_ensure(b, &st->counts, count_bytes, "pt's counters", err)) != FV_OK ||
+        (s = fv_pinned_ensure(b, &st->counts_host, count_bytes, "pt's counters", err)) != FV_OK ||
+        (s = fv_backend_clear(b, st->counts.p, 0, count_bytes, "pt's counters", err)) != FV_OK)
+        return s;
+    uint64_t *counts = st->counts.p;
+    t0 = fv_stage_clock_now();
+    fv_backend_mark(b, 0);
+    bool done = true;
+    for (int e = 0; e < eyes && s == FV_OK && done; e++) {
         const fv_camera *cam = frames[e].camera;
-        j[e].scene = fv_scene_export_view(st->flat);
-        j[e].f.seed = frames[e].seed;
-        j[e].f.eye = frames[e].eye;
-        j[e].f.frame = frames[e].index;
-        j[e].f.opt = st->opt;
-        j[e].out = fv_film_views_of(films[e]);
-        f[e] = j[e].f;
-        out[e] = j[e].out;
+        a[e].scene = *fv_scene_device_view(st->dscene);
+        a[e].f.seed = frames[e].seed;
+        a[e].f.eye = frames[e].eye;
+        a[e].f.frame = frames[e].index;
+        a[e].f.opt = st->opt;
+        host[e] = fv_film_views_of(films[e]);
+        n[e] = (size_t)cam->width * (size_t)cam->height;
         fv_stats_add_count(stats, "samples", (double)cam->width * cam->height * st->opt.spp);
-    }
-    if (st->cuda) {
-        uint64_t rays = 0, bad = 0;
-        double kernel_ms = 0.0;
-        int syncs = 0;
-        /* on the device: no serial share (the CPU only waits) */
-        const double tk = fv_time_ms();
-        if ((s = fv_cuda_pt_render(st->cuda, eyes, f, out, &rays, &bad, &kernel_ms, &syncs, err)) != FV_OK) return s;
-        fv_stats_add_ms(stats, "trace", fv_time_ms() - tk);
-        fv_stats_add_ms(stats, "kernel", kernel_ms);
-        fv_stats_add_count(stats, "rays", (double)rays);
-        fv_stats_add_count(stats, "nan_samples", (double)bad);
-        fv_stats_add_count(stats, "host_syncs", (double)syncs);
-        fv_cuda_calls after;
-        fv_cuda_pt_calls(st->cuda, &after);
-        fv_cuda_calls_report(stats, &before, &after);
-        return FV_OK;
-    }
-    for (int e = 0; e < eyes; e++) {
-        if (!(j[e].counters = fv_kit_counters_reuse(&st->counters))) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
         fv_kit_progress prog = {0};
         fv_kit_phase(&prog, &frames[e], 0.0, 1.0);
-        t0 = fv_stage_clock_now();
-        bool done = fv_parallel_tiles(j[e].f.cam.width, j[e].f.cam.height, frames[e].threads, pt_flat_tile, &j[e], fv_kit_progress_fn, &prog);
-        fv_stage_stop(stats, "trace", t0);
-        fv_kit_report(j[e].counters, stats);
-        if (!done) return fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+        const fv_launch_progress lp = {fv_kit_progress_fn, &prog};
+        if ((s = fv_film_device_views(b, &st->film[e], &host[e], n[e], &a[e].out, err)) == FV_OK)
+            s = fv_backend_launch_progress(b, &fv_pt_pixel_kernel, cam->width, cam->height, &a[e], counts + e * FV_PT_COUNTS, &lp, &done, err);
+    }
+    fv_backend_mark(b, 1);
+    for (int e = 0; e < eyes && s == FV_OK && done; e++) s = fv_film_device_download(b, &st->film[e], &host[e], n[e], err);
+    if (s == FV_OK) s = fv_backend_download(b, st->counts_host.p, st->counts.p, count_bytes, "pt's counters", err);
+    /* the wait even after a failure: nothing queued may write into a film the caller has back */
+    const fv_status sw = fv_backend_wait(b, "the pt kernel", err);
+    if (s == FV_OK) s = sw;
+    if (s != FV_OK) return s;
+    if (!done) return fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    for (int e = 0; e < eyes; e++) fv_film_device_deliver(b, &st->film[e], &host[e], n[e]);
+    fv_stage_stop(stats, "trace", t0);
+    const uint64_t *c = st->counts_host.p;
+    uint64_t rays = 0, bad = 0;
+    for (int e = 0; e < eyes; e++) rays += c[e * FV_PT_COUNTS + FV_PT_COUNT_RAYS], bad += c[e * FV_PT_COUNTS + FV_PT_COUNT_NAN];
+    fv_stats_add_count(stats, "rays", (double)rays);
+    fv_stats_add_count(stats, "nan_samples", (double)bad);
+    if (st->device == FV_DEVICE_CUDA) {
+        fv_stats_add_ms(stats, "kernel", fv_backend_elapsed_ms(b, 0, 1));
+        fv_stats_add_count(stats, "host_syncs", 1.0);
+        fv_backend_calls after;
+        fv_backend_calls_get(b, &after);
+        fv_backend_calls_report(stats, &before, &after);
     }
     return FV_OK;
 }
@@ -224,7 +233,7 @@ static fv_status pt_render_flat(pt_state *st, int eyes, const fv_frame *frames, 
 static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
     pt_state *st = state;
-    if (st->device != FV_DEVICE_CPU) return pt_render_flat(st, 1, frame, &film, stats, err);
+    if (st->device != FV_DEVICE_CPU) return pt_render_device(st, 1, frame, &film, stats, err);
     const fv_camera *cam = frame->camera;
     pt_job j;
     memset(&j, 0, sizeof j);
@@ -252,7 +261,7 @@ static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv
 static fv_status pt_render_pair(void *state, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
 {
     pt_state *st = state;
-    if (st->device != FV_DEVICE_CPU) return pt_render_flat(st, 2, frames, films, stats, err);
+    if (st->device != FV_DEVICE_CPU) return pt_render_device(st, 2, frames, films, stats, err);
     fv_status s = pt_render(state, &frames[0], films[0], stats, err);
     return s == FV_OK ? pt_render(state, &frames[1], films[1], stats, err) : s;
 }

@@ -6,6 +6,7 @@
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "filter/blur.h"
+#include "device/calls_report.h"
 #include "device/cuda_backend.h"
 #include "kernel/sdf_pixel.h"
 #include "technique/kit.h"
@@ -347,7 +348,7 @@ static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
         fv_stats_add_ms(stats, "kernel", kernel_ms);
         fv_stats_add_count(stats, "host_syncs", (double)syncs);
         fv_cuda_sdf_calls(d->cuda, &after);
-        fv_cuda_calls_report(stats, &before, &after);
+        fv_backend_calls_report(stats, &before, &after);
     } else {
         for (int e = 0; e < eyes && s == FV_OK; e++) {
             if (!pyramid) {

@@ -15,6 +15,7 @@
 #include "filter/blur.h"
 #include "filter/phi_mips.h"
 #include "kernel/vp_reproject.h"
+#include "device/calls_report.h"
 #include "technique/vpolar/device.h"
 #include "technique/vpolar/pipeline.h"
 
@@ -465,7 +466,7 @@ static fv_status whole_finish(fv_vp_pipeline *p, const fv_frame *frame, fv_stats
     fv_stats_add_ms(stats, "kernel", r.kernel_ms);
     fv_stats_add_count(stats, "host_syncs", (double)r.syncs);
     const fv_cuda_calls none = {0};
-    fv_cuda_calls_report(stats, &none, &r.calls);
+    fv_backend_calls_report(stats, &none, &r.calls);
     fv_stats_add_count(stats, "rays", (double)r.rays);
     fv_stats_add_count(stats, "samples", (double)r.paths);
     fv_stats_add_count(stats, "grid_samples", (double)fv_space_sample_count(p->space));

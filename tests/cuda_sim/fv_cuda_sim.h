@@ -1,4 +1,4 @@
-/* fovea — what the CUDA simulator (device/cuda/sim/cuda_runtime.h) counted, for the tests that run
+/* fovea — what the CUDA simulator (tests/cuda_sim/cuda_runtime.h) counted, for the tests that run
  * the CUDA backend on it (tests/gpu, built a second time as sim_test_gpu_*): C, so that the C tests
  * can read it. Exists only in the test-only library fovea_sim.
  */

@@ -1,10 +1,7 @@
-/* fovea — a CUDA frame's runtime calls as --stats-json counters (see fv_cuda_calls in
- * device/cuda_backend.h). Plain C, in every build: the counts come from the backend's own calls,
- * so they read the same on a GPU and on the CUDA simulator, and are absent on the CPU. */
-#include "device/cuda_backend.h"
-#include "fovea/stats.h"
+/* fovea — a device frame's runtime calls as --stats-json counters (device/calls_report.h). */
+#include "device/calls_report.h"
 
-void fv_cuda_calls_report(fv_stats *stats, const fv_cuda_calls *before, const fv_cuda_calls *after)
+void fv_backend_calls_report(fv_stats *stats, const fv_backend_calls *before, const fv_backend_calls *after)
 {
     fv_stats_add_count(stats, "launches", (double)(after->launches - before->launches));
     fv_stats_add_count(stats, "host_waits", (double)(after->host_waits - before->host_waits));

@@ -1,0 +1,31 @@
+/* fovea — a film's buffers on a device backend (device/backend.h): the kernels write a frame's
+ * colour and auxiliary buffers into device memory, the frame queues their download into pinned
+ * staging buffers (a copy that does not block the host, unlike one into the film's own pageable
+ * memory), and after the frame's one wait the staging buffers are handed to the film. On portable
+ * the kernels write the film's own buffers and nothing is copied.
+ *
+ * Only the buffers the host film has are made and read back. The buffers only grow, so a sequence
+ * allocates in its first frame and never after.
+ */
+#ifndef FV_DEVICE_FILM_DEVICE_H
+#define FV_DEVICE_FILM_DEVICE_H
+
+#include "device/backend.h"
+#include "fovea/film.h"
+
+enum { FV_FILM_DEVICE_BUFFERS = 6 }; /* colour, depth, normal, albedo, position, id */
+
+typedef struct fv_film_device {
+    fv_buffer dev[FV_FILM_DEVICE_BUFFERS];
+    fv_buffer stage[FV_FILM_DEVICE_BUFFERS]; /* pinned */
+} fv_film_device;
+
+/* *dev receives the views the kernels write for host's n pixels (the buffers host has, else NULL). */
+fv_status fv_film_device_views(fv_backend *b, fv_film_device *f, const fv_film_views *host, size_t n, fv_film_views *dev, fv_error *err);
+/* Queues the download of those buffers into the staging buffers (after the frame's kernels). */
+fv_status fv_film_device_download(fv_backend *b, fv_film_device *f, const fv_film_views *host, size_t n, fv_error *err);
+/* After the wait: the downloaded pixels into host's buffers. */
+void fv_film_device_deliver(fv_backend *b, const fv_film_device *f, const fv_film_views *host, size_t n);
+void fv_film_device_release(fv_backend *b, fv_film_device *f);
+
+#endif
