@@ -198,6 +198,13 @@ static void run_tile(void *ctx, const fv_tile *t)
     j->k->tile(j->args, t->x0, t->x1, t->y0, t->y1, j->counts[t->thread]);
 }
 
+/* A one-dimensional kernel in long runs rather than 16-item tiles. */
+static void run_range(void *ctx, int64_t begin, int64_t end, int thread)
+{
+    const tile_job *j = ctx;
+    j->k->tile(j->args, (int)begin, (int)end, 0, 1, j->counts[thread]);
+}
+
 fv_status fv_backend_launch_progress(fv_backend *b, const fv_kernel *k, int w, int h, const void *args, uint64_t *counts,
                                      const fv_launch_progress *progress, bool *done, fv_error *err)
 {
@@ -211,7 +218,10 @@ fv_status fv_backend_launch_progress(fv_backend *b, const fv_kernel *k, int w, i
     uint64_t (*per)[FV_KERNEL_MAX_COUNTS] = calloc((size_t)nt, sizeof *per);
     if (!per) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     tile_job j = {k, args, per};
-    const bool ran = fv_parallel_tiles(w, h, b->threads, run_tile, &j, progress ? progress->fn : NULL, progress ? progress->user : NULL);
+    fv_progress_fn pf = progress ? progress->fn : NULL;
+    void *pu = progress ? progress->user : NULL;
+    const bool ran = k->dims == 1 ? fv_parallel_for_progress(w, 4096, b->threads, run_range, &j, pf, pu)
+                                  : fv_parallel_tiles(w, h, b->threads, run_tile, &j, pf, pu);
     for (int t = 0; t < nt; t++)
         for (int i = 0; i < k->ncounts; i++) counts[i] += per[t][i];
     free(per);
