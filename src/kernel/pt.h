@@ -1,6 +1,6 @@
 /* fovea — `pt` as a device kernel: one pixel's camera paths on the flat scene (kernel/scene.h),
  * run by the portable backend on the CPU (technique/pt/pt.c) and by the CUDA backend
- * (device/cuda/pt.cu), one thread a pixel.
+ * (technique/pt/pt_kernels.cu), one thread a pixel.
  *
  * The estimator is kernel/path_impl.h, the CPU pt's own source, with the flat scene's traversal
  * (kernel/traverse.h) answering the ray queries; the pixel draws the same random numbers as the

@@ -112,6 +112,7 @@ struct cudaDeviceProp {
 #define __device__
 #define __host__
 #define __forceinline__ inline
+#define __grid_constant__
 /* One block runs at a time, so a function static is the block's shared memory. */
 #define __shared__ static
 
