@@ -12,8 +12,8 @@
  *   - in the family's .c file, FV_KERNEL_DEFINE: the portable tile function (the items of a tile,
  *     row by row) and the descriptor, which points at the CUDA launcher in a build with CUDA;
  *   - in the family's .cu file, FV_KERNEL_CUDA (device/cuda/kernel_cuda.h): the __global__ kernel
- *     (a thread an item, 8 x 8 blocks for dims 2, 256 threads for dims 1; the counters summed per
- *     block in shared memory, then once per block into the launch's) and its launcher.
+ *     (a thread an item, 8 x 8 blocks for dims 2, 256 threads for dims 1; a thread's counters added
+ *     to the launch's with one atomic each) and its launcher.
  *
  * So adding a GPU stage to a family is one line in its table and one launch in its frame; there is
  * no hand-written wrapper on either side.
