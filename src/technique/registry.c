@@ -22,8 +22,9 @@
 #include "scene/query.h"
 #include "technique/class.h"
 
-/* The registered classes, in the registry's order (families follow their first method), listed
- * once: each name X is the class fv_technique_X, declared and listed from this one line each. */
+/* The registered classes in the registry's order (families follow their first method), listed
+ * once: an entry X names the class fv_technique_X, which this one list both declares and
+ * registers, so adding a method is adding its entry here. */
 #define FV_CLASSES(X)                                                                                                       \
     X(pt) X(pm) X(pm_t) X(fpm) X(vpolar) X(cartesian) X(cartesian_full) X(linear_falloff) X(logpolar) X(sdf_gt) X(sdf_relaxed) \
         X(ipr) X(fipr) X(ir) X(ir_low) X(fir) X(fpm_guided) X(ppm)
