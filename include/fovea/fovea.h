@@ -2,11 +2,6 @@
 #ifndef FOVEA_H
 #define FOVEA_H
 
-#define FOVEA_VERSION_MAJOR 0
-#define FOVEA_VERSION_MINOR 1
-#define FOVEA_VERSION_PATCH 0
-#define FOVEA_VERSION_STRING "0.1.0"
-
 #include "fovea/export.h"
 #include "fovea/status.h"
 #include "fovea/math.h"
@@ -18,6 +13,7 @@
 #include "fovea/film.h"
 #include "fovea/params.h"
 #include "fovea/stats.h"
+#include "fovea/progress.h"
 #include "fovea/frame.h"
 #include "fovea/technique.h"
 #include "fovea/device.h"

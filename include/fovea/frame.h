@@ -14,14 +14,11 @@
 #include "fovea/camera.h"
 #include "fovea/export.h"
 #include "fovea/gaze.h"
+#include "fovea/progress.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* Called now and then with the fraction of the eye's work done, never from two threads at once.
- * Returning false cancels the render: the technique stops soon and returns FV_ERR_CANCELLED. */
-typedef bool (*fv_progress_fn)(void *user, double fraction);
 
 typedef struct fv_frame {
     double time;                  /* scene time in seconds; the scene is already set to it */

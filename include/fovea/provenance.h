@@ -11,6 +11,12 @@
 #include <stdbool.h>
 #include "fovea/export.h"
 
+/* The library's version (also in the build info below, and in every report). */
+#define FOVEA_VERSION_MAJOR 0
+#define FOVEA_VERSION_MINOR 1
+#define FOVEA_VERSION_PATCH 0
+#define FOVEA_VERSION_STRING "0.1.0"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

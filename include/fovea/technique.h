@@ -58,6 +58,19 @@ FV_API int fv_technique_warmup_frames(int i);
  * render` runs them unwritten at frame 0's views (fv_drive_opts.warmup). 0 for a method whose
  * first frame is already its steady state (photons, fipr's refresh), and for an index out of range. */
 FV_API int fv_technique_still_warmup(int i);
+/* The built-in scene method i's family benchmarks it on ("cornell-fpm" for the photon family,
+ * "sdf-temple" for the sphere tracers, ...; "cornell" when its family has none of its own): what
+ * `fovea bench scaling` renders it in. NULL for i out of range. */
+FV_API const char *fv_technique_bench_scene(int i);
+/* What a sample block of method i holds ("samples" for pt, "passes" for ppm) when its estimate is
+ * the sum of such blocks along one fixed tree (parameters block_first and block_count render a
+ * range of them), so that a still may be split over MPI ranks and stay the one-process image bit
+ * for bit (docs/distributed.md); NULL for any other method and for i out of range. */
+FV_API const char *fv_technique_block_unit(int i);
+/* Why a still of method i is rendered in one process when its parameter *param is above 1 (pm:
+ * "passes", "averaged and filtered in one process": its passes are not a sum of blocks); NULL,
+ * with *param NULL, for a method without such a parameter. */
+FV_API const char *fv_technique_unsplit(int i, const char **param);
 
 /* ---- parameters: every key a method reads from its fv_params bag, described once ----
  *

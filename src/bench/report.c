@@ -15,7 +15,14 @@
 #include "core/fileio.h"
 #include "core/provenance.h"
 #include "core/rng.h"
-#include "fovea/fovea.h"
+#include "fovea/bench.h"
+#include "fovea/drive.h"
+#include "fovea/film.h"
+#include "fovea/metrics.h"
+#include "fovea/provenance.h"
+#include "fovea/scene.h"
+#include "fovea/technique.h"
+#include "fovea/view.h"
 #include "drive/params_json.h"
 
 /* A growable text buffer for the Markdown and CSV files. */

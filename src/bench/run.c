@@ -21,7 +21,14 @@
 #include "fovea/device.h"
 #include "core/rng.h"
 #include "drive/frame_meta.h"
-#include "fovea/fovea.h"
+#include "fovea/bench.h"
+#include "fovea/drive.h"
+#include "fovea/film.h"
+#include "fovea/metrics.h"
+#include "fovea/provenance.h"
+#include "fovea/scene.h"
+#include "fovea/technique.h"
+#include "fovea/view.h"
 #include "scene/edit.h"
 
 typedef struct frame_setup {

@@ -14,7 +14,7 @@
 #include "fovea/limits.h"
 #include "gaze/gaze_json.h"
 #include "scene/anim.h"
-#include "scene/load_impl.h"
+#include "scene/anim_json.h"
 
 /* Objects merge key by key, recursively; any other value replaces. */
 static bool json_merge(cJSON *dst, const cJSON *src)

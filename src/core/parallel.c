@@ -1,5 +1,6 @@
 /* fovea — tile loop and parallel-for over OpenMP (see parallel.h). */
 #include <omp.h>
+#include <stddef.h>
 #include "core/parallel.h"
 #include "fovea/stats.h"
 

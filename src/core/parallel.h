@@ -9,7 +9,7 @@
 
 #include <stdint.h>
 #include <stdbool.h>
-#include "fovea/frame.h"
+#include "fovea/progress.h"
 
 #define FV_TILE_SIZE 16
 #define FV_MAX_THREADS 256

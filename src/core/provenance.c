@@ -12,7 +12,6 @@
 #include <unistd.h>
 #include "core/parallel.h"
 #include "core/provenance.h"
-#include "fovea/fovea.h"
 #include "fv_build_info.h"
 
 void fv_build_info_get(fv_build_info *out)

@@ -62,8 +62,8 @@ double fv_dist_still_share(const fv_dist_still_job *job, int rank, int size)
 
 bool fv_dist_still_splits(const fv_dist_still_job *job, int size)
 {
-    /* the methods whose estimate is core/blocks.h's sum: pt's samples, ppm's passes */
-    const bool blocked = strcmp(job->method, "pt") == 0 || strcmp(job->method, "ppm") == 0;
+    /* the methods whose estimate is core/blocks.h's sum (their class says so): pt's samples, ppm's passes */
+    const bool blocked = fv_technique_block_unit(fv_technique_index(job->method)) != NULL;
     return size > 1 && job->spp > FV_SAMPLE_BLOCK && blocked && !job->other_device;
 }
 

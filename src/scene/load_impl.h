@@ -32,11 +32,4 @@ bool fv_mtl_find_fault(const char *obj_path, char *why, size_t n);
  * (not NULL). */
 fv_status fv_load_json(const char *path, fv_scene *scene, fv_view *view, const fv_log *log, fv_error *err);
 
-/* The keys of an "animation" array (docs/scene-format.md), the one parser of that format: the
- * scene file's objects and lights and the bench's "animate" field use it. `where` names the
- * block holding the array (errors read "FILE: WHERE.animation[i].FIELD: ..."). The rules
- * between keys (increasing times, ...) are the scene's, checked when they are applied
- * (fv_scene_animate_*) or earlier with fv_anim_check. On success *keys (free()) holds *count. */
-fv_status fv_load_json_anim_keys(const cJSON *arr, const char *file, const char *where, fv_anim_key **keys, int *count, fv_error *err);
-
 #endif

@@ -16,6 +16,7 @@
 #include "fovea/limits.h"
 #include "core/json_util.h"
 #include "gaze/gaze_json.h"
+#include "scene/anim_json.h"
 #include "scene/load_impl.h"
 #include "scene/mesh_gen.h"
 #include "scene/texture.h"

@@ -102,6 +102,19 @@ typedef struct fv_technique_class {
      * light set that is refined over frames (fir's VPL management); photons and fipr's refresh
      * are as good in their first frame (measured in tests/cli/test_still_warmup.sh). */
     int still_warmup_frames;
+    /* The built-in scene its family's benchmarks render (fv_technique_bench_scene: what `fovea
+     * bench scaling` measures the method on); NULL: "cornell", pt's and Visual-Polar's. */
+    const char *bench_scene;
+    /* MPI (src/dist, docs/distributed.md): a method whose parameter table declares `block_first`
+     * and `block_count` sums its estimate along core/blocks.h's tree of sample blocks of its
+     * spp_param, so a still is split over ranks by blocks, bit-identical to one process
+     * (fv_technique_block_unit); nothing else is needed here. A method with a parameter whose
+     * value above 1 averages frames in one process in a way that is not such a sum names it and
+     * says why, as the clause that follows "<method>'s <n> <param> are " in the note of a still
+     * rendered on rank 0 alone (pm's passes: a running mean, then filtered). */
+    struct {
+        const char *param, *why;
+    } unsplit;
 } fv_technique_class;
 
 /* The class of a registered method by index or name (NULL when unknown). */

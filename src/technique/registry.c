@@ -5,9 +5,10 @@
  * and the method it is measured against (baseline), a table of every parameter create reads
  * (type, default, range or choices, help: `fovea methods`, its JSON and the CLI's help are made
  * from it, and the conformance suite holds the readers to it), the main parameter an interactive
- * viewer steps, its devices, warm-up frames and samples-per-pixel key. Nothing else in the project
- * switches on a technique's name; the conformance suite (tests/conformance) runs every class
- * listed here.
+ * viewer steps, its devices, warm-up frames, samples-per-pixel key, how MPI may split its stills
+ * and the scene its family's benchmarks use. Nothing outside src/technique/ switches on a
+ * technique's name (scripts/check-includes refuses it); the conformance suite
+ * (tests/conformance) runs every class listed here.
  *
  * What every method shares is done here once: parameters are validated on a private copy of the
  * caller's bag (the caller's bag is never marked or changed) and keys the method never read are
@@ -21,32 +22,17 @@
 #include "scene/query.h"
 #include "technique/class.h"
 
-extern const fv_technique_class fv_technique_pt;
-extern const fv_technique_class fv_technique_pm;
-extern const fv_technique_class fv_technique_pm_t;
-extern const fv_technique_class fv_technique_fpm;
-extern const fv_technique_class fv_technique_fpm_guided;
-extern const fv_technique_class fv_technique_ppm;
-extern const fv_technique_class fv_technique_vpolar;
-extern const fv_technique_class fv_technique_cartesian;
-extern const fv_technique_class fv_technique_cartesian_full;
-extern const fv_technique_class fv_technique_linear_falloff;
-extern const fv_technique_class fv_technique_logpolar;
-extern const fv_technique_class fv_technique_sdf_gt;
-extern const fv_technique_class fv_technique_sdf_relaxed;
-extern const fv_technique_class fv_technique_ipr;
-extern const fv_technique_class fv_technique_fipr;
-extern const fv_technique_class fv_technique_ir;
-extern const fv_technique_class fv_technique_ir_low;
-extern const fv_technique_class fv_technique_fir;
+/* The registered classes in the registry's order (families follow their first method), listed
+ * once: an entry X names the class fv_technique_X, which this one list both declares and
+ * registers, so adding a method is adding its entry here. */
+#define FV_CLASSES(X)                                                                                                       \
+    X(pt) X(pm) X(pm_t) X(fpm) X(vpolar) X(cartesian) X(cartesian_full) X(linear_falloff) X(logpolar) X(sdf_gt) X(sdf_relaxed) \
+        X(ipr) X(fipr) X(ir) X(ir_low) X(fir) X(fpm_guided) X(ppm)
 
-static const fv_technique_class *const k_classes[] = {
-    &fv_technique_pt,       &fv_technique_pm,        &fv_technique_pm_t,           &fv_technique_fpm,
-    &fv_technique_vpolar,   &fv_technique_cartesian, &fv_technique_cartesian_full, &fv_technique_linear_falloff,
-    &fv_technique_logpolar, &fv_technique_sdf_gt,   &fv_technique_sdf_relaxed,    &fv_technique_ipr,
-    &fv_technique_fipr,     &fv_technique_ir,        &fv_technique_ir_low,
-    &fv_technique_fir,      &fv_technique_fpm_guided, &fv_technique_ppm,
-};
+#define FV_CLASS_DECLARE(c) extern const fv_technique_class fv_technique_##c;
+#define FV_CLASS_ENTRY(c) &fv_technique_##c,
+FV_CLASSES(FV_CLASS_DECLARE)
+static const fv_technique_class *const k_classes[] = {FV_CLASSES(FV_CLASS_ENTRY)};
 
 #define N_CLASSES ((int)(sizeof k_classes / sizeof k_classes[0]))
 
@@ -81,6 +67,25 @@ const char *fv_technique_family(int i) { return i >= 0 && i < N_CLASSES ? k_clas
 const char *fv_technique_baseline(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->baseline : NULL; }
 int fv_technique_warmup_frames(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->warmup_frames : 0; }
 int fv_technique_still_warmup(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->still_warmup_frames : 0; }
+const char *fv_technique_bench_scene(int i)
+{
+    if (i < 0 || i >= N_CLASSES) return NULL;
+    return k_classes[i]->bench_scene ? k_classes[i]->bench_scene : "cornell";
+}
+
+const char *fv_technique_block_unit(int i)
+{
+    if (!fv_technique_param_find(i, "block_first") || !fv_technique_param_find(i, "block_count") || !k_classes[i]->spp_param) return NULL;
+    /* what its spp_param counts: pt's "spp" are samples, ppm's "passes" passes */
+    return strcmp(k_classes[i]->spp_param, "spp") == 0 ? "samples" : k_classes[i]->spp_param;
+}
+
+const char *fv_technique_unsplit(int i, const char **param)
+{
+    *param = i >= 0 && i < N_CLASSES ? k_classes[i]->unsplit.param : NULL;
+    return *param ? k_classes[i]->unsplit.why : NULL;
+}
+
 int fv_technique_param_count(int i) { return i >= 0 && i < N_CLASSES ? k_classes[i]->param_count : 0; }
 
 const fv_param_info *fv_technique_param_at(int i, int j)

@@ -180,6 +180,11 @@ static void test_registry_bounds(void **st)
         assert_null(fv_technique_main_step(i, 0));
         assert_int_equal(fv_technique_main_default_step(i), -1);
         assert_false(fv_technique_progressive(i));
+        assert_null(fv_technique_bench_scene(i));
+        assert_null(fv_technique_block_unit(i));
+        const char *param = "x";
+        assert_null(fv_technique_unsplit(i, &param));
+        assert_null(param);
     }
     const int pt = fv_technique_index("pt");
     assert_null(fv_technique_param_at(pt, fv_technique_param_count(pt)));
@@ -229,6 +234,43 @@ static void test_rng(void **st)
     assert_float_equal(cross / n, 0.0, 0.001);
 }
 
+/* The facts the MPI split and `fovea bench scaling` once decided by method name, now read from
+ * each class: the values the name tests gave, for every registered method. */
+static void test_registry_family_facts(void **st)
+{
+    (void)st;
+    static const struct {
+        const char *method, *scene, *block_unit, *unsplit_param;
+    } k[] = {
+        {"pt", "cornell", "samples", NULL},           {"pm", "cornell-fpm", NULL, "passes"},
+        {"pm-t", "cornell-fpm", NULL, NULL},          {"fpm", "cornell-fpm", NULL, NULL},
+        {"fpm-guided", "cornell-fpm", NULL, NULL},    {"ppm", "cornell-fpm", "passes", NULL},
+        {"vpolar", "cornell", NULL, NULL},            {"cartesian", "cornell", NULL, NULL},
+        {"cartesian-full", "cornell", NULL, NULL},    {"linear-falloff", "cornell", NULL, NULL},
+        {"log-polar", "cornell", NULL, NULL},         {"sdf-gt", "sdf-temple", NULL, NULL},
+        {"sdf-relaxed", "sdf-temple", NULL, NULL},    {"ipr", "sdf-temple", NULL, NULL},
+        {"fipr", "sdf-temple", NULL, NULL},           {"ir", "cornell-fir", NULL, NULL},
+        {"ir-low", "cornell-fir", NULL, NULL},        {"fir", "cornell-fir", NULL, NULL},
+    };
+    const int n = (int)(sizeof k / sizeof k[0]);
+    assert_int_equal(fv_technique_count(), n); /* a new method is added to this table too */
+    for (int j = 0; j < n; j++) {
+        const int i = fv_technique_index(k[j].method);
+        assert_true(i >= 0);
+        assert_string_equal(fv_technique_bench_scene(i), k[j].scene);
+        const char *unit = fv_technique_block_unit(i), *param = NULL, *why = fv_technique_unsplit(i, &param);
+        if (k[j].block_unit) assert_string_equal(unit, k[j].block_unit);
+        else assert_null(unit);
+        if (k[j].unsplit_param) {
+            assert_string_equal(param, k[j].unsplit_param);
+            assert_non_null(why);
+        } else {
+            assert_null(param);
+            assert_null(why);
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -237,6 +279,7 @@ int main(void)
         cmocka_unit_test(test_params_watch),
         cmocka_unit_test(test_param_format),
         cmocka_unit_test(test_registry_bounds),
+        cmocka_unit_test(test_registry_family_facts),
         cmocka_unit_test(test_stats),
         cmocka_unit_test(test_rng),
     };

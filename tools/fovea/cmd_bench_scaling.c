@@ -33,16 +33,6 @@ typedef struct scaling_opts {
     bool quiet;
 } scaling_opts;
 
-/* One of the method's own scenes: the one its family's benchmarks use. */
-static const char *scene_for(const char *m)
-{
-    if (!strcmp(m, "pm") || !strcmp(m, "pm-t") || !strcmp(m, "fpm") || !strcmp(m, "fpm-guided") || !strcmp(m, "ppm"))
-        return "cornell-fpm";
-    if (!strncmp(m, "sdf-", 4) || !strcmp(m, "ipr") || !strcmp(m, "fipr")) return "sdf-temple";
-    if (!strcmp(m, "ir") || !strcmp(m, "ir-low") || !strcmp(m, "fir")) return "cornell-fir";
-    return "cornell";
-}
-
 static double karp_flatt(double t1, double tp, int p)
 {
     if (p < 2 || !(t1 > 0.0) || !(tp > 0.0)) return NAN;
@@ -259,7 +249,7 @@ int fv_cmd_bench_scaling(int argc, char **argv)
         fv_view *view = NULL;
         bool quiet = true;
         fv_log log = fv_cli_log(&quiet);
-        if ((rc = fv_cli_open_scene(cmd, scene_for(m), &log, NULL, &scene, &view)) != 0) break;
+        if ((rc = fv_cli_open_scene(cmd, fv_technique_bench_scene(i), &log, NULL, &scene, &view)) != 0) break;
         run_result res[MAX_COUNTS];
         for (int k = 0; k < nc && rc == 0; k++) {
             if (!o.quiet) fprintf(stderr, "fovea bench scaling: %s, %d thread%s\n", m, counts[k], counts[k] > 1 ? "s" : "");
@@ -269,7 +259,7 @@ int fv_cmd_bench_scaling(int argc, char **argv)
             double sp = res[0].p50 / res[k].p50, kf = karp_flatt(res[0].p50, res[k].p50, counts[k]);
             char share[32] = "-"; /* one thread: no speed-up to read a serial share from */
             if (!isnan(kf)) snprintf(share, sizeof share, "%.1f%%", 100.0 * kf);
-            put(&rep, "| %s | %s | %d | %.1f | %.1f | %.2f | %.2f | %.2f | %s | %.1f%% | %.0f |\n", m, scene_for(m), counts[k], res[k].p50,
+            put(&rep, "| %s | %s | %d | %.1f | %.1f | %.2f | %.2f | %.2f | %s | %.1f%% | %.0f |\n", m, fv_technique_bench_scene(i), counts[k], res[k].p50,
                 res[k].p99, res[k].p99 / res[k].p50, sp, sp / counts[k], share, 100.0 * res[k].serial, res[k].regions);
         }
         if (rc == 0 && nc > 1) {

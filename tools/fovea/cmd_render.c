@@ -367,20 +367,26 @@ static bool on_dist_progress(void *user, double f)
  * said by rank 0, which renders it alone. */
 static void unsplit_note(const char *method, const fv_params *params, int size, const fv_dist_still_job *job)
 {
-    char why[200];
-    int passes = 1;
-    for (int i = 0; i < fv_params_count(params); i++)
-        if (!strcmp(fv_params_key(params, i), "passes")) passes = atoi(fv_params_value(params, i));
-    if (!strcmp(method, "pm") && passes > 1)
-        /* pm's passes are a float running mean, then filtered (and a stereo right eye reuses the
-         * left eye's mean): not a sum of passes that ranks could each take a part of */
-        snprintf(why, sizeof why, "pm's %d passes are averaged and filtered in one process; ppm's passes are split", passes);
-    else if (strcmp(method, "pt") && strcmp(method, "ppm"))
-        snprintf(why, sizeof why, "only pt's samples and ppm's passes are split");
+    char why[200], split[120] = "";
+    const int mi = fv_technique_index(method);
+    const char *param = NULL, *unsplit = fv_technique_unsplit(mi, &param), *unit = fv_technique_block_unit(mi);
+    int n = 1;
+    for (int i = 0; param && i < fv_params_count(params); i++)
+        if (!strcmp(fv_params_key(params, i), param)) n = atoi(fv_params_value(params, i));
+    /* what is split, from the registry: "pt's samples and ppm's passes" */
+    for (int i = 0, k = 0; i < fv_technique_count(); i++) {
+        if (!fv_technique_block_unit(i)) continue;
+        size_t l = strlen(split);
+        snprintf(split + l, sizeof split - l, "%s%s's %s", k++ ? " and " : "", fv_technique_name(i), fv_technique_block_unit(i));
+    }
+    if (unsplit && n > 1)
+        snprintf(why, sizeof why, "%s's %d %s are %s; %s are split", method, n, param, unsplit, split);
+    else if (!unit)
+        snprintf(why, sizeof why, "only %s are split", split);
     else if (job->other_device)
         snprintf(why, sizeof why, "it runs on a device other than the cpu");
     else
-        snprintf(why, sizeof why, "%s %s fit in one block of 64", job->spp > 0 ? "its" : "its default", !strcmp(method, "ppm") ? "passes" : "samples");
+        snprintf(why, sizeof why, "%s %s fit in one block of 64", job->spp > 0 ? "its" : "its default", unit);
     fprintf(stderr, "mpi: the still is not split over %d ranks (%s): rank 0 renders it alone\n", size, why);
 }
 

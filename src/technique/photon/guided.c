@@ -668,4 +668,5 @@ const fv_technique_class fv_technique_fpm_guided = {
     .furnace_tolerance = 0.04,
     .spp_param = "fovea_spp",
     .gathers_photons = true,
+    .bench_scene = FV_PHOTON_BENCH_SCENE,
 };

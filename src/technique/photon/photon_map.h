@@ -120,6 +120,10 @@ float fv_photon_radius_eq8(fv_vec3 lo, fv_vec3 hi, int width, int height);
  * it must be > 0, else FV_ERR_INVALID naming the value and `what` ("gather radius", ...). */
 struct fv_params;
 fv_status fv_photon_read_radius(struct fv_params *p, const char *what, double *radius, fv_error *err);
+/* The scene the photon family's benchmarks render (class.h, bench_scene): the paper's Cornell box
+ * with its moving objects. */
+#define FV_PHOTON_BENCH_SCENE "cornell-fpm"
+
 /* Its entry in a class's parameter table (technique/class.h), with the method's own help. */
 #define FV_PHOTON_RADIUS_PARAM(h)                                                                                    \
     {.key = "radius", .type = FV_PARAM_FLOAT, .def_note = "Eq. 8", .min = 0.0, .min_open = true, .max = FV_COORD_MAX, \

@@ -654,7 +654,7 @@ static const fv_param_info k_fpm_params[] = {
 #define FURNACE_TEST                                                                                \
     .test_params = "photons=40000", .furnace_params = "radius=0.25", .furnace_radiance = 0.998046875, \
     .furnace_tolerance = 0.04,                                                                       \
-    .gathers_photons = true,                                                                         \
+    .gathers_photons = true, .bench_scene = FV_PHOTON_BENCH_SCENE,                                   \
     .spp_instead = "one eye path per pixel centre gathers the photon maps: use --param photons=N, or passes=N to average N passes with pm; ppm takes --spp as its passes"
 
 const fv_technique_class fv_technique_pm = {
@@ -668,6 +668,9 @@ const fv_technique_class fv_technique_pm = {
     .render = pm_render,
     .destroy = pm_destroy,
     FURNACE_TEST,
+    /* its passes are a float running mean, then filtered (and a stereo right eye reuses the left
+     * eye's mean): not a sum of passes that MPI ranks could each take a part of */
+    .unsplit = {"passes", "averaged and filtered in one process"},
 };
 
 const fv_technique_class fv_technique_pm_t = {

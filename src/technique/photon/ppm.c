@@ -320,4 +320,5 @@ const fv_technique_class fv_technique_ppm = {
     .furnace_tolerance = 0.04,
     .spp_param = "passes",
     .gathers_photons = true,
+    .bench_scene = FV_PHOTON_BENCH_SCENE,
 };

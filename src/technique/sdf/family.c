@@ -224,7 +224,7 @@ static const fv_param_info k_fipr_params[] = {
     const fv_technique_class id = {.name = nm, .summary = sum, .family = FV_FAMILY_SDF, .baseline = base, FV_CLASS_PARAMS(table), \
                                    .main = SDF_STEPS, .create = fn, .create_on = fn_on, .devices = devs, .render = render, .render_pair = render_pair, .destroy = destroy, .sdf_only = true, \
                                    .test_params = "spp=1", .furnace_radiance = 1.0, .furnace_tolerance = 0.01, .spp_param = "spp", \
-                                   .foveated = fov, .warmup_frames = warmup}
+                                   .foveated = fov, .warmup_frames = warmup, .bench_scene = "sdf-temple"}
 
 /* Baselines: sdf-gt is the ground truth of the paper's Sec. 4.5, which pt with direct light only
  * renders too (docs/sdf-tracing.md, "Shading"); the others are measured against sdf-gt (Table 1,

@@ -922,4 +922,5 @@ const fv_technique_class fv_technique_fir = {
     .furnace_radiance = 0.9375,
     .furnace_tolerance = 0.08,
     .spp_instead = FV_VPL_SPP_INSTEAD,
+    .bench_scene = FV_VPL_BENCH_SCENE,
 };

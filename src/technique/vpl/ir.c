@@ -253,6 +253,7 @@ const fv_technique_class fv_technique_ir = {
     .furnace_radiance = 1.0,
     .furnace_tolerance = 0.03,
     .spp_instead = FV_VPL_SPP_INSTEAD,
+    .bench_scene = FV_VPL_BENCH_SCENE,
 };
 
 const fv_technique_class fv_technique_ir_low = {
@@ -270,4 +271,5 @@ const fv_technique_class fv_technique_ir_low = {
     .furnace_radiance = 1.0,
     .furnace_tolerance = 0.03,
     .spp_instead = FV_VPL_SPP_INSTEAD,
+    .bench_scene = FV_VPL_BENCH_SCENE,
 };

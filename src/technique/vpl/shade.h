@@ -18,6 +18,8 @@
 
 /* What the family says to `--spp N` (technique class spp_instead): it shades one point per pixel. */
 #define FV_VPL_SPP_INSTEAD "one shading point per pixel centre: use --param vpls=N (and area_samples=N for area lights)"
+/* The scene the family's benchmarks render (class.h, bench_scene): fir's Cornell box variant. */
+#define FV_VPL_BENCH_SCENE "cornell-fir"
 
 /* Counter slots the passes fill (the kit's RAYS counts every ray as well). */
 enum { FV_VPL_SLOT_VPL_RAYS = FV_KIT_USER0, FV_VPL_SLOT_LOOKUPS = FV_KIT_USER1, FV_VPL_SLOT_DIRECT_RAYS = FV_KIT_USER2 };
