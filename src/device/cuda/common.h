@@ -1,4 +1,5 @@
-/* fovea — what the CUDA backends share (device/cuda/pt.cu, sdf.cu, vpolar.cu): the launch macro
+/* fovea — what the CUDA code shares (device/cuda/backend.cu, and the family frames not yet over the
+ * backend, sdf.cu and vpolar.cu): the launch macro
  * (device/cuda/launch.h, FV_CUDA_LAUNCH), the runtime calls through wrappers that count them
  * (fv_cuda_tally: what --stats-json reports), the error line of a failed CUDA call, a device array
  * refilled from the host only when its bytes changed, and a film on the GPU, its buffers kept
