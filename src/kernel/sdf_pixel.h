@@ -2,8 +2,8 @@
  * target sample sphere-traced from the camera, plain or over-relaxed, kernel/sdf_march.h, and shaded
  * with sphere-traced shadows, kernel/sdf_shade.h) for all four methods, and a ray of a pyramid level
  * below it for ipr and fipr (kernel/sdf_pyramid.h holds the pyramid's image steps). The portable
- * backend runs them a cell at a time on the CPU's threads (technique/sdf/device.c), CUDA one thread
- * a cell (device/cuda/sdf.cu).
+ * backend runs them a cell at a time on the CPU's threads, CUDA one thread a cell (the kernels of
+ * technique/sdf/sdf_kernels.h, launched by technique/sdf/device.c's frame).
  *
  * The target level lays the samples out as the CPU pipeline's target level does (technique/sdf/pipeline.c): spp 1, 4 or 16 is a regular S x S grid of sub-pixel centres, sample (a, b) of pixel (x, y)
  * through target-grid position (x S + a + 1/2, y S + b + 1/2), rows first; the ray is clipped to the
