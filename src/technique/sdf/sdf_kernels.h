@@ -1,6 +1,6 @@
 /* fovea — the sphere-tracing family's device kernels, declared once (device/kernel_decl.h): every
  * pass technique/sdf/device.c's frame launches, each one item a cell or pixel of its grid and each
- * the kernel code the CPU pipeline's passes are made of (kernel/sdf_pixel.h, kernel/sdf_pyramid.h,
+ * the kernel code the CPU pipeline's passes are made of (technique/sdf/ksdf_pixel.h, kpyr.h,
  * kernel/vp_blur.h), so the portable backend, CUDA and the CPU run one source:
  *
  *   level      a ray of pyramid level k below the target (ipr, fipr; Polychronakis et al. 2023,
@@ -25,7 +25,7 @@
 #include <limits.h>
 #include <string.h>
 #include "device/kernel_decl.h"
-#include "kernel/sdf_pixel.h"
+#include "technique/sdf/ksdf_pixel.h"
 #include "kernel/vp_blur.h"
 
 /* A marching pass's counters, in this order. */

@@ -14,8 +14,8 @@
  * rays, the last row and column covering what is left of an odd size; each ray passes through the
  * centre of the part of its block inside the grid.
  */
-#ifndef FV_KERNEL_SDF_PYRAMID_H
-#define FV_KERNEL_SDF_PYRAMID_H
+#ifndef FV_TECHNIQUE_SDF_KPYR_H
+#define FV_TECHNIQUE_SDF_KPYR_H
 
 #include <limits.h>
 #include <math.h>
