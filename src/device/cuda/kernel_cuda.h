@@ -38,7 +38,7 @@ template <int N> __device__ __forceinline__ void fv_cuda_kernel_sum(const uint64
     __global__ void name##_global(args_t a_, int w_, int h_, unsigned long long *counts_)                         \
     {                                                                                                              \
         const int x_ = (int)(blockIdx.x * blockDim.x + threadIdx.x), y_ = (int)(blockIdx.y * blockDim.y + threadIdx.y); \
-        uint64_t c_[FV_KERNEL_MAX_COUNTS] = {0, 0, 0, 0};                                                         \
+        uint64_t c_[(ncounts_) > 0 ? (ncounts_) : 1] = {0}; /* its own counters only: no stack for the others */ \
         if (x_ < w_ && y_ < h_) fn(&a_, x_, y_, c_);                                                               \
         fv_cuda_kernel_sum<(ncounts_)>(c_, counts_);                                                               \
     }                                                                                                              \
