@@ -7,29 +7,6 @@
 
 static const char k_no_cuda[] = "fovea was built without CUDA (configure with a CUDA compiler on the PATH, or -DFOVEA_CUDA=ON; docs/gpu.md)";
 
-fv_status fv_cuda_sdf_create(fv_cuda_sdf **out, fv_error *err)
-{
-    *out = NULL;
-    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
-}
-
-fv_status fv_cuda_sdf_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, int eyes, const struct fv_ksdf_frame *f, const fv_film_views *out,
-                             struct fv_ksdf_counts *counts, double *kernel_ms, int *syncs, fv_error *err)
-{
-    (void)c, (void)w, (void)eyes, (void)f, (void)out, (void)counts, (void)kernel_ms, (void)syncs;
-    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
-}
-
-fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const struct fv_ksdf_world *w, int eyes, const struct fv_ksdf_frame *f, const struct fv_kpyr *shape,
-                                     const struct fv_kpyr_fovea *fov, const fv_cuda_pyr_opts *po, const fv_film_views *out,
-                                     struct fv_ksdf_pyr_counts *counts, double *kernel_ms, int *syncs, fv_error *err)
-{
-    (void)c, (void)w, (void)eyes, (void)f, (void)shape, (void)fov, (void)po, (void)out, (void)counts, (void)kernel_ms, (void)syncs;
-    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
-}
-
-void fv_cuda_sdf_destroy(fv_cuda_sdf *c) { (void)c; }
-
 fv_status fv_cuda_vp_create(const struct fv_kscene *host, fv_cuda_vp **out, fv_error *err)
 {
     (void)host;
@@ -47,12 +24,6 @@ fv_status fv_cuda_vp_render(fv_cuda_vp *const *c, int eyes, const fv_cuda_vp_fra
 }
 
 /* Nothing is ever created here, so nothing has been asked of a runtime. */
-void fv_cuda_sdf_calls(const fv_cuda_sdf *c, fv_cuda_calls *out)
-{
-    (void)c;
-    memset(out, 0, sizeof *out);
-}
-
 void fv_cuda_vp_calls(const fv_cuda_vp *c, fv_cuda_calls *out)
 {
     (void)c;

@@ -29,7 +29,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define FV_KERNEL_MAX_COUNTS 4
+/* 8: the sphere tracers count seven costs per pass (technique/sdf/sdf_kernels.h) */
+#define FV_KERNEL_MAX_COUNTS 8
 
 /* The CUDA side of a kernel (device/cuda/kernel_cuda.h); opaque here. */
 typedef struct fv_kernel_cuda fv_kernel_cuda;

@@ -18,7 +18,7 @@
 #include "fovea/status.h"
 
 #ifdef __cplusplus
-extern "C" { /* device/cuda/sdf.cu builds pass 5's kernels with the table functions */
+extern "C" { /* C++ (a .cu file, the CUDA simulator) may build a blur table too */
 #endif
 
 /* Sigma profile of Sec. 3.5: 0 up to fovea_deg, rising linearly to sigma_max at ramp_deg, held at

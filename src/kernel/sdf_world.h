@@ -1,6 +1,6 @@
 /* fovea — the sphere-tracing family's world (technique/sdf/world.h) as kernel code: the union of a
  * scene's SDF objects as one field, its box and its delta lights, in flat, index-based arrays, the
- * same on the CPU (host memory) and on a GPU (after device/cuda/sdf.cu copies it field by field).
+ * same on the CPU (host memory) and on a GPU (after technique/sdf/device.c copies it array by array).
  *
  * The field is evaluated as technique/sdf/world.c always has: the static objects' merged union
  * first, then each moving object in its own space (the point moved back by its inverse transform,

@@ -3,10 +3,11 @@
  * scene's traversal with SDF leaves and the path estimator; this unit calls what no CUDA kernel
  * uses yet (the eye model and the acuity models of kernel/eye.h, the light table's other queries),
  * so a change that makes them host-only fails the build, not a later GPU kernel. The sphere-tracing
- * family's headers (kernel/sdf_*.h) are instantiated on their own below, outside any backend. */
+ * family's headers (kernel/sdf_*.h, technique/sdf/ksdf_pixel.h, kpyr.h) are instantiated on their
+ * own below, outside any backend. */
 #include "kernel/eye.h"
 #include "kernel/pt.h"
-#include "kernel/sdf_pixel.h"
+#include "technique/sdf/ksdf_pixel.h"
 
 __global__ void fv_check_eye(fv_eye_model m, fv_gaze g, double *out)
 {

@@ -1,6 +1,6 @@
 /* GPU tests (ctest label `gpu`; scripts/gpu-check runs them on an NVIDIA machine): the sphere-tracing
- * family on CUDA against the portable backend, which runs the same kernel source (kernel/sdf_pixel.h,
- * kernel/sdf_pyramid.h) on the CPU and equals the CPU pipeline bit for bit (test_device_sdf):
+ * family on CUDA against the portable backend, which runs the same kernel source
+ * (technique/sdf/ksdf_pixel.h, kpyr.h, launched as sdf_kernels.h declares them) on the CPU and equals the CPU pipeline bit for bit (test_device_sdf):
  * `sdf-gt` and `sdf-relaxed` one frame, `ipr` one frame, `fipr` over a stereo sequence with a moving
  * gaze (its history stays on the GPU between frames, per eye), every frame compared.
  *

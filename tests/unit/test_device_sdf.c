@@ -1,5 +1,6 @@
-/* The sphere-tracing family on the portable backend (kernel/sdf_pixel.h and kernel/sdf_pyramid.h
- * run a cell at a time on the CPU's threads, the code CUDA runs) against the CPU pipeline
+/* The sphere-tracing family on the portable backend (technique/sdf/ksdf_pixel.h and kpyr.h, through
+ * the kernels of sdf_kernels.h, run a cell at a time on the CPU's threads, the code CUDA runs)
+ * against the CPU pipeline
  * (technique/sdf/pipeline.c: eight rays at a time through the 8-wide field, shading in batches), on
  * the three sphere-tracing scenes: `sdf-gt` and `sdf-relaxed` one frame each; `ipr` one frame with
  * and without shadow_reuse and the min filter, at 3 and 4 levels; `fipr` over a stereo sequence

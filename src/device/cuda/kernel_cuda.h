@@ -38,7 +38,7 @@ template <int N> __device__ __forceinline__ void fv_cuda_kernel_add(const uint64
     {                                                                                                              \
         const int x_ = (int)(blockIdx.x * blockDim.x + threadIdx.x), y_ = (int)(blockIdx.y * blockDim.y + threadIdx.y); \
         if (x_ >= w_ || y_ >= h_) return;                                                                          \
-        uint64_t c_[FV_KERNEL_MAX_COUNTS] = {0, 0, 0, 0};                                                         \
+        uint64_t c_[(ncounts_) > 0 ? (ncounts_) : 1] = {0}; /* its own counters only: no stack for the others */ \
         fn(&a_, x_, y_, c_);                                                                                       \
         if ((ncounts_) > 0) fv_cuda_kernel_add<(ncounts_)>(c_, counts_);                                           \
     }                                                                                                              \

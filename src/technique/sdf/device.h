@@ -1,13 +1,16 @@
 /* fovea — the sphere-tracing family on the device backends (docs/gpu.md): `sdf-gt` and
- * `sdf-relaxed` (the target pixel of kernel/sdf_pixel.h), `ipr` and `fipr` (its pyramid passes:
- * the level rays of kernel/sdf_pixel.h, the Sobel edges, mask and refresh of kernel/sdf_pyramid.h,
- * then the target pixel), run by the portable backend (each pass over tiles of its grid on the
- * CPU's threads, what CI tests against the CPU pipeline) or by CUDA (device/cuda/sdf.cu, a kernel
- * per pass). The world is built on the host each frame, as the CPU pipeline builds it
- * (technique/sdf/world.h), and read in its flat form. fipr's pass 5 (blur=true) is kernels too:
- * the transitions' sigma (kernel/sdf_pyramid.h) and the blur's two passes (kernel/vp_blur.h).
- * A stereo frame can be rendered as a pair: the world built once, and on CUDA both eyes' kernels
- * launched before the one host wait.
+ * `sdf-relaxed` (the target pixel of technique/sdf/ksdf_pixel.h), `ipr` and `fipr` (its pyramid
+ * passes: the level rays of ksdf_pixel.h, the Sobel edges, mask and refresh of kpyr.h, then the
+ * target pixel). The frame is written once (device.c) over the device backend
+ * (device/backend.h), a kernel per pass declared in technique/sdf/sdf_kernels.h: the portable
+ * backend runs each pass at once over tiles of its grid on the CPU's threads (what CI tests against
+ * the CPU pipeline), CUDA queues them on its stream. The world is built on the host as the CPU
+ * pipeline builds it (technique/sdf/world.h), only when the scene's time changed and something in
+ * it moves, and read in its flat form (on CUDA through mirrors, copied only after a rebuild).
+ * fipr's pass 5 (blur=true) is kernels too: the transitions' sigma (technique/sdf/kpyr.h) and the
+ * blur's two passes (kernel/vp_blur.h). A stereo frame can be rendered as a pair: the world built
+ * once, both eyes' passes queued, the films and counters read back into pinned memory, and one
+ * host wait for the pair.
  */
 #ifndef FV_SDF_DEVICE_H
 #define FV_SDF_DEVICE_H

@@ -10,7 +10,7 @@
 #include "core/stage_time.h"
 #include "core/rng.h"
 #include "filter/blur.h"
-#include "kernel/sdf_pixel.h"
+#include "technique/sdf/ksdf_pixel.h"
 #include "technique/kit.h"
 #include "technique/sdf/pipeline.h"
 
@@ -107,7 +107,7 @@ typedef struct job {
     fv_camera_basis cam;
     fv_film_views out;
     int level;               /* the level of a level pass */
-    fv_ksdf_frame kf;        /* what the kernel steps read of the frame (kernel/sdf_pixel.h) */
+    fv_ksdf_frame kf;        /* what the kernel steps read of the frame (technique/sdf/ksdf_pixel.h) */
     fv_kit_counters *c;      /* RAYS (all rays), NAN, USER0 steps, USER1 shadow steps, USER2 normal evals, USER3 exhausted, USER4 shadow rays */
     fv_kit_counters *lsteps; /* per level: steps */
     fv_kit_counters *lrays;  /* per level: rays */
@@ -352,7 +352,7 @@ void fv_sdf_fovea_of(const fv_frame *f, const fv_sdf_opts *o, int w, int h, fv_k
     out->refresh = o->refresh;
 }
 
-/* Passes 2 and 3 and the refresh: fills edge, mask and need (kernel/sdf_pyramid.h's steps);
+/* Passes 2 and 3 and the refresh: fills edge, mask and need (technique/sdf/kpyr.h's steps);
  * returns the number of mask pixels. */
 static uint64_t build_mask(job *j, uint64_t *edge_pixels, uint64_t *refreshed)
 {

@@ -63,7 +63,7 @@ void fv_sdf_pipeline_destroy(fv_sdf_pipeline *p);
 /* What the CPU pipeline and the device backends (device.h) share of a frame: */
 /* samples per pixel along each axis for spp 1, 4, 16; */
 int fv_sdf_samples_per_axis(int spp);
-/* what fipr's mask and refresh read of the frame (kernel/sdf_pyramid.h) for a w x h film; */
+/* what fipr's mask and refresh read of the frame (technique/sdf/kpyr.h) for a w x h film; */
 void fv_sdf_fovea_of(const fv_frame *f, const fv_sdf_opts *o, int w, int h, fv_kpyr_fovea *out);
 /* pass 5: the transitions of mask (w x h) blurred in rgb with sigma blur_sigma (sigma: w x h
  * scratch), by filter/blur.h, its temporaries from room (a kept arena; NULL: for the call). */

@@ -1,5 +1,5 @@
 /* fovea — the inverted pyramid's image operations (pyramid.h): the kernel steps of
- * kernel/sdf_pyramid.h over whole buffers, and the host buffers. */
+ * technique/sdf/kpyr.h over whole buffers, and the host buffers. */
 #include <limits.h>
 #include <math.h>
 #include <stdlib.h>

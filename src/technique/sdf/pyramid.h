@@ -4,8 +4,8 @@
  * tested by hand (tests/unit/test_sdf_family.c).
  *
  * Levels are counted from the tip (level 0) to the target (L-1) on the sample grid; how they are
- * laid out: kernel/sdf_pyramid.h. The host buffers below are the CPU pipeline's and the portable
- * backend's (CUDA keeps its own on the GPU, device/cuda/sdf.cu).
+ * laid out: technique/sdf/kpyr.h. The host buffers below are the CPU pipeline's and the portable
+ * backend's (the device backends keep their own, technique/sdf/device.c).
  */
 #ifndef FV_SDF_PYRAMID_H
 #define FV_SDF_PYRAMID_H
@@ -14,10 +14,10 @@
 #include <stdint.h>
 #include "fovea/math.h"
 #include "fovea/status.h"
-#include "kernel/sdf_pyramid.h"
+#include "technique/sdf/kpyr.h"
 
 /* fv_pyramid_level, fv_kpyr (a pyramid's shape and buffers) and the per-cell steps:
- * kernel/sdf_pyramid.h. These are their whole-buffer forms and the host buffers. */
+ * technique/sdf/kpyr.h. These are their whole-buffer forms and the host buffers. */
 
 /* Fills level[0 .. levels-1] for a target grid of sw x sh samples. */
 void fv_pyramid_levels(int sw, int sh, int levels, fv_pyramid_level *level);

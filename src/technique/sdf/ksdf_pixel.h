@@ -1,9 +1,9 @@
 /* fovea — the rays of the sphere-tracing family as kernel code: a pixel of the target level (every
  * target sample sphere-traced from the camera, plain or over-relaxed, kernel/sdf_march.h, and shaded
  * with sphere-traced shadows, kernel/sdf_shade.h) for all four methods, and a ray of a pyramid level
- * below it for ipr and fipr (kernel/sdf_pyramid.h holds the pyramid's image steps). The portable
- * backend runs them a cell at a time on the CPU's threads (technique/sdf/device.c), CUDA one thread
- * a cell (device/cuda/sdf.cu).
+ * below it for ipr and fipr (technique/sdf/kpyr.h holds the pyramid's image steps). The portable
+ * backend runs them a cell at a time on the CPU's threads, CUDA one thread a cell (the kernels of
+ * technique/sdf/sdf_kernels.h, launched by technique/sdf/device.c's frame).
  *
  * The target level lays the samples out as the CPU pipeline's target level does (technique/sdf/pipeline.c): spp 1, 4 or 16 is a regular S x S grid of sub-pixel centres, sample (a, b) of pixel (x, y)
  * through target-grid position (x S + a + 1/2, y S + b + 1/2), rows first; the ray is clipped to the
@@ -12,13 +12,13 @@
  * The march and the shading are the CPU's own steps, and the world's field is evaluated by the
  * scalar build the CPU's lanes agree with bit for bit, so on a CPU the image is the CPU pipeline's.
  */
-#ifndef FV_KERNEL_SDF_PIXEL_H
-#define FV_KERNEL_SDF_PIXEL_H
+#ifndef FV_TECHNIQUE_SDF_KSDF_PIXEL_H
+#define FV_TECHNIQUE_SDF_KSDF_PIXEL_H
 
 #include "fovea/camera.h"
 #include "fovea/film.h"
 #include "kernel/path.h"
-#include "kernel/sdf_pyramid.h"
+#include "technique/sdf/kpyr.h"
 #include "kernel/sdf_shade.h"
 #include "kernel/simt.h"
 
@@ -62,7 +62,7 @@ FV_HD static inline void fv_ksdf_camera_ray(const fv_ksdf_world *w, const fv_ksd
 /* Ray (x, y) of pyramid level k below the target (ipr, fipr; Polychronakis et al. 2023, Sec. 3.1):
  * through the centre of its block, starting at the min-filtered depth of level k-1 (Sec. 3.2.4);
  * its depth and steps into the level's buffers. On level L-2, the one the target starts from:
- * fipr's rays that pass 4 does not need are skipped (kernel/sdf_pyramid.h, need), those due for a
+ * fipr's rays that pass 4 does not need are skipped (technique/sdf/kpyr.h, need), those due for a
  * refresh are shaded into the eye's history (stamped with the frame's index), and with
  * shadow_reuse every hit's visibility is kept for the target's samples. The costs are added to *c. */
 FV_HD static inline void fv_ksdf_level_cell(const fv_ksdf_world *w, const fv_ksdf_frame *f, const fv_kpyr *py, int k, int x, int y, int index,

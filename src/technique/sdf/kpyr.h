@@ -4,8 +4,8 @@
  * which middle-level rays pass 4 must trace (the refresh), the reconstruction of a pixel outside the
  * mask, shadow_reuse's agreed visibility and pass 5's transition test. Each is one cell or pixel,
  * reading and writing only its own output, so the CPU pipeline (technique/sdf/pipeline.c, its
- * batched tracer around them), the portable backend (technique/sdf/device.c, a cell at a time on
- * the CPU's threads) and CUDA (device/cuda/sdf.cu, a thread a cell) run the same code.
+ * batched tracer around them), the portable backend (a cell at a time on the CPU's threads) and
+ * CUDA (a thread a cell; both through technique/sdf/sdf_kernels.h) run the same code.
  *
  * Levels are counted from the tip: level 0 is the coarsest, level L-1 the target. They are built on
  * the sample grid (the film's pixels times the samples per pixel along each axis, so at 16 spp the
@@ -14,8 +14,8 @@
  * rays, the last row and column covering what is left of an odd size; each ray passes through the
  * centre of the part of its block inside the grid.
  */
-#ifndef FV_KERNEL_SDF_PYRAMID_H
-#define FV_KERNEL_SDF_PYRAMID_H
+#ifndef FV_TECHNIQUE_SDF_KPYR_H
+#define FV_TECHNIQUE_SDF_KPYR_H
 
 #include <limits.h>
 #include <math.h>
