@@ -30,30 +30,8 @@ fv_status fv_cuda_sdf_pyramid_render(fv_cuda_sdf *c, const struct fv_ksdf_world 
 
 void fv_cuda_sdf_destroy(fv_cuda_sdf *c) { (void)c; }
 
-fv_status fv_cuda_vp_create(const struct fv_kscene *host, fv_cuda_vp **out, fv_error *err)
-{
-    (void)host;
-    *out = NULL;
-    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
-}
-
-void fv_cuda_vp_destroy(fv_cuda_vp *c) { (void)c; }
-
-fv_status fv_cuda_vp_render(fv_cuda_vp *const *c, int eyes, const fv_cuda_vp_frame *f, const fv_film_views *out, fv_cuda_vp_result *res,
-                            fv_error *err)
-{
-    (void)c, (void)eyes, (void)f, (void)out, (void)res;
-    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
-}
-
 /* Nothing is ever created here, so nothing has been asked of a runtime. */
 void fv_cuda_sdf_calls(const fv_cuda_sdf *c, fv_cuda_calls *out)
-{
-    (void)c;
-    memset(out, 0, sizeof *out);
-}
-
-void fv_cuda_vp_calls(const fv_cuda_vp *c, fv_cuda_calls *out)
 {
     (void)c;
     memset(out, 0, sizeof *out);
