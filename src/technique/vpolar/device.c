@@ -6,17 +6,15 @@
  * reads them), each cleared when the grid is new; the φ-mip levels are a buffer each. Everything
  * only grows (fv_buffer), so a sequence allocates in its first frame.
  *
- * SVGF's step order (kernel/svgf.h): accumulate, the rows' counters, variance, each pass with its
- * prefilter inside its launch (the last one also finishing its pixel, or the finish alone when there
- * is no pass), holes. The holes step runs every frame: whether the frame has
- * a hole is known from the rows' counters only after the wait, and on a pixel that is no hole the
- * step changes nothing, so the images are those of filter/svgf_kernels.c, which asks first.
+ * SVGF's steps are queued in their one order (fv_svgf_kernels_queue, filter/svgf_kernels.h), the
+ * order every device runs them in.
  */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "device/fill_kernels.h"
 #include "device/film_device.h"
+#include "filter/svgf_kernels.h"
 #include "scene/export.h"
 #include "scene/export_device.h"
 #include "technique/vpolar/device.h"
@@ -324,23 +322,8 @@ static fv_status svgf_queue(fv_vp_device_eye *e, const fv_vp_device_frame *f, co
     k->sampled = f->trace.kill ? e->g.sampled : NULL;
     k->active = dmask;
     k->history = d->have_history && f->history;
-    const int w = f->grid.w, h = f->grid.h;
-    fv_vp_svgf_args a = {*k, 0};
-    fv_status s;
-    if ((s = fv_backend_launch(b, &fv_vp_svgf_accumulate_kernel, w, h, &a, NULL, err)) != FV_OK ||
-        (s = fv_backend_launch(b, &fv_vp_svgf_rows_kernel, h, 1, &a, NULL, err)) != FV_OK ||
-        (s = fv_backend_launch(b, &fv_vp_svgf_variance_kernel, w, h, &a, NULL, err)) != FV_OK)
-        return s;
-    for (a.pass = 0; a.pass < k->iterations; a.pass++) {
-        const fv_kernel *pass = a.pass == k->iterations - 1 ? &fv_vp_svgf_last_pass_kernel : &fv_vp_svgf_pass_kernel;
-        if ((s = fv_backend_launch(b, pass, w, h, &a, NULL, err)) != FV_OK) return s;
-    }
-    if ((k->iterations == 0 && (s = fv_backend_launch(b, &fv_vp_svgf_finish_kernel, w, h, &a, NULL, err)) != FV_OK) ||
-        (s = fv_backend_launch(b, &fv_vp_svgf_holes_kernel, w, h, &a, NULL, err)) != FV_OK)
-        return s;
-    /* this frame's features become the next frame's history (pointers only: the launches above
-     * hold their copies of the struct) */
-    fv_ksvgf_swap(k);
+    fv_status s = fv_svgf_kernels_queue(b, k, true, err);
+    if (s != FV_OK) return s;
     d->have_history = true;
     return FV_OK;
 }

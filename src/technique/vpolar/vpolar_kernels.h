@@ -4,9 +4,8 @@
  *   trace (Sec. 3.1)    a grid cell a thread, pt's path kernel on the flat scene (kernel/vp_trace.h),
  *                       counting rays, paths and non-finite paths;
  *   reproject           the denoiser's history coordinates of a cell (kernel/vp_reproject.h);
- *   SVGF (Sec. 3.3)     kernel/svgf.h's steps a pixel at a time: accumulate, the rows' counters,
- *                       variance, each à-trous pass with its prefilter (the last one with the
- *                       finish; the finish alone without passes), holes;
+ *   SVGF (Sec. 3.3)     kernel/svgf.h's steps, declared with their one order in
+ *                       filter/svgf_kernels.h;
  *   φ-mip halve         a cell of mip level k from level k - 1 (Sec. 3.4, kernel/vp_map.h);
  *   map                 a screen pixel from the sample space (Sec. 3.4, kernel/vp_map.h);
  *   blur h, blur v      the two passes of the foveated blur (Sec. 3.5, kernel/vp_blur.h).
@@ -19,7 +18,6 @@
 
 #include <math.h>
 #include "device/kernel_decl.h"
-#include "kernel/svgf.h"
 #include "kernel/vp_blur.h"
 #include "kernel/vp_map.h"
 #include "kernel/vp_reproject.h"
@@ -56,62 +54,6 @@ FV_HD static inline void fv_vp_reproject_item(const fv_vp_reproject_args *a, int
 {
     (void)y, (void)c;
     fv_kvp_reproject_sample(&a->f, (long)i, &a->prev_coord[2 * (size_t)i]);
-}
-
-/* ---- SVGF (kernel/svgf.h), a launch per step; pass: the à-trous pass ---- */
-
-typedef struct fv_vp_svgf_args {
-    fv_ksvgf k;
-    int pass;
-} fv_vp_svgf_args;
-
-FV_HD static inline void fv_vp_svgf_accumulate_item(const fv_vp_svgf_args *a, int x, int y, uint64_t *c)
-{
-    (void)c;
-    (void)fv_ksvgf_accumulate_pixel(&a->k, x, y);
-}
-
-/* a row an item (h) */
-FV_HD static inline void fv_vp_svgf_rows_item(const fv_vp_svgf_args *a, int y, int unused, uint64_t *c)
-{
-    (void)unused, (void)c;
-    fv_ksvgf_count_row(&a->k, y);
-}
-
-FV_HD static inline void fv_vp_svgf_variance_item(const fv_vp_svgf_args *a, int x, int y, uint64_t *c)
-{
-    (void)c;
-    fv_ksvgf_variance_pixel(&a->k, x, y);
-}
-
-/* a pass with its own prefilter (it reads its pixel's prefiltered variance only) */
-FV_HD static inline void fv_vp_svgf_pass_item(const fv_vp_svgf_args *a, int x, int y, uint64_t *c)
-{
-    (void)c;
-    fv_ksvgf_prefilter_atrous_pixel(&a->k, a->pass, x, y);
-}
-
-FV_HD static inline void fv_vp_svgf_finish_item(const fv_vp_svgf_args *a, int x, int y, uint64_t *c)
-{
-    (void)c;
-    fv_ksvgf_finish_pixel(&a->k, x, y);
-}
-
-/* the last pass and the finish in one launch: the finish reads and writes its own pixel only (the
- * pass's result there; colour and history, which no pass reads), so the bits are the two launches' */
-FV_HD static inline void fv_vp_svgf_last_pass_item(const fv_vp_svgf_args *a, int x, int y, uint64_t *c)
-{
-    (void)c;
-    fv_ksvgf_prefilter_atrous_pixel(&a->k, a->pass, x, y);
-    fv_ksvgf_finish_pixel(&a->k, x, y);
-}
-
-/* launched every frame: only the rows' counters (on the device) know whether a hole exists, and a
- * pixel that is no hole is left alone, so a frame without holes is unchanged */
-FV_HD static inline void fv_vp_svgf_holes_item(const fv_vp_svgf_args *a, int x, int y, uint64_t *c)
-{
-    (void)c;
-    fv_ksvgf_hole_pixel(&a->k, x, y);
 }
 
 /* ---- φ-mipmaps: level k >= 1 from level k - 1, over w x (level k's rows of storage) ---- */
@@ -176,13 +118,6 @@ FV_HD static inline void fv_vp_blur_v_item(const fv_vp_blur_args *a, int x, int 
 #define FV_VP_KERNELS(K)                                                                          \
     K(fv_vp_trace_kernel, fv_vp_trace_args, fv_vp_trace_item, 2, FV_VP_COUNTS)                    \
     K(fv_vp_reproject_kernel, fv_vp_reproject_args, fv_vp_reproject_item, 1, 0)                   \
-    K(fv_vp_svgf_accumulate_kernel, fv_vp_svgf_args, fv_vp_svgf_accumulate_item, 2, 0)            \
-    K(fv_vp_svgf_rows_kernel, fv_vp_svgf_args, fv_vp_svgf_rows_item, 1, 0)                        \
-    K(fv_vp_svgf_variance_kernel, fv_vp_svgf_args, fv_vp_svgf_variance_item, 2, 0)                \
-    K(fv_vp_svgf_pass_kernel, fv_vp_svgf_args, fv_vp_svgf_pass_item, 2, 0)                        \
-    K(fv_vp_svgf_finish_kernel, fv_vp_svgf_args, fv_vp_svgf_finish_item, 2, 0)                    \
-    K(fv_vp_svgf_last_pass_kernel, fv_vp_svgf_args, fv_vp_svgf_last_pass_item, 2, 0)              \
-    K(fv_vp_svgf_holes_kernel, fv_vp_svgf_args, fv_vp_svgf_holes_item, 2, 0)                      \
     K(fv_vp_halve_kernel, fv_vp_halve_args, fv_vp_halve_item, 2, 0)                               \
     K(fv_vp_map_kernel, fv_vp_map_args, fv_vp_map_item, 2, 0)                                     \
     K(fv_vp_blur_h_kernel, fv_vp_blur_args, fv_vp_blur_h_item, 2, 0)                              \
