@@ -477,8 +477,9 @@ fv_status fv_vp_device_frames(fv_vp_device *d, fv_vp_device_eye *const *eye, int
     if ((s = fv_scene_export_update(d->flat, d->scene, err)) != FV_OK ||
         (s = fv_scene_device_update(d->dscene, fv_scene_export_view(d->flat), err)) != FV_OK)
         return s;
-    bool done = true;
-    for (int e = 0; e < eyes && s == FV_OK && done; e++) s = queue_eye(eye[e], &f[e], &out[e], e * MARKS_PER_EYE, &done, err);
+    bool done = true, queued[2] = {false, false};
+    for (int e = 0; e < eyes && s == FV_OK && done; e++)
+        if ((s = queue_eye(eye[e], &f[e], &out[e], e * MARKS_PER_EYE, &done, err)) == FV_OK) queued[e] = done;
     /* the wait even after a failure: nothing queued may write into a film the caller has back */
     const fv_status sw = fv_backend_wait(b, "the Visual-Polar frame", s == FV_OK ? err : NULL);
     if (s == FV_OK) s = sw;
@@ -486,10 +487,12 @@ fv_status fv_vp_device_frames(fv_vp_device *d, fv_vp_device_eye *const *eye, int
     fv_backend_calls_get(b, &after);
     fv_backend_calls_diff(&after, &before, calls);
     if (s != FV_OK) return s;
-    if (!done) return FV_OK; /* every res[e].done false */
-    for (int e = 0; e < eyes; e++) {
-        eye_result(eye[e], &f[e], &out[e], e * MARKS_PER_EYE, &res[e]);
-        res[e].done = true;
-    }
+    /* an eye queued whole has run (its device history moved on), even when the next one's trace
+     * was cancelled */
+    for (int e = 0; e < eyes; e++)
+        if (queued[e]) {
+            eye_result(eye[e], &f[e], &out[e], e * MARKS_PER_EYE, &res[e]);
+            res[e].done = true;
+        }
     return FV_OK;
 }

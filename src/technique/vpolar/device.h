@@ -89,7 +89,8 @@ typedef struct fv_vp_device_result {
     double history_fraction;   /* the denoiser's (fv_svgf_info) */
     double stage_ms[5];        /* trace, denoise, mip, map, blur (between the backend's marks) */
     double kernel_ms;          /* the eye's stages, first to last */
-    bool done;                 /* false: the trace was cancelled (portable), nothing after it ran */
+    bool done;                 /* the eye ran; false: its trace (or an earlier eye's) was cancelled
+                                  (portable), and nothing of it after the trace ran */
 } fv_vp_device_result;
 
 /* Renders `eyes` frames (1, or 2: a stereo pair; an eye, frame, film and result each, the eyes

@@ -557,9 +557,14 @@ static fv_status render_device(fv_vp_pipeline *const *p, int eyes, const fv_fram
         fv_stats_add_count(stats, "host_syncs", 1.0);
         fv_backend_calls_report(stats, &none, &calls);
     }
-    /* a cancelled trace (portable): the history is left as it was */
-    if (!r[0].done) return fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    /* Every eye the device ran takes its result and history, even after a later eye's trace was
+     * cancelled (portable): the device's history has moved on for it. A cancelled eye's history
+     * is left as it was. */
     for (int e = 0; e < eyes; e++) {
+        if (!r[e].done) {
+            if (s == FV_OK) s = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+            continue;
+        }
         const fv_status se = device_finish(p[e], &frames[e], stats, &ef[e].job, &ef[e].view, &r[e], &ef[e].prog, s == FV_OK ? err : NULL);
         if (s == FV_OK) s = se;
     }
