@@ -1,15 +1,41 @@
-/* fovea — SVGF's kernels on the portable backend (svgf_kernels.h): kernel/svgf.h's steps over
- * tiles, one fv_parallel_tiles per step (a step reads its neighbours' results of the one before,
- * as a GPU launch would), in kernel/svgf.h's order, the prefilter inside each pass's launch unless
- * told otherwise. */
+/* fovea — SVGF's kernels (svgf_kernels.h): their portable side and descriptors, their one launch
+ * order, and the filter over them on the portable backend (a launch per step: a step reads its
+ * neighbours' results of the one before, as a GPU launch would). */
 #include <stdlib.h>
 #include "core/alloc.h"
-#include "core/parallel.h"
 #include "filter/svgf_kernels.h"
-#include "kernel/svgf.h"
+
+FV_SVGF_KERNELS(FV_KERNEL_DEFINE)
+
+fv_status fv_svgf_kernels_queue(fv_backend *b, fv_ksvgf *k, bool fused, fv_error *err)
+{
+    const int w = k->g.w, h = k->g.h;
+    fv_svgf_step_args a = {*k, 0};
+    fv_status s;
+    if ((s = fv_backend_launch(b, &fv_svgf_accumulate_kernel, w, h, &a, NULL, err)) != FV_OK ||
+        (s = fv_backend_launch(b, &fv_svgf_rows_kernel, h, 1, &a, NULL, err)) != FV_OK ||
+        (s = fv_backend_launch(b, &fv_svgf_variance_kernel, w, h, &a, NULL, err)) != FV_OK)
+        return s;
+    for (a.pass = 0; a.pass < k->iterations; a.pass++) {
+        if (fused) {
+            const fv_kernel *pass = a.pass == k->iterations - 1 ? &fv_svgf_last_pass_kernel : &fv_svgf_pass_kernel;
+            if ((s = fv_backend_launch(b, pass, w, h, &a, NULL, err)) != FV_OK) return s;
+            continue;
+        }
+        if ((s = fv_backend_launch(b, &fv_svgf_prefilter_kernel, w, h, &a, NULL, err)) != FV_OK ||
+            (s = fv_backend_launch(b, &fv_svgf_atrous_kernel, w, h, &a, NULL, err)) != FV_OK)
+            return s;
+    }
+    if (((!fused || k->iterations == 0) && (s = fv_backend_launch(b, &fv_svgf_finish_kernel, w, h, &a, NULL, err)) != FV_OK) ||
+        (s = fv_backend_launch(b, &fv_svgf_holes_kernel, w, h, &a, NULL, err)) != FV_OK)
+        return s;
+    fv_ksvgf_swap(k);
+    return FV_OK;
+}
 
 struct fv_svgf_kernels {
     fv_ksvgf k;         /* the buffers below, the options, and each frame's inputs */
+    fv_backend *b;      /* portable: its device memory is host memory */
     bool have_history;
     bool fused;         /* fv_svgf_kernels_set_fused */
     float *feat[2][7];  /* nx, ny, nz, z, m1, m2, len: this frame's and the previous (swapped) */
@@ -42,6 +68,7 @@ static void free_all(fv_svgf_kernels *s)
     for (int i = 0; i < nb; i++) free(*ptr[i]);
     free(s->k.kind), free(s->k.found), free(s->k.hist_id);
     free(s->k.row_surface), free(s->k.row_hist), free(s->k.row_holes), free(s->k.row_len);
+    if (s->b) fv_backend_destroy(s->b);
     free(s);
 }
 
@@ -81,6 +108,10 @@ fv_status fv_svgf_kernels_create(const fv_grid *grid, const fv_svgf_opts *o, fv_
         free_all(s);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for SVGF buffers of a %dx%d grid", grid->w, grid->h);
     }
+    if ((st = fv_backend_create(FV_DEVICE_PORTABLE, &s->b, err)) != FV_OK) {
+        free_all(s);
+        return st;
+    }
     float **cur[7] = {&k->nx, &k->ny, &k->nz, &k->z, &k->m1, &k->m2, &k->len};
     const float **prev[7] = {&k->pnx, &k->pny, &k->pnz, (const float **)&k->pz, &k->pm1, &k->pm2, &k->plen};
     for (int c = 0; c < 7; c++) *cur[c] = s->feat[0][c], *prev[c] = s->feat[1][c];
@@ -109,42 +140,6 @@ void fv_svgf_kernels_reset(fv_svgf_kernels *s)
     if (s) s->have_history = false;
 }
 
-enum { STEP_ACCUMULATE, STEP_VARIANCE, STEP_PREFILTER, STEP_ATROUS, STEP_PREFILTER_ATROUS, STEP_FINISH, STEP_HOLES };
-
-typedef struct step_job {
-    const fv_ksvgf *k;
-    int step, pass;
-} step_job;
-
-static void step_tile(void *ctx, const fv_tile *t)
-{
-    const step_job *j = ctx;
-    const fv_ksvgf *k = j->k;
-    for (int y = t->y0; y < t->y1; y++)
-        for (int x = t->x0; x < t->x1; x++) switch (j->step) {
-            case STEP_ACCUMULATE: fv_ksvgf_accumulate_pixel(k, x, y); break;
-            case STEP_VARIANCE: fv_ksvgf_variance_pixel(k, x, y); break;
-            case STEP_PREFILTER: fv_ksvgf_prefilter_pixel(k, j->pass, x, y); break;
-            case STEP_ATROUS: fv_ksvgf_atrous_pixel(k, j->pass, x, y); break;
-            case STEP_PREFILTER_ATROUS: fv_ksvgf_prefilter_atrous_pixel(k, j->pass, x, y); break;
-            case STEP_FINISH: fv_ksvgf_finish_pixel(k, x, y); break;
-            default: fv_ksvgf_hole_pixel(k, x, y); break;
-            }
-}
-
-static void count_rows(void *ctx, int64_t b, int64_t e, int thread)
-{
-    (void)thread;
-    const fv_ksvgf *k = ctx;
-    for (int64_t y = b; y < e; y++) fv_ksvgf_count_row(k, (int)y);
-}
-
-static void run_step(const fv_ksvgf *k, int step, int pass, int threads)
-{
-    step_job j = {k, step, pass};
-    fv_parallel_tiles(k->g.w, k->g.h, threads, step_tile, &j, NULL, NULL);
-}
-
 fv_status fv_svgf_kernels_filter(fv_svgf_kernels *s, const fv_svgf_frame *fr, int threads, fv_svgf_info *info, fv_error *err)
 {
     if (!s) return fv_error_set(err, FV_ERR_INVALID, "SVGF: no filter");
@@ -155,22 +150,10 @@ fv_status fv_svgf_kernels_filter(fv_svgf_kernels *s, const fv_svgf_frame *fr, in
     k->position = fr->position, k->prev_coord = fr->prev_coord, k->id = fr->id;
     k->sampled = fr->sampled, k->active = fr->active;
     k->history = s->have_history && fr->prev_coord;
-    run_step(k, STEP_ACCUMULATE, 0, threads);
-    fv_parallel_for(k->g.h, 16, threads, count_rows, k);
-    run_step(k, STEP_VARIANCE, 0, threads);
-    for (int pass = 0; pass < k->iterations; pass++) {
-        if (s->fused) {
-            run_step(k, STEP_PREFILTER_ATROUS, pass, threads);
-            continue;
-        }
-        run_step(k, STEP_PREFILTER, pass, threads);
-        run_step(k, STEP_ATROUS, pass, threads);
-    }
-    run_step(k, STEP_FINISH, 0, threads);
+    fv_backend_set_threads(s->b, threads);
+    if ((st = fv_svgf_kernels_queue(s->b, k, s->fused, err)) != FV_OK || (st = fv_backend_wait(s->b, "SVGF", err)) != FV_OK) return st;
     fv_svgf_info in;
-    if (fv_ksvgf_sum_rows(k->g.h, k->row_surface, k->row_hist, k->row_holes, k->row_len, &in.history_fraction, &in.mean_history))
-        run_step(k, STEP_HOLES, 0, threads);
-    fv_ksvgf_swap(k);
+    fv_ksvgf_sum_rows(k->g.h, k->row_surface, k->row_hist, k->row_holes, k->row_len, &in.history_fraction, &in.mean_history);
     s->have_history = true;
     if (info) *info = in;
     return FV_OK;

@@ -1,14 +1,108 @@
-/* fovea — SVGF as kernels (kernel/svgf.h) on the portable backend: the filter's buffers in host
- * memory, and a frame as the kernels' launch sequence, each step a pixel at a time over tiles of
- * the grid on the CPU's threads. The same contract and the same bits as fv_svgf (filter/svgf.h) in
- * any of its builds; this is what the Visual-Polar family's portable device runs
- * (technique/vpolar/device.c) and what tests the kernels against the CPU filter. The CPU filter
- * stays fv_svgf (its vectorised sweeps are several times faster on a CPU).
+/* fovea — SVGF as kernels (kernel/svgf.h): its steps declared once for every device backend and
+ * their one launch order (fv_svgf_kernels_queue), which the Visual-Polar family's device frame
+ * queues (technique/vpolar/device.c); and a filter over them on the portable backend, its buffers
+ * in host memory, with the same contract and the same bits as fv_svgf (filter/svgf.h) in any of
+ * its builds, which tests the kernels against the CPU filter. The CPU filter stays fv_svgf (its
+ * vectorised sweeps are several times faster on a CPU).
  */
 #ifndef FV_FILTER_SVGF_KERNELS_H
 #define FV_FILTER_SVGF_KERNELS_H
 
+#include "device/backend.h"
+#include "device/kernel_decl.h"
 #include "filter/svgf.h"
+#include "kernel/svgf.h"
+
+/* ---- SVGF's steps declared once (device/kernel_decl.h), a pixel an item (the rows' counters a row
+ * an item); svgf_kernels.c makes the portable side, svgf_kernels.cu the CUDA side. pass: the
+ * à-trous pass. ---- */
+
+typedef struct fv_svgf_step_args {
+    fv_ksvgf k; /* device pointers */
+    int pass;
+} fv_svgf_step_args;
+
+FV_HD static inline void fv_svgf_accumulate_item(const fv_svgf_step_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    (void)fv_ksvgf_accumulate_pixel(&a->k, x, y);
+}
+
+FV_HD static inline void fv_svgf_rows_item(const fv_svgf_step_args *a, int y, int unused, uint64_t *c)
+{
+    (void)unused, (void)c;
+    fv_ksvgf_count_row(&a->k, y);
+}
+
+FV_HD static inline void fv_svgf_variance_item(const fv_svgf_step_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    fv_ksvgf_variance_pixel(&a->k, x, y);
+}
+
+FV_HD static inline void fv_svgf_prefilter_item(const fv_svgf_step_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    fv_ksvgf_prefilter_pixel(&a->k, a->pass, x, y);
+}
+
+FV_HD static inline void fv_svgf_atrous_item(const fv_svgf_step_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    fv_ksvgf_atrous_pixel(&a->k, a->pass, x, y);
+}
+
+/* a pass with its own prefilter (it reads its pixel's prefiltered variance only) */
+FV_HD static inline void fv_svgf_pass_item(const fv_svgf_step_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    fv_ksvgf_prefilter_atrous_pixel(&a->k, a->pass, x, y);
+}
+
+/* the last pass and the finish in one launch: the finish reads and writes its own pixel only (the
+ * pass's result there; colour and the history, which no pass reads), so the bits are the two
+ * launches' */
+FV_HD static inline void fv_svgf_last_pass_item(const fv_svgf_step_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    fv_ksvgf_prefilter_atrous_pixel(&a->k, a->pass, x, y);
+    fv_ksvgf_finish_pixel(&a->k, x, y);
+}
+
+FV_HD static inline void fv_svgf_finish_item(const fv_svgf_step_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    fv_ksvgf_finish_pixel(&a->k, x, y);
+}
+
+FV_HD static inline void fv_svgf_holes_item(const fv_svgf_step_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    fv_ksvgf_hole_pixel(&a->k, x, y);
+}
+
+#define FV_SVGF_KERNELS(K)                                                                   \
+    K(fv_svgf_accumulate_kernel, fv_svgf_step_args, fv_svgf_accumulate_item, 2, 0)          \
+    K(fv_svgf_rows_kernel, fv_svgf_step_args, fv_svgf_rows_item, 1, 0)                      \
+    K(fv_svgf_variance_kernel, fv_svgf_step_args, fv_svgf_variance_item, 2, 0)              \
+    K(fv_svgf_prefilter_kernel, fv_svgf_step_args, fv_svgf_prefilter_item, 2, 0)            \
+    K(fv_svgf_atrous_kernel, fv_svgf_step_args, fv_svgf_atrous_item, 2, 0)                  \
+    K(fv_svgf_pass_kernel, fv_svgf_step_args, fv_svgf_pass_item, 2, 0)                      \
+    K(fv_svgf_last_pass_kernel, fv_svgf_step_args, fv_svgf_last_pass_item, 2, 0)            \
+    K(fv_svgf_finish_kernel, fv_svgf_step_args, fv_svgf_finish_item, 2, 0)                  \
+    K(fv_svgf_holes_kernel, fv_svgf_step_args, fv_svgf_holes_item, 2, 0)
+
+FV_SVGF_KERNELS(FV_KERNEL_EXTERN)
+
+/* One frame of SVGF queued on b over k (its buffers b's device memory, its options and this
+ * frame's inputs set), in the one step order every device runs: accumulate, the rows' counters,
+ * variance, each pass with its prefilter (fused: in the pass's launch, the last pass also
+ * finishing its pixel; else a prefilter launch then the pass's, then the finish), the finish alone
+ * when there is no pass, holes. The holes step runs every frame: whether a hole exists is known
+ * from the rows' counters only after a wait, and a pixel that is no hole is left alone, so a frame
+ * without holes is unchanged. Then k's features become the next frame's history (fv_ksvgf_swap:
+ * pointers only; the launches hold their copies). */
+fv_status fv_svgf_kernels_queue(fv_backend *b, fv_ksvgf *k, bool fused, fv_error *err);
 
 typedef struct fv_svgf_kernels fv_svgf_kernels;
 

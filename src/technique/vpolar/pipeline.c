@@ -29,7 +29,9 @@ enum { COORDS_NONE = 0, COORDS_STORE, COORDS_READ };
 struct fv_vp_pipeline {
     const fv_scene *scene;
     fv_vp_opts o;
-    fv_vp_device *dev;      /* NULL: the CPU's own stages */
+    fv_vp_device *dev;      /* NULL: the CPU's own stages; else the method's device (not owned) */
+    fv_vp_device_eye *deye; /* this pipeline's buffers and history there */
+    bool fresh;             /* setup made a new grid: the device's next frame starts it afresh */
     int sw, sh;             /* screen size the buffers are for, 0 before the first frame */
     double ppd;
     fv_space *space;
@@ -58,7 +60,7 @@ struct fv_vp_pipeline {
     bool have_image;
 };
 
-fv_status fv_vp_pipeline_create(const fv_scene *scene, const fv_vp_opts *o, fv_vp_pipeline **out, fv_error *err)
+fv_status fv_vp_pipeline_create(const fv_scene *scene, const fv_vp_opts *o, fv_vp_device *dev, fv_vp_pipeline **out, fv_error *err)
 {
     *out = NULL;
     fv_status s = fv_svgf_opts_validate(&o->svgf, err);
@@ -67,7 +69,12 @@ fv_status fv_vp_pipeline_create(const fv_scene *scene, const fv_vp_opts *o, fv_v
     if (!p) return fv_error_set(err, FV_ERR_NOMEM, "out of memory");
     p->scene = scene;
     p->o = *o;
-    if (o->device != FV_DEVICE_CPU && (s = fv_vp_device_create(scene, o->device, &p->dev, err)) != FV_OK) {
+    if (o->device != FV_DEVICE_CPU && !dev) s = fv_error_set(err, FV_ERR_INTERNAL, "a Visual-Polar pipeline on device %s without its device", fv_device_name(o->device));
+    if (s == FV_OK && dev) {
+        p->dev = dev;
+        s = fv_vp_device_eye_create(dev, &p->deye, err);
+    }
+    if (s != FV_OK) {
         free(p);
         return s;
     }
@@ -79,7 +86,6 @@ static void free_buffers(fv_vp_pipeline *p)
 {
     fv_space_destroy(p->space);
     fv_svgf_destroy(p->svgf);
-    if (p->dev) fv_vp_device_svgf_release(p->dev); /* its grid is the space's */
     fv_phi_mips_destroy(p->mips);
     free(p->g.color), free(p->g.albedo), free(p->g.reflectance), free(p->g.normal), free(p->g.depth), free(p->g.position), free(p->g.id);
     free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm), free(p->lut), free(p->onscreen);
@@ -100,7 +106,7 @@ void fv_vp_pipeline_destroy(fv_vp_pipeline *p)
     free_buffers(p);
     fv_kit_counters_destroy(p->counters);
     fv_scratch_free(&p->blur_room);
-    fv_vp_device_destroy(p->dev);
+    fv_vp_device_eye_destroy(p->deye);
     free(p);
 }
 
@@ -113,11 +119,11 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
     if (s != FV_OK) return s;
     const fv_grid *g = fv_space_grid(p->space);
     size_t n = (size_t)g->w * g->h, ns = (size_t)sw * sh;
-    /* A device that renders whole frames (cuda) keeps the grid on the GPU: the host's copy would be
-     * written once here and never read (69 bytes a cell; some 300 MB for a stereo pair of
-     * cartesian-full at 1440x1600). Its history coordinates and sigma are still allocated, as the
-     * frame's description points to them, but never touched, so they cost no memory. */
-    const bool host_grid = !(p->dev && fv_vp_device_whole_frame(p->dev));
+    /* A device keeps the grid in its own memory (device.h): the host's copy would be written once
+     * here and never read (69 bytes a cell; some 300 MB for a stereo pair of cartesian-full at
+     * 1440x1600). Its history coordinates and sigma are still allocated, as the frame's
+     * description points to them, but never touched, so they cost no memory. */
+    const bool host_grid = !p->dev;
     if (host_grid) {
         p->g.color = fv_alloc_array(n, 3 * sizeof(float));
         p->g.albedo = fv_alloc_array(n, 3 * sizeof(float));
@@ -158,9 +164,8 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
         }
         p->mask_gx = p->mask_gy = NAN;
     }
-    /* The denoiser: on the host for the CPU, as kernels on a device (its buffers there). */
-    if (p->o.denoise && (s = p->dev ? fv_vp_device_svgf_setup(p->dev, g, &p->o.svgf, err) : fv_svgf_create(g, &p->o.svgf, &p->svgf, err)) !=
-                            FV_OK) {
+    /* The denoiser: on the host for the CPU; a device keeps its buffers (device.h). */
+    if (p->o.denoise && !p->dev && (s = fv_svgf_create(g, &p->o.svgf, &p->svgf, err)) != FV_OK) {
         free_buffers(p);
         return s;
     }
@@ -179,6 +184,7 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
     }
     p->sw = sw;
     p->sh = sh;
+    p->fresh = true;
     return FV_OK;
 }
 
@@ -377,39 +383,43 @@ static void reproject_frame(const fv_vp_pipeline *p, fv_kvp_reproject_frame *rf)
     rf->inv_step = 1.0f / LUT_STEP;
 }
 
-/* A whole frame for a device that takes one, as the host prepared it: the device's frame, the
- * film's views and the blur's kernels (host memory the frame points to until the device has it). */
-typedef struct whole_frame {
-    fv_cuda_vp_frame f;
+/* A frame on a device (device.h), as the host prepared it: the device's frame and the film's views
+ * (the blur's kernels host memory it points to until the device has them). */
+typedef struct device_frame {
+    fv_vp_device_frame f;
     fv_film_views out;
     int *off;
     float *k;
-} whole_frame;
+} device_frame;
 
-static void whole_free(whole_frame *w)
+static void device_frame_free(device_frame *w)
 {
     free(w->off), free(w->k);
     w->off = NULL, w->k = NULL;
 }
 
-/* A whole frame on a device that takes one (cuda: device/cuda/vpolar.cu): the host builds what
- * depends on the screen size and the gaze (the on-screen mask above, the radial table, the blur's
- * kernels) and receives the film and the counts; the grid, the denoiser's history coordinates,
- * SVGF's buffers and history and the mipmaps stay on the device (the host keeps no copy of the
- * grid: setup). whole_prepare builds the frame, fv_vp_device_frames renders it (with the other eye's, for
- * a stereo pair), whole_finish takes its result. The stage times are the device's (events). */
-static fv_status whole_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, const fv_vp_trace_job *job,
-                               const fv_space_view *view, whole_frame *w, fv_error *err)
+/* A frame on the device: the host builds what depends on the screen size and the gaze (the
+ * on-screen mask, the radial table, the blur's kernels) and receives the film and the counts; the
+ * grid, the denoiser's history coordinates, SVGF's buffers and history and the mipmaps stay on the
+ * device (the host keeps no copy of the grid: setup). device_prepare builds the frame,
+ * fv_vp_device_frames renders it (with the other eye's, for a stereo pair), device_finish takes its
+ * result. The stage times are the device's (the backend's marks). */
+static fv_status device_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, const fv_vp_trace_job *job,
+                                const fv_space_view *view, device_frame *w, fv_error *err)
 {
     memset(w, 0, sizeof *w);
     const fv_grid *g = fv_space_grid(p->space);
     const bool polar = fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN;
-    fv_cuda_vp_frame f;
+    fv_vp_device_frame f;
     memset(&f, 0, sizeof f);
+    f.fresh = p->fresh;
+    f.threads = frame->threads;
+    f.progress = (fv_launch_progress){fv_kit_progress_fn, job->progress};
     f.onscreen = p->onscreen;
     fv_vp_trace_kframe(job, &f.trace);
     if (p->o.denoise) {
         f.denoise = 1;
+        f.grid = *g;
         f.svgf = p->o.svgf;
         f.periph_x = g->w, f.periph_passes = p->o.svgf.iterations;
         periphery(p, view, &f.periph_x, &f.periph_passes);
@@ -457,16 +467,13 @@ static fv_status whole_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_film
     return FV_OK;
 }
 
-static fv_status whole_finish(fv_vp_pipeline *p, const fv_frame *frame, fv_stats *stats, const fv_vp_trace_job *job, const fv_space_view *view,
-                              const fv_cuda_vp_result *res, fv_kit_progress *prog, fv_error *err)
+static fv_status device_finish(fv_vp_pipeline *p, const fv_frame *frame, fv_stats *stats, const fv_vp_trace_job *job, const fv_space_view *view,
+                               const fv_vp_device_result *res, fv_kit_progress *prog, fv_error *err)
 {
-    const fv_cuda_vp_result r = *res;
+    const fv_vp_device_result r = *res;
     static const char *const stage[5] = {"trace", "denoise", "mip", "map", "blur"};
     for (int i = 0; i < 5; i++) fv_stats_add_ms(stats, stage[i], r.stage_ms[i]);
-    fv_stats_add_ms(stats, "kernel", r.kernel_ms);
-    fv_stats_add_count(stats, "host_syncs", (double)r.syncs);
-    const fv_cuda_calls none = {0};
-    fv_backend_calls_report(stats, &none, &r.calls);
+    if (fv_vp_device_kind(p->dev) == FV_DEVICE_CUDA) fv_stats_add_ms(stats, "kernel", r.kernel_ms);
     fv_stats_add_count(stats, "rays", (double)r.rays);
     fv_stats_add_count(stats, "samples", (double)r.paths);
     fv_stats_add_count(stats, "grid_samples", (double)fv_space_sample_count(p->space));
@@ -474,10 +481,12 @@ static fv_status whole_finish(fv_vp_pipeline *p, const fv_frame *frame, fv_stats
     fv_stats_add_count(stats, "mrays_per_s", r.stage_ms[0] > 0.0 ? (double)r.rays / r.stage_ms[0] / 1000.0 : 0.0);
     fv_stats_add_count(stats, "nan_samples", (double)r.nan_paths);
     if (p->o.denoise) fv_stats_add_count(stats, "history_fraction", r.history_fraction);
+    p->fresh = false;
     p->prev_cam = job->cam;
     p->prev_view = *view;
     p->have_prev = true;
-    /* have_image stays false: the sample-space image is on the device (show= is refused there) */
+    /* the sample-space image where the host can read it (portable; show= is refused on cuda) */
+    p->have_image = fv_vp_device_eye_image(p->deye) != NULL;
     fv_kit_phase(prog, frame, 0.8, 0.2);
     return fv_kit_phase_end(prog, err);
 }
@@ -522,28 +531,41 @@ static fv_status begin_frame(fv_vp_pipeline *p, const fv_frame *frame, fv_film *
     return FV_OK;
 }
 
-/* `eyes` whole frames (1, or a stereo pair: a pipeline, frame, film and eye_frame each) on their
- * devices, with one host wait for them all; each eye's film, counters and history as if it were
- * rendered alone, eye 0's stats added before eye 1's. */
-static fv_status render_whole(fv_vp_pipeline *const *p, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, eye_frame *ef,
-                              fv_error *err)
+/* `eyes` frames (1, or a stereo pair: a pipeline, frame, film and eye_frame each, the pipelines on
+ * one device) queued on the device with one host wait for them all; each eye's film, counters and
+ * history as if it were rendered alone, eye 0's stats added before eye 1's. */
+static fv_status render_device(fv_vp_pipeline *const *p, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, eye_frame *ef,
+                               fv_error *err)
 {
-    whole_frame w[2];
+    device_frame w[2];
     memset(w, 0, sizeof w);
     fv_status s = FV_OK;
-    for (int e = 0; e < eyes && s == FV_OK; e++) s = whole_prepare(p[e], &frames[e], films[e], stats, &ef[e].job, &ef[e].view, &w[e], err);
-    fv_cuda_vp_frame f[2];
+    for (int e = 0; e < eyes && s == FV_OK; e++) s = device_prepare(p[e], &frames[e], films[e], stats, &ef[e].job, &ef[e].view, &w[e], err);
+    fv_vp_device_frame f[2];
     fv_film_views out[2];
-    fv_cuda_vp_result r[2];
-    fv_vp_device *dev[2];
-    for (int e = 0; e < eyes; e++) f[e] = w[e].f, out[e] = w[e].out, dev[e] = p[e]->dev;
-    if (s == FV_OK) s = fv_vp_device_frames(dev, eyes, f, out, r, err);
-    for (int e = 0; e < eyes; e++) whole_free(&w[e]);
+    fv_vp_device_result r[2];
+    fv_vp_device_eye *eye[2];
+    fv_backend_calls calls;
+    memset(&calls, 0, sizeof calls);
+    for (int e = 0; e < eyes; e++) f[e] = w[e].f, out[e] = w[e].out, eye[e] = p[e]->deye;
+    if (s == FV_OK) s = fv_vp_device_frames(p[0]->dev, eye, eyes, f, out, r, &calls, err);
+    for (int e = 0; e < eyes; e++) device_frame_free(&w[e]);
     if (s != FV_OK) return s;
-    /* Every eye the device rendered takes its result and history, even after eye 0's progress
-     * asked to cancel: the device's history has moved on for both. */
+    if (fv_vp_device_kind(p[0]->dev) == FV_DEVICE_CUDA) {
+        /* the pair's one wait and what it asked of the runtime, with eye 0's figures */
+        const fv_backend_calls none = {0};
+        fv_stats_add_count(stats, "host_syncs", 1.0);
+        fv_backend_calls_report(stats, &none, &calls);
+    }
+    /* Every eye the device ran takes its result and history, even after a later eye's trace was
+     * cancelled (portable): the device's history has moved on for it. A cancelled eye's history
+     * is left as it was. */
     for (int e = 0; e < eyes; e++) {
-        const fv_status se = whole_finish(p[e], &frames[e], stats, &ef[e].job, &ef[e].view, &r[e], &ef[e].prog, s == FV_OK ? err : NULL);
+        if (!r[e].done) {
+            if (s == FV_OK) s = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+            continue;
+        }
+        const fv_status se = device_finish(p[e], &frames[e], stats, &ef[e].job, &ef[e].view, &r[e], &ef[e].prog, s == FV_OK ? err : NULL);
         if (s == FV_OK) s = se;
     }
     return s;
@@ -559,17 +581,14 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     const fv_camera_basis basis = ef.basis;
     fv_space_view view = ef.view;
 
+    /* a device: the whole frame there (device.h) */
+    if (p->dev) return render_device(&p, 1, frame, &film, stats, &ef, err);
+
     /* 1. trace */
-    if (p->dev && fv_vp_device_whole_frame(p->dev)) return render_whole(&p, 1, frame, &film, stats, &ef, err);
     ef.job.counters = fv_kit_counters_reuse(&p->counters);
     fv_vp_trace_result tr;
     fv_stage_clock t0 = fv_stage_clock_now();
-    bool traced;
-    if (p->dev) {
-        if ((s = fv_vp_device_trace(p->dev, &ef.job, &p->g, &tr, &traced, err)) != FV_OK) return s;
-    } else {
-        traced = fv_vp_trace(&ef.job, &p->g, &tr);
-    }
+    const bool traced = fv_vp_trace(&ef.job, &p->g, &tr);
     const fv_stage_clock t1 = fv_stage_clock_now();
     const double t_trace = t1.wall - t0.wall;
     fv_stage_add(stats, "trace", t0, t1);
@@ -590,25 +609,14 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
              * stayed kept it). */
             reproject_ctx rc = {p, fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN && p->prev_view.gx == p->lut_gx &&
                                        p->prev_view.gy == p->lut_gy};
-            if (p->dev && (rc.lut || fv_space_kind_of(p->space) == FV_SPACE_CARTESIAN)) {
-                fv_kvp_reproject_frame rf;
-                reproject_frame(p, &rf);
-                fv_vp_device_reproject(p->dev, &rf, p->prev_coord, frame->threads);
-            } else {
-                fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
-            }
+            fv_parallel_for((int64_t)g->w * g->h, 4096, frame->threads, reproject_range, &rc);
         }
         fv_svgf_frame fr = {p->g.color, p->g.reflectance, p->g.normal, p->g.depth, p->g.position, p->g.id,
                             hist ? p->prev_coord : NULL, p->o.kill ? p->g.sampled : NULL, p->onscreen};
         int x_from, passes;
-        if (periphery(p, &view, &x_from, &passes)) {
-            if (p->dev)
-                fv_vp_device_svgf_periphery(p->dev, x_from, passes);
-            else
-                fv_svgf_set_periphery(p->svgf, x_from, passes);
-        }
+        if (periphery(p, &view, &x_from, &passes)) fv_svgf_set_periphery(p->svgf, x_from, passes);
         fv_svgf_info info;
-        s = p->dev ? fv_vp_device_svgf(p->dev, &fr, frame->threads, &info, err) : fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err);
+        s = fv_svgf_filter(p->svgf, &fr, frame->threads, &info, err);
         if (s != FV_OK) return s;
         fv_stats_add_count(stats, "history_fraction", info.history_fraction);
     }
@@ -621,12 +629,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     /* 3. mipmaps along φ (Sec. 3.4) */
     bool identity = fv_space_kind_of(p->space) == FV_SPACE_CARTESIAN && g->w == p->sw && g->h == p->sh;
     t0 = fv_stage_clock_now();
-    if (!identity) {
-        if (p->dev)
-            fv_vp_device_mips(p->dev, p->mips, p->g.color, frame->threads);
-        else
-            fv_phi_mips_build(p->mips, p->g.color, frame->threads);
-    }
+    if (!identity) fv_phi_mips_build(p->mips, p->g.color, frame->threads);
     fv_stage_stop(stats, "mip", t0);
 
     /* 4. back to the screen */
@@ -640,7 +643,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     /* A gaze that stays (a still eye, a screenshot, the viewer) reuses the coordinates: from the
      * second frame at the same gaze they are kept (if the memory is there), from the third read.
      * A gaze that moves never pays for keeping them. */
-    const bool still = !p->dev && view.gx == p->map_gx && view.gy == p->map_gy; /* a device recomputes them */
+    const bool still = view.gx == p->map_gx && view.gy == p->map_gy;
     p->coords_state = !mc.polar || !still ? COORDS_NONE : (p->coords_state == COORDS_NONE ? COORDS_STORE : COORDS_READ);
     if (p->coords_state == COORDS_STORE && !p->coords && !(p->coords = fv_alloc_array((size_t)p->sw * p->sh, 3 * sizeof(float))))
         p->coords_state = COORDS_NONE;
@@ -648,17 +651,13 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     if (p->coords_state != COORDS_READ) build_radial_lut(p, &view);
     fv_stats_add_count(stats, "map_reused", p->coords_state == COORDS_READ);
     map_frame(p, &view, identity, &mc.mf);
-    if (p->dev)
-        fv_vp_device_map(p->dev, &mc.mf, &mc.out, frame->threads);
-    else
-        fv_parallel_for(p->sh, 8, frame->threads, map_rows, &mc);
+    fv_parallel_for(p->sh, 8, frame->threads, map_rows, &mc);
     fv_stage_stop(stats, "map", t0);
 
     /* 5. foveated blur (Sec. 3.5) */
     t0 = fv_stage_clock_now();
     if (p->o.blur) {
-        s = p->dev ? fv_vp_device_blur(p->dev, fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, err)
-                   : fv_blur_variable_in(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, &p->blur_room, err);
+        s = fv_blur_variable_in(fv_film_color(film), p->sw, p->sh, p->sigma, frame->threads, &p->blur_room, err);
         if (s != FV_OK) return s;
     }
     fv_stage_stop(stats, "blur", t0);
@@ -668,7 +667,7 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
 
 fv_status fv_vp_pipeline_render_pair(fv_vp_pipeline *const *p, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
 {
-    if (p[0] == p[1] || !p[0]->dev || !p[1]->dev || !fv_vp_device_whole_frame(p[0]->dev) || !fv_vp_device_whole_frame(p[1]->dev)) {
+    if (p[0] == p[1] || !p[0]->dev || p[0]->dev != p[1]->dev) {
         fv_status s = fv_vp_pipeline_render(p[0], &frames[0], films[0], stats, err);
         return s == FV_OK ? fv_vp_pipeline_render(p[1], &frames[1], films[1], stats, err) : s;
     }
@@ -676,14 +675,14 @@ fv_status fv_vp_pipeline_render_pair(fv_vp_pipeline *const *p, const fv_frame *f
     fv_status s;
     for (int e = 0; e < 2; e++)
         if ((s = begin_frame(p[e], &frames[e], films[e], &ef[e], err)) != FV_OK) return s;
-    return render_whole(p, 2, frames, films, stats, ef, err);
+    return render_device(p, 2, frames, films, stats, ef, err);
 }
 
 const fv_space *fv_vp_pipeline_space(const fv_vp_pipeline *p, fv_space_view *view, const float **image, double *px_per_deg)
 {
     if (!p->have_image) return NULL;
     *view = p->prev_view; /* set by the frame just rendered */
-    *image = p->g.color;
+    *image = p->dev ? fv_vp_device_eye_image(p->deye) : p->g.color;
     *px_per_deg = p->ppd;
     return p->space;
 }

@@ -18,6 +18,7 @@
 #include "fovea/film.h"
 #include "fovea/frame.h"
 #include "fovea/stats.h"
+#include "technique/vpolar/device.h"
 #include "technique/vpolar/space.h"
 #include "technique/vpolar/trace.h"
 
@@ -38,19 +39,21 @@ typedef struct fv_vp_opts {
                                   iterations: every pass everywhere */
     double periphery_deg;      /* where the periphery's fewer passes start (blur_ramp_deg by default),
                                   stretched with the space like the blur's profile */
-    fv_device device;          /* cpu, or portable: trace, mipmaps and map as kernels (device.h) */
+    fv_device device;          /* cpu: the CPU's own stages; portable, cuda: the device frame (device.h) */
 } fv_vp_opts;
 
 typedef struct fv_vp_pipeline fv_vp_pipeline;
 
-fv_status fv_vp_pipeline_create(const fv_scene *scene, const fv_vp_opts *o, fv_vp_pipeline **out, fv_error *err);
+/* dev: the device the frames run on when o->device is not cpu (shared by a method's pipelines, so a
+ * stereo pair's eyes are queued together; it must outlive the pipeline), else NULL. */
+fv_status fv_vp_pipeline_create(const fv_scene *scene, const fv_vp_opts *o, fv_vp_device *dev, fv_vp_pipeline **out, fv_error *err);
 void fv_vp_pipeline_destroy(fv_vp_pipeline *p);
 
 /* Renders one eye of a frame (its camera and gaze; its previous camera, NULL: no history). */
 fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err);
 /* Renders both eyes of a stereo frame, p[e] eye e's pipeline (frames[e] into films[e]): the images,
- * counters and histories of fv_vp_pipeline_render called for eye 0 then eye 1. On a device that
- * takes whole frames (cuda) both eyes are queued before one host wait; elsewhere the two calls. */
+ * counters and histories of fv_vp_pipeline_render called for eye 0 then eye 1. On a device (both
+ * pipelines on the same one) both eyes are queued before one host wait; on the CPU the two calls. */
 fv_status fv_vp_pipeline_render_pair(fv_vp_pipeline *const *p, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err);
 
 /* The last frame's sample space, its view (where the gaze was), the sample-space image (denoised

@@ -31,6 +31,7 @@ typedef struct vp_state {
     vp_kind kind;
     fv_vp_opts o;
     vp_show show;
+    fv_vp_device *dev;       /* portable and cuda: the backend every pipeline below runs on */
     fv_vp_pipeline *eye[2];
     /* The foveated kinds (vpolar, linear-falloff, log-polar) while the frame's fovea covers the whole
      * screen (a missing gaze under `widen`, docs/gaze.md): cartesian-full's pipeline with this
@@ -160,10 +161,12 @@ static fv_status create_kind(vp_kind kind, const char *name, const fv_scene *sce
         s = fv_error_set(err, FV_ERR_INVALID, "parameter show=%s: device cuda renders the image only (devices cpu and portable draw diagnostics)",
                          k_show[st->show]);
 
-    for (int e = 0; s == FV_OK && e < 2; e++) s = fv_vp_pipeline_create(scene, &st->o, &st->eye[e], err);
+    if (s == FV_OK && device != FV_DEVICE_CPU) s = fv_vp_device_create(scene, device, &st->dev, err);
+    for (int e = 0; s == FV_OK && e < 2; e++) s = fv_vp_pipeline_create(scene, &st->o, st->dev, &st->eye[e], err);
     if (s != FV_OK) {
         fv_vp_pipeline_destroy(st->eye[0]);
         fv_vp_pipeline_destroy(st->eye[1]);
+        fv_vp_device_destroy(st->dev);
         free(st);
         return s;
     }
@@ -267,7 +270,7 @@ static fv_status eye_pipeline(vp_state *st, const fv_frame *frame, fv_vp_pipelin
     *full = whole_fovea(st, frame);
     if (*full && !st->full[e]) {
         const fv_vp_opts fo = full_opts(&st->o);
-        fv_status s = fv_vp_pipeline_create(st->scene, &fo, &st->full[e], err);
+        fv_status s = fv_vp_pipeline_create(st->scene, &fo, st->dev, &st->full[e], err);
         if (s != FV_OK) return s;
     }
     *p = *full ? st->full[e] : st->eye[e];
@@ -293,14 +296,14 @@ static fv_status vp_render(void *state, const fv_frame *frame, fv_film *film, fv
     return s;
 }
 
-/* A stereo frame: on cuda both eyes' whole frames are queued before one host wait
+/* A stereo frame: on a device both eyes' frames are queued before one host wait
  * (fv_vp_pipeline_render_pair, docs/gpu.md), each eye on its own pipeline as vp_render renders it;
- * on the CPU and the portable backend (whose stages wait for themselves) the two per-eye calls. */
+ * on the CPU, and for the diagnostics (show=space, density: drawn per eye), the two per-eye calls. */
 static fv_status vp_render_pair(void *state, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
 {
     vp_state *st = state;
     fv_status s;
-    if (st->o.device != FV_DEVICE_CUDA || st->show != SHOW_SCREEN) {
+    if (st->o.device == FV_DEVICE_CPU || st->show != SHOW_SCREEN) {
         s = vp_render(state, &frames[0], films[0], stats, err);
         return s == FV_OK ? vp_render(state, &frames[1], films[1], stats, err) : s;
     }
@@ -322,6 +325,7 @@ static void vp_destroy(void *state)
     fv_vp_pipeline_destroy(st->eye[1]);
     fv_vp_pipeline_destroy(st->full[0]);
     fv_vp_pipeline_destroy(st->full[1]);
+    fv_vp_device_destroy(st->dev); /* after its pipelines */
     free(st);
 }
 

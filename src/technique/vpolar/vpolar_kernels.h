@@ -1,0 +1,128 @@
+/* fovea — the Visual-Polar family's device kernels, declared once (device/kernel_decl.h), in the
+ * order its device frame (technique/vpolar/device.c) launches them:
+ *
+ *   trace (Sec. 3.1)    a grid cell a thread, pt's path kernel on the flat scene (kernel/vp_trace.h),
+ *                       counting rays, paths and non-finite paths;
+ *   reproject           the denoiser's history coordinates of a cell (kernel/vp_reproject.h);
+ *   SVGF (Sec. 3.3)     kernel/svgf.h's steps, declared with their one order in
+ *                       filter/svgf_kernels.h;
+ *   φ-mip halve         a cell of mip level k from level k - 1 (Sec. 3.4, kernel/vp_map.h);
+ *   map                 a screen pixel from the sample space (Sec. 3.4, kernel/vp_map.h);
+ *   blur h, blur v      the two passes of the foveated blur (Sec. 3.5, kernel/vp_blur.h).
+ *
+ * vpolar_kernels.c makes the portable side and the descriptors, vpolar_kernels.cu the CUDA side.
+ * Each argument struct is copied into its launch, so the kernels see device pointers only.
+ */
+#ifndef FV_TECHNIQUE_VPOLAR_KERNELS_H
+#define FV_TECHNIQUE_VPOLAR_KERNELS_H
+
+#include <math.h>
+#include "device/kernel_decl.h"
+#include "kernel/vp_blur.h"
+#include "kernel/vp_map.h"
+#include "kernel/vp_reproject.h"
+#include "kernel/vp_trace.h"
+
+enum { FV_VP_COUNT_RAYS, FV_VP_COUNT_PATHS, FV_VP_COUNT_NAN, FV_VP_COUNTS };
+
+/* ---- trace ---- */
+
+typedef struct fv_vp_trace_args {
+    fv_kscene scene; /* device pointers */
+    fv_kvp_trace_frame f;
+    fv_kvp_gbuf g;
+} fv_vp_trace_args;
+
+/* Cell (x, y) when it is a valid cell of its column (the rows beyond keep "no surface"). */
+FV_HD static inline void fv_vp_trace_item(const fv_vp_trace_args *a, int x, int y, uint64_t *c)
+{
+    if (y >= (a->f.col_h ? a->f.col_h[x] : a->f.space.gh)) return;
+    fv_kvp_trace_counts k;
+    k.rays = k.paths = k.nan_paths = 0;
+    fv_kvp_trace_sample(&a->scene, &a->f, &a->g, (long)y * a->f.space.gw + x, &k);
+    c[FV_VP_COUNT_RAYS] += k.rays, c[FV_VP_COUNT_PATHS] += k.paths, c[FV_VP_COUNT_NAN] += k.nan_paths;
+}
+
+/* ---- the denoiser's history coordinates, a cell an item (gw * gh) ---- */
+
+typedef struct fv_vp_reproject_args {
+    fv_kvp_reproject_frame f;
+    float *prev_coord; /* 2 per cell */
+} fv_vp_reproject_args;
+
+FV_HD static inline void fv_vp_reproject_item(const fv_vp_reproject_args *a, int i, int y, uint64_t *c)
+{
+    (void)y, (void)c;
+    fv_kvp_reproject_sample(&a->f, (long)i, &a->prev_coord[2 * (size_t)i]);
+}
+
+/* ---- φ-mipmaps: level k >= 1 from level k - 1, over w x (level k's rows of storage) ---- */
+
+typedef struct fv_vp_halve_args {
+    fv_kphi_mips m;
+    int k;
+} fv_vp_halve_args;
+
+FV_HD static inline void fv_vp_halve_item(const fv_vp_halve_args *a, int x, int j, uint64_t *c)
+{
+    (void)c;
+    fv_kphi_halve_cell(&a->m, a->k, x, j);
+}
+
+/* ---- map to the screen, a pixel an item ---- */
+
+typedef struct fv_vp_map_args {
+    fv_kvp_map_frame mf;
+    fv_film_views out; /* device buffers */
+} fv_vp_map_args;
+
+FV_HD static inline void fv_vp_map_item(const fv_vp_map_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    fv_kvp_map_pixel(&a->mf, x, y, &a->out);
+}
+
+/* ---- the foveated blur: src -> dst, horizontally then vertically ---- */
+
+typedef struct fv_vp_blur_args {
+    fv_kblur_table t;
+    const float *sigma;
+    const float *src;
+    float *dst;
+} fv_vp_blur_args;
+
+/* A sigma whose kernel is not in the table: the pixel becomes NaN (visible to every check) rather
+ * than a read past the table. The frame sizes the table to a bound of every sigma, so this does not
+ * happen. */
+FV_HD static inline bool fv_vp_blur_outside(const fv_vp_blur_args *a, int x, int y)
+{
+    const size_t pix = (size_t)y * (size_t)a->t.w + (size_t)x;
+    const int q = fv_kblur_quantise(a->sigma[pix]);
+    if (q >= 0 && q < a->t.nq) return false;
+    for (int ch = 0; ch < 3; ch++) a->dst[3 * pix + ch] = NAN;
+    return true;
+}
+
+FV_HD static inline void fv_vp_blur_h_item(const fv_vp_blur_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    if (!fv_vp_blur_outside(a, x, y)) fv_kblur_h_pixel(&a->t, a->sigma, a->src, a->dst, x, y);
+}
+
+FV_HD static inline void fv_vp_blur_v_item(const fv_vp_blur_args *a, int x, int y, uint64_t *c)
+{
+    (void)c;
+    if (!fv_vp_blur_outside(a, x, y)) fv_kblur_v_pixel(&a->t, a->sigma, a->src, a->dst, x, y);
+}
+
+#define FV_VP_KERNELS(K)                                                                          \
+    K(fv_vp_trace_kernel, fv_vp_trace_args, fv_vp_trace_item, 2, FV_VP_COUNTS)                    \
+    K(fv_vp_reproject_kernel, fv_vp_reproject_args, fv_vp_reproject_item, 1, 0)                   \
+    K(fv_vp_halve_kernel, fv_vp_halve_args, fv_vp_halve_item, 2, 0)                               \
+    K(fv_vp_map_kernel, fv_vp_map_args, fv_vp_map_item, 2, 0)                                     \
+    K(fv_vp_blur_h_kernel, fv_vp_blur_args, fv_vp_blur_h_item, 2, 0)                              \
+    K(fv_vp_blur_v_kernel, fv_vp_blur_args, fv_vp_blur_v_item, 2, 0)
+
+FV_VP_KERNELS(FV_KERNEL_EXTERN)
+
+#endif
