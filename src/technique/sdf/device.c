@@ -9,6 +9,7 @@
 #include "device/calls_report.h"
 #include "device/film_device.h"
 #include "filter/blur.h"
+#include "filter/blur_kernels.h"
 #include "technique/kit.h"
 #include "technique/sdf/device.h"
 #include "technique/sdf/sdf_kernels.h"
@@ -390,11 +391,11 @@ static fv_status eye_passes(fv_sdf_device *d, const fv_frame *frame, const fv_ks
     /* pass 5 (on portable each launch runs at once: its time is the blur's) */
     const double t0 = fv_time_ms();
     const fv_sdf_sigma_args sg = {k->mask, w, h, o->blur_sigma, d->blur.sigma.p};
-    const fv_sdf_blur_args bh = {*bt, d->blur.sigma.p, out->color, d->blur.tmp.p};
-    const fv_sdf_blur_args bv = {*bt, d->blur.sigma.p, d->blur.tmp.p, out->color};
+    const fv_blur_args bh = {*bt, d->blur.sigma.p, out->color, d->blur.tmp.p};
+    const fv_blur_args bv = {*bt, d->blur.sigma.p, d->blur.tmp.p, out->color};
     if ((s = fv_backend_launch(b, &fv_sdf_sigma_kernel, w, h, &sg, NULL, err)) == FV_OK &&
-        (s = fv_backend_launch(b, &fv_sdf_blur_h_kernel, w, h, &bh, NULL, err)) == FV_OK)
-        s = fv_backend_launch(b, &fv_sdf_blur_v_kernel, w, h, &bv, NULL, err);
+        (s = fv_backend_launch(b, &fv_blur_h_kernel, w, h, &bh, NULL, err)) == FV_OK)
+        s = fv_backend_launch(b, &fv_blur_v_kernel, w, h, &bv, NULL, err);
     *blur_ms += fv_time_ms() - t0;
     return s;
 }

@@ -13,8 +13,8 @@
  *   forget     fipr's history at a sequence's first frame: no middle-level ray shaded yet;
  *   target     a pixel of the target level: every sample from the camera (sdf-gt, sdf-relaxed) or
  *              from the level below (ipr, fipr), or reconstructed outside fipr's mask;
- *   sigma,     fipr's pass 5: the transitions' sigma, then the blur's horizontal and vertical
- *   blur_h/v   passes (filter/blur.h's table).
+ *   sigma      fipr's pass 5: the transitions' sigma (the blur's two passes are
+ *              filter/blur_kernels.h's, shared with the Visual-Polar family).
  *
  * The marching kernels count FV_SDF_COUNTS costs (the CPU pipeline's counters); a frame gives each
  * pass its own slot of counters, so a level's rays and steps are its slot's.
@@ -175,24 +175,6 @@ FV_HD static inline void fv_sdf_sigma_item(const fv_sdf_sigma_args *a, int x, in
     a->sigma[(size_t)y * a->w + x] = fv_kpyr_blur_sigma(a->mask, a->w, a->h, x, y, a->blur_sigma);
 }
 
-typedef struct fv_sdf_blur_args {
-    fv_kblur_table t; /* device pointers */
-    const float *sigma, *src;
-    float *dst;
-} fv_sdf_blur_args;
-
-FV_HD static inline void fv_sdf_blur_h_item(const fv_sdf_blur_args *a, int x, int y, uint64_t *c)
-{
-    (void)c;
-    fv_kblur_h_pixel(&a->t, a->sigma, a->src, a->dst, x, y);
-}
-
-FV_HD static inline void fv_sdf_blur_v_item(const fv_sdf_blur_args *a, int x, int y, uint64_t *c)
-{
-    (void)c;
-    fv_kblur_v_pixel(&a->t, a->sigma, a->src, a->dst, x, y);
-}
-
 #define FV_SDF_KERNELS(K)                                                                            \
     K(fv_sdf_level_kernel, fv_sdf_level_args, fv_sdf_level_item, 2, FV_SDF_COUNTS)                    \
     K(fv_sdf_target_kernel, fv_sdf_target_args, fv_sdf_target_item, 2, FV_SDF_COUNTS)                 \
@@ -202,9 +184,7 @@ FV_HD static inline void fv_sdf_blur_v_item(const fv_sdf_blur_args *a, int x, in
     K(fv_sdf_mask_kernel, fv_sdf_fovea_args, fv_sdf_mask_item, 2, FV_SDF_MASK_COUNTS)                 \
     K(fv_sdf_need_kernel, fv_sdf_fovea_args, fv_sdf_need_item, 2, FV_SDF_NEED_COUNTS)                 \
     K(fv_sdf_forget_kernel, fv_sdf_forget_args, fv_sdf_forget_item, 1, 0)                             \
-    K(fv_sdf_sigma_kernel, fv_sdf_sigma_args, fv_sdf_sigma_item, 2, 0)                                \
-    K(fv_sdf_blur_h_kernel, fv_sdf_blur_args, fv_sdf_blur_h_item, 2, 0)                               \
-    K(fv_sdf_blur_v_kernel, fv_sdf_blur_args, fv_sdf_blur_v_item, 2, 0)
+    K(fv_sdf_sigma_kernel, fv_sdf_sigma_args, fv_sdf_sigma_item, 2, 0)
 
 FV_SDF_KERNELS(FV_KERNEL_EXTERN)
 

@@ -14,6 +14,7 @@
 #include <string.h>
 #include "device/fill_kernels.h"
 #include "device/film_device.h"
+#include "filter/blur_kernels.h"
 #include "filter/svgf_kernels.h"
 #include "scene/export.h"
 #include "scene/export_device.h"
@@ -421,9 +422,9 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
         fv_kblur_table bt = f->blur_table;
         bt.off = doff;
         bt.k = dk;
-        const fv_vp_blur_args h = {bt, e->sigma.p, dv.color, e->blur_tmp.p}, v = {bt, e->sigma.p, e->blur_tmp.p, dv.color};
-        if ((s = fv_backend_launch(b, &fv_vp_blur_h_kernel, sw, sh, &h, NULL, err)) != FV_OK ||
-            (s = fv_backend_launch(b, &fv_vp_blur_v_kernel, sw, sh, &v, NULL, err)) != FV_OK)
+        const fv_blur_args h = {bt, e->sigma.p, dv.color, e->blur_tmp.p}, v = {bt, e->sigma.p, e->blur_tmp.p, dv.color};
+        if ((s = fv_backend_launch(b, &fv_blur_h_kernel, sw, sh, &h, NULL, err)) != FV_OK ||
+            (s = fv_backend_launch(b, &fv_blur_v_kernel, sw, sh, &v, NULL, err)) != FV_OK)
             return s;
     }
     fv_backend_mark(b, m0 + ST_COUNT);

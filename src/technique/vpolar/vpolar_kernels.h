@@ -8,7 +8,7 @@
  *                       filter/svgf_kernels.h;
  *   φ-mip halve         a cell of mip level k from level k - 1 (Sec. 3.4, kernel/vp_map.h);
  *   map                 a screen pixel from the sample space (Sec. 3.4, kernel/vp_map.h);
- *   blur h, blur v      the two passes of the foveated blur (Sec. 3.5, kernel/vp_blur.h).
+ * (the foveated blur's two passes, Sec. 3.5, are filter/blur_kernels.h's, shared with fipr).
  *
  * vpolar_kernels.c makes the portable side and the descriptors, vpolar_kernels.cu the CUDA side.
  * Each argument struct is copied into its launch, so the kernels see device pointers only.
@@ -82,46 +82,11 @@ FV_HD static inline void fv_vp_map_item(const fv_vp_map_args *a, int x, int y, u
     fv_kvp_map_pixel(&a->mf, x, y, &a->out);
 }
 
-/* ---- the foveated blur: src -> dst, horizontally then vertically ---- */
-
-typedef struct fv_vp_blur_args {
-    fv_kblur_table t;
-    const float *sigma;
-    const float *src;
-    float *dst;
-} fv_vp_blur_args;
-
-/* A sigma whose kernel is not in the table: the pixel becomes NaN (visible to every check) rather
- * than a read past the table. The frame sizes the table to a bound of every sigma, so this does not
- * happen. */
-FV_HD static inline bool fv_vp_blur_outside(const fv_vp_blur_args *a, int x, int y)
-{
-    const size_t pix = (size_t)y * (size_t)a->t.w + (size_t)x;
-    const int q = fv_kblur_quantise(a->sigma[pix]);
-    if (q >= 0 && q < a->t.nq) return false;
-    for (int ch = 0; ch < 3; ch++) a->dst[3 * pix + ch] = NAN;
-    return true;
-}
-
-FV_HD static inline void fv_vp_blur_h_item(const fv_vp_blur_args *a, int x, int y, uint64_t *c)
-{
-    (void)c;
-    if (!fv_vp_blur_outside(a, x, y)) fv_kblur_h_pixel(&a->t, a->sigma, a->src, a->dst, x, y);
-}
-
-FV_HD static inline void fv_vp_blur_v_item(const fv_vp_blur_args *a, int x, int y, uint64_t *c)
-{
-    (void)c;
-    if (!fv_vp_blur_outside(a, x, y)) fv_kblur_v_pixel(&a->t, a->sigma, a->src, a->dst, x, y);
-}
-
 #define FV_VP_KERNELS(K)                                                                          \
     K(fv_vp_trace_kernel, fv_vp_trace_args, fv_vp_trace_item, 2, FV_VP_COUNTS)                    \
     K(fv_vp_reproject_kernel, fv_vp_reproject_args, fv_vp_reproject_item, 1, 0)                   \
     K(fv_vp_halve_kernel, fv_vp_halve_args, fv_vp_halve_item, 2, 0)                               \
-    K(fv_vp_map_kernel, fv_vp_map_args, fv_vp_map_item, 2, 0)                                     \
-    K(fv_vp_blur_h_kernel, fv_vp_blur_args, fv_vp_blur_h_item, 2, 0)                              \
-    K(fv_vp_blur_v_kernel, fv_vp_blur_args, fv_vp_blur_v_item, 2, 0)
+    K(fv_vp_map_kernel, fv_vp_map_args, fv_vp_map_item, 2, 0)
 
 FV_VP_KERNELS(FV_KERNEL_EXTERN)
 
