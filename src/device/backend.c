@@ -124,14 +124,27 @@ void fv_pinned_release(fv_backend *b, fv_buffer *buf)
     buf->cap = 0;
 }
 
+fv_status fv_mirror_reserve(fv_backend *b, fv_mirror *m, size_t bytes, const char *what, fv_error *err)
+{
+    const void *was[3] = {m->dev.p, m->stage[0].p, m->stage[1].p};
+    fv_status s;
+    if ((s = fv_pinned_ensure(b, &m->stage[0], bytes, what, err)) == FV_OK && (s = fv_pinned_ensure(b, &m->stage[1], bytes, what, err)) == FV_OK)
+        s = fv_buffer_ensure(b, &m->dev, bytes, what, err);
+    if (m->dev.p != was[0] || m->stage[0].p != was[1] || m->stage[1].p != was[2]) {
+        m->bytes = 0; /* what it held is gone */
+        m->last = NULL;
+    }
+    return s;
+}
+
 fv_status fv_mirror_fill(fv_backend *b, fv_mirror *m, const void *src, size_t bytes, const void **dev, const char *what, fv_error *err)
 {
     *dev = m->dev.p;
     if (bytes == 0) return FV_OK;
     if (m->bytes == bytes && m->last && memcmp(m->last, src, bytes) == 0) return FV_OK; /* unchanged since the last copy */
     fv_buffer *st = &m->stage[m->next];
-    fv_status s;
-    if ((s = fv_pinned_ensure(b, st, bytes, what, err)) != FV_OK || (s = fv_buffer_ensure(b, &m->dev, bytes, what, err)) != FV_OK) return s;
+    fv_status s = fv_mirror_reserve(b, m, bytes, what, err);
+    if (s != FV_OK) return s;
     m->bytes = 0; /* stale until the copy is queued */
     memcpy(st->p, src, bytes);
     if ((s = fv_backend_upload(b, m->dev.p, st->p, bytes, what, err)) != FV_OK) return s;

@@ -90,7 +90,13 @@ typedef struct fv_mirror {
     size_t bytes;       /* what dev holds, 0: nothing yet */
     const void *last;   /* the stage holding dev's bytes (compared with the next fill) */
 } fv_mirror;
-/* Makes m hold src's bytes (nothing when it already does); *dev receives the device copy. */
+/* Room for `bytes` on the device and in both pinned buffers, made now (a fill makes it as it first
+ * needs it): a frame that knows a table's size before it fills it, say a table used in turn with
+ * another, allocates in the first frame rather than the second. Contents are kept only when
+ * nothing grows. */
+fv_status fv_mirror_reserve(fv_backend *b, fv_mirror *m, size_t bytes, const char *what, fv_error *err);
+/* Makes m hold src's bytes (nothing when it already does); *dev receives the device copy. The
+ * first fill makes both pinned buffers, so a later change allocates nothing. */
 fv_status fv_mirror_fill(fv_backend *b, fv_mirror *m, const void *src, size_t bytes, const void **dev, const char *what, fv_error *err);
 void fv_mirror_release(fv_backend *b, fv_mirror *m);
 

@@ -39,7 +39,7 @@ refused name 'src/drive/driver.c:'
 refused name 'compares with the method name "fipr"'
 
 tree stale
-sed -i '/#include "fovea\/technique.h"/d' "$T/src/device/device.c"
-refused stale 'allowed but no longer found: src/device/device.c -> fovea/technique.h'
+sed -i '/#include "filter\/grid.h"/d' "$T/src/kernel/svgf.h"
+refused stale 'allowed but no longer found: src/kernel/svgf.h -> filter/grid.h'
 
 finish

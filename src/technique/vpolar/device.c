@@ -342,7 +342,7 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
 
     /* What the frame needs on the device: buffers (kept), the host's tables where they changed (the
      * radial table into the buffer the previous frame did not map with: the reprojection reads
-     * that one). */
+     * that one; the first frame makes room in both, so that the second allocates nothing). */
     const int lut_now = e->lut_prev ^ 1;
     const void *dcol_h_v = NULL, *dmask_v = NULL, *dlut = NULL, *doff = NULL, *dk = NULL;
     fv_kphi_mips dm;
@@ -353,6 +353,8 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
         (f->onscreen && (s = fv_mirror_fill(b, &e->onscreen, f->onscreen, n, &dmask_v, "the on-screen mask", err)) != FV_OK) ||
         (f->blur && ((s = fv_mirror_fill(b, &e->blur_off, f->blur_table.off, (size_t)f->blur_table.nq * sizeof(int), &doff, "the blur's kernels", err)) != FV_OK ||
                      (s = fv_mirror_fill(b, &e->blur_k, f->blur_table.k, f->blur_nk * sizeof(float), &dk, "the blur's kernels", err)) != FV_OK)) ||
+        (!e->lut[e->lut_prev].bytes &&
+         (s = fv_mirror_reserve(b, &e->lut[e->lut_prev], (size_t)f->map.nlut * 3 * sizeof(float), "the radial table", err)) != FV_OK) ||
         (s = fv_mirror_fill(b, &e->lut[lut_now], f->map.lut, (size_t)f->map.nlut * 3 * sizeof(float), &dlut, "the radial table", err)) != FV_OK ||
         (s = grid_ensure(e, gw, gh, fresh, err)) != FV_OK || (f->denoise && (s = svgf_ensure(e, gw, gh, fresh, err)) != FV_OK) ||
         (f->mips && (s = mips_ensure(e, f, fresh, &dm, err)) != FV_OK) ||
