@@ -41,12 +41,6 @@ fv_status fv_blur_variable_in(float *rgb, int w, int h, const float *sigma, int 
 void fv_blur_table_size(float smax, int w, int h, int *nq, size_t *nk);
 void fv_blur_table_fill(int w, int h, int nq, int *off, float *k);
 
-/* The same blur as the kernels' two passes (kernel/vp_blur.h), a pixel at a time over tiles on the
- * CPU's threads (filter/blur_passes.c): the portable backends' blur, the functions CUDA launches.
- * tmp: the horizontal pass's image (w * h * 3 floats); smax: at least every sigma (finite, >= 0).
- * The same bits as fv_blur_variable (test_blur). */
-fv_status fv_blur_kernel_passes(float *rgb, float *tmp, int w, int h, const float *sigma, float smax, int threads, fv_error *err);
-
 #ifdef __cplusplus
 }
 #endif
