@@ -27,7 +27,7 @@ typedef struct fv_cuda_sim_counts {
     uint64_t live_bytes;
     uint64_t live_streams, live_events;
     uint64_t live_pinned;      /* pinned or registered host ranges not yet freed or unregistered */
-    uint64_t injected_failures; /* allocations failed by fv_cuda_sim_fail_allocation */
+    uint64_t injected_failures; /* device or pinned allocations failed by fv_cuda_sim_fail_allocation */
     uint64_t uploads_behind_kernels; /* cudaMemcpyAsync host to device from pageable memory queued
                                       * behind a kernel launched on its stream since the host last
                                       * waited: the host waits for that kernel first, mid-frame */
@@ -36,8 +36,8 @@ typedef struct fv_cuda_sim_counts {
 /* The counts since the process started (the live ones: now). */
 void fv_cuda_sim_counts_get(fv_cuda_sim_counts *out);
 
-/* Makes the n-th cudaMalloc from now (0: the next) fail with cudaErrorMemoryAllocation, as a full
- * GPU would; n < 0 cancels. So a test can walk every allocation's failure path in turn. */
+/* Makes the n-th cudaMalloc or cudaHostAlloc from now (0: the next) fail with
+ * cudaErrorMemoryAllocation, as a full GPU (or pinned memory run out) would; n < 0 cancels. So a test can walk every allocation's failure path in turn. */
 void fv_cuda_sim_fail_allocation(int64_t n);
 
 /* SIMT efficiency of one kernel over its launches since the last reset (kernel/simt.h): the

@@ -749,6 +749,11 @@ cudaError_t fv_cuda_sim_host_alloc(void **p, size_t bytes, unsigned flags, const
     Device &d = device();
     std::lock_guard<std::mutex> l(d.m);
     if (flags != 0) return d.fail(cudaErrorInvalidValue); /* the flags fovea would use: none */
+    /* pinned memory runs out too (it is page-locked host memory): the same injected failures */
+    if (d.fail_in >= 0 && d.fail_in-- == 0) {
+        d.counts.injected_failures++;
+        return d.fail(cudaErrorMemoryAllocation);
+    }
     void *q = malloc(bytes ? bytes : 1);
     if (!q) return d.fail(cudaErrorMemoryAllocation);
     d.pinned[(uintptr_t)q] = Allocation{bytes ? bytes : 1, file, line};
