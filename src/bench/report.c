@@ -13,7 +13,7 @@
 #include <unistd.h>
 #include "bench/bench_impl.h"
 #include "core/fileio.h"
-#include "core/provenance.h"
+#include "core/provenance_json.h"
 #include "core/rng.h"
 #include "fovea/bench.h"
 #include "fovea/drive.h"

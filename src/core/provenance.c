@@ -11,7 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "core/parallel.h"
-#include "core/provenance.h"
+#include "core/provenance_json.h"
 #include "fv_build_info.h"
 
 void fv_build_info_get(fv_build_info *out)

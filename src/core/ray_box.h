@@ -1,6 +1,6 @@
 /* fovea — the slab test: where a ray crosses an axis-aligned box. Shared by the SDF user geometry
  * (scene/scene_sdf.c), which clips each ray to a field's box before sphere-tracing it, and the
- * sphere tracers of the SDF family (technique/sdf/world.c); kernel code too (kernel/sdf_trace.h). */
+ * sphere tracers of the SDF family (technique/sdf/world.c); kernel code too (kernel/ksdf_trace.h). */
 #ifndef FV_CORE_RAY_BOX_H
 #define FV_CORE_RAY_BOX_H
 

@@ -77,7 +77,7 @@ bool fv_dist_note_take(fv_dist *d, double *v, int *from);
 /* While this rank waits in fv_dist_agree, fn(user) runs about every millisecond (rank 0's bar
  * goes on showing the others' progress); NULL stops it. */
 void fv_dist_set_idle(fv_dist *d, void (*fn)(void *user), void *user);
-/* 0, 1, 2, ...: the number of the job's next progress bar (progress.h), counted alike on every rank. */
+/* 0, 1, 2, ...: the number of the job's next progress bar (dist_progress.h), counted alike on every rank. */
 int fv_dist_bar_next(fv_dist *d);
 
 /* Seconds this rank spent moving data (sends, receives, sums): the communication share of the

@@ -24,7 +24,7 @@ static void share(int nb, int rank, int size, int *lo, int *hi)
     *hi = (int)(((long long)nb * (rank + 1) + size - 1) / size);
 }
 
-/* Progress through this rank's own nodes (progress.h adds the ranks' shares up), stopping when
+/* Progress through this rank's own nodes (dist_progress.h adds the ranks' shares up), stopping when
  * another rank failed. */
 typedef struct node_progress {
     fv_dist *d;

@@ -6,7 +6,7 @@
 #include <cjson/cJSON.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include "core/provenance.h"
+#include "core/provenance_json.h"
 #include "drive/frame_meta.h"
 #include "drive/params_json.h"
 #include "fovea/technique.h"

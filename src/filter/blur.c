@@ -33,7 +33,7 @@
 #include "core/scratch.h"
 #include "core/parallel.h"
 #include "filter/blur.h"
-#include "kernel/vp_blur.h"
+#include "filter/kblur.h"
 
 #define Q_BITS FV_KBLUR_Q_BITS       /* sigma grid: 2^Q_BITS values per octave (see quantise) */
 #define Q_STEPS FV_KBLUR_Q_STEPS
@@ -58,7 +58,7 @@ double fv_blur_sigma_at(double e_deg, double fovea_deg, double ramp_deg, double 
  * pixel or 1/64 of itself, far below what anyone can see. Relative steps keep runs of equal kernels
  * a few pixels long even where the paper's profile ramps up (uniform steps of 1/32 would cut the
  * ramp into runs of one or two pixels). q indexes the grid: q / 32 pixels below 64, above it octave
- * q / 32 - 1, step q % 32 (fv_kblur_quantise, kernel/vp_blur.h: it runs for every pixel of the
+ * q / 32 - 1, step q % 32 (fv_kblur_quantise, filter/kblur.h: it runs for every pixel of the
  * ramp, and on the device backends). */
 #define quantise fv_kblur_quantise
 

@@ -35,7 +35,7 @@ fv_status fv_blur_variable(float *rgb, int w, int h, const float *sigma, int thr
  * call allocates nothing (docs/threads.md, "No allocation in a frame"). The same bytes. */
 fv_status fv_blur_variable_in(float *rgb, int w, int h, const float *sigma, int threads, fv_scratch *room, fv_error *err);
 
-/* The kernels fv_blur_variable uses, for the kernels' passes (kernel/vp_blur.h, fv_kblur_table):
+/* The kernels fv_blur_variable uses, for the kernels' passes (filter/kblur.h, fv_kblur_table):
  * on a w x h image whose largest sigma is smax, *nq kernels of *nk floats in all; fill writes
  * kernel q at k + off[q] (off: nq ints, k: nk floats). */
 void fv_blur_table_size(float smax, int w, int h, int *nq, size_t *nk);

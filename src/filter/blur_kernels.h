@@ -1,6 +1,6 @@
 /* fovea — the foveated blur's two passes as device kernels, declared once (device/kernel_decl.h)
  * for every family that blurs on a device: the Visual-Polar family's stage 5 (Sec. 3.5 of the
- * Visual-Polar paper) and fipr's pass 5. Each pixel runs kernel/vp_blur.h's functions, which the
+ * Visual-Polar paper) and fipr's pass 5. Each pixel runs filter/kblur.h's functions, which the
  * CPU's blur (filter/blur.c) runs too; the kernels' table is filter/blur.h's, copied to the device.
  */
 #ifndef FV_FILTER_BLUR_KERNELS_H
@@ -9,7 +9,7 @@
 #include <math.h>
 #include <stdbool.h>
 #include "device/kernel_decl.h"
-#include "kernel/vp_blur.h"
+#include "filter/kblur.h"
 
 /* src -> dst, one pass; every pointer device memory (the table's too). */
 typedef struct fv_blur_args {

@@ -19,7 +19,7 @@
  * the rule before (a, or 1).
  *
  * The callers pass what the surface reflects, not only its diffuse albedo: for a glossy surface the
- * albedo plus its specular colour (fv_bsdf_demod_reflectance, kernel/bsdf.h), since its highlight is
+ * albedo plus its specular colour (fv_bsdf_demod_reflectance, kernel/kbsdf.h), since its highlight is
  * not proportional to the diffuse albedo (a dark-tinted glossy panel divided by (0, 0.04, 0.02)
  * bled its highlight red and cyan into its surroundings: CesiumMilkTruck's windows).
  */

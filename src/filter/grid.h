@@ -17,7 +17,7 @@
  * V = Y / h with Y the continuous row coordinate.
  *
  * Plain C marked FV_HD: the same functions serve the CPU filters and the device kernels
- * (kernel/svgf.h), which nvcc compiles for the GPU.
+ * (filter/ksvgf.h), which nvcc compiles for the GPU.
  */
 #ifndef FV_FILTER_GRID_H
 #define FV_FILTER_GRID_H

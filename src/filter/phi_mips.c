@@ -106,7 +106,7 @@ const fv_grid *fv_phi_mips_grid(const fv_phi_mips *m, int k)
     return m && k >= 0 && k < m->levels ? &m->grid[k] : NULL;
 }
 
-/* Row j of level k from level k - 1, a cell at a time with the kernel's step (kernel/vp_map.h). */
+/* Row j of level k from level k - 1, a cell at a time with the kernel's step (filter/kphi.h). */
 static void halve_row(const fv_kphi_mips *km, int k, int j)
 {
     for (int x = 0; x < km->w; x++) fv_kphi_halve_cell(km, k, x, j);
@@ -148,7 +148,7 @@ fv_region_begin();
 fv_region_end();
 }
 
-/* The map stage samples through the kernel (kernel/vp_map.h); this is the same lookup for host
+/* The map stage samples through the kernel (filter/kphi.h); this is the same lookup for host
  * callers, so there is one implementation of it. */
 void fv_phi_mips_sample(const fv_phi_mips *m, float X, float V, float level, float out[3])
 {

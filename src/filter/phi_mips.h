@@ -13,7 +13,7 @@
 
 #include "filter/grid.h"
 #include "fovea/status.h"
-#include "kernel/vp_map.h"
+#include "filter/kphi.h"
 
 typedef struct fv_phi_mips fv_phi_mips;
 
@@ -37,7 +37,7 @@ void fv_phi_mips_build(fv_phi_mips *m, const float *rgb, int threads);
  * wraps on a polar grid and clamps on a screen grid; a NaN X, V or level reads 0. */
 void fv_phi_mips_sample(const fv_phi_mips *m, float X, float V, float level, float out[3]);
 
-/* The chain as the kernels see it (kernel/vp_map.h): its sizes and the pointers to its buffers,
+/* The chain as the kernels see it (filter/kphi.h): its sizes and the pointers to its buffers,
  * valid while the chain lives. */
 void fv_phi_mips_kernel(const fv_phi_mips *m, fv_kphi_mips *out);
 

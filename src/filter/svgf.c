@@ -10,7 +10,7 @@
  *     between two buffers; the first pass also writes the history;
  *  D. remodulate and store this frame's G-buffer as the next frame's history;
  *  E. fill the pixels that had no path (only when there are some).
- * A, D and E are the kernels' per-pixel steps (kernel/svgf.h: one implementation for the CPU and
+ * A, D and E are the kernels' per-pixel steps (filter/ksvgf.h: one implementation for the CPU and
  * the devices), as are the counters' sums and the arithmetic of B and C's weights; B and C are the
  * vectorised sweeps below, which add each pixel's taps in the kernels' order.
  *
@@ -259,7 +259,7 @@ void fv_svgf_reset(fv_svgf *f)
 
 /* ---- A. classification, demodulation, temporal accumulation */
 
-/* The kernels' view of the filter for this frame (kernel/svgf.h): the per-pixel steps that are not
+/* The kernels' view of the filter for this frame (filter/ksvgf.h): the per-pixel steps that are not
  * vectorised sweeps are the kernels' own functions. */
 static void kernel_view(const fv_svgf *f, const fv_svgf_frame *fr, bool history, fv_ksvgf *k)
 {

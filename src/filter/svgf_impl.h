@@ -8,10 +8,10 @@
 #include <stdint.h>
 #include <string.h>
 #include "filter/svgf.h"
-#include "kernel/svgf.h"
+#include "filter/ksvgf.h"
 
 /* The constants, the weights' arithmetic and the per-pixel steps that are not sweeps are the
- * kernels' (kernel/svgf.h): one implementation for the CPU and the devices. */
+ * kernels' (filter/ksvgf.h): one implementation for the CPU and the devices. */
 #define LEN_MAX FV_KSVGF_LEN_MAX
 #define LUM_EPS FV_KSVGF_LUM_EPS
 #define VAR_TEMPORAL_LEN FV_KSVGF_VAR_TEMPORAL_LEN

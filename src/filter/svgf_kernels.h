@@ -1,6 +1,6 @@
-/* fovea — SVGF as kernels (kernel/svgf.h): its steps declared once for every device backend and
+/* fovea — SVGF as kernels (filter/ksvgf.h): its steps declared once for every device backend and
  * their one launch order (fv_svgf_kernels_queue), which the Visual-Polar family's device frame
- * queues (technique/vpolar/device.c); and a filter over them on the portable backend, its buffers
+ * queues (technique/vpolar/vp_device.c); and a filter over them on the portable backend, its buffers
  * in host memory, with the same contract and the same bits as fv_svgf (filter/svgf.h) in any of
  * its builds, which tests the kernels against the CPU filter. The CPU filter stays fv_svgf (its
  * vectorised sweeps are several times faster on a CPU).
@@ -11,7 +11,7 @@
 #include "device/backend.h"
 #include "device/kernel_decl.h"
 #include "filter/svgf.h"
-#include "kernel/svgf.h"
+#include "filter/ksvgf.h"
 
 /* ---- SVGF's steps declared once (device/kernel_decl.h), a pixel an item (the rows' counters a row
  * an item); svgf_kernels.c makes the portable side, svgf_kernels.cu the CUDA side. pass: the

@@ -1,9 +1,9 @@
 /* fovea — the acuity models the papers use to decide where effort goes: the public entry points
- * of the kernel's equations (kernel/eye.h), which a GPU kernel calls directly; tests/unit/test_gaze.c
+ * of the kernel's equations (kernel/keye.h), which a GPU kernel calls directly; tests/unit/test_gaze.c
  * checks them against values worked by hand.
  */
 #include "fovea/gaze.h"
-#include "kernel/eye.h"
+#include "kernel/keye.h"
 
 double fv_acuity_v(double e) { return fv_kacuity_v(e); }
 

@@ -1,10 +1,10 @@
 /* fovea — display/eye model: its defaults and checks, and the public entry points of its geometry
  * (eccentricity of a pixel, the fovea / transition / periphery split, the transition's blend),
- * whose equations are kernel code (kernel/eye.h, which cites the papers).
+ * whose equations are kernel code (kernel/keye.h, which cites the papers).
  */
 #include <math.h>
 #include "fovea/gaze.h"
-#include "kernel/eye.h"
+#include "kernel/keye.h"
 
 void fv_eye_model_default(int width, int height, fv_eye_model *m)
 {

@@ -1,7 +1,7 @@
-/* fovea — light sampling on fv_scene (see light.h): the kernel's sampling (kernel/light.h) on the
+/* fovea — light sampling on fv_scene (see light.h): the kernel's sampling (kernel/klight.h) on the
  * scene's own table, and the emission of photons and VPLs, which only CPU techniques use. */
 #include "scene/light.h"
-#include "kernel/bsdf.h"
+#include "kernel/kbsdf.h"
 #include "scene/scene_impl.h"
 
 static int pick_light(const fv_scene *s, float u, float *pmf) { return fv_klights_pick(&s->klights, u, pmf); }

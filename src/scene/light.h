@@ -1,7 +1,7 @@
 /* fovea — light sampling shared by every technique: next-event estimation from a shading point,
  * the density of hitting an emitter by chance (for MIS), and emission of photons/VPLs.
  *
- * The sampling itself is kernel code (kernel/light.h: the pick by power, area lights uniform by
+ * The sampling itself is kernel code (kernel/klight.h: the pick by power, area lights uniform by
  * area, the environment by hemisphere), shared with the GPU; these wrap it for fv_scene and add
  * what only the CPU needs: photon and VPL emission (the environment's photons start on a disc of
  * the scene's bounding-sphere radius facing their direction, power L pi R^2 / pdf). Point and spot lights may move
@@ -13,7 +13,7 @@
 
 #include <stdbool.h>
 #include "core/rng.h"
-#include "kernel/light.h"
+#include "kernel/klight.h"
 #include "scene/query.h"
 
 typedef struct fv_light fv_light;
@@ -28,7 +28,7 @@ bool fv_light_sample_li(const fv_scene *s, fv_vec3 p, float u0, float u1, float 
  * that shades delta lights one by one and samples only the rest. */
 bool fv_light_sample_li_area(const fv_scene *s, fv_vec3 p, float u0, float u1, float u2, fv_light_sample *out);
 
-/* The scene's light table as kernels read it (kernel/light.h): what the shared path kernel samples. */
+/* The scene's light table as kernels read it (kernel/klight.h): what the shared path kernel samples. */
 const fv_klights *fv_scene_klights(const fv_scene *s);
 /* The table index of emissive triangle (obj, prim), -1 when it is not a light. */
 int fv_light_of_triangle(const fv_scene *s, int obj, int prim);

@@ -1,4 +1,4 @@
-/* fovea — material defaults, names and validation (the BSDFs themselves are kernel/bsdf.h). */
+/* fovea — material defaults, names and validation (the BSDFs themselves are kernel/kbsdf.h). */
 #include <stdio.h>
 #include <string.h>
 #include "fovea/limits.h"

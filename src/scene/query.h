@@ -12,7 +12,7 @@
 #include <stdbool.h>
 #include "fovea/scene.h"
 #include "fovea/sdf.h"
-#include "kernel/hit.h"
+#include "kernel/khit.h"
 
 /* ---- ray queries (scene.c) ---- */
 

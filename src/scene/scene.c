@@ -450,7 +450,7 @@ static fv_status build_lights(fv_scene *s, fv_error *err)
             l->emission = m->emission;
             l->two_sided = m->two_sided_emission;
             /* A textured emitter is picked by its mean emission over the triangle; the radiance
-             * itself is read at each sampled point (kernel/light.h), so the pick weight only has
+             * itself is read at each sampled point (kernel/klight.h), so the pick weight only has
              * to be positive where it emits: a floor keeps dark-but-not-black triangles. */
             fv_vec3 mean = fv_v3s(1.0f);
             l->emission_texture = o->uv && m->emission_texture >= 1 && m->emission_texture <= s->ntex ? m->emission_texture : 0;

@@ -16,7 +16,7 @@
 #include <embree3/rtcore.h>
 #include "fovea/scene.h"
 #include "fovea/sdf.h"
-#include "kernel/light.h"
+#include "kernel/klight.h"
 #include "scene/anim.h"
 #include "scene/query.h"
 
@@ -44,7 +44,7 @@ typedef struct fv_delta {
     fv_anim anim;
 } fv_delta;
 
-/* One sampleable light (struct fv_light) is kernel data: kernel/light.h. */
+/* One sampleable light (struct fv_light) is kernel data: kernel/klight.h. */
 
 /* A texture as fv_scene_add_texture keeps it: linear RGB, rows from the top (texture.c). */
 typedef struct fv_texture {

@@ -12,7 +12,7 @@
  *
  * Limits: the hit is where |distance| falls below 1e-4 of the field's bounds diagonal (then
  * refined), so a ray grazing a surface closer than that counts as a hit, as in any sphere tracer;
- * a ray that needs more than FV_KSDF_TRACE_STEPS steps is reported as a miss (kernel/sdf_trace.h). SDF objects never
+ * a ray that needs more than FV_KSDF_TRACE_STEPS steps is reported as a miss (kernel/ksdf_trace.h). SDF objects never
  * emit: lights stay emissive triangles and delta lights.
  */
 #include <float.h>
@@ -20,7 +20,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "core/alloc.h"
-#include "kernel/sdf_trace.h"
+#include "kernel/ksdf_trace.h"
 #include "scene/scene_impl.h"
 
 /* Hit distance relative to the field's bounds diagonal; the scene's ray offset (1e-4 of the
@@ -82,11 +82,11 @@ int fv_scene_sdf_material(const fv_object *o, fv_vec3 p)
     return m;
 }
 
-/* The box the tracer clips to and Embree bounds the field by (kernel/sdf_trace.h). */
+/* The box the tracer clips to and Embree bounds the field by (kernel/ksdf_trace.h). */
 static void padded_box(const fv_object *o, fv_vec3 *lo, fv_vec3 *hi) { fv_sdf_padded_box(o->lo, o->hi, o->sdf_eps, lo, hi); }
 
 /* Sphere-traces o + t d for t in [tnear, tfar] (d need not be unit): the one tracer of fields,
- * kernel/sdf_trace.h, which the portable and CUDA traversals run too. */
+ * kernel/ksdf_trace.h, which the portable and CUDA traversals run too. */
 static bool sdf_trace(const fv_object *ob, fv_vec3 o, fv_vec3 d, float tnear, float tfar, float *thit)
 {
     return fv_sdf_trace_field(ob->sdf, ob->sdf_eps, o, d, tnear, tfar, thit);

@@ -1,6 +1,6 @@
 /* fovea — textures in the scene: adding them (sRGB -> linear), sampling them, and the material
  * at a hit with its albedo read from its texture (see texture.h and query.h; the sampling itself
- * is kernel code, kernel/texture.h). */
+ * is kernel code, kernel/ktexture.h). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,8 +8,8 @@
 #include "fovea/film.h"
 #include "fovea/limits.h"
 #include "scene/scene_impl.h"
-#include "kernel/light.h"
-#include "kernel/texture.h"
+#include "kernel/klight.h"
+#include "kernel/ktexture.h"
 #include "scene/texture.h"
 
 fv_status fv_scene_add_texture(fv_scene *s, const fv_texture_desc *t, int *id, fv_error *err)

@@ -30,7 +30,7 @@
  * made programs without a culled chain 4-6% slower (sdf-temple, one thread). */
 #define FV_KFN_COLD static __attribute__((noinline))
 #else
-/* The scalar build is also what GPU kernels evaluate (kernel/sdf_trace.h): host-and-device under
+/* The scalar build is also what GPU kernels evaluate (kernel/ksdf_trace.h): host-and-device under
  * nvcc (FV_HD, fovea/math.h), plain static inline for a C compiler, so the CPU's bits do not change. */
 #define FV_KFN FV_HD static inline
 #define FV_KFN_COLD FV_KFN

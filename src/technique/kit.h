@@ -15,7 +15,7 @@
 #include "fovea/math.h"
 #include "fovea/stats.h"
 #include "fovea/status.h"
-#include "kernel/path.h"
+#include "kernel/kpath.h"
 
 /* ---- the frame ---- */
 

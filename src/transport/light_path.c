@@ -1,6 +1,6 @@
 /* fovea — light paths from the lights (see light_path.h). */
 #include <math.h>
-#include "kernel/bsdf.h"
+#include "kernel/kbsdf.h"
 #include "scene/light.h"
 #include "transport/light_path.h"
 

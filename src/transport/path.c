@@ -1,9 +1,9 @@
-/* fovea — the path tracing kernel on the CPU's scene (see path.h): kernel/path_impl.h, the
+/* fovea — the path tracing kernel on the CPU's scene (see path.h): kernel/kpath_impl.h, the
  * estimator every device runs, with Embree answering the ray queries.
  */
 #include <math.h>
 #include "core/params_read.h"
-#include "kernel/bsdf.h"
+#include "kernel/kbsdf.h"
 #include "scene/light.h"
 #include "transport/path.h"
 
@@ -16,7 +16,7 @@
 #define FV_PATH_LIGHT_OF(s, h) fv_light_of_triangle(s, (h)->obj, (h)->prim)
 #define FV_PATH_VISIBLE(s, p, ng, q) fv_scene_visible(s, FV_TRACE_ALL, p, ng, q)
 #define FV_PATH_OFFSET(s, p, ng, d) fv_offset_point(s, p, ng, d)
-#include "kernel/path_impl.h"
+#include "kernel/kpath_impl.h"
 
 fv_vec3 fv_path_trace(const fv_scene *s, const fv_path_opts *opt, fv_vec3 o, fv_vec3 d, fv_rng *rng, fv_path_first_hit *first,
                       uint64_t *rays)

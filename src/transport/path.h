@@ -1,8 +1,8 @@
 /* fovea — the path tracing kernel shared by every technique that traces camera paths: `pt` (the
  * reference), the trace stage of `vpolar` and its baselines, and any family that needs a path
  * traced estimate. One integrator, so the reference and the foveated methods never drift apart.
- * The estimator is kernel/path_impl.h, the same source as the GPU's (kernel/pt.h); its options
- * and first-hit record are kernel/path.h.
+ * The estimator is kernel/kpath_impl.h, the same source as the GPU's (kernel/kpt.h); its options
+ * and first-hit record are kernel/kpath.h.
  */
 #ifndef FV_TRANSPORT_PATH_H
 #define FV_TRANSPORT_PATH_H
@@ -11,7 +11,7 @@
 #include <stdint.h>
 #include "core/rng.h"
 #include "fovea/params.h"
-#include "kernel/path.h"
+#include "kernel/kpath.h"
 #include "scene/query.h"
 
 /* Reads spp (16), max_depth (8), rr_depth (3) from params, marking them used. */

@@ -39,7 +39,7 @@ refused name 'src/drive/driver.c:'
 refused name 'compares with the method name "fipr"'
 
 tree stale
-sed -i '/#include "filter\/grid.h"/d' "$T/src/kernel/svgf.h"
-refused stale 'allowed but no longer found: src/kernel/svgf.h -> filter/grid.h'
+sed -i '/#include "kernel\/kpath_impl.h"/d' "$T/src/transport/path.c"
+refused stale 'allowed but no longer found: src/transport/path.c -> kernel/kpath_impl.h'
 
 finish

@@ -25,7 +25,7 @@
  * not, between the device and pageable host memory (host memory not from cudaHostAlloc or
  * cudaHostRegister), which CUDA stages through a pinned buffer while the host waits. An async copy
  * to or from pinned memory is queued like a kernel. Bytes each way, allocations and frees, and per
- * kernel the SIMT efficiency of its warps (kernel/simt.h) are counted too (tests/cuda_sim/
+ * kernel the SIMT efficiency of its warps (kernel/ksimt.h) are counted too (tests/cuda_sim/
  * fv_cuda_sim.h reads the counts). With FOVEA_CUDA_SIM_CALLS_ONLY=1 in the environment launches are
  * counted but run nothing: the host's calls at a size whose kernels the simulator could not run in
  * time (test_gpu_counts' FOVEA_GPU_FIGURES).

@@ -7,7 +7,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
-#include "kernel/simt.h"
+#include "kernel/ksimt.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -40,7 +40,7 @@ void fv_cuda_sim_counts_get(fv_cuda_sim_counts *out);
  * cudaErrorMemoryAllocation, as a full GPU (or pinned memory run out) would; n < 0 cancels. So a test can walk every allocation's failure path in turn. */
 void fv_cuda_sim_fail_allocation(int64_t n);
 
-/* SIMT efficiency of one kernel over its launches since the last reset (kernel/simt.h): the
+/* SIMT efficiency of one kernel over its launches since the last reset (kernel/ksimt.h): the
  * iterations the lanes counted, and what the warps paid for them (32 x each warp's busiest lane),
  * per kind and in all (a lane's kinds summed). A kernel whose loops count nothing has zeros. */
 typedef struct fv_cuda_sim_simt {

@@ -111,7 +111,7 @@ class Pool;
 thread_local Pool *t_pool;  /* set on the pool's threads: they are running a kernel */
 thread_local unsigned t_id; /* the thread's index in its block */
 typedef std::array<uint64_t, FV_SIMT_KINDS> Steps;
-thread_local Steps t_steps; /* kernel/simt.h: this thread's iterations in its current block */
+thread_local Steps t_steps; /* kernel/ksimt.h: this thread's iterations in its current block */
 
 /* A launch's SIMT sums (fv_cuda_sim_simt without the name). */
 struct Simt {

@@ -19,7 +19,7 @@
 #include "cuda_runtime.h"
 #include "device/cuda/common.h"
 #include "device/cuda/launch.h"
-#include "kernel/simt.h"
+#include "kernel/ksimt.h"
 #include "fv_cuda_sim.h"
 
 #define CHECK(cond)                                                                  \

@@ -1,12 +1,12 @@
 /* Built only in a CUDA build (tests/CMakeLists.txt): every kernel header compiles for the device.
  * pt's kernel (device/cuda/pt.cu) already instantiates the BSDFs, lights, textures, the flat
  * scene's traversal with SDF leaves and the path estimator; this unit calls what no CUDA kernel
- * uses yet (the eye model and the acuity models of kernel/eye.h, the light table's other queries),
+ * uses yet (the eye model and the acuity models of kernel/keye.h, the light table's other queries),
  * so a change that makes them host-only fails the build, not a later GPU kernel. The sphere-tracing
- * family's headers (kernel/sdf_*.h, technique/sdf/ksdf_pixel.h, kpyr.h) are instantiated on their
+ * family's headers (technique/sdf/k*.h) are instantiated on their
  * own below, outside any backend. */
-#include "kernel/eye.h"
-#include "kernel/pt.h"
+#include "kernel/keye.h"
+#include "kernel/kpt.h"
 #include "technique/sdf/ksdf_pixel.h"
 
 __global__ void fv_check_eye(fv_eye_model m, fv_gaze g, double *out)
@@ -44,10 +44,10 @@ __global__ void fv_check_sdf(fv_ksdf_world w, fv_ksdf_frame f, fv_film_views out
     res[0] = c.x + n.y + fv_ksdf_world_eval1(&w, 0.0f, 1.0f, 2.0f, 0) + (float)pc.steps + fv_ksdf_lobe_of(&w.mats[0]).norm;
 }
 
-/* Visual-Polar's kernels (kernel/vp_space.h, kernel/vp_map.h): a sample's screen position, a
+/* Visual-Polar's kernels (technique/vpolar/kvp_space.h, technique/vpolar/kvp_map.h): a sample's screen position, a
  * pixel's coordinates through the radial table, a φ-mip cell and lookup. */
-#include "kernel/vp_map.h"
-#include "kernel/vp_space.h"
+#include "technique/vpolar/kvp_map.h"
+#include "technique/vpolar/kvp_space.h"
 
 __global__ void fv_check_vp(fv_kvp_space s, fv_kvp_view v, const float *table, int n, fv_kphi_mips m, float *out)
 {
@@ -59,16 +59,16 @@ __global__ void fv_check_vp(fv_kvp_space s, fv_kvp_view v, const float *table, i
     out[3] = sigma + (float)fv_kvp_nearest_cell(m.rows[0], m.w, 4, X, V);
 }
 
-/* Visual-Polar's trace (kernel/vp_trace.h): one grid sample's path on the flat scene. */
-#include "kernel/vp_trace.h"
+/* Visual-Polar's trace (technique/vpolar/kvp_trace.h): one grid sample's path on the flat scene. */
+#include "technique/vpolar/kvp_trace.h"
 
 __global__ void fv_check_vp_trace(fv_kscene s, fv_kvp_trace_frame f, fv_kvp_gbuf g, fv_kvp_trace_counts *c)
 {
     fv_kvp_trace_sample(&s, &f, &g, (long)blockIdx.x * blockDim.x + threadIdx.x, c);
 }
 
-/* Visual-Polar's foveated blur (kernel/vp_blur.h): a pixel of each pass. */
-#include "kernel/vp_blur.h"
+/* Visual-Polar's foveated blur (filter/kblur.h): a pixel of each pass. */
+#include "filter/kblur.h"
 
 __global__ void fv_check_vp_blur(fv_kblur_table t, const float *sigma, float *rgb, float *tmp)
 {
@@ -76,8 +76,8 @@ __global__ void fv_check_vp_blur(fv_kblur_table t, const float *sigma, float *rg
     fv_kblur_v_pixel(&t, sigma, tmp, rgb, threadIdx.x, blockIdx.x);
 }
 
-/* Visual-Polar's history reprojection (kernel/vp_reproject.h): one grid sample. */
-#include "kernel/vp_reproject.h"
+/* Visual-Polar's history reprojection (technique/vpolar/kvp_reproject.h): one grid sample. */
+#include "technique/vpolar/kvp_reproject.h"
 
 __global__ void fv_check_vp_reproject(fv_kvp_reproject_frame f, float *prev_coord)
 {

@@ -11,7 +11,7 @@
  * on purpose, with the new figures. They are counts of calls, not times, so they are the same on a
  * GPU and on the simulator; built a second time against the CUDA simulator (sim_test_gpu_counts),
  * the simulator's own counts must equal the backend's, and it also reports each kernel's SIMT
- * efficiency (kernel/simt.h) over the frames.
+ * efficiency (kernel/ksimt.h) over the frames.
  *
  * FOVEA_GPU_FIGURES=WxH prints the same table at another size per eye (the headset's 1440x1600
  * for docs/results.md) and asserts only the steady state and the simulator's agreement.
@@ -48,7 +48,7 @@ typedef struct family {
  * passes an eye (level 0, the sky's two steps, edges, mask, refresh, the middle level, the target)
  * and seven counters for each of its three levels, its mask and its refresh; fipr mono the same for
  * one eye.
- * The Visual-Polar family (its one device frame, technique/vpolar/device.c) queues both eyes,
+ * The Visual-Polar family (its one device frame, technique/vpolar/vp_device.c) queues both eyes,
  * then reads back each eye's film, three counters and SVGF's four row counters into pinned memory
  * and waits once; the radial table (and vpolar's on-screen mask and mip shape, which follow the
  * gaze) is copied through pinned mirrors when its bytes changed, here every frame (issue 38: one

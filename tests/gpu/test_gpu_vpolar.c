@@ -1,7 +1,7 @@
 /* GPU tests (ctest label `gpu`; scripts/gpu-check runs them on an NVIDIA machine): the Visual-Polar
- * family on CUDA (technique/vpolar/device.c: trace, reprojection, SVGF, φ-mipmaps, map and blur as
+ * family on CUDA (technique/vpolar/vp_device.c: trace, reprojection, SVGF, φ-mipmaps, map and blur as
  * kernels on one stream) against the portable backend, which runs the same frame and kernel source
- * on the CPU with the same random numbers (SVGF included: kernel/svgf.h's steps). Each of the five methods, and vpolar with two paths a sample and
+ * on the CPU with the same random numbers (SVGF included: filter/ksvgf.h's steps). Each of the five methods, and vpolar with two paths a sample and
  * every cell traced, cartesian-full without the denoiser, over four frames whose gaze moves and then
  * stays (so the history is reprojected from one gaze's space into another's on the GPU, with the
  * radial table the GPU kept from the frame before), vpolar in stereo (a pipeline per eye), with 0

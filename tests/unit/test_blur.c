@@ -15,7 +15,7 @@
 #include <string.h>
 #include <cmocka.h>
 #include "filter/blur.h"
-#include "kernel/vp_blur.h"
+#include "filter/kblur.h"
 
 static float *filled(size_t n, float v)
 {
@@ -370,7 +370,7 @@ static void test_bad_input(void **st)
     free(img), free(ref), free(sig);
 }
 
-/* The kernels' two passes (kernel/vp_blur.h, a pixel at a time: what the portable backend and CUDA
+/* The kernels' two passes (filter/kblur.h, a pixel at a time: what the portable backend and CUDA
  * run) against fv_blur_variable (runs of pixels, vectors, slabs of rows), bit for bit. */
 static void kernel_against_filter(int w, int h, const float *sig, unsigned seed)
 {

@@ -4,7 +4,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 #include "core/rng.h"
-#include "kernel/bsdf.h"
+#include "kernel/kbsdf.h"
 
 static void test_fresnel_hand_values(void **st)
 {

@@ -99,7 +99,7 @@ static void test_textured_mesh(void **st)
 }
 
 /* A floor lit only by a panel whose emission is a texture: the light table's emission texture
- * (kernel/light.h) read through the exported scene's textures. */
+ * (kernel/klight.h) read through the exported scene's textures. */
 static void test_emission_texture(void **st)
 {
     (void)st;

@@ -1,7 +1,7 @@
 /* The sphere-tracing family on the portable backend (technique/sdf/ksdf_pixel.h and kpyr.h, through
  * the kernels of sdf_kernels.h, run a cell at a time on the CPU's threads, the code CUDA runs)
  * against the CPU pipeline
- * (technique/sdf/pipeline.c: eight rays at a time through the 8-wide field, shading in batches), on
+ * (technique/sdf/sdf_pipeline.c: eight rays at a time through the 8-wide field, shading in batches), on
  * the three sphere-tracing scenes: `sdf-gt` and `sdf-relaxed` one frame each; `ipr` one frame with
  * and without shadow_reuse and the min filter, at 3 and 4 levels; `fipr` over a stereo sequence
  * whose gaze moves, so the mask changes and the history kept per eye is refreshed every 1, 2 or 4
@@ -11,8 +11,8 @@
  * counter. Measured, not assumed: the first renders of the two backends agreed exactly on all six
  * method/scene pairs (0 differing pixels, max |difference| 0, the same steps, shadow steps and
  * normal evaluations). That is what the design gives: both backends step every ray with the same
- * function (kernel/sdf_march.h's fv_kmarch_advance), shade every hit with the same steps in the
- * same order (kernel/sdf_shade.h), and evaluate the world's field with the scalar build of
+ * function (technique/sdf/kmarch.h's fv_kmarch_advance), shade every hit with the same steps in the
+ * same order (technique/sdf/ksdf_shade.h), and evaluate the world's field with the scalar build of
  * sdf/kernel.h, whose result the CPU's 8-wide lanes equal bit for bit (test_sdf_many checks that
  * with moving objects too); nothing is compiled with FMA contraction. So any difference here is a
  * divergence of the two paths, not rounding, and the test allows none. The same holds for ipr and

@@ -1,7 +1,7 @@
-/* The Visual-Polar family on the portable backend (technique/vpolar/device.h: every stage as
- * kernels, a cell or pixel at a time on the CPU's threads: the trace, kernel/vp_trace.h; the
- * denoiser's reprojection and its steps, kernel/vp_reproject.h and kernel/svgf.h; the φ-mipmaps;
- * the map to the screen, kernel/vp_map.h; the blur, kernel/vp_blur.h) against the
+/* The Visual-Polar family on the portable backend (technique/vpolar/vp_device.h: every stage as
+ * kernels, a cell or pixel at a time on the CPU's threads: the trace, technique/vpolar/kvp_trace.h; the
+ * denoiser's reprojection and its steps, technique/vpolar/kvp_reproject.h and filter/ksvgf.h; the φ-mipmaps;
+ * the map to the screen, technique/vpolar/kvp_map.h; the blur, filter/kblur.h) against the
  * CPU pipeline (Embree packets, vectorised rows), for each of the five methods over four frames of
  * a sequence whose gaze moves and then stays, so the denoiser's history is reprojected from one
  * gaze's space into another's and then accumulated, and the CPU's kept map coordinates are stored

@@ -1,7 +1,7 @@
 /* fovea — emission textures (issue 25, item 2: glTF emissiveTexture, MTL map_Ke): the emitted
  * radiance at a point is the material's emission times its emission texture there, everywhere a
  * method meets light: a camera ray that hits the emitter, next-event estimation's light samples
- * (kernel/light.h), photons and VPLs leaving it (scene/light.c).
+ * (kernel/klight.h), photons and VPLs leaving it (scene/light.c).
  *
  * Scene: a white diffuse floor (y = 0) under a 1 x 1 emitter at y = 1 facing down, its u along
  * +x. Texture A is two texels, red then green (sRGB 255: linear 1); B the same swapped. With

@@ -13,7 +13,7 @@
 #include <cmocka.h>
 #include "fovea/fovea.h"
 #include "filter/lattice.h"
-#include "technique/photon/gather.h"
+#include "technique/photon/pm_gather.h"
 #include "technique/photon/guide.h"
 #include "technique/photon/path_store.h"
 #include "testkit.h"

@@ -1,4 +1,4 @@
-/* SVGF as kernels (kernel/svgf.h, run by filter/svgf_kernels.c a pixel at a time) against the CPU
+/* SVGF as kernels (filter/ksvgf.h, run by filter/svgf_kernels.c a pixel at a time) against the CPU
  * filter adding one tap at a time (fv_svgf, FV_SVGF_ISA_PLAIN): the same bits, frame after frame
  * with a moving history (bilinear taps between pixels, some outside the grid, some inconsistent),
  * on a screen grid, on the Visual-Polar grid of a 160x90 screen (technique/vpolar/space.c: short

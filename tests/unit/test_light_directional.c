@@ -1,4 +1,4 @@
-/* Tests of directional lights (FV_LIGHT_DIRECTIONAL: kernel/light.h, scene/light.c), against
+/* Tests of directional lights (FV_LIGHT_DIRECTIONAL: kernel/klight.h, scene/light.c), against
  * analytic answers:
  *  - pt: a diffuse quad of albedo a under a directional light of irradiance E arriving at angle
  *    theta from its normal has radiance a / pi E cos(theta), with next-event estimation alone

@@ -16,8 +16,8 @@
 #include <string.h>
 #include <cmocka.h>
 #include "fovea/fovea.h"
-#include "kernel/bsdf.h"
-#include "technique/photon/gather.h"
+#include "kernel/kbsdf.h"
+#include "technique/photon/pm_gather.h"
 #include "technique/photon/photon_map.h"
 
 static uint64_t rng_state;

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
-#include "core/provenance.h"
+#include "core/provenance_json.h"
 #include "fovea/fovea.h"
 #include "drive/params_json.h"
 

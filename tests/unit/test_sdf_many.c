@@ -6,7 +6,7 @@
  *  - a union of 150 mixed children (rotated, scaled, smooth unions, subtractions, an intersection
  *    with a plane, a limited repetition, nested unions of ten) gives at 12 000 points, far and near,
  *    exactly the fold of its children's own fields (value and material bit for bit), through the
- *    scalar evaluator, both eight-lane builds and the kernel's (kernel/sdf_trace.h);
+ *    scalar evaluator, both eight-lane builds and the kernel's (kernel/ksdf_trace.h);
  *  - fv_sdf_union_create (how the SDF world merges its static objects) gives the same fold, also
  *    when a part holds a culled chain of its own (its jumps are relocated);
  *  - a union of 200 spheres returns the exact distance min |p - c| - r (within float rounding) and
@@ -28,7 +28,7 @@
 #include <string.h>
 #include <cmocka.h>
 #include "core/rng.h"
-#include "kernel/sdf_trace.h"
+#include "kernel/ksdf_trace.h"
 #include "sdf/sdf_eval.h"
 #include "technique/sdf/world.h"
 #include "testkit.h"

@@ -1,4 +1,4 @@
-/* Tests of the portable traversal (kernel/traverse.h) over an exported scene (scene/export.c)
+/* Tests of the portable traversal (kernel/ktraverse.h) over an exported scene (scene/flat_export.c)
  * against Embree (scene/query.h): the same rays through both must find the same surfaces.
  *
  * Agreement, per scene (random rays from inside and outside the bounds with random directions
@@ -28,8 +28,8 @@
 #include <cmocka.h>
 #include "fovea/fovea.h"
 #include "core/rng.h"
-#include "kernel/traverse.h"
-#include "scene/export.h"
+#include "kernel/ktraverse.h"
+#include "scene/flat_export.h"
 #include "scene/mesh_gen.h"
 #include "scene/query.h"
 #include "testkit.h"

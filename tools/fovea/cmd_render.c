@@ -15,7 +15,7 @@
 #include "gaze/overlay.h"
 #include "render_record.h"
 #ifdef FOVEA_HAVE_MPI
-#include "dist/progress.h"
+#include "dist/dist_progress.h"
 #include "dist/split.h"
 #endif
 
@@ -337,7 +337,7 @@ static void ranks_path(const char *out, char path[4096])
 }
 
 /* Every rank's progress through its own work (base + span x the render's fraction) goes to the
- * job's bar (src/dist/progress.h), which rank 0 alone draws. */
+ * job's bar (src/dist/dist_progress.h), which rank 0 alone draws. */
 typedef struct dist_progress {
     fv_dist *d;
     fv_dist_progress *job;

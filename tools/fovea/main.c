@@ -3,7 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "cli.h"
-#include "core/provenance.h"
+#include "core/provenance_json.h"
 
 typedef struct fv_command {
     const char *name;

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/fileio.h"
-#include "core/provenance.h"
+#include "core/provenance_json.h"
 #include "render_record.h"
 #include "drive/params_json.h"
 

@@ -5,7 +5,7 @@
 #include "core/alloc.h"
 #include "core/parallel.h"
 #include "core/rng.h"
-#include "kernel/bsdf.h"
+#include "kernel/kbsdf.h"
 #include "technique/photon/foveated.h"
 
 struct fv_foveated {

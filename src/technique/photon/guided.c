@@ -8,7 +8,7 @@
  * and the time are:
  *   - eye side: in the focus region (the fovea and the transition of Eq. 6) `fovea_spp` eye paths
  *     per pixel, ramping down to one across the transition with Eq. 6's b(x), each split at its
- *     first dielectric (gather.h) instead of choosing reflection or refraction at random; in the
+ *     first dielectric (pm_gather.h) instead of choosing reflection or refraction at random; in the
  *     periphery the gather is made only on a lattice of every `periphery_step`-th pixel, filtered
  *     at that resolution and filled in at full resolution from the first-hit buffers
  *     (filter/lattice.h); the full-resolution filter runs only over the focus region;
@@ -37,7 +37,7 @@
 #include "scene/light.h"
 #include "technique/class.h"
 #include "technique/kit.h"
-#include "technique/photon/gather.h"
+#include "technique/photon/pm_gather.h"
 #include "technique/photon/guide.h"
 #include "technique/photon/path_store.h"
 

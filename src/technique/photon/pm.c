@@ -40,9 +40,9 @@
 #include "technique/class.h"
 #include "technique/kit.h"
 #include "technique/photon/foveated.h"
-#include "technique/photon/gather.h"
+#include "technique/photon/pm_gather.h"
 #include "technique/photon/photon_trace.h"
-#include "technique/photon/temporal.h"
+#include "technique/photon/pm_temporal.h"
 
 typedef enum pm_mode { MODE_PM = 0, MODE_PMT, MODE_FPM } pm_mode;
 

@@ -4,14 +4,14 @@
  *
  * A pass is plain photon mapping with its own radius: an independent photon map (its own random
  * stream), a fresh jittered eye path per pixel (so pixels are averaged over their area, as pt
- * does), the disc estimate of gather.c. Pass i's radius follows Eq. 15 (ppm.h): the variance of a
+ * does), the disc estimate of pm_gather.c. Pass i's radius follows Eq. 15 (ppm.h): the variance of a
  * pass grows as its radius shrinks, slowly enough that the plain average of the passes' estimates
  * converges (Sec. 4) while the bias, which the radius drives (boundaries, blur into shadows),
  * vanishes. Unlike pbrt's SPPM the radius is one per pass, not one per pixel: the probabilistic
  * formulation needs no per-pixel statistics, and every pass stays pm's estimator exactly.
  *
  * Everything is pm's: photon_trace.c traces, photon_map.c grids (a cell of the pass's radius),
- * gather.c follows eye paths and gathers; no filter, which would be a bias of its own. Each eye is
+ * pm_gather.c follows eye paths and gathers; no filter, which would be a bias of its own. Each eye is
  * rendered on its own, each frame from scratch.
  *
  * Passes are summed in double in blocks of FV_SAMPLE_BLOCK, the blocks along core/blocks.h's fixed
@@ -29,7 +29,7 @@
 #include "film/film_sums.h"
 #include "technique/class.h"
 #include "technique/kit.h"
-#include "technique/photon/gather.h"
+#include "technique/photon/pm_gather.h"
 #include "technique/photon/photon_trace.h"
 #include "technique/photon/ppm.h"
 

@@ -1,9 +1,9 @@
 /* fovea — `pt`, the reference unidirectional path tracer: the ground truth every technique is
- * measured against. The integrator is the shared kernel (kernel/path_impl.h through
+ * measured against. The integrator is the shared kernel (kernel/kpath_impl.h through
  * transport/path.h); this file only lays the camera samples out, on one of three devices:
  *  - cpu: pixels eight at a time as Embree ray packets, `spp` jittered samples each;
- *  - portable: the device kernel (kernel/pt.h) on the CPU, a pixel at a time over the flat scene
- *    (scene/export.h), which is how CI tests the GPU's code;
+ *  - portable: the device kernel (kernel/kpt.h) on the CPU, a pixel at a time over the flat scene
+ *    (scene/flat_export.h), which is how CI tests the GPU's code;
  *  - cuda: the same kernel on an NVIDIA GPU.
  * The portable and cuda devices share one frame (pt_render_device) over the device backend
  * (device/backend.h), the kernel declared once in technique/pt/pt_kernels.h.
@@ -21,8 +21,8 @@
 #include "device/calls_report.h"
 #include "device/film_device.h"
 #include "film/film_sums.h"
-#include "scene/export.h"
-#include "scene/export_device.h"
+#include "scene/flat_export.h"
+#include "scene/flat_export_device.h"
 #include "technique/pt/pt_kernels.h"
 #include "technique/class.h"
 #include "technique/kit.h"

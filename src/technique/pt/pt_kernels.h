@@ -1,11 +1,11 @@
 /* fovea — `pt`'s device kernels, declared once (device/kernel_decl.h): the pixel kernel of
- * kernel/pt.h, one item a pixel, counting rays and non-finite estimates. pt_kernels.c makes the
+ * kernel/kpt.h, one item a pixel, counting rays and non-finite estimates. pt_kernels.c makes the
  * portable side, pt_kernels.cu the CUDA side; pt.c's device frame launches them. */
 #ifndef FV_TECHNIQUE_PT_KERNELS_H
 #define FV_TECHNIQUE_PT_KERNELS_H
 
 #include "device/kernel_decl.h"
-#include "kernel/pt.h"
+#include "kernel/kpt.h"
 
 enum { FV_PT_COUNT_RAYS, FV_PT_COUNT_NAN, FV_PT_COUNTS };
 

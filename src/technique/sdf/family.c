@@ -1,16 +1,16 @@
 /* fovea — the sphere-tracing family's four registered methods and their parameters: `sdf-gt`,
- * `sdf-relaxed`, `ipr` and `fipr` (pipeline.h says what each does). All four refuse a scene without
+ * `sdf-relaxed`, `ipr` and `fipr` (sdf_pipeline.h says what each does). All four refuse a scene without
  * a signed distance field object (the registry checks the class's `sdf_only`).
  */
 #include <stdlib.h>
 #include <string.h>
 #include "technique/class.h"
-#include "technique/sdf/device.h"
-#include "technique/sdf/pipeline.h"
+#include "technique/sdf/sdf_device.h"
+#include "technique/sdf/sdf_pipeline.h"
 
 typedef struct family_state {
     fv_sdf_pipeline *pipe; /* the cpu device */
-    fv_sdf_device *dev;    /* portable and cuda (device.h) */
+    fv_sdf_device *dev;    /* portable and cuda (sdf_device.h) */
 } family_state;
 
 /* The show modes each method has, in fv_sdf_show's order: the baselines one level, ipr the level
@@ -138,7 +138,7 @@ static void destroy(void *state)
     free(st);
 }
 
-/* All four also run on the device backends (device.h), so the registry hands them the device. */
+/* All four also run on the device backends (sdf_device.h), so the registry hands them the device. */
 static fv_status create_gt(const fv_scene *s, fv_params *p, fv_device d, const fv_log *l, void **st, fv_error *e)
 {
     return create_method(FV_SDF_GT, s, p, d, l, st, e);

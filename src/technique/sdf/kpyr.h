@@ -3,7 +3,7 @@
  * (Sec. 3.2.4), the Sobel edge of a tip cell (pass 2), a pixel of the foveation mask (pass 3, Eq. 1),
  * which middle-level rays pass 4 must trace (the refresh), the reconstruction of a pixel outside the
  * mask, shadow_reuse's agreed visibility and pass 5's transition test. Each is one cell or pixel,
- * reading and writing only its own output, so the CPU pipeline (technique/sdf/pipeline.c, its
+ * reading and writing only its own output, so the CPU pipeline (technique/sdf/sdf_pipeline.c, its
  * batched tracer around them), the portable backend (a cell at a time on the CPU's threads) and
  * CUDA (a thread a cell; both through technique/sdf/sdf_kernels.h) run the same code.
  *
@@ -23,8 +23,8 @@
 #include <stdint.h>
 #include "core/rng.h"
 #include "fovea/math.h"
-#include "kernel/eye.h"
-#include "kernel/sdf_shade.h"
+#include "kernel/keye.h"
+#include "technique/sdf/ksdf_shade.h"
 
 #define FV_PYRAMID_MAX_LEVELS 6
 

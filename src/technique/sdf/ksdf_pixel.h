@@ -1,11 +1,11 @@
 /* fovea — the rays of the sphere-tracing family as kernel code: a pixel of the target level (every
- * target sample sphere-traced from the camera, plain or over-relaxed, kernel/sdf_march.h, and shaded
- * with sphere-traced shadows, kernel/sdf_shade.h) for all four methods, and a ray of a pyramid level
+ * target sample sphere-traced from the camera, plain or over-relaxed, technique/sdf/kmarch.h, and shaded
+ * with sphere-traced shadows, technique/sdf/ksdf_shade.h) for all four methods, and a ray of a pyramid level
  * below it for ipr and fipr (technique/sdf/kpyr.h holds the pyramid's image steps). The portable
  * backend runs them a cell at a time on the CPU's threads, CUDA one thread a cell (the kernels of
- * technique/sdf/sdf_kernels.h, launched by technique/sdf/device.c's frame).
+ * technique/sdf/sdf_kernels.h, launched by technique/sdf/sdf_device.c's frame).
  *
- * The target level lays the samples out as the CPU pipeline's target level does (technique/sdf/pipeline.c): spp 1, 4 or 16 is a regular S x S grid of sub-pixel centres, sample (a, b) of pixel (x, y)
+ * The target level lays the samples out as the CPU pipeline's target level does (technique/sdf/sdf_pipeline.c): spp 1, 4 or 16 is a regular S x S grid of sub-pixel centres, sample (a, b) of pixel (x, y)
  * through target-grid position (x S + a + 1/2, y S + b + 1/2), rows first; the ray is clipped to the
  * world's box, its hit distance max(eps_abs, eps_k t). The samples' colours are summed in that
  * order through the same non-finite guard, and the first sample's hit fills the auxiliary buffers.
@@ -17,10 +17,10 @@
 
 #include "fovea/camera.h"
 #include "fovea/film.h"
-#include "kernel/path.h"
+#include "kernel/kpath.h"
 #include "technique/sdf/kpyr.h"
-#include "kernel/sdf_shade.h"
-#include "kernel/simt.h"
+#include "technique/sdf/ksdf_shade.h"
+#include "kernel/ksimt.h"
 
 /* What a frame's pixels share. */
 typedef struct fv_ksdf_frame {

@@ -1,5 +1,5 @@
 /* fovea — the SDF family's sphere tracer (march.h): the CPU's batches of rays, each ray stepped by
- * kernel/sdf_march.h, the rule the portable and CUDA backends run. */
+ * technique/sdf/kmarch.h, the rule the portable and CUDA backends run. */
 #include <math.h>
 #include "technique/sdf/march.h"
 

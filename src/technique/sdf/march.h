@@ -14,7 +14,7 @@
  * result depends only on the ray: the 8-wide and the scalar tracer (`wide` false, the "plain
  * scalar loop" the issue compares against) give bit-identical results in any order.
  *
- * The step rule is kernel/sdf_march.h's, shared with the portable and CUDA backends.
+ * The step rule is technique/sdf/kmarch.h's, shared with the portable and CUDA backends.
  *
  * Termination, after the shader convention of the paper's scenes: a hit when the distance is under
  * max(eps, eps_k t) (eps_k: a fraction of a target sample's footprint per unit distance, the same
@@ -31,10 +31,10 @@
 
 #include <stdbool.h>
 #include <stdint.h>
-#include "kernel/sdf_march.h"
+#include "technique/sdf/kmarch.h"
 #include "technique/sdf/world.h"
 
-/* fv_march_opts, fv_march_ray, fv_march_hit and the step rule: kernel/sdf_march.h. */
+/* fv_march_opts, fv_march_ray, fv_march_hit and the step rule: technique/sdf/kmarch.h. */
 
 /* Marches n rays. any_hit: stop at the first surface (shadow rays: hit = blocked, an exhausted
  * ray counts as not blocked). */

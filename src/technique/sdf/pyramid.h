@@ -5,7 +5,7 @@
  *
  * Levels are counted from the tip (level 0) to the target (L-1) on the sample grid; how they are
  * laid out: technique/sdf/kpyr.h. The host buffers below are the CPU pipeline's and the portable
- * backend's (the device backends keep their own, technique/sdf/device.c).
+ * backend's (the device backends keep their own, technique/sdf/sdf_device.c).
  */
 #ifndef FV_SDF_PYRAMID_H
 #define FV_SDF_PYRAMID_H

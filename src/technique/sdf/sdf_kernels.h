@@ -1,7 +1,7 @@
 /* fovea — the sphere-tracing family's device kernels, declared once (device/kernel_decl.h): every
- * pass technique/sdf/device.c's frame launches, each one item a cell or pixel of its grid and each
+ * pass technique/sdf/sdf_device.c's frame launches, each one item a cell or pixel of its grid and each
  * the kernel code the CPU pipeline's passes are made of (technique/sdf/ksdf_pixel.h, kpyr.h,
- * kernel/vp_blur.h), so the portable backend, CUDA and the CPU run one source:
+ * filter/kblur.h), so the portable backend, CUDA and the CPU run one source:
  *
  *   level      a ray of pyramid level k below the target (ipr, fipr; Polychronakis et al. 2023,
  *              Sec. 3.1), the middle level's shading into fipr's history;
@@ -26,7 +26,7 @@
 #include <string.h>
 #include "device/kernel_decl.h"
 #include "technique/sdf/ksdf_pixel.h"
-#include "kernel/vp_blur.h"
+#include "filter/kblur.h"
 
 /* A marching pass's counters, in this order. */
 enum {

@@ -11,7 +11,7 @@
  * static union, each skipped when its box proves it cannot be nearer than what was found (which
  * changes no value): the 8-wide and the scalar evaluation give the same numbers bit for bit.
  *
- * The world is also built in the flat form of kernel/sdf_world.h, which the scalar evaluation, the
+ * The world is also built in the flat form of technique/sdf/ksdf_world.h, which the scalar evaluation, the
  * portable backend and the CUDA backend read (one evaluation of the world, docs/gpu.md).
  *
  * Meshes are not sphere-traced (the family's techniques warn once); pt renders mixed scenes.
@@ -20,7 +20,7 @@
 #define FV_SDF_WORLD_H
 
 #include <stdbool.h>
-#include "kernel/sdf_world.h"
+#include "technique/sdf/ksdf_world.h"
 #include "scene/light.h"
 #include "scene/query.h"
 
@@ -29,7 +29,7 @@ typedef struct fv_sdf_world {
     const fv_sdf *statics;     /* the static objects' union (NULL: none); owned when merged */
     fv_sdf *merged;            /* statics when several were merged, else NULL */
     const fv_sdf **sdfs;       /* the moving objects' fields, in the order of k.objs */
-    /* The flat form (kernel/sdf_world.h): what the scalar evaluation, the portable backend and a
+    /* The flat form (technique/sdf/ksdf_world.h): what the scalar evaluation, the portable backend and a
      * GPU's copy read. Its arrays (the static union's program then each moving object's, the
      * moving objects, the lights) are owned here; mats is the scene's. */
     fv_ksdf_world k;

@@ -32,7 +32,7 @@
 #include "technique/vpl/fir.h"
 #include "technique/vpl/manage.h"
 #include "technique/vpl/radiosity.h"
-#include "technique/vpl/shade.h"
+#include "technique/vpl/vpl_shade.h"
 #include "technique/vpl/weights.h"
 
 /* index ranges within FV_STREAM_VPL, one per purpose (radiosity.h: ir's walks use 0 .. walks - 1,

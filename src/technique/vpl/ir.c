@@ -6,7 +6,7 @@
  * unlimited resolution). ir-low builds a 128^2 depth cube map per VPL every frame (cubemap.h:
  * rasterised like the paper's shadow maps, or by casting rays in large scenes) and looks
  * visibility up in it; maps are built and used in batches so memory stays bounded whatever the VPL count.
- * Both add the family's direct light (direct.h) and use the same clamped geometry term (gather.h).
+ * Both add the family's direct light (direct.h) and use the same clamped geometry term (vpl_gather.h).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -17,7 +17,7 @@
 #include "scene/light.h"
 #include "technique/class.h"
 #include "technique/vpl/lightvpl.h"
-#include "technique/vpl/shade.h"
+#include "technique/vpl/vpl_shade.h"
 
 /* ir-low's maps are built this many at a time (about 100 MB of 128^2 maps). */
 #define IR_LOW_BATCH_BYTES (100u << 20)

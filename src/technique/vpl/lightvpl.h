@@ -18,7 +18,7 @@
 #define FV_TECHNIQUE_VPL_LIGHTVPL_H
 
 #include <stdint.h>
-#include "technique/vpl/gather.h"
+#include "technique/vpl/vpl_gather.h"
 
 /* Fills vpls[0..count) (map = -1); returns how many were made (fewer only when the scene emits
  * nothing or walks keep dying: after 100 x count walks without reaching the count). *walks receives

@@ -28,7 +28,7 @@
 #include "filter/grid.h"
 #include "fovea/gaze.h"
 #include "fovea/status.h"
-#include "kernel/vp_space.h"
+#include "technique/vpolar/kvp_space.h"
 
 typedef enum fv_space_kind { FV_SPACE_CARTESIAN = 0, FV_SPACE_VPOLAR, FV_SPACE_LOGPOLAR } fv_space_kind;
 
@@ -95,9 +95,9 @@ float fv_space_radius(const fv_space_view *v, float X);
 void fv_space_radial_table(const fv_space_view *v, float step, int n, int stride, float *table);
 
 /* fv_space_turns and fv_space_table_x, the per-pixel steps of the lookups through such a table,
- * are kernel code: kernel/vp_space.h. */
+ * are kernel code: technique/vpolar/kvp_space.h. */
 
-/* The flat form of the space (kernel/vp_space.h) and of a view of it, for the kernels. */
+/* The flat form of the space (technique/vpolar/kvp_space.h) and of a view of it, for the kernels. */
 const fv_kvp_space *fv_space_kernel(const fv_space *s);
 static inline fv_kvp_view fv_space_kview(const fv_space_view *v)
 {

@@ -39,7 +39,7 @@ void fv_vp_trace_kframe(const fv_vp_trace_job *job, fv_kvp_trace_frame *out)
 }
 
 /* Traces up to eight samples (grid pixel indices, -1 for an empty lane) as one camera packet: each
- * placed and stored by the kernel's steps (kernel/vp_trace.h), the camera rays through Embree. */
+ * placed and stored by the kernel's steps (technique/vpolar/kvp_trace.h), the camera rays through Embree. */
 static void trace_packet(trace_ctx *c, const long *pix, int thread)
 {
     const fv_vp_trace_job *j = c->job;

@@ -21,11 +21,11 @@
 #include "technique/kit.h"
 #include "transport/path.h"
 #include "technique/vpolar/space.h"
-#include "kernel/vp_trace.h"
+#include "technique/vpolar/kvp_trace.h"
 
 typedef enum fv_vp_order { FV_VP_ORDER_GRID = 0, FV_VP_ORDER_RANDOM } fv_vp_order;
 
-/* Buffers on the grid's storage (w * h pixels): kernel/vp_trace.h's. */
+/* Buffers on the grid's storage (w * h pixels): technique/vpolar/kvp_trace.h's. */
 typedef fv_kvp_gbuf fv_vp_gbuf;
 
 typedef struct fv_vp_trace_job {
@@ -55,7 +55,7 @@ typedef struct fv_vp_trace_result {
  * survives, 1 up to e0 planar degrees from the gaze, p from e1 on, linear between. */
 double fv_vp_survival(const fv_space_view *v, float px, float py, double px_per_deg, double e0, double e1, double p);
 
-/* The job as the trace kernels take it (kernel/vp_trace.h); its pointers are the job's. */
+/* The job as the trace kernels take it (technique/vpolar/kvp_trace.h); its pointers are the job's. */
 void fv_vp_trace_kframe(const fv_vp_trace_job *job, fv_kvp_trace_frame *out);
 
 /* Traces every valid sample of job->view's grid into g (every valid cell is written, traced or not;

@@ -1,6 +1,6 @@
 /* fovea — `vpolar` (Foveated Real-Time Path Tracing in Visual-Polar Space) and the sample
  * distributions it is compared with (Sec. 4.3), each a technique of its own on one pipeline
- * (pipeline.h): they differ only in the sample space and the launch.
+ * (vp_pipeline.h): they differ only in the sample space and the launch.
  *
  *   vpolar          Visual-Polar space, 61% fewer samples than pixels, foveated blur
  *   cartesian       a uniform screen grid with the same sample count, bilinear upscaling
@@ -19,7 +19,7 @@
 #include <string.h>
 #include "core/alloc.h"
 #include "technique/class.h"
-#include "technique/vpolar/pipeline.h"
+#include "technique/vpolar/vp_pipeline.h"
 
 typedef enum vp_show { SHOW_SCREEN = 0, SHOW_SPACE, SHOW_DENSITY } vp_show;
 
@@ -375,7 +375,7 @@ static fv_status create_logpolar(const fv_scene *s, fv_params *p, const fv_log *
     return create_logpolar_on(s, p, FV_DEVICE_CPU, l, st, e);
 }
 
-/* The devices beyond the CPU: the portable backend and CUDA (technique/vpolar/device.h). */
+/* The devices beyond the CPU: the portable backend and CUDA (technique/vpolar/vp_device.h). */
 #define VP_DEVICES ((1u << FV_DEVICE_PORTABLE) | (1u << FV_DEVICE_CUDA))
 
 /* The furnace with one bounce (max_depth 2): emission 0.5 seen directly, plus 0.25 and 0.125

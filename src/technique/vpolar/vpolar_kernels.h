@@ -1,13 +1,13 @@
 /* fovea — the Visual-Polar family's device kernels, declared once (device/kernel_decl.h), in the
- * order its device frame (technique/vpolar/device.c) launches them:
+ * order its device frame (technique/vpolar/vp_device.c) launches them:
  *
- *   trace (Sec. 3.1)    a grid cell a thread, pt's path kernel on the flat scene (kernel/vp_trace.h),
+ *   trace (Sec. 3.1)    a grid cell a thread, pt's path kernel on the flat scene (technique/vpolar/kvp_trace.h),
  *                       counting rays, paths and non-finite paths;
- *   reproject           the denoiser's history coordinates of a cell (kernel/vp_reproject.h);
- *   SVGF (Sec. 3.3)     kernel/svgf.h's steps, declared with their one order in
+ *   reproject           the denoiser's history coordinates of a cell (technique/vpolar/kvp_reproject.h);
+ *   SVGF (Sec. 3.3)     filter/ksvgf.h's steps, declared with their one order in
  *                       filter/svgf_kernels.h;
- *   φ-mip halve         a cell of mip level k from level k - 1 (Sec. 3.4, kernel/vp_map.h);
- *   map                 a screen pixel from the sample space (Sec. 3.4, kernel/vp_map.h);
+ *   φ-mip halve         a cell of mip level k from level k - 1 (Sec. 3.4, filter/kphi.h);
+ *   map                 a screen pixel from the sample space (Sec. 3.4, technique/vpolar/kvp_map.h);
  * (the foveated blur's two passes, Sec. 3.5, are filter/blur_kernels.h's, shared with fipr).
  *
  * vpolar_kernels.c makes the portable side and the descriptors, vpolar_kernels.cu the CUDA side.
@@ -18,10 +18,10 @@
 
 #include <math.h>
 #include "device/kernel_decl.h"
-#include "kernel/vp_blur.h"
-#include "kernel/vp_map.h"
-#include "kernel/vp_reproject.h"
-#include "kernel/vp_trace.h"
+#include "filter/kblur.h"
+#include "technique/vpolar/kvp_map.h"
+#include "technique/vpolar/kvp_reproject.h"
+#include "technique/vpolar/kvp_trace.h"
 
 enum { FV_VP_COUNT_RAYS, FV_VP_COUNT_PATHS, FV_VP_COUNT_NAN, FV_VP_COUNTS };
 
