@@ -14,6 +14,7 @@
 #include <string.h>
 #include <cmocka.h>
 #include "filter/phi_mips.h"
+#include "technique/vpolar/kvp_map.h"
 
 static const int k_cols[4] = {1, 3, 8, 5};
 
