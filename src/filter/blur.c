@@ -44,13 +44,10 @@
 #define PAD 8                        /* floats after every buffer: the last block of a run reads up
                                         to 7 floats beyond it */
 
+/* kernel code (filter/kblur.h): the Visual-Polar device frame tabulates it per gaze on the device */
 double fv_blur_sigma_at(double e_deg, double fovea_deg, double ramp_deg, double sigma_max)
 {
-    /* Negated comparisons, so that a NaN eccentricity gets no blur and a ramp that ends at (or
-     * before) the fovea's edge becomes a step instead of a division by zero. */
-    if (!(e_deg > fovea_deg)) return 0.0;
-    if (!(e_deg < ramp_deg)) return sigma_max;
-    return sigma_max * (e_deg - fovea_deg) / (ramp_deg - fovea_deg);
+    return fv_kblur_sigma_at(e_deg, fovea_deg, ramp_deg, sigma_max);
 }
 
 /* Sigma is rounded to a grid: multiples of 1/32 up to 2 pixels, then 32 values per octave

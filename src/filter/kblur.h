@@ -16,6 +16,17 @@
 #define FV_KBLUR_Q_BITS 5 /* sigma grid: 2^Q_BITS values per octave */
 #define FV_KBLUR_Q_STEPS (1 << FV_KBLUR_Q_BITS)
 
+/* The sigma profile of Sec. 3.5 (fv_blur_sigma_at, filter/blur.h): 0 up to fovea_deg, rising
+ * linearly to sigma_max at ramp_deg, held beyond. Negated comparisons, so that a NaN eccentricity
+ * gets no blur and a ramp that ends at (or before) the fovea's edge becomes a step instead of a
+ * division by zero. */
+FV_HD static inline double fv_kblur_sigma_at(double e_deg, double fovea_deg, double ramp_deg, double sigma_max)
+{
+    if (!(e_deg > fovea_deg)) return 0.0;
+    if (!(e_deg < ramp_deg)) return sigma_max;
+    return sigma_max * (e_deg - fovea_deg) / (ramp_deg - fovea_deg);
+}
+
 /* Sigma rounded to its grid index q: multiples of 1/32 pixel below 2 pixels, then 32 values per
  * octave (filter/blur.c says why). Integer arithmetic on the float's bits keeps it exact. */
 FV_HD static inline int fv_kblur_quantise(float s)

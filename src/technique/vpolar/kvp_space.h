@@ -14,6 +14,7 @@
 #include <math.h>
 #include <stdint.h>
 #include "fovea/math.h"
+#include "kernel/keye.h"
 
 #define FV_KVP_MAX_COEF 11 /* the fit's degree is at most 10 */
 
@@ -28,7 +29,22 @@ typedef struct fv_kvp_space {
     double coef[FV_KVP_MAX_COEF]; /* Visual-Polar: e / E_ref as a polynomial in t, lowest order first */
     int ncoef;
     double lp_alpha;       /* log-polar */
+    /* Visual-Polar, screen to grid (fv_kvp_from_screen): the fovea's radius and the centre gaze's
+     * largest ρ in planar degrees, and the cumulative acuity at both (fv_kvp_acuity_area) */
+    double fovea_deg, e_ref, a_f, a_e;
 } fv_kvp_space;
+
+#define FV_KVP_ACUITY_FLAT_DEG 5.79 /* Eq. 1: V(e) = 60 up to here */
+#define FV_KVP_EQ2_AT_FLAT 105.04624271125317 /* Eq. 2 at 5.79 degrees (test_vp_space checks it) */
+
+/* The cumulative acuity of Eq. 2 continued as pi e^2 inside 5.79 degrees, where they meet
+ * (fv_space_acuity_area): Eq. 2 with its constant adjusted so that the two pieces meet exactly (the
+ * printed -612.3 leaves a step of 0.27 at 5.79 degrees, which would make the inverse ambiguous). */
+FV_HD static inline double fv_kvp_acuity_area(double e)
+{
+    if (e <= FV_KVP_ACUITY_FLAT_DEG) return FV_PI_D * e * e;
+    return fv_kacuity_cdf(e) - FV_KVP_EQ2_AT_FLAT + FV_PI_D * FV_KVP_ACUITY_FLAT_DEG * FV_KVP_ACUITY_FLAT_DEG;
+}
 
 /* Buffers on the grid's storage (w * h cells; host memory on the CPU and the portable backend,
  * device memory on CUDA). */
@@ -153,6 +169,55 @@ FV_HD static inline void fv_kvp_cartesian_from_screen(const fv_kvp_space *s, flo
 {
     *X = px * (float)s->gw / (float)s->sw;
     *V = py / (float)s->sh;
+}
+
+/* Screen position in pixels to grid (X, V) (fv_space_from_screen); *phi_per_px (optional) receives
+ * how many rows of the column one screen pixel spans along φ (0 on a Cartesian space). Visual-Polar
+ * evaluates Eq. 2 directly (Sec. 3.2): the periphery's X - X_f is proportional to A(e) - A(e_f). */
+FV_HD static inline void fv_kvp_from_screen(const fv_kvp_space *s, const fv_kvp_view *v, float px, float py, float *X, float *V, float *phi_per_px)
+{
+    if (s->kind == FV_KVP_CARTESIAN) {
+        fv_kvp_cartesian_from_screen(s, px, py, X, V);
+        if (phi_per_px) *phi_per_px = 0.0f;
+        return;
+    }
+    const float dx = px - v->gx, dy = py - v->gy;
+    const float r = sqrtf(dx * dx + dy * dy);
+    /* fv_space_turns, not atan2f: the reprojection of every grid sample (the denoiser's history)
+     * comes here, and libm's arc tangent was 1.3% of a frame there. */
+    *V = fv_space_turns(dx, dy);
+    float x, rows;
+    if (s->kind == FV_KVP_VPOLAR) {
+        const double e = (double)r / v->rho_max * s->e_ref;
+        if (e <= s->fovea_deg) {
+            x = (float)(s->x_f * e / s->fovea_deg);
+            /* Column height grows with X in the fovea, so rows per pixel along φ are constant there. */
+            rows = (float)(s->gh / s->x_f) * x;
+        } else {
+            const double t = (fv_kvp_acuity_area(e) - s->a_f) / (s->a_e - s->a_f);
+            x = (float)(s->x_f + t * (s->gw - s->x_f));
+            rows = (float)s->gh;
+        }
+    } else {
+        const float lr = r > 1.0f ? logf(r) : 0.0f;
+        x = powf(lr / v->log_rho_max, (float)(1.0 / s->lp_alpha)) * (float)s->gw;
+        rows = (float)s->gh;
+    }
+    *X = x;
+    if (phi_per_px) {
+        const float circ = 2.0f * FV_PI * (r > 0.5f ? r : 0.5f);
+        *phi_per_px = rows / circ;
+    }
+}
+
+/* Entry i of a view's radial table (fv_space_radial_table): the column X at distance i * step from
+ * the gaze along +x, and the φ-mip level there (log2 of the rows one pixel spans along φ, 0 below
+ * one row). */
+FV_HD static inline void fv_kvp_radial_coords(const fv_kvp_space *s, const fv_kvp_view *v, float step, int i, float *X, float *level)
+{
+    float V, rows;
+    fv_kvp_from_screen(s, v, v->gx + (float)i * step, v->gy, X, &V, &rows);
+    *level = rows > 1.0f ? log2f(rows) : 0.0f;
 }
 
 #endif

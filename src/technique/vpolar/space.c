@@ -24,10 +24,10 @@
 #include <string.h>
 #include "core/alloc.h"
 #include "fovea/film.h"
+#include "technique/vpolar/kvp_tables.h"
 #include "technique/vpolar/space.h"
 
-#define ACUITY_FLAT_DEG 5.79 /* Eq. 1: V(e) = 60 up to here */
-#define EQ2_AT_FLAT 105.04624271125317 /* Eq. 2 at 5.79 degrees (test_vp_space checks it) */
+#define ACUITY_FLAT_DEG FV_KVP_ACUITY_FLAT_DEG
 #define FIT_MAX_DEGREE 10
 #define FIT_POINTS 1025
 _Static_assert(FIT_MAX_DEGREE + 1 == FV_KVP_MAX_COEF, "the kernel's copy of the fit holds every coefficient");
@@ -62,10 +62,7 @@ void fv_space_opts_default(fv_space_kind kind, fv_space_opts *o)
 
 double fv_space_acuity_area(double e)
 {
-    if (e <= ACUITY_FLAT_DEG) return FV_PI_D * e * e;
-    /* Eq. 2 with its constant adjusted so that the two pieces meet exactly (the printed -612.3
-     * leaves a step of 0.27 at 5.79 degrees, which would make the inverse ambiguous). */
-    return fv_acuity_cdf(e) - EQ2_AT_FLAT + FV_PI_D * ACUITY_FLAT_DEG * ACUITY_FLAT_DEG;
+    return fv_kvp_acuity_area(e);
 }
 
 /* e with A(e) = a, for a in [A(lo), A(hi)]: A is increasing, so bisection converges. */
@@ -250,10 +247,7 @@ fv_status fv_space_create(const fv_space_opts *o, int screen_w, int screen_h, do
     /* The onscreen mask's angle table, made once here so that a frame that moves the gaze
      * allocates nothing (docs/threads.md, "No allocation in a frame"). */
     if (o->kind != FV_SPACE_CARTESIAN && (s->row_cs = fv_alloc_array((size_t)s->grid.h, 2 * sizeof(float))))
-        for (int y = 0; y < s->grid.h; y++) {
-            float phi = 2.0f * FV_PI * ((float)y + 0.5f) / (float)s->grid.h;
-            s->row_cs[2 * y] = cosf(phi), s->row_cs[2 * y + 1] = sinf(phi);
-        }
+        for (int y = 0; y < s->grid.h; y++) fv_kvp_row_angle(y, s->grid.h, &s->row_cs[2 * y], &s->row_cs[2 * y + 1]);
     s->k.kind = (int)o->kind;
     s->k.sw = s->sw, s->k.sh = s->sh;
     s->k.gw = s->grid.w, s->k.gh = s->grid.h;
@@ -261,6 +255,7 @@ fv_status fv_space_create(const fv_space_opts *o, int screen_w, int screen_h, do
     memcpy(s->k.coef, s->coef, sizeof s->coef);
     s->k.ncoef = s->ncoef;
     s->k.lp_alpha = o->lp_alpha;
+    s->k.fovea_deg = o->fovea_deg, s->k.e_ref = s->e_ref, s->k.a_f = s->a_f, s->k.a_e = s->a_e;
     s->count = 0;
     for (int x = 0; x < s->grid.w; x++) s->count += fv_grid_col_h(&s->grid, x);
     *out = s;
@@ -316,57 +311,26 @@ long fv_space_onscreen_mask(const fv_space_view *v, float reach_px, uint8_t *mas
         memset(mask, 1, (size_t)w * h);
         return (long)w * h;
     }
-    /* Column x spans the radii [r(x), r(x + 1)]; a cell of an n-row column spans 2 pi / n of angle,
-     * so every point of it is within (r1 - r0) / 2 + pi r1 / n of its centre (radial half-width
-     * plus the arc, which is longer than the chord). That bound, doubled for the neighbouring cells a
-     * bilinear tap reaches, is how far the centre may be off the screen widened by reach_px. */
-    const float *cs = s->row_cs; /* NULL (out of memory at create): the angles are computed per cell */
-    const float lo_x = -reach_px, lo_y = -reach_px, hi_x = (float)s->sw + reach_px, hi_y = (float)s->sh + reach_px;
+    /* A column's bound, then its cells (technique/vpolar/kvp_tables.h, what the device frame's kernels run);
+     * the full-height rows' angles from the table made at create (NULL: computed per cell). */
+    const fv_kvp_view kv = fv_space_kview(v);
     long on = 0;
-    float r0 = fv_space_radius(v, 0.0f);
     for (int x = 0; x < w; x++) {
-        const float r1 = fv_space_radius(v, (float)x + 1.0f), rm = fv_space_radius(v, (float)x + 0.5f);
         const int n = fv_grid_col_h(g, x);
-        const float bound = 2.0f * (0.5f * (r1 - r0) + FV_PI * r1 / (float)n);
-        const float b2 = bound * bound;
-        /* Every cell centre of the column (radius rm) within the widened screen: all on. */
-        bool all = v->gx - rm >= lo_x && v->gy - rm >= lo_y && v->gx + rm <= hi_x && v->gy + rm <= hi_y;
+        const fv_kvp_onscreen_col c = fv_kvp_onscreen_column(&s->k, &kv, reach_px, x, n);
         for (int y = 0; y < h; y++) {
-            size_t p = (size_t)y * w + x;
-            if (y >= n) {
-                mask[p] = 0;
-                continue;
-            }
-            bool in = all;
-            if (!in) {
-                float c, sn;
-                if (n == h && cs) {
-                    c = cs[2 * y], sn = cs[2 * y + 1];
-                } else {
-                    float phi = 2.0f * FV_PI * ((float)y + 0.5f) / (float)n;
-                    c = cosf(phi), sn = sinf(phi);
-                }
-                float px = v->gx + rm * c, py = v->gy + rm * sn;
-                float dx = px < lo_x ? lo_x - px : (px > hi_x ? px - hi_x : 0.0f);
-                float dy = py < lo_y ? lo_y - py : (py > hi_y ? py - hi_y : 0.0f);
-                in = dx * dx + dy * dy <= b2;
-            }
-            mask[p] = in;
+            const uint8_t in = y < n ? fv_kvp_onscreen_cell(&s->k, &kv, reach_px, &c, n, h, y, s->row_cs) : 0;
+            mask[(size_t)y * w + x] = in;
             on += in;
         }
-        r0 = r1;
     }
     return on;
 }
 
 void fv_space_radial_table(const fv_space_view *v, float step, int n, int stride, float *table)
 {
-    for (int i = 0; i < n; i++) {
-        float X, V, rows;
-        fv_space_from_screen(v, v->gx + (float)i * step, v->gy, &X, &V, &rows);
-        table[stride * i] = X;
-        table[stride * i + 1] = rows > 1.0f ? log2f(rows) : 0.0f;
-    }
+    const fv_kvp_view kv = fv_space_kview(v);
+    for (int i = 0; i < n; i++) fv_kvp_radial_coords(&v->space->k, &kv, step, i, &table[stride * i], &table[stride * i + 1]);
 }
 
 void fv_space_to_screen(const fv_space_view *v, float X, float V, float *px, float *py)
@@ -377,37 +341,6 @@ void fv_space_to_screen(const fv_space_view *v, float X, float V, float *px, flo
 
 void fv_space_from_screen(const fv_space_view *v, float px, float py, float *X, float *V, float *phi_per_px)
 {
-    const fv_space *s = v->space;
-    if (s->o.kind == FV_SPACE_CARTESIAN) {
-        fv_kvp_cartesian_from_screen(&s->k, px, py, X, V);
-        if (phi_per_px) *phi_per_px = 0.0f;
-        return;
-    }
-    float dx = px - v->gx, dy = py - v->gy;
-    float r = sqrtf(dx * dx + dy * dy);
-    /* fv_space_turns, not atan2f: the reprojection of every grid sample (the denoiser's history)
-     * comes here, and libm's arc tangent was 1.3% of a frame there. */
-    *V = fv_space_turns(dx, dy);
-    float x, rows;
-    if (s->o.kind == FV_SPACE_VPOLAR) {
-        double e = (double)r / v->rho_max * s->e_ref;
-        if (e <= s->o.fovea_deg) {
-            x = (float)(s->x_f * e / s->o.fovea_deg);
-            /* Column height grows with X in the fovea, so rows per pixel along φ are constant there. */
-            rows = (float)(s->grid.h / s->x_f) * x;
-        } else {
-            double t = (fv_space_acuity_area(e) - s->a_f) / (s->a_e - s->a_f);
-            x = (float)(s->x_f + t * (s->grid.w - s->x_f));
-            rows = (float)s->grid.h;
-        }
-    } else {
-        float lr = r > 1.0f ? logf(r) : 0.0f;
-        x = powf(lr / v->log_rho_max, (float)(1.0 / s->o.lp_alpha)) * (float)s->grid.w;
-        rows = (float)s->grid.h;
-    }
-    *X = x;
-    if (phi_per_px) {
-        float circ = 2.0f * FV_PI * (r > 0.5f ? r : 0.5f);
-        *phi_per_px = rows / circ;
-    }
+    const fv_kvp_view kv = fv_space_kview(v);
+    fv_kvp_from_screen(&v->space->k, &kv, px, py, X, V, phi_per_px);
 }

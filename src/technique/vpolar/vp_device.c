@@ -8,6 +8,9 @@
  *
  * SVGF's steps are queued in their one order (fv_svgf_kernels_queue, filter/svgf_kernels.h), the
  * order every device runs them in.
+ *
+ * The tables that follow the gaze are computed here too, in the frame's first launches, each only
+ * when its view (or the grid) changed (gaze_tables.h).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -19,6 +22,7 @@
 #include "scene/flat_export.h"
 #include "scene/flat_export_device.h"
 #include "technique/vpolar/vp_device.h"
+#include "technique/vpolar/gaze_tables.h"
 #include "technique/vpolar/vpolar_kernels.h"
 
 enum { ST_TRACE = 0, ST_DENOISE, ST_MIP, ST_MAP, ST_BLUR, ST_COUNT };
@@ -54,9 +58,8 @@ struct fv_vp_device_eye {
     int mip_levels, mip_w, mip_h[FV_KPHI_MAX_LEVELS]; /* the shape the levels were cleared for */
     float *shape_host;        /* the mips' shape packed for one mirror: per level rows, rowsf, inv_src */
     size_t shape_cap;         /* floats */
-    fv_mirror col_h, onscreen, shape, blur_off, blur_k;
-    fv_mirror lut[2];         /* the radial tables, this frame's and the previous one's, in turn */
-    int lut_prev;             /* the one the previous frame mapped with */
+    fv_mirror col_h, shape, blur_off, blur_k;
+    fv_vp_gaze_tables tables; /* the on-screen mask and the radial tables */
     fv_buffer counts;         /* FV_VP_COUNTS */
     fv_buffer host;           /* pinned: the counts, then SVGF's rows' counters */
     dev_svgf svgf;
@@ -116,8 +119,9 @@ void fv_vp_device_eye_destroy(fv_vp_device_eye *e)
     fv_film_device_release(b, &e->film);
     for (int k = 0; k < FV_KPHI_MAX_LEVELS; k++) fv_buffer_release(b, &e->mip[k]);
     free(e->shape_host);
-    fv_mirror *const m[] = {&e->col_h, &e->onscreen, &e->shape, &e->blur_off, &e->blur_k, &e->lut[0], &e->lut[1]};
+    fv_mirror *const m[] = {&e->col_h, &e->shape, &e->blur_off, &e->blur_k};
     for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) fv_mirror_release(b, m[i]);
+    fv_vp_gaze_tables_release(b, &e->tables);
     fv_buffer_release(b, &e->counts);
     fv_pinned_release(b, &e->host);
     fv_buffer_release(b, &e->svgf.mem);
@@ -156,6 +160,8 @@ static fv_status grid_ensure(fv_vp_device_eye *e, int gw, int gh, bool fresh, fv
     e->g = (fv_kvp_gbuf){p[0], p[1], p[3], p[5], p[4], p[2], p[6], p[7]};
     e->prev_coord = p[8];
     e->gw = e->gh = 0;
+    /* a new grid (or screen: the pipeline's setup makes both) recomputes every table */
+    fv_vp_gaze_tables_forget(&e->tables);
     if ((s = fv_backend_clear(b, e->grid.p, 0, total, "the sample grid", err)) != FV_OK) return s;
     const fv_fill_f32_args fill = {e->g.depth, INFINITY};
     if ((s = fv_backend_launch(b, &fv_fill_f32_kernel, (int)n, 1, &fill, NULL, err)) != FV_OK) return s;
@@ -286,13 +292,12 @@ static fv_status check_frame(const fv_vp_device_frame *f, fv_error *err)
     else if (f->map.space.gw != sp->gw || f->map.space.gh != sp->gh || f->map.space.sw != sp->sw || f->map.space.sh != sp->sh)
         bad = "the map's space is not the trace's";
     else if (f->map.col_h != f->trace.col_h) bad = "the map's column heights are not the trace's";
-    else if (!f->map.lut || f->map.nlut < 3) bad = "no radial table";
+    else if (f->map.nlut < 3 || f->radial.n != f->map.nlut || f->radial.step * f->map.inv_step != 1.0f) bad = "no radial table, or not the map's";
     else if (f->map.identity && (sp->gw != sp->sw || sp->gh != sp->sh)) bad = "an identity map on a grid not the screen's size";
     else if (!f->map.identity && !f->mips) bad = "a map without φ-mipmaps";
     else if (f->history && (f->reproject.space.gw != sp->gw || f->reproject.space.gh != sp->gh || f->reproject.nlut != f->map.nlut))
         bad = "the reprojection's space or table is not the frame's";
-    else if ((f->trace.onscreen && f->trace.onscreen != f->onscreen) || (f->history && f->reproject.onscreen && f->reproject.onscreen != f->onscreen))
-        bad = "a second on-screen mask";
+    else if (f->trace_skip && !f->onscreen) bad = "a trace that skips the cells off screen without the on-screen mask";
     else if (f->history && !f->denoise) bad = "a history without the denoiser";
     else if (f->denoise && (f->grid.w != sp->gw || f->grid.h != sp->gh || f->grid.col_h != f->trace.col_h)) bad = "the denoiser's grid is not the trace's";
     else if (f->blur && (!f->map.sigma || f->blur_table.w != sp->sw || f->blur_table.h != sp->sh || f->blur_table.nq < 1 ||
@@ -340,23 +345,19 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
     const size_t rows_bytes = f->denoise ? 4 * (size_t)gh * 8 : 0, counts_bytes = FV_VP_COUNTS * sizeof(uint64_t);
     *done = true;
 
-    /* What the frame needs on the device: buffers (kept), the host's tables where they changed (the
-     * radial table into the buffer the previous frame did not map with: the reprojection reads
-     * that one; the first frame makes room in both, so that the second allocates nothing). */
-    const int lut_now = e->lut_prev ^ 1;
-    const void *dcol_h_v = NULL, *dmask_v = NULL, *dlut = NULL, *doff = NULL, *dk = NULL;
+    /* What the frame needs on the device: buffers (kept), the host's per-size tables where they
+     * changed, then the tables that follow the gaze, computed there. */
+    const void *dcol_h_v = NULL, *doff = NULL, *dk = NULL;
     fv_kphi_mips dm;
     memset(&dm, 0, sizeof dm);
     fv_film_views dv;
     fv_status s;
     if ((f->trace.col_h && (s = fv_mirror_fill(b, &e->col_h, f->trace.col_h, (size_t)gw * sizeof(int), &dcol_h_v, "the column heights", err)) != FV_OK) ||
-        (f->onscreen && (s = fv_mirror_fill(b, &e->onscreen, f->onscreen, n, &dmask_v, "the on-screen mask", err)) != FV_OK) ||
         (f->blur && ((s = fv_mirror_fill(b, &e->blur_off, f->blur_table.off, (size_t)f->blur_table.nq * sizeof(int), &doff, "the blur's kernels", err)) != FV_OK ||
                      (s = fv_mirror_fill(b, &e->blur_k, f->blur_table.k, f->blur_nk * sizeof(float), &dk, "the blur's kernels", err)) != FV_OK)) ||
-        (!e->lut[e->lut_prev].bytes &&
-         (s = fv_mirror_reserve(b, &e->lut[e->lut_prev], (size_t)f->map.nlut * 3 * sizeof(float), "the radial table", err)) != FV_OK) ||
-        (s = fv_mirror_fill(b, &e->lut[lut_now], f->map.lut, (size_t)f->map.nlut * 3 * sizeof(float), &dlut, "the radial table", err)) != FV_OK ||
-        (s = grid_ensure(e, gw, gh, fresh, err)) != FV_OK || (f->denoise && (s = svgf_ensure(e, gw, gh, fresh, err)) != FV_OK) ||
+        (s = grid_ensure(e, gw, gh, fresh, err)) != FV_OK ||
+        (s = fv_vp_gaze_tables_queue(b, &e->tables, &f->map.space, &f->map.view, dcol_h_v, f->onscreen != 0, f->onscreen_reach, &f->radial, err)) != FV_OK ||
+        (f->denoise && (s = svgf_ensure(e, gw, gh, fresh, err)) != FV_OK) ||
         (f->mips && (s = mips_ensure(e, f, fresh, &dm, err)) != FV_OK) ||
         (s = fv_buffer_ensure(b, &e->sigma, ns * sizeof(float), "the blur's sigma", err)) != FV_OK ||
         (f->blur && (s = fv_buffer_ensure(b, &e->blur_tmp, 3 * ns * sizeof(float), "the blur's image", err)) != FV_OK) ||
@@ -366,7 +367,7 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
         (s = fv_backend_clear(b, e->counts.p, 0, counts_bytes, "the trace's counters", err)) != FV_OK)
         return s;
     const int *dcol_h = dcol_h_v;
-    const uint8_t *dmask = dmask_v;
+    const uint8_t *dmask = fv_vp_gaze_tables_mask(&e->tables);
 
     /* 1. trace */
     fv_backend_mark(b, m0 + ST_TRACE);
@@ -374,7 +375,7 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
     ta.scene = *fv_scene_device_view(e->d->dscene);
     ta.f = f->trace;
     ta.f.col_h = dcol_h;
-    ta.f.onscreen = f->trace.onscreen ? dmask : NULL;
+    ta.f.onscreen = f->trace_skip ? dmask : NULL;
     ta.g = e->g;
     if ((s = fv_backend_launch_progress(b, &fv_vp_trace_kernel, gw, gh, &ta, e->counts.p, f->progress.fn ? &f->progress : NULL, done, err)) != FV_OK)
         return s;
@@ -387,8 +388,8 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
         fv_vp_reproject_args ra;
         ra.f = f->reproject;
         ra.f.g = e->g;
-        ra.f.onscreen = f->reproject.onscreen ? dmask : NULL;
-        ra.f.prev_lut = e->lut[e->lut_prev].bytes ? e->lut[e->lut_prev].dev.p : NULL;
+        ra.f.onscreen = dmask;
+        ra.f.prev_lut = fv_vp_gaze_tables_prev_lut(&e->tables);
         ra.prev_coord = e->prev_coord;
         if (!ra.f.prev_lut && ra.f.space.kind != FV_KVP_CARTESIAN)
             return fv_error_set(err, FV_ERR_INTERNAL, "Visual-Polar device frame: a history without the previous frame's radial table");
@@ -413,7 +414,7 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
     ma.mf.col_h = dcol_h;
     ma.mf.g = e->g;
     ma.mf.mips = dm;
-    ma.mf.lut = dlut;
+    ma.mf.lut = fv_vp_gaze_tables_lut(&e->tables);
     ma.mf.sigma = f->blur ? e->sigma.p : NULL;
     ma.out = dv;
     if ((s = fv_backend_launch(b, &fv_vp_map_kernel, sw, sh, &ma, NULL, err)) != FV_OK) return s;
@@ -430,7 +431,7 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
             return s;
     }
     fv_backend_mark(b, m0 + ST_COUNT);
-    e->lut_prev = lut_now; /* the next frame's reprojection reads it */
+    fv_vp_gaze_tables_advance(&e->tables); /* the next frame's reprojection reads this frame's table */
 
     /* the read-back, into pinned memory */
     char *host = e->host.p;

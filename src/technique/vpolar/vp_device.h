@@ -3,23 +3,28 @@
  * Space, Fig. 2): a frame of one eye is the kernels of technique/vpolar/vpolar_kernels.h queued in
  * this order,
  *
- *   trace (Sec. 3.1) -> the history's coordinates, SVGF's steps (Sec. 3.3) -> φ-mipmaps (Sec. 3.4)
- *   -> map to the screen (Sec. 3.4) -> foveated blur (Sec. 3.5) -> the film's and counters'
- *   read-back,
+ *   the tables that follow the gaze, where it moved (Sec. 3.2: the on-screen mask, the radial
+ *   table) -> trace (Sec. 3.1) -> the history's coordinates, SVGF's steps (Sec. 3.3) -> φ-mipmaps
+ *   (Sec. 3.4) -> map to the screen (Sec. 3.4) -> foveated blur (Sec. 3.5) -> the film's and
+ *   counters' read-back,
  *
  * and the host waits once for every eye it was given (a stereo pair: both eyes queued, then one
  * wait). The CPU's own stages (Embree, vectorised filters) stay in vp_pipeline.c.
  *
  * What stays on the device between frames: the sample grid, the history's coordinates, SVGF's
- * buffers and history, the φ-mipmaps, the blur's sigma and scratch image, the film's buffers. What
- * the host builds per screen size or per gaze (column heights, the on-screen mask, the mipmaps'
- * shape, the radial table, the blur's kernels) goes through mirrors (fv_mirror: pinned, copied only
- * when its bytes changed); the radial table has two, used in turn, since the reprojection reads the
- * previous frame's while the map reads this one's. The film and counters come back into pinned
- * memory. So after a sequence's first frame nothing is allocated and the host waits once a frame.
+ * buffers and history, the φ-mipmaps, the blur's sigma and scratch image, the film's buffers, and
+ * the tables that follow the gaze. Those are computed there (technique/vpolar/kvp_tables.h, the functions the
+ * CPU's space.c and vp_pipeline.c run), each only when what it depends on changed: the on-screen mask
+ * and the radial table when the view moved; the radial table has two buffers, used in turn, since
+ * the reprojection reads the previous frame's while the map reads this one's (one serves both
+ * while the gaze stays). What the host builds per screen size (column heights, the mipmaps' shape,
+ * the blur's kernels) goes through mirrors (fv_mirror: pinned, copied only when its bytes changed),
+ * so a steady frame uploads nothing however the gaze moves. The film and counters come back into
+ * pinned memory. So after a sequence's first frame nothing is allocated and the host waits once a
+ * frame.
  */
-#ifndef FV_TECHNIQUE_VPOLAR_VP_DEVICE_H
-#define FV_TECHNIQUE_VPOLAR_VP_DEVICE_H
+#ifndef FV_TECHNIQUE_VPOLAR_DEVICE_H
+#define FV_TECHNIQUE_VPOLAR_DEVICE_H
 
 #include <stdbool.h>
 #include "device/backend.h"
@@ -31,6 +36,7 @@
 #include "filter/kblur.h"
 #include "technique/vpolar/kvp_map.h"
 #include "technique/vpolar/kvp_reproject.h"
+#include "technique/vpolar/kvp_tables.h"
 #include "technique/vpolar/kvp_trace.h"
 
 /* The backend and the flat scene on it, shared by a method's pipelines (both eyes, and
@@ -56,13 +62,19 @@ typedef struct fv_vp_device_frame {
                                       surface, not sampled" and the denoiser without history */
     int threads;                   /* the portable backend's CPU threads (fv_thread_count's rule) */
     fv_launch_progress progress;   /* the trace's (portable), fn NULL: none */
-    const uint8_t *onscreen;       /* a polar grid's cells any pixel sees (gw * gh flags), NULL: none;
-                                      the trace's and the reprojection's onscreen are this or NULL */
-    /* 1. the trace (col_h: gw heights or NULL; its g ignored) */
+    /* 0. the tables that follow the gaze, computed on the device (technique/vpolar/kvp_tables.h).
+     *    onscreen 1: a polar grid's on-screen mask (the cells some pixel within onscreen_reach of
+     *    the screen sees) at the map's view, which the reprojection and the denoiser read, and the
+     *    trace too when trace_skip (offscreen=skip); radial: the radial table the map reads (its
+     *    table ignored; n the map's nlut, step 1 / the map's inv_step) */
+    int onscreen, trace_skip;
+    float onscreen_reach;
+    fv_kvp_radial radial;
+    /* 1. the trace (col_h: gw heights or NULL; its g and onscreen ignored) */
     fv_kvp_trace_frame trace;
     /* 2. the denoiser (SVGF on grid, with col_h the trace's). history: the previous frame of this
-     *    sequence ran on this eye, its camera and view in reproject (whose prev_lut and g are
-     *    ignored: the previous frame's radial table is kept on the device) */
+     *    sequence ran on this eye, its camera and view in reproject (whose prev_lut, g and onscreen
+     *    are ignored: the previous frame's radial table and the mask are the device's) */
     int denoise;
     fv_grid grid;
     fv_svgf_opts svgf;
@@ -74,11 +86,11 @@ typedef struct fv_vp_device_frame {
     int mips;
     fv_kphi_mips mip_shape;
     int mip_h[FV_KPHI_MAX_LEVELS];
-    /* 4. the map (lut: nlut entries of three floats; sigma non-NULL: the blur follows; col_h, g and
-     *    mips ignored) */
+    /* 4. the map (sigma non-NULL: the blur follows; lut, col_h, g and mips ignored: the radial
+     *    table is radial's, on the device) */
     fv_kvp_map_frame map;
     /* 5. the blur (blur 0: none): its kernels (off: nq ints, k: nk floats) up to a bound on every
-     *    pixel's sigma */
+     *    pixel's sigma that holds for every gaze (the kernels follow the screen's size only) */
     int blur;
     fv_kblur_table blur_table;
     size_t blur_nk;

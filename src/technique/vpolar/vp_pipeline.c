@@ -15,6 +15,7 @@
 #include "filter/blur.h"
 #include "filter/phi_mips.h"
 #include "technique/vpolar/kvp_reproject.h"
+#include "technique/vpolar/kvp_tables.h"
 #include "device/calls_report.h"
 #include "technique/vpolar/vp_device.h"
 #include "technique/vpolar/vp_pipeline.h"
@@ -40,9 +41,11 @@ struct fv_vp_pipeline {
     fv_vp_gbuf g;
     float *prev_coord;
     float *sigma;           /* per screen pixel */
-    uint8_t *onscreen;      /* polar spaces: per grid cell, fv_space_onscreen_mask at (mask_gx, mask_gy) */
+    uint8_t *onscreen;      /* polar spaces on the CPU: per grid cell, fv_space_onscreen_mask at (mask_gx, mask_gy)
+                               (a device computes its own: vp_device.h) */
     float mask_gx, mask_gy; /* the gaze onscreen was computed for (NaN: not yet) */
-    float *lut;             /* per frame, per radius step: column X, mip level, blur sigma */
+    float *lut;             /* the CPU's, per frame, per radius step: column X, mip level, blur sigma
+                               (a device computes its own: vp_device.h) */
     int nlut;
     float lut_gx, lut_gy;   /* the gaze lut was built for (NaN: none) */
     /* The map stage's per-pixel coordinates (X, V, mip level; the blur's sigma is p->sigma) kept
@@ -52,6 +55,10 @@ struct fv_vp_pipeline {
     int coords_state;       /* COORDS_NONE, _STORE (this frame writes them), _READ */
     uint32_t *perm;
     long nperm;
+    int *blur_off;          /* a device's blur kernels for every gaze (fv_blur_table_fill; NULL: no blur, or the CPU) */
+    float *blur_k;
+    int blur_nq;
+    size_t blur_nk;
     fv_kit_counters *counters; /* the trace's, kept from frame to frame (fv_kit_counters_reuse) */
     fv_scratch blur_room;      /* the foveated blur's temporaries, kept from frame to frame */
     bool have_prev;
@@ -89,8 +96,8 @@ static void free_buffers(fv_vp_pipeline *p)
     fv_phi_mips_destroy(p->mips);
     free(p->g.color), free(p->g.albedo), free(p->g.reflectance), free(p->g.normal), free(p->g.depth), free(p->g.position), free(p->g.id);
     free(p->g.sampled), free(p->prev_coord), free(p->sigma), free(p->perm), free(p->lut), free(p->onscreen);
-    free(p->coords);
-    p->onscreen = NULL, p->coords = NULL;
+    free(p->coords), free(p->blur_off), free(p->blur_k);
+    p->onscreen = NULL, p->coords = NULL, p->blur_off = NULL, p->blur_k = NULL;
     p->map_gx = p->map_gy = NAN;
     p->lut_gx = p->lut_gy = NAN;
     p->coords_state = COORDS_NONE;
@@ -108,6 +115,12 @@ void fv_vp_pipeline_destroy(fv_vp_pipeline *p)
     fv_scratch_free(&p->blur_room);
     fv_vp_device_eye_destroy(p->deye);
     free(p);
+}
+
+/* The blur's largest sigma in pixels (Sec. 3.5: 6.8 at 1280 pixels wide, scaled with the width). */
+static double blur_sigma_px(const fv_vp_pipeline *p)
+{
+    return p->o.blur_sigma * (double)p->sw / 1280.0;
 }
 
 /* (Re)builds the space and every buffer for a sw x sh screen. */
@@ -138,10 +151,10 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
     p->sigma = fv_alloc_array(ns, sizeof(float));
     /* The largest radius from any gaze is the diagonal. */
     p->nlut = (int)(sqrt((double)sw * sw + (double)sh * sh) / LUT_STEP) + 3;
-    p->lut = fv_alloc_array((size_t)p->nlut, 3 * sizeof(float));
+    if (host_grid) p->lut = fv_alloc_array((size_t)p->nlut, 3 * sizeof(float));
     if ((host_grid && (!p->g.color || !p->g.albedo || !p->g.reflectance || !p->g.normal || !p->g.position || !p->g.depth || !p->g.id ||
-                       !p->g.sampled)) ||
-        !p->prev_coord || !p->sigma || !p->lut) {
+                       !p->g.sampled || !p->lut)) ||
+        !p->prev_coord || !p->sigma) {
         free_buffers(p);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d sample grid", g->w, g->h);
     }
@@ -157,7 +170,7 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
         memset(p->g.sampled, 0, n);
         for (size_t i = 0; i < n; i++) p->g.depth[i] = INFINITY;
     }
-    if (fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
+    if (host_grid && fv_space_kind_of(p->space) != FV_SPACE_CARTESIAN) {
         if (!(p->onscreen = fv_alloc_array(n, 1))) {
             free_buffers(p);
             return fv_error_set(err, FV_ERR_NOMEM, "out of memory for a %dx%d sample grid", g->w, g->h);
@@ -184,6 +197,21 @@ static fv_status setup(fv_vp_pipeline *p, int sw, int sh, const fv_eye_model *ey
     }
     p->sw = sw;
     p->sh = sh;
+    /* A device's blur kernels, up to the largest sigma any gaze gives: the profile never exceeds its
+     * sigma_max (fv_blur_sigma_at), and a pixel's sigma interpolates two of the radial table's
+     * entries, so it is at most their larger one plus rounding. A kernel does not depend on how many
+     * there are, so the image is the one the kernels up to each gaze's own largest sigma give, and
+     * the kernels are built, and copied, once per screen size rather than at every gaze. */
+    if (p->dev && p->o.blur) {
+        fv_blur_table_size((float)blur_sigma_px(p) * 1.001f, sw, sh, &p->blur_nq, &p->blur_nk);
+        p->blur_off = fv_alloc_array((size_t)p->blur_nq, sizeof(int));
+        p->blur_k = fv_alloc_array(p->blur_nk, sizeof(float));
+        if (!p->blur_off || !p->blur_k) {
+            free_buffers(p);
+            return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the blur's kernels");
+        }
+        fv_blur_table_fill(sw, sh, p->blur_nq, p->blur_off, p->blur_k);
+    }
     p->fresh = true;
     return FV_OK;
 }
@@ -259,18 +287,30 @@ static double blur_profile_radius(const fv_vp_pipeline *p, const fv_space_view *
 /* Everything the map stage needs that depends only on the distance from the gaze, tabulated for
  * this frame every LUT_STEP pixels: the column X, the φ-mip level (log2 of the rows one pixel spans
  * along φ) and the blur's sigma (Sec. 3.5). The per-pixel work is then a square root, an arc
- * tangent and two table lookups instead of Eq. 2's logarithm. */
+ * tangent and two table lookups instead of Eq. 2's logarithm. The table's description (its
+ * entries are technique/vpolar/kvp_tables.h's, computed by the CPU here and by the device frame's kernel);
+ * table NULL. */
+static void radial_frame(const fv_vp_pipeline *p, const fv_space_view *view, fv_kvp_radial *rf)
+{
+    memset(rf, 0, sizeof *rf);
+    rf->space = *fv_space_kernel(p->space);
+    rf->view = fv_space_kview(view);
+    rf->step = LUT_STEP;
+    rf->n = p->nlut;
+    rf->blur = p->o.blur;
+    rf->px_per_deg = p->ppd;
+    rf->scale = blur_scale(p, view);
+    rf->fovea_deg = p->o.blur_fovea_deg, rf->ramp_deg = p->o.blur_ramp_deg;
+    rf->sigma_px = blur_sigma_px(p);
+}
+
 static void build_radial_lut(fv_vp_pipeline *p, const fv_space_view *view)
 {
-    double sigma_px = p->o.blur_sigma * (double)p->sw / 1280.0;
-    const double scale = blur_scale(p, view);
+    fv_kvp_radial rf;
+    radial_frame(p, view, &rf);
+    rf.table = p->lut;
     p->lut_gx = view->gx, p->lut_gy = view->gy;
-    fv_space_radial_table(view, LUT_STEP, p->nlut, 3, p->lut);
-    for (int i = 0; i < p->nlut; i++) {
-        const float r = (float)i * LUT_STEP;
-        p->lut[3 * i + 2] =
-            p->o.blur ? (float)fv_blur_sigma_at((double)r / p->ppd * scale, p->o.blur_fovea_deg, p->o.blur_ramp_deg, sigma_px) : 0.0f;
-    }
+    for (int i = 0; i < p->nlut; i++) fv_kvp_radial_entry(&rf, i);
 }
 
 /* Row y's pixels [x0, x0 + n) on a polar space: column X, angle V and mip level from the radial
@@ -383,25 +423,17 @@ static void reproject_frame(const fv_vp_pipeline *p, fv_kvp_reproject_frame *rf)
     rf->inv_step = 1.0f / LUT_STEP;
 }
 
-/* A frame on a device (vp_device.h), as the host prepared it: the device's frame and the film's views
- * (the blur's kernels host memory it points to until the device has them). */
+/* A frame on a device (vp_device.h), as the host prepared it: the device's frame and the film's views. */
 typedef struct device_frame {
     fv_vp_device_frame f;
     fv_film_views out;
-    int *off;
-    float *k;
 } device_frame;
 
-static void device_frame_free(device_frame *w)
-{
-    free(w->off), free(w->k);
-    w->off = NULL, w->k = NULL;
-}
-
-/* A frame on the device: the host builds what depends on the screen size and the gaze (the
- * on-screen mask, the radial table, the blur's kernels) and receives the film and the counts; the
- * grid, the denoiser's history coordinates, SVGF's buffers and history and the mipmaps stay on the
- * device (the host keeps no copy of the grid: setup). device_prepare builds the frame,
+/* A frame on the device: the host describes it (the view, the radial table's and the on-screen
+ * mask's parameters; per screen size the blur's kernels) and receives the film and the counts; the
+ * tables that follow the gaze are computed there, and the grid, the denoiser's history
+ * coordinates, SVGF's buffers and history and the mipmaps stay there (the host keeps no copy of the
+ * grid: setup). device_prepare builds the frame,
  * fv_vp_device_frames renders it (with the other eye's, for a stereo pair), device_finish takes its
  * result. The stage times are the device's (the backend's marks). */
 static fv_status device_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, const fv_vp_trace_job *job,
@@ -415,7 +447,12 @@ static fv_status device_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     f.fresh = p->fresh;
     f.threads = frame->threads;
     f.progress = (fv_launch_progress){fv_kit_progress_fn, job->progress};
-    f.onscreen = p->onscreen;
+    /* the tables that follow the gaze, computed on the device (its trace and reprojection read
+     * its own mask: the host has none) */
+    f.onscreen = polar;
+    f.trace_skip = polar && p->o.skip_offscreen;
+    f.onscreen_reach = MASK_REACH_PX;
+    radial_frame(p, view, &f.radial);
     fv_vp_trace_kframe(job, &f.trace);
     if (p->o.denoise) {
         f.denoise = 1;
@@ -436,34 +473,15 @@ static fv_status device_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     /* the map: a device recomputes the coordinates every frame */
     p->coords_state = COORDS_NONE;
     p->map_gx = view->gx, p->map_gy = view->gy;
-    build_radial_lut(p, view);
     fv_stats_add_count(stats, "map_reused", 0.0);
     map_frame(p, view, identity, &f.map);
-    int *off = NULL;
-    float *k = NULL;
     if (p->o.blur) {
-        /* A pixel's sigma interpolates two entries of the table's sigma column, so it is at most
-         * their larger one plus rounding: the kernels up to slightly above the column's largest
-         * cover every pixel (a kernel does not depend on how many there are). */
-        float smax = 0.0f;
-        for (int i = 0; i < p->nlut; i++) smax = p->lut[3 * i + 2] > smax ? p->lut[3 * i + 2] : smax;
-        int nq;
-        size_t nk;
-        fv_blur_table_size(smax * 1.001f, p->sw, p->sh, &nq, &nk);
-        off = fv_alloc_array((size_t)nq, sizeof(int));
-        k = fv_alloc_array(nk, sizeof(float));
-        if (!off || !k) {
-            free(off), free(k);
-            return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the blur's kernels");
-        }
-        fv_blur_table_fill(p->sw, p->sh, nq, off, k);
         f.blur = 1;
-        f.blur_table = (fv_kblur_table){p->sw, p->sh, (p->sw > p->sh ? p->sw : p->sh) - 1, nq, off, k};
-        f.blur_nk = nk;
+        f.blur_table = (fv_kblur_table){p->sw, p->sh, (p->sw > p->sh ? p->sw : p->sh) - 1, p->blur_nq, p->blur_off, p->blur_k};
+        f.blur_nk = p->blur_nk;
     }
     w->f = f;
     w->out = fv_film_views_of(film);
-    w->off = off, w->k = k;
     return FV_OK;
 }
 
@@ -517,7 +535,8 @@ static fv_status begin_frame(fv_vp_pipeline *p, const fv_frame *frame, fv_film *
      * wherever the gaze is): the trace skips them with offscreen=skip, the denoiser always (they
      * would only cost time and pull the edge's samples towards values nobody sees). The reach
      * covers the map stage's trilinear φ-mip lookup (two levels, one texel each way, a level's
-     * texel about one pixel along φ). Kept while the gaze stays. */
+     * texel about one pixel along φ). Kept while the gaze stays. A device computes its own (its
+     * pipeline has no host mask: vp_device.h). */
     if (p->onscreen && !(ef->view.gx == p->mask_gx && ef->view.gy == p->mask_gy)) {
         fv_space_onscreen_mask(&ef->view, MASK_REACH_PX, p->onscreen);
         p->mask_gx = ef->view.gx, p->mask_gy = ef->view.gy;
@@ -549,7 +568,6 @@ static fv_status render_device(fv_vp_pipeline *const *p, int eyes, const fv_fram
     memset(&calls, 0, sizeof calls);
     for (int e = 0; e < eyes; e++) f[e] = w[e].f, out[e] = w[e].out, eye[e] = p[e]->deye;
     if (s == FV_OK) s = fv_vp_device_frames(p[0]->dev, eye, eyes, f, out, r, &calls, err);
-    for (int e = 0; e < eyes; e++) device_frame_free(&w[e]);
     if (s != FV_OK) return s;
     if (fv_vp_device_kind(p[0]->dev) == FV_DEVICE_CUDA) {
         /* the pair's one wait and what it asked of the runtime, with eye 0's figures */
