@@ -1,6 +1,6 @@
 /* GPU tests (ctest label `gpu`; scripts/gpu-check runs them on an NVIDIA machine): what a stereo
  * frame of each CUDA family asks of the CUDA runtime besides its kernels, as the backend counts its
- * own calls (fv_cuda_calls, device/cuda_backend.h; --stats-json shows the same counters): kernel
+ * own calls (fv_backend_calls, device/backend.h; --stats-json shows the same counters): kernel
  * launches, host waits (a synchronize after queued work, and every copy between the device and
  * pageable host memory, which CUDA makes the host wait for), pageable copies, bytes each way, and
  * device allocations and frees once the first frame has made its buffers (steady state: none).
