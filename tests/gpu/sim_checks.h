@@ -16,6 +16,15 @@
 #ifdef FOVEA_CUDA_SIM
 #include "fv_cuda_sim.h"
 
+/* An image side of a CUDA-against-portable comparison. On a GPU the tests' sizes are the ones their
+ * bounds were chosen for (the share of pixels a last-bit difference of the GPU's powf or sinf may
+ * move). The simulator runs the kernels on the CPU with the C library's functions, so its images
+ * equal the portable ones exactly at any size, and every launch, copy, counter and host wait is
+ * the same at half the side: a quarter of the pixels, at a quarter of the cost of the suite's
+ * slowest tests under the sanitizers. Halving also leaves partial 8x8 blocks at the edges of the
+ * sizes that are multiples of 8, which the full sizes never had. */
+#define FV_SIM_SIDE(n) ((n) / 2)
+
 /* The simulator always has its device: a test that finds none fails rather than skips. */
 #define FV_GPU_TEST_NO_DEVICE 1
 
@@ -152,6 +161,7 @@ static inline fv_status fv_sim_run_frames(void *ctx, fv_error *err)
 }
 #else
 #define FV_GPU_TEST_NO_DEVICE 77 /* ctest: skipped */
+#define FV_SIM_SIDE(n) (n)
 typedef int fv_sim_mark;
 static inline fv_sim_mark fv_sim_now(void) { return 0; }
 static inline void fv_sim_expect(fv_sim_mark since, uint64_t syncs, long launches, const char *what)

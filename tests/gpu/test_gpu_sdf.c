@@ -21,7 +21,8 @@
  * histories carried on the GPU and the scene's lights moving (sdf-columns).
  * Exits 77 (skipped) where CUDA cannot run: a build without CUDA, a machine without a GPU. Built a
  * second time against the CUDA simulator (sim_test_gpu_sdf, tests/gpu/sim_checks.h), where the host's
- * waits are also counted, not only reported.
+ * waits are also counted, not only reported, at half the image side (FV_SIM_SIDE: its images equal
+ * the portable ones exactly at any size).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -54,6 +55,8 @@ static fv_film *render(const char *method, const char *params, const fv_scene *s
 
 static void compare(const char *scene, const char *method, int w, int h, int spp)
 {
+    w = FV_SIM_SIDE(w); /* the simulator: half the side (sim_checks.h) */
+    h = FV_SIM_SIDE(h);
     fv_scene *s = NULL;
     fv_view *v = NULL;
     if (fv_test_load(scene, &s, &v) != 0) fail_msg("cannot load %s", scene);
@@ -98,6 +101,8 @@ static void compare(const char *scene, const char *method, int w, int h, int spp
 /* ipr or fipr on portable and twice on CUDA over frames x eyes with a moving gaze. */
 static void compare_pyramid(const char *scene, const char *method, const char *params, int w, int h, int frames, int eyes)
 {
+    w = FV_SIM_SIDE(w); /* the simulator: half the side (sim_checks.h) */
+    h = FV_SIM_SIDE(h);
     fv_scene *s = NULL;
     fv_view *v = NULL;
     if (fv_test_load(scene, &s, &v) != 0) fail_msg("cannot load %s", scene);
@@ -207,6 +212,8 @@ static void test_temple(void **st)
  * calls (bit for bit) and against portable's pairs (the bounds above); one host wait per pair. */
 static void compare_pair(const char *scene, const char *method, const char *params, int w, int h, int frames)
 {
+    w = FV_SIM_SIDE(w); /* the simulator: half the side (sim_checks.h) */
+    h = FV_SIM_SIDE(h);
     fv_scene *s = NULL;
     fv_view *v = NULL;
     if (fv_test_load(scene, &s, &v) != 0) fail_msg("cannot load %s", scene);

@@ -29,7 +29,8 @@
  * for bit, every film buffer and counter, over frames whose gaze moves and then stays, with
  * host_syncs 1 per pair against 2 for the two calls; the portable backend's pair (its per-eye
  * calls) likewise. Built a second time against the CUDA simulator (sim_test_gpu_vpolar,
- * tests/gpu/sim_checks.h), where the host's waits are also counted.
+ * tests/gpu/sim_checks.h), where the host's waits are also counted, at half the image side
+ * (FV_SIM_SIDE: its images equal the portable ones exactly at any size).
  * Exits 77 (skipped) where CUDA cannot run: a build without CUDA, a machine without a GPU.
  */
 #include <math.h>
@@ -57,6 +58,8 @@ static double rms(const float *a, const float *b, size_t n)
 /* frames x eyes of method on scene, its time dt seconds further each frame (0: still). */
 static void compare(const char *scene, const char *method, const char *params, int w, int h, int eyes, double dt)
 {
+    w = FV_SIM_SIDE(w); /* the simulator: half the side (sim_checks.h) */
+    h = FV_SIM_SIDE(h);
     fv_scene *s = NULL;
     fv_view *v = NULL;
     if (fv_test_load(scene, &s, &v) != 0) fail_msg("cannot load %s", scene);
@@ -206,6 +209,8 @@ static void films_equal(fv_film *a, fv_film *b, const char *what)
  * cuda (2 for the two calls). The gaze moves over the first frames, then stays. */
 static void compare_pair(const char *method, const char *params, const char *device, int w, int h, int frames)
 {
+    w = FV_SIM_SIDE(w); /* the simulator: half the side (sim_checks.h) */
+    h = FV_SIM_SIDE(h);
     fv_scene *s = NULL;
     fv_view *v = NULL;
     if (fv_test_load("cornell", &s, &v) != 0) fail_msg("cannot load cornell");

@@ -2,7 +2,11 @@
  * on the cornell_box.obj it ships, lit by the point light and seen by the camera of the
  * cornell_box.ecs beside it. Both images go through Embree's output mapping (linear, clamped to
  * [0,1], 8 bits by truncation of 255.01 x) and their mean pixel values must agree within 3%.
- * The same max path length (8) is used on both sides, so the truncated integrals are the same. */
+ * The same max path length (8) is used on both sides, so the truncated integrals are the same.
+ * 64x64 at 1024 spp: the mean of 12,288 values of 1024 samples each is the image's integral to far
+ * better than the 3% (Embree's own mean moves 0.25% from 128x128), at a quarter of the time of
+ * both renders (Embree's pathtracer is not instrumented: it cost the sanitized suite as much as the
+ * plain one). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,7 +18,7 @@
 #include "fovea/fovea.h"
 
 #define MODELS "/usr/share/doc/embree3/models"
-#define SIZE 128
+#define SIZE 64
 #define SPP 1024
 
 /* Reads a binary P6 PPM with maxval 255 into 8-bit values; returns the mean over all channels. */
