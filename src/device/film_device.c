@@ -31,35 +31,40 @@ fv_status fv_film_device_views(fv_backend *b, fv_film_device *f, const fv_film_v
     return FV_OK;
 }
 
-fv_status fv_film_device_download(fv_backend *b, fv_film_device *f, const fv_film_views *host, size_t n, fv_error *err)
+fv_status fv_film_device_download(fv_backend *b, fv_film_device *f, int slot, const fv_film_views *host, size_t n, fv_error *err)
 {
     if (shares_host(b)) return FV_OK;
+    if (slot < 0 || slot >= FV_FILM_DEVICE_SLOTS) return fv_error_set(err, FV_ERR_INTERNAL, "the film's read-back: slot %d", slot);
     void *hp[FV_FILM_DEVICE_BUFFERS];
     size_t per[FV_FILM_DEVICE_BUFFERS];
     slots(host, hp, per);
     for (int i = 0; i < FV_FILM_DEVICE_BUFFERS; i++) {
         if (!hp[i]) continue;
-        fv_status s = fv_pinned_ensure(b, &f->stage[i], n * per[i], "the film's read-back", err);
-        if (s == FV_OK) s = fv_backend_download(b, f->stage[i].p, f->dev[i].p, n * per[i], "the film", err);
+        /* both slots now, so that the next frame, in the other slot, allocates nothing */
+        for (int k = 0; k < FV_FILM_DEVICE_SLOTS; k++) {
+            fv_status s = fv_pinned_ensure(b, &f->stage[k][i], n * per[i], "the film's read-back", err);
+            if (s != FV_OK) return s;
+        }
+        fv_status s = fv_backend_download(b, f->stage[slot][i].p, f->dev[i].p, n * per[i], "the film", err);
         if (s != FV_OK) return s;
     }
     return FV_OK;
 }
 
-void fv_film_device_deliver(fv_backend *b, const fv_film_device *f, const fv_film_views *host, size_t n)
+void fv_film_device_deliver(fv_backend *b, const fv_film_device *f, int slot, const fv_film_views *host, size_t n)
 {
-    if (shares_host(b)) return;
+    if (shares_host(b) || slot < 0 || slot >= FV_FILM_DEVICE_SLOTS) return;
     void *hp[FV_FILM_DEVICE_BUFFERS];
     size_t per[FV_FILM_DEVICE_BUFFERS];
     slots(host, hp, per);
     for (int i = 0; i < FV_FILM_DEVICE_BUFFERS; i++)
-        if (hp[i] && f->stage[i].p) memcpy(hp[i], f->stage[i].p, n * per[i]);
+        if (hp[i] && f->stage[slot][i].p) memcpy(hp[i], f->stage[slot][i].p, n * per[i]);
 }
 
 void fv_film_device_release(fv_backend *b, fv_film_device *f)
 {
     for (int i = 0; i < FV_FILM_DEVICE_BUFFERS; i++) {
         fv_buffer_release(b, &f->dev[i]);
-        fv_pinned_release(b, &f->stage[i]);
+        for (int k = 0; k < FV_FILM_DEVICE_SLOTS; k++) fv_pinned_release(b, &f->stage[k][i]);
     }
 }

@@ -434,7 +434,7 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
 
     /* the read-back, into pinned memory */
     char *host = e->host.p;
-    if ((s = fv_film_device_download(b, &e->film, out, ns, err)) != FV_OK ||
+    if ((s = fv_film_device_download(b, &e->film, 0, out, ns, err)) != FV_OK ||
         (s = fv_backend_download(b, host, e->counts.p, counts_bytes, "the trace's counters", err)) != FV_OK ||
         (f->denoise && (s = fv_backend_download(b, host + counts_bytes, (char *)e->svgf.mem.p + e->svgf.rows_at, rows_bytes, "SVGF's counters", err)) != FV_OK))
         return s;
@@ -446,7 +446,7 @@ static void eye_result(fv_vp_device_eye *e, const fv_vp_device_frame *f, const f
 {
     fv_backend *b = e->d->b;
     const size_t ns = (size_t)f->trace.space.sw * (size_t)f->trace.space.sh;
-    fv_film_device_deliver(b, &e->film, out, ns);
+    fv_film_device_deliver(b, &e->film, 0, out, ns);
     uint64_t c[FV_VP_COUNTS];
     memcpy(c, e->host.p, sizeof c);
     r->rays = c[FV_VP_COUNT_RAYS], r->paths = c[FV_VP_COUNT_PATHS], r->nan_paths = c[FV_VP_COUNT_NAN];
