@@ -25,6 +25,7 @@ enum { FV_FILM_DEVICE_SLOTS = 2 };   /* frames in flight: the one being collecte
 typedef struct fv_film_device {
     fv_buffer dev[FV_FILM_DEVICE_BUFFERS];
     fv_buffer stage[FV_FILM_DEVICE_SLOTS][FV_FILM_DEVICE_BUFFERS]; /* pinned */
+    fv_buffer display, display_stage[FV_FILM_DEVICE_SLOTS];       /* a display-only film's RGBA8 */
 } fv_film_device;
 
 /* *dev receives the views the kernels write for host's n pixels (the buffers host has, else NULL). */
@@ -34,6 +35,12 @@ fv_status fv_film_device_views(fv_backend *b, fv_film_device *f, const fv_film_v
 fv_status fv_film_device_download(fv_backend *b, fv_film_device *f, int slot, const fv_film_views *host, size_t n, fv_error *err);
 /* After the wait for slot's frame: its downloaded pixels into host's buffers. */
 void fv_film_device_deliver(fv_backend *b, const fv_film_device *f, int slot, const fv_film_views *host, size_t n);
+/* The same for a whole film, its display output included: a display-only film
+ * (fv_film_set_display) has its colour converted to RGBA8 on the device (device/display_kernels.h)
+ * after the frame's kernels, and that is read back (4 bytes a pixel) instead of the float colour;
+ * the delivery then marks the film's display output filled. Any other film as the views above. */
+fv_status fv_film_device_download_film(fv_backend *b, fv_film_device *f, int slot, fv_film *film, fv_error *err);
+void fv_film_device_deliver_film(fv_backend *b, const fv_film_device *f, int slot, fv_film *film);
 void fv_film_device_release(fv_backend *b, fv_film_device *f);
 
 #endif

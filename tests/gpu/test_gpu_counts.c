@@ -96,7 +96,7 @@ static void print_simt(const char *what)
 }
 #endif
 
-static void run_family(const family *fam, bool mono, int w, int h, bool exact)
+static void run_family_films(const family *fam, bool mono, bool display, int w, int h, bool exact)
 {
     fv_scene *s = NULL;
     fv_view *v = NULL;
@@ -110,7 +110,8 @@ static void run_family(const family *fam, bool mono, int w, int h, bool exact)
     fv_film *film[2];
     fv_error err;
     for (int e = 0; e < 2; e++)
-        if (fv_film_create(w, h, 0, &film[e], &err) != FV_OK) fail_msg("%s", err.msg);
+        if (fv_film_create(w, h, 0, &film[e], &err) != FV_OK || (display && fv_film_set_display(film[e], 1.0f, &err) != FV_OK))
+            fail_msg("%s", err.msg);
     char what[160];
 #ifdef FOVEA_CUDA_SIM
     fv_cuda_sim_simt_reset();
@@ -128,7 +129,9 @@ static void run_family(const family *fam, bool mono, int w, int h, bool exact)
         const fv_sim_mark m = fv_sim_now();
         const fv_status rs = mono ? fv_technique_render(t, &f[0], film[0], &st, &err) : fv_technique_render_pair(t, f, film, &st, &err);
         if (rs != FV_OK) fail_msg("%s %s frame %d: %s", fam->method, fam->scene, i, err.msg);
-        snprintf(what, sizeof what, "%s %s [%s] %s %dx%d frame %d", fam->method, fam->scene, fam->params, mono ? "mono" : "stereo", w, h, i);
+        snprintf(what, sizeof what, "%s %s [%s] %s%s %dx%d frame %d", fam->method, fam->scene, fam->params, mono ? "mono" : "stereo",
+                 display ? " display-only" : "", w, h, i);
+        if (display && !fv_film_display(film[0])) fail_msg("%s: the display output was not filled", what);
         fv_sim_expect_reported(m, &st, what);
         printf("| %s |", what);
         for (size_t k = 0; k < NKEYS; k++) printf(" %s %.0f |", k_keys[k], fv_stats_get_count(&st, k_keys[k]));
@@ -157,6 +160,22 @@ static void run_family(const family *fam, bool mono, int w, int h, bool exact)
     fv_view_destroy(v);
     fv_scene_destroy(s);
     fv_sim_expect_freed(what);
+}
+
+static void run_family(const family *fam, bool mono, int w, int h, bool exact) { run_family_films(fam, mono, false, w, h, exact); }
+
+/* Display-only films (fv_film_set_display): the colour converted on the device, RGBA8 read back,
+ * 4 bytes a pixel instead of 12 (the counters as in k_families). */
+#define DISPLAY (2 * 64 * 48 * 4)
+static const family k_display[] = {
+    {"pt", "cornell", "spp=1", 64.0f, false, 4, 1, 0, 0, DISPLAY + 4 * 8},
+    {"fipr", "sdf-temple", "spp=1", 0.064f, false, 18, 1, 0, 0, DISPLAY + 5 * 7 * 8},
+};
+
+static void test_display_only(void **st)
+{
+    (void)st;
+    for (size_t i = 0; i < sizeof k_display / sizeof k_display[0]; i++) run_family_films(&k_display[i], false, true, 64, 48, true);
 }
 
 static void test_families(void **st)
@@ -192,6 +211,6 @@ int main(void)
         printf("skipped: %s\n", why);
         return FV_GPU_TEST_NO_DEVICE;
     }
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_families), cmocka_unit_test(test_in_flight)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_families), cmocka_unit_test(test_in_flight), cmocka_unit_test(test_display_only)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -702,6 +702,13 @@ static int render(int argc, char **argv, void *dist)
      * submit that is cancelled or fails still lets the frame before it be written, and whatever
      * is in flight when the loop stops is collected and dropped. */
     for (int e = 0; e < neyes && s == FV_OK && o.frames > 1; e++) s = fv_film_create(o.width, o.height, aux, &film_b[e], &err);
+    /* PNGs without an overlay need nothing but what a display shows: a device frame converts there
+     * and reads back 4 bytes a pixel instead of 12 (docs/gpu.md, "Display output on the device") */
+    const bool display_only = fmt == FV_IMG_PNG && !o.overlay;
+    for (int e = 0; e < neyes && s == FV_OK && display_only; e++) {
+        s = fv_film_set_display(film[e], (float)o.exposure, &err);
+        if (s == FV_OK && film_b[e]) s = fv_film_set_display(film_b[e], (float)o.exposure, &err);
+    }
     fv_film *const sets[2][2] = {{film[0], film[1]}, {film_b[0], film_b[1]}};
     fv_stats stats[2];
     double frame_ms[2] = {0.0, 0.0}; /* each frame's time in its submit and collect */

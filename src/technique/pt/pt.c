@@ -224,7 +224,7 @@ static fv_status pt_submit_device(pt_state *st, int eyes, const fv_frame *frames
             s = fv_backend_launch_progress(b, &fv_pt_pixel_kernel, cam->width, cam->height, &a[e], counts + e * FV_PT_COUNTS, &lp, &done, err);
     }
     fv_backend_mark(b, 2 * slot + 1);
-    for (int e = 0; e < eyes && s == FV_OK && done; e++) s = fv_film_device_download(b, &st->film[e], slot, &host[e], n[e], err);
+    for (int e = 0; e < eyes && s == FV_OK && done; e++) s = fv_film_device_download_film(b, &st->film[e], slot, films[e], err);
     if (s == FV_OK) s = fv_backend_download(b, fl->counts_host.p, st->counts.p, count_bytes, "pt's counters", err);
     if (s != FV_OK || !done) {
         /* the wait even after a failure: nothing queued may write into a film the caller has back */
@@ -263,9 +263,7 @@ static fv_status pt_collect_device(pt_state *st, fv_error *err)
     uint64_t rays = 0, bad = 0;
     const uint64_t *c = fl->counts_host.p;
     for (int e = 0; e < fl->eyes; e++) {
-        const size_t n = (size_t)fv_film_width(fl->films[e]) * (size_t)fv_film_height(fl->films[e]);
-        const fv_film_views host = fv_film_views_of(fl->films[e]);
-        fv_film_device_deliver(b, &st->film[e], slot, &host, n);
+        fv_film_device_deliver_film(b, &st->film[e], slot, fl->films[e]);
         rays += c[e * FV_PT_COUNTS + FV_PT_COUNT_RAYS], bad += c[e * FV_PT_COUNTS + FV_PT_COUNT_NAN];
     }
     fv_stage_stop(stats, "trace", fl->t0);

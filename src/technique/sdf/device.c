@@ -473,7 +473,7 @@ static fv_status submit_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
     for (int e = 0; e < eyes && s == FV_OK && done; e++)
         s = eye_passes(d, &frames[e], &dw, &f[e], &k, &bt, &out[e], d->counts.p, &blur_ms, &done, err);
     fv_backend_mark(b, 2 * slot + 1);
-    for (int e = 0; e < eyes && s == FV_OK && done; e++) s = fv_film_device_download(b, &d->film[e], slot, &host[e], np, err);
+    for (int e = 0; e < eyes && s == FV_OK && done; e++) s = fv_film_device_download_film(b, &d->film[e], slot, films[e], err);
     if (s == FV_OK) s = fv_backend_download(b, fl->counts_host.p, d->counts.p, count_bytes, "the sphere tracers' counters", err);
     if (s != FV_OK || !done) {
         /* the wait even after a failure: nothing queued may write into a film the caller has back */
@@ -512,11 +512,7 @@ static fv_status finish(fv_sdf_device *d, int slot, fv_error *err)
     fv_backend_calls_get(b, &after);
     if (s != FV_OK) return s;
     const int w = fv_film_width(fl->films[0]), h = fv_film_height(fl->films[0]);
-    const size_t np = (size_t)w * h;
-    for (int e = 0; e < fl->eyes; e++) {
-        const fv_film_views host = fv_film_views_of(fl->films[e]);
-        fv_film_device_deliver(b, &d->film[e], slot, &host, np);
-    }
+    for (int e = 0; e < fl->eyes; e++) fv_film_device_deliver_film(b, &d->film[e], slot, fl->films[e]);
     fv_stats_add_ms(stats, "target", fv_time_ms() - fl->t0 - (portable ? fl->blur_ms : 0.0));
     if (blurred && portable) fv_stats_add_ms(stats, "blur", fl->blur_ms);
     fv_ksdf_pyr_counts c;
