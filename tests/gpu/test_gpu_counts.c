@@ -189,9 +189,10 @@ static void test_families(void **st)
     for (size_t i = 0; i < sizeof k_mono / sizeof k_mono[0]; i++) run_family(&k_mono[i], true, w, h, exact);
 }
 
-/* Frames in flight (fv_technique_submit / _collect): pt's and fipr's stereo sequences pipelined
- * are byte-identical to the frames rendered one by one, with the same counters per frame; no
- * synchronize within a submit, one within a collect (in_flight_check.h). The host's one wait of
+/* Frames in flight (fv_technique_submit / _collect): pt's, fipr's and vpolar's stereo sequences
+ * and sdf-gt's and cartesian-full's mono ones pipelined are byte-identical to the frames rendered
+ * one by one, with the same counters per frame; no synchronize within a submit, one within a
+ * collect (in_flight_check.h). The host's one wait of
  * frame N then comes after frame N+1 is queued: none blocks the next frame's queueing. */
 static void test_in_flight(void **st)
 {
@@ -200,6 +201,8 @@ static void test_in_flight(void **st)
         {"pt", "cornell", "spp=1 device=cuda", 64.0f, 64, 48, 3},
         {"fipr", "sdf-temple", "spp=1 device=cuda", 0.064f, 64, 48, 3},
         {"sdf-gt", "sdf-temple", "spp=1 device=cuda", 0.0f, 64, 48, 3},
+        {"vpolar", "cornell", "device=cuda", 64.0f, 64, 48, 3},
+        {"cartesian-full", "cornell", "device=cuda", 0.0f, 64, 48, 3},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) fv_in_flight_check(&cases[i]);
 }

@@ -1,7 +1,7 @@
 /* Frames in flight (fovea/technique.h, fv_technique_submit / fv_technique_collect): a short
  * sequence pipelined is byte-identical to the frames rendered one by one, on the portable backend
- * (pt, fipr: the device frames with two staging slots) and for methods that render in submit (pt
- * on the cpu, vpolar); misuse is refused; a cancelled submit leaves the frame before it
+ * (pt, fipr, vpolar: the device frames with two staging slots) and for methods that render in
+ * submit (pt and vpolar on the cpu); misuse is refused; a cancelled submit leaves the frame before it
  * collectable and nothing of its own in flight; a technique destroyed with frames in flight leaks
  * nothing (ASan). The same check runs on the CUDA simulator in tests/gpu/test_gpu_counts.c. */
 #include <math.h>
@@ -24,7 +24,8 @@ static void test_sequences(void **st)
         {"pt", "cornell", "spp=1 device=portable", 64.0f, 24, 16, 4},
         {"pt", "cornell", "spp=1", 0.0f, 24, 16, 3},
         {"fipr", "sdf-temple", "spp=1 device=portable", 0.064f, 24, 16, 4},
-        {"vpolar", "cornell", "device=portable", 0.0f, 24, 16, 3},
+        {"vpolar", "cornell", "device=portable", 64.0f, 24, 16, 4},
+        {"vpolar", "cornell", "", 0.0f, 24, 16, 3},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) fv_in_flight_check(&cases[i]);
 }
