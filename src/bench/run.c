@@ -167,7 +167,7 @@ static fv_status submit_into(const render_job *j, fv_technique *t, int i, int fi
 
 /* The frames are pipelined (docs/gpu.md, "Frames in flight"): frame i+1 is submitted into the
  * other set of films before frame i is collected and handed to on_frame, so that a device runs
- * i+1 while the host measures i. A frame's time is what its submit and its collect took. The
+ * i+1 while the host measures i (except in a step whose progress is reported within its frames). A frame's time is what its submit and its collect took. The
  * calls on_frame sees, and its errors, are those of rendering the frames one by one. */
 static fv_status render_sequence(const render_job *j, int first, int nframes, frame_fn on_frame, void *user, fv_error *err)
 {
@@ -194,11 +194,14 @@ static fv_status render_sequence(const render_job *j, int first, int nframes, fr
         st = submit_into(j, t, first, first, films[0], &stats[0], &ms[0], fn, fn_user, err);
         if (st != FV_OK) fv_error_prefix(err, "%s, frame %d: ", j->m->label, first);
     }
+    /* A step that reports progress within its frames (a reference, the probe: not timed) counts
+     * them as they are collected, so it submits the next one only then. */
+    const bool ahead = !within;
     for (int i = first; i < nframes && st == FV_OK; i++, k ^= 1) {
         const bool more = i + 1 < nframes;
         fv_status sn = FV_OK;
         fv_error errn;
-        if (more) sn = submit_into(j, t, i + 1, first, films[k ^ 1], &stats[k ^ 1], &ms[k ^ 1], fn, fn_user, &errn);
+        if (more && ahead) sn = submit_into(j, t, i + 1, first, films[k ^ 1], &stats[k ^ 1], &ms[k ^ 1], fn, fn_user, &errn);
         const double t0 = fv_time_ms();
         st = fv_driver_collect(j->driver, t, err);
         ms[k] += fv_time_ms() - t0;
@@ -211,6 +214,7 @@ static fv_status render_sequence(const render_job *j, int first, int nframes, fr
             j->step->done++;
             step_report(j->step, 0.0);
         }
+        if (st == FV_OK && more && !ahead) sn = submit_into(j, t, i + 1, first, films[k ^ 1], &stats[k ^ 1], &ms[k ^ 1], fn, fn_user, &errn);
         if (st == FV_OK && sn != FV_OK) {
             *err = errn;
             fv_error_prefix(err, "%s, frame %d: ", j->m->label, i + 1);
