@@ -83,7 +83,8 @@ void fv_pinned_release(fv_backend *b, fv_buffer *buf);
 /* A table the host builds (per screen size, per gaze) with its copy on the device, refilled only
  * when the host's bytes differ from what was copied last. The bytes go through one of two pinned
  * buffers in turn, so the copy never blocks and a copy still queued from the frame before is never
- * overwritten (a frame waits for the one before it before it fills again). */
+ * overwritten: fills alternate, so a stage is refilled two fills later, and with at most two frames
+ * in flight (technique/class.h's submit) the frame that last used it has been collected. */
 typedef struct fv_mirror {
     fv_buffer dev;
     fv_buffer stage[2]; /* pinned */
