@@ -113,6 +113,16 @@ FV_API void fv_driver_set_camera(fv_driver *d, const fv_camera *c);
  * may cancel it (FV_ERR_CANCELLED). */
 FV_API fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool continues, fv_film *const *films, fv_stats *stats,
                                   fv_progress_fn progress, void *progress_user, fv_error *err);
+/* Frame `index` as fv_driver_render takes it, queued rather than rendered (fv_technique_submit):
+ * on a device it returns before the frame has run, so that a sequence submits frame N+1 before it
+ * collects frame N (two sets of films and stats, each alive and unread until collected). Progress
+ * is reported, and may cancel, within the submit. A cancelled or failed submit leaves nothing of
+ * its frame in flight; the frames before it stay collectable. */
+FV_API fv_status fv_driver_submit(fv_driver *d, fv_technique *t, int index, bool continues, fv_film *const *films, fv_stats *stats,
+                                  fv_progress_fn progress, void *progress_user, fv_error *err);
+/* Waits for the oldest frame submitted with t and delivers it into the films and stats it was
+ * submitted with (fv_technique_collect). */
+FV_API fv_status fv_driver_collect(fv_driver *d, fv_technique *t, fv_error *err);
 /* Renders the options' warm-up frames with technique t, each at frame 0's views, into films
  * (their pixels are then the last warm-up frame's); a later fv_driver_render(index 0, continues
  * true) goes on from them. Nothing happens when the count is 0. progress (optional) receives the

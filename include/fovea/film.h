@@ -120,6 +120,20 @@ FV_API fv_status fv_image_read(const char *path, fv_image *out, fv_error *err);
 FV_API fv_status fv_image_read_layer(const char *path, const char *layer, fv_image *out, fv_error *err);
 FV_API void fv_image_free(fv_image *img);
 
+/* ---- display output (docs/gpu.md, "Display output on the device") ----
+ *
+ * fv_film_set_display makes film display-only, for a consumer that wants nothing but what a
+ * display shows (a PNG sequence, `fovea render` asks for it then): a frame rendered on a device (pt
+ * and the sphere tracers on portable or cuda) converts its colour there with `exposure` (clamped,
+ * sRGB-encoded, 8 bits: what a PNG holds) and reads back 4 bytes a pixel (RGBA8, alpha 255)
+ * instead of the 12 of its float colour, which that frame then leaves unwritten. Any other method
+ * writes the float colour as before. fv_film_display returns the RGBA8 pixels when the last frame
+ * filled them, else NULL. fv_film_write_meta writes a PNG from them (the bytes it would write from
+ * the float colour at that exposure) and refuses, for such a frame, another format or exposure.
+ * FV_ERR_INVALID for an exposure that is not finite and >= 0. */
+FV_API fv_status fv_film_set_display(fv_film *film, float exposure, fv_error *err);
+FV_API const uint8_t *fv_film_display(const fv_film *film);
+
 /* The sRGB transfer function and its inverse, on one channel. */
 FV_API float fv_srgb_encode(float linear);
 FV_API float fv_srgb_decode(float encoded);

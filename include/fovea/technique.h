@@ -168,6 +168,27 @@ FV_API fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_
  * frame's callback. */
 FV_API fv_status fv_technique_render_pair(fv_technique *t, const fv_frame frames[2], fv_film *const films[2], fv_stats *stats,
                                           fv_error *err);
+/* ---- frames in flight: a sequence that queues frame N+1 before it waits for frame N ----
+ *
+ * fv_technique_submit queues one frame, `eyes` 1 (frames[0] into films[0], as fv_technique_render)
+ * or 2 (a stereo pair into films[0] and films[1], as fv_technique_render_pair), with the same
+ * checks, and returns; on a GPU before the device has run it (the films are read back through two
+ * pinned staging slots, docs/gpu.md "Frames in flight"). fv_technique_collect waits for the oldest
+ * frame submitted and delivers it into the films and stats it was submitted with: they must stay
+ * alive, and the films unread, until then. The images and stats are fv_technique_render's; a
+ * method without a device frame (every CPU method) renders in submit, and collect only hands the
+ * frame over. At most FV_TECHNIQUE_IN_FLIGHT frames are in flight: a third submit, a collect with
+ * none in flight and a render with frames in flight are refused (FV_ERR_INVALID).
+ * Progress is reported, and may cancel, within submit only. A submit that fails or is cancelled
+ * leaves nothing of its frame queued or in flight (the frames before it stay collectable, so a
+ * sequence still writes them); a collect that fails has taken its frame all the same. Destroying
+ * the technique drops the frames in flight (their films are left as they were). */
+#define FV_TECHNIQUE_IN_FLIGHT 2
+FV_API fv_status fv_technique_submit(fv_technique *t, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats,
+                                     fv_error *err);
+FV_API fv_status fv_technique_collect(fv_technique *t, fv_error *err);
+/* Frames submitted and not yet collected (0 for NULL). */
+FV_API int fv_technique_in_flight(const fv_technique *t);
 /* The method's registry name (a static string). */
 FV_API const char *fv_technique_name_of(const fv_technique *t);
 /* NULL is ignored. */

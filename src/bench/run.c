@@ -152,44 +152,82 @@ static bool frame_progress(void *user, double fraction)
     return !(j->split && j->split->stopped) || keep_going((void *)j->split, fraction);
 }
 
+/* Frame i submitted into films (cleared first) with its stats (cleared); *ms: the submit's time. */
+static fv_status submit_into(const render_job *j, fv_technique *t, int i, int first, fv_film *const *films, fv_stats *stats, double *ms,
+                             fv_progress_fn fn, void *fn_user, fv_error *err)
+{
+    fv_stats_clear(stats);
+    fv_film_clear(films[0]);
+    if (films[1]) fv_film_clear(films[1]);
+    const double t0 = fv_time_ms();
+    const fv_status st = fv_driver_submit(j->driver, t, i, i > first, films, stats, fn, fn_user, err);
+    *ms = fv_time_ms() - t0;
+    return st;
+}
+
+/* The frames are pipelined (docs/gpu.md, "Frames in flight"): frame i+1 is submitted into the
+ * other set of films before frame i is collected and handed to on_frame, so that a device runs
+ * i+1 while the host measures i (except in a step whose progress is reported within its frames). A frame's time is what its submit and its collect took. The
+ * calls on_frame sees, and its errors, are those of rendering the frames one by one. */
 static fv_status render_sequence(const render_job *j, int first, int nframes, frame_fn on_frame, void *user, fv_error *err)
 {
     fv_technique *t = NULL;
     /* A stereo scenario renders both eyes per frame of a method (both timed); the left eye is
      * the one measured and shown, so its reference renders the left eye alone. */
-    fv_film *films[2] = {NULL, NULL};
+    fv_film *films[2][2] = {{NULL, NULL}, {NULL, NULL}};
     fv_status st = fv_technique_create(j->m->method, j->scene, j->m->params, j->log, &t, err);
     if (st != FV_OK) fv_error_prefix(err, "%s: ", j->m->label);
-    for (int e = 0; e < (j->left_only ? 1 : fv_driver_eye_count(j->driver)) && st == FV_OK; e++)
-        st = fv_film_create(j->sc->width, j->sc->height, 0, &films[e], err);
-    fv_film *film = films[0];
-    for (int i = first; i < nframes && st == FV_OK; i++) {
-        fv_stats stats;
-        fv_stats_clear(&stats);
-        fv_film_clear(film);
-        if (films[1]) fv_film_clear(films[1]);
-        /* split over processes: a frame stops early once another rank has failed; a measured
-         * method's frame reports no progress within it (only between frames, below, outside
-         * the timed call) */
-        const bool poll = j->split && j->split->stopped;
-        const bool within = j->step && j->step->within && j->step->opt->progress;
-        fv_progress_fn fn = within ? frame_progress : poll ? keep_going : NULL;
-        void *fn_user = within ? (void *)j : poll ? (void *)j->split : NULL;
-        double t0 = fv_time_ms();
-        st = fv_driver_render(j->driver, t, i, i > first, films, &stats, fn, fn_user, err);
-        double ms = fv_time_ms() - t0;
+    const int eyes = j->left_only ? 1 : fv_driver_eye_count(j->driver);
+    for (int k = 0; k < (nframes - first > 1 ? 2 : 1); k++)
+        for (int e = 0; e < eyes && st == FV_OK; e++) st = fv_film_create(j->sc->width, j->sc->height, 0, &films[k][e], err);
+    /* split over processes: a frame stops early once another rank has failed; a measured
+     * method's frame reports no progress within it (only between frames, below, outside the
+     * timed calls) */
+    const bool poll = j->split && j->split->stopped;
+    const bool within = j->step && j->step->within && j->step->opt->progress;
+    fv_progress_fn fn = within ? frame_progress : poll ? keep_going : NULL;
+    void *fn_user = within ? (void *)j : poll ? (void *)j->split : NULL;
+    fv_stats stats[2];
+    double ms[2] = {0.0, 0.0};
+    int k = 0;
+    if (st == FV_OK && first < nframes) {
+        st = submit_into(j, t, first, first, films[0], &stats[0], &ms[0], fn, fn_user, err);
+        if (st != FV_OK) fv_error_prefix(err, "%s, frame %d: ", j->m->label, first);
+    }
+    /* A step that reports progress within its frames (a reference, the probe: not timed) counts
+     * them as they are collected, so it submits the next one only then. */
+    const bool ahead = !within;
+    for (int i = first; i < nframes && st == FV_OK; i++, k ^= 1) {
+        const bool more = i + 1 < nframes;
+        fv_status sn = FV_OK;
+        fv_error errn;
+        if (more && ahead) sn = submit_into(j, t, i + 1, first, films[k ^ 1], &stats[k ^ 1], &ms[k ^ 1], fn, fn_user, &errn);
+        const double t0 = fv_time_ms();
+        st = fv_driver_collect(j->driver, t, err);
+        ms[k] += fv_time_ms() - t0;
         if (st != FV_OK) {
             fv_error_prefix(err, "%s, frame %d: ", j->m->label, i);
             break;
         }
-        st = on_frame(user, i, film, ms, &stats, err);
+        st = on_frame(user, i, films[k][0], ms[k], &stats[k], err);
         if (st == FV_OK && j->step) {
             j->step->done++;
             step_report(j->step, 0.0);
         }
+        if (st == FV_OK && more && !ahead) sn = submit_into(j, t, i + 1, first, films[k ^ 1], &stats[k ^ 1], &ms[k ^ 1], fn, fn_user, &errn);
+        if (st == FV_OK && sn != FV_OK) {
+            *err = errn;
+            fv_error_prefix(err, "%s, frame %d: ", j->m->label, i + 1);
+            st = sn;
+        }
     }
-    fv_film_destroy(films[0]);
-    fv_film_destroy(films[1]);
+    /* a frame still in flight (the loop stopped early) is collected and dropped */
+    while (t && fv_technique_in_flight(t) > 0) {
+        fv_error dropped;
+        (void)fv_driver_collect(j->driver, t, &dropped);
+    }
+    for (int q = 0; q < 2; q++)
+        for (int e = 0; e < 2; e++) fv_film_destroy(films[q][e]);
     fv_technique_destroy(t);
     return st;
 }

@@ -266,6 +266,18 @@ double fv_backend_elapsed_ms(fv_backend *b, int from, int to)
     return b->mark_ms[from] > 0.0 && b->mark_ms[to] > 0.0 ? b->mark_ms[to] - b->mark_ms[from] : 0.0;
 }
 
+void fv_backend_fence(fv_backend *b, int slot)
+{
+    if (b->cuda && slot >= 0 && slot < FV_BACKEND_FENCES) fv_cuda_backend_fence(b->cuda, slot);
+}
+
+fv_status fv_backend_wait_fence(fv_backend *b, int slot, const char *what, fv_error *err)
+{
+    if (slot < 0 || slot >= FV_BACKEND_FENCES) return fv_error_set(err, FV_ERR_INTERNAL, "%s: fence %d of %d", what, slot, FV_BACKEND_FENCES);
+    if (b->cuda) return fv_cuda_backend_wait_fence(b->cuda, slot, what, err);
+    return fv_backend_wait(b, what, err);
+}
+
 fv_status fv_backend_wait(fv_backend *b, const char *what, fv_error *err)
 {
     if (b->cuda) return fv_cuda_backend_wait(b->cuda, what, err);

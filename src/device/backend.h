@@ -8,6 +8,7 @@
  *   copies       upload, download, device to device and clears, queued in order;
  *   launches     of a kernel declared once (device/kernel_decl.h) over w x h items;
  *   marks        timestamps between stages, read after the wait;
+ *   fences       points in the queue the host may wait for while what follows them runs;
  *   one wait     for everything queued.
  *
  * Two implementations: `portable` runs each launch at once over tiles on the CPU's threads
@@ -82,7 +83,8 @@ void fv_pinned_release(fv_backend *b, fv_buffer *buf);
 /* A table the host builds (per screen size, per gaze) with its copy on the device, refilled only
  * when the host's bytes differ from what was copied last. The bytes go through one of two pinned
  * buffers in turn, so the copy never blocks and a copy still queued from the frame before is never
- * overwritten (a frame waits for the one before it before it fills again). */
+ * overwritten: fills alternate, so a stage is refilled two fills later, and with at most two frames
+ * in flight (technique/class.h's submit) the frame that last used it has been collected. */
 typedef struct fv_mirror {
     fv_buffer dev;
     fv_buffer stage[2]; /* pinned */
@@ -124,11 +126,21 @@ fv_status fv_backend_launch_progress(fv_backend *b, const fv_kernel *k, int w, i
 
 /* Timestamps: mark slot i (0 .. FV_BACKEND_MARKS-1) where the queue has got to; the milliseconds
  * between two marks, read after a wait (0 when either was not marked since). */
-#define FV_BACKEND_MARKS 16
+#define FV_BACKEND_MARKS 32
 void fv_backend_mark(fv_backend *b, int slot);
 double fv_backend_elapsed_ms(fv_backend *b, int from, int to);
 
 /* The one host wait: returns when everything queued has run, with the first error any of it met. */
 fv_status fv_backend_wait(fv_backend *b, const char *what, fv_error *err);
+
+/* Fences: fence slot i (0 .. FV_BACKEND_FENCES-1) records where the queue has got to;
+ * fv_backend_wait_fence returns when everything queued before it has run, while what was queued
+ * after it runs on. How a sequence collects frame N with frame N+1 already queued (the films' two
+ * read-back slots, device/film_device.h). A wait as fv_backend_wait's (counted in syncs, and as a
+ * host wait when something before the fence was not waited for yet); on portable, where
+ * everything ran when it was queued, a fence is nothing and its wait counts as fv_backend_wait's. */
+#define FV_BACKEND_FENCES 2
+void fv_backend_fence(fv_backend *b, int slot);
+fv_status fv_backend_wait_fence(fv_backend *b, int slot, const char *what, fv_error *err);
 
 #endif

@@ -73,6 +73,14 @@ double fv_cuda_backend_elapsed_ms(fv_cuda_backend *c, int from, int to)
     return 0.0;
 }
 
+void fv_cuda_backend_fence(fv_cuda_backend *c, int slot) { (void)c, (void)slot; }
+
+fv_status fv_cuda_backend_wait_fence(fv_cuda_backend *c, int slot, const char *what, fv_error *err)
+{
+    (void)c, (void)slot, (void)what;
+    return fv_error_set(err, FV_ERR_INVALID, "%s", k_no_cuda);
+}
+
 fv_status fv_cuda_backend_wait(fv_cuda_backend *c, const char *what, fv_error *err)
 {
     (void)c, (void)what;

@@ -144,11 +144,16 @@ static bool on_eye_progress(void *user, double f)
     return p->fn(p->user, (p->frame + (p->eye + f) / p->eyes) / p->frames);
 }
 
+/* How render_views hands the frame to the technique: rendered now, or submitted
+ * (fv_technique_submit; fv_driver_collect delivers it). */
+typedef enum { RENDER_NOW, SUBMIT } hand_over;
+
 /* Renders views v as the technique's frame `seen` (its index: warm-up frames first); a stereo
  * frame as a pair (fv_technique_render_pair), so a device runs both eyes without a host round
- * trip between them. */
+ * trip between them. With SUBMIT the frame is queued instead; its progress is reported within
+ * the submit, so the frames and their progress records may live on this stack. */
 static fv_status render_views(fv_driver *d, fv_technique *t, const fv_frame_views *v, int seen, const fv_frame_views *pv,
-                              fv_film *const *films, fv_stats *stats, eye_progress *ep, fv_error *err)
+                              fv_film *const *films, fv_stats *stats, eye_progress *ep, hand_over how, fv_error *err)
 {
     fv_status s = fv_scene_set_time(d->scene, v->time, err);
     fv_frame fr[2];
@@ -177,7 +182,8 @@ static fv_status render_views(fv_driver *d, fv_technique *t, const fv_frame_view
             fr[e].progress_user = &eps[e];
         }
     }
-    if (s == FV_OK) s = eyes == 2 ? fv_technique_render_pair(t, fr, films, stats, err) : fv_technique_render(t, &fr[0], films[0], stats, err);
+    if (s == FV_OK && how == SUBMIT) s = fv_technique_submit(t, eyes, fr, films, stats, err);
+    else if (s == FV_OK) s = eyes == 2 ? fv_technique_render_pair(t, fr, films, stats, err) : fv_technique_render(t, &fr[0], films[0], stats, err);
     if (s == FV_OK) {
         d->last = *v;
         d->last_seen = seen;
@@ -185,8 +191,9 @@ static fv_status render_views(fv_driver *d, fv_technique *t, const fv_frame_view
     return s;
 }
 
-fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool continues, fv_film *const *films, fv_stats *stats,
-                           fv_progress_fn progress, void *progress_user, fv_error *err)
+/* Frame `index` handed to t as `how` says: its views, and its previous frame's when it continues. */
+static fv_status render_index(fv_driver *d, fv_technique *t, int index, bool continues, fv_film *const *films, fv_stats *stats,
+                              fv_progress_fn progress, void *progress_user, hand_over how, fv_error *err)
 {
     if (index < 0) return fv_error_set(err, FV_ERR_INVALID, "driver: frame index %d must be >= 0", index);
     if (index > INT_MAX - d->o.warmup) return fv_error_set(err, FV_ERR_INVALID, "driver: frame index %d is too large", index);
@@ -196,7 +203,25 @@ fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool contin
     bool has_prev = continues && seen > 0;
     if (has_prev) fv_driver_prev_views(d, index, &pv);
     eye_progress ep = {progress, progress_user, 0, v.eye_count, 0, 1};
-    return render_views(d, t, &v, seen, has_prev ? &pv : NULL, films, stats, &ep, err);
+    return render_views(d, t, &v, seen, has_prev ? &pv : NULL, films, stats, &ep, how, err);
+}
+
+fv_status fv_driver_render(fv_driver *d, fv_technique *t, int index, bool continues, fv_film *const *films, fv_stats *stats,
+                           fv_progress_fn progress, void *progress_user, fv_error *err)
+{
+    return render_index(d, t, index, continues, films, stats, progress, progress_user, RENDER_NOW, err);
+}
+
+fv_status fv_driver_submit(fv_driver *d, fv_technique *t, int index, bool continues, fv_film *const *films, fv_stats *stats,
+                           fv_progress_fn progress, void *progress_user, fv_error *err)
+{
+    return render_index(d, t, index, continues, films, stats, progress, progress_user, SUBMIT, err);
+}
+
+fv_status fv_driver_collect(fv_driver *d, fv_technique *t, fv_error *err)
+{
+    (void)d;
+    return fv_technique_collect(t, err);
 }
 
 fv_status fv_driver_warm_up(fv_driver *d, fv_technique *t, fv_film *const *films, fv_stats *stats, fv_progress_fn progress,
@@ -208,7 +233,7 @@ fv_status fv_driver_warm_up(fv_driver *d, fv_technique *t, fv_film *const *films
     for (int k = 0; k < d->o.warmup && s == FV_OK; k++) {
         eye_progress ep = {progress, progress_user, 0, v.eye_count, k, d->o.warmup};
         /* a still: each warm-up frame's previous frame had the same views */
-        s = render_views(d, t, &v, k, k > 0 ? &v : NULL, films, stats, &ep, err);
+        s = render_views(d, t, &v, k, k > 0 ? &v : NULL, films, stats, &ep, RENDER_NOW, err);
     }
     return s;
 }

@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/alloc.h"
+#include "film/display.h"
+#include "film/film_display.h"
 #include "film/film_sums.h"
 #include "fovea/film.h"
 
@@ -16,6 +18,11 @@ struct fv_film {
     float *color, *depth, *normal, *albedo, *position;
     uint32_t *id;
     double *sums; /* film_sums.h: only when a caller asked for it */
+    /* fv_film_set_display: the RGBA8 pixels, their exposure, and whether the last frame filled
+     * them (then its float colour was not written) */
+    uint8_t *display;
+    float display_exposure;
+    bool display_filled;
 };
 
 fv_status fv_film_check_size(int width, int height, fv_error *err)
@@ -67,6 +74,7 @@ void fv_film_destroy(fv_film *f)
     free(f->id);
     free(f->position);
     free(f->sums);
+    free(f->display);
     free(f);
 }
 
@@ -89,6 +97,7 @@ void fv_film_clear(fv_film *f)
     if (f->albedo) memset(f->albedo, 0, n * 3 * sizeof(float));
     if (f->position) memset(f->position, 0, n * 3 * sizeof(float));
     if (f->id) memset(f->id, 0, n * sizeof(uint32_t));
+    f->display_filled = false;
 }
 
 int fv_film_width(const fv_film *f) { return f->width; }
@@ -118,16 +127,29 @@ const uint32_t *fv_film_id_const(const fv_film *f) { return f->id; }
 
 fv_film_views fv_film_views_of(fv_film *f)
 {
+    /* whoever writes the film now writes its float colour: the display output is a frame's, and
+     * only a device frame's delivery says it filled it */
+    f->display_filled = false;
     fv_film_views v = {f->color, f->depth, f->normal, f->albedo, f->position, f->id};
     return v;
 }
 
-float fv_srgb_encode(float x)
+float fv_srgb_encode(float x) { return fv_display_encode(x); }
+
+fv_status fv_film_set_display(fv_film *f, float exposure, fv_error *err)
 {
-    if (!(x > 0.0f)) return 0.0f;
-    if (x >= 1.0f) return 1.0f;
-    return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
+    if (!isfinite(exposure) || exposure < 0.0f) return fv_error_set(err, FV_ERR_INVALID, "film: display exposure %g must be finite and >= 0", exposure);
+    if (!f->display && !(f->display = fv_alloc_array((size_t)f->width * (size_t)f->height, 4)))
+        return fv_error_set(err, FV_ERR_NOMEM, "out of memory for the film's display output");
+    f->display_exposure = exposure;
+    f->display_filled = false;
+    return FV_OK;
 }
+
+const uint8_t *fv_film_display(const fv_film *f) { return f->display_filled ? f->display : NULL; }
+uint8_t *fv_film_display_buffer(fv_film *f) { return f->display; }
+float fv_film_display_exposure(const fv_film *f) { return f->display_exposure; }
+void fv_film_display_filled(fv_film *f) { f->display_filled = f->display != NULL; }
 
 float fv_srgb_decode(float e)
 {

@@ -24,6 +24,8 @@
 #include "core/alloc.h"
 #include "core/fileio.h"
 #include "fovea/film.h"
+#include "film/display.h"
+#include "film/film_display.h"
 #include "film/image_meta.h"
 #include "film/png_errors.h"
 
@@ -80,7 +82,9 @@ static bool png_write_stream(FILE *f, unsigned char *px, png_bytep *rows, png_te
     return true;
 }
 
-static fv_status png_write(const char *path, const float *rgb, int w, int h, float exposure, const fv_params *meta, fv_error *err)
+/* rgba (NULL: none): the pixels converted already (fv_film_display), taken as they are. */
+static fv_status png_write(const char *path, const float *rgb, const uint8_t *rgba, int w, int h, float exposure, const fv_params *meta,
+                           fv_error *err)
 {
     size_t n = (size_t)w * (size_t)h * 3;
     int nm = fv_params_count(meta);
@@ -92,7 +96,10 @@ static fv_status png_write(const char *path, const float *rgb, int w, int h, flo
         free(px), free(rows), free(texts), free(keys);
         return fv_error_set(err, FV_ERR_NOMEM, "out of memory writing '%s'", path);
     }
-    for (size_t i = 0; i < n; i++) px[i] = (unsigned char)lrintf(255.0f * fv_srgb_encode(rgb[i] * exposure));
+    if (rgba)
+        for (size_t i = 0; i < n; i++) px[i] = rgba[i / 3 * 4 + i % 3];
+    else
+        for (size_t i = 0; i < n; i++) px[i] = fv_display_byte(rgb[i], exposure);
     int nt = 0;
     for (int i = 0; i < nm; i++) {
         const char *v = fv_params_value(meta, i);
@@ -540,7 +547,7 @@ fv_status fv_image_write_meta(const char *path, const float *rgb, int w, int h, 
         return fv_error_set(err, FV_ERR_INVALID, "cannot write '%s': exposure %g must be finite and >= 0", path, exposure);
     if (err) fv_error_clear(err);
     switch (fmt) {
-    case FV_IMG_PNG: return png_write(path, rgb, w, h, exposure, meta, err);
+    case FV_IMG_PNG: return png_write(path, rgb, NULL, w, h, exposure, meta, err);
     case FV_IMG_PFM: return pfm_write(path, rgb, w, h, err);
     default: return exr_write(path, rgb, w, h, NULL, meta, err);
     }
@@ -557,6 +564,14 @@ fv_status fv_film_write_meta(const fv_film *film, const char *path, float exposu
     fv_image_format fmt;
     fv_status s = check_args(path, w, h, &fmt, err);
     if (s != FV_OK) return s;
+    if (fv_film_display(film)) {
+        /* the frame left its float colour unwritten: only the PNG it was converted for */
+        if (fmt != FV_IMG_PNG || exposure != fv_film_display_exposure(film))
+            return fv_error_set(err, FV_ERR_INVALID, "cannot write '%s': the film holds display output only (PNG at exposure %g)", path,
+                                fv_film_display_exposure(film));
+        if (err) fv_error_clear(err);
+        return png_write(path, NULL, fv_film_display(film), w, h, exposure, meta, err);
+    }
     if (fmt != FV_IMG_EXR) return fv_image_write_meta(path, fv_film_color_const(film), w, h, exposure, meta, err);
     if (err) fv_error_clear(err);
     return exr_write(path, fv_film_color_const(film), w, h, film, meta, err);

@@ -64,6 +64,19 @@ typedef struct fv_technique_class {
      * without a host round trip between them. Its images and counters must be those of render
      * called for eye 0 then eye 1. NULL: fv_technique_render_pair calls render twice. */
     fv_status (*render_pair)(void *state, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err);
+    /* Optional, both or neither: render split in two, so that a sequence queues frame N+1 before it
+     * waits for frame N (fovea/technique.h, fv_technique_submit). submit queues one frame of `eyes`
+     * eyes (1, or a stereo pair as render_pair takes them) with its read-back into the next of two
+     * staging slots, and returns without waiting for the device; collect waits for the oldest
+     * frame submitted and delivers it into the films and stats it was submitted with (the class
+     * keeps those pointers). The registry keeps at most two frames in flight and calls progress
+     * only within submit. A submit that fails or is cancelled waits for what it queued and leaves
+     * no frame of its own in flight, the ones before it still collectable; a collect that fails
+     * has still taken its frame; destroy drops what is in flight. Images and counters are
+     * render's: a class with the split renders as submit then collect. NULL: the registry renders
+     * in submit and collect only hands the frame over. */
+    fv_status (*submit)(void *state, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err);
+    fv_status (*collect)(void *state, fv_error *err);
     void (*destroy)(void *state);
     /* Devices beyond the CPU (fovea/device.h): a bit (1 << FV_DEVICE_*) per device the method
      * also runs on; 0 for a CPU-only method. Such a method is created by create_on, which is told

@@ -188,6 +188,7 @@ static fv_status read_device(const fv_technique_class *cls, fv_params *p, fv_dev
 struct fv_technique {
     const fv_technique_class *cls;
     void *state;
+    int in_flight; /* frames submitted and not collected (fv_technique_submit) */
 };
 
 fv_status fv_technique_create(const char *name, const fv_scene *scene, const fv_params *params, const fv_log *log,
@@ -262,9 +263,10 @@ static void relay_frame(const fv_frame *frame, relay *r, fv_frame *out)
     }
 }
 
-fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+/* render and render_pair once checked, whatever is in flight (fv_technique_submit renders with them
+ * for a method without the split). */
+static fv_status render_one(fv_technique *t, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
-    if (!t || !frame || !film || !stats) return fv_error_set(err, FV_ERR_INVALID, "render: missing technique, frame, film or stats");
     fv_status s = check_frame(frame, film, err);
     if (s != FV_OK) return s;
     /* Every eye reports the parallel regions it opened (core/parallel.h; docs/threads.md): each
@@ -279,10 +281,9 @@ fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_film *f
     return s;
 }
 
-fv_status fv_technique_render_pair(fv_technique *t, const fv_frame frames[2], fv_film *const films[2], fv_stats *stats, fv_error *err)
+/* What every stereo pair is checked for: each eye's frame and film, and one index and time. */
+static fv_status check_pair(const fv_frame frames[2], fv_film *const films[2], fv_error *err)
 {
-    if (!t || !frames || !films || !films[0] || !films[1] || !stats)
-        return fv_error_set(err, FV_ERR_INVALID, "render: missing technique, frames, films or stats");
     for (int e = 0; e < 2; e++) {
         if (frames[e].eye != e || frames[e].eye_count != 2)
             return fv_error_set(err, FV_ERR_INVALID, "render: a stereo pair's frame %d is eye %d of %d (expected eye %d of 2)", e, frames[e].eye,
@@ -293,19 +294,88 @@ fv_status fv_technique_render_pair(fv_technique *t, const fv_frame frames[2], fv
     if (frames[0].index != frames[1].index || frames[0].time != frames[1].time)
         return fv_error_set(err, FV_ERR_INVALID, "render: a stereo pair's eyes differ in frame index (%d, %d) or time (%g, %g)", frames[0].index,
                             frames[1].index, frames[0].time, frames[1].time);
+    return FV_OK;
+}
+
+static fv_status render_two(fv_technique *t, const fv_frame frames[2], fv_film *const films[2], fv_stats *stats, fv_error *err)
+{
+    fv_status s = check_pair(frames, films, err);
+    if (s != FV_OK) return s;
     if (!t->cls->render_pair) {
-        fv_status s = fv_technique_render(t, &frames[0], films[0], stats, err);
-        return s == FV_OK ? fv_technique_render(t, &frames[1], films[1], stats, err) : s;
+        s = render_one(t, &frames[0], films[0], stats, err);
+        return s == FV_OK ? render_one(t, &frames[1], films[1], stats, err) : s;
     }
     const uint64_t regions = fv_region_count();
     relay r[2];
     fv_frame f[2];
     for (int e = 0; e < 2; e++) relay_frame(&frames[e], &r[e], &f[e]);
-    fv_status s = t->cls->render_pair(t->state, f, films, stats, err);
+    s = t->cls->render_pair(t->state, f, films, stats, err);
     if (s == FV_OK && (r[0].cancelled || r[1].cancelled)) s = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
     fv_stats_add_count(stats, "parallel_regions", (double)(fv_region_count() - regions));
     return s;
 }
+
+static fv_status refuse_in_flight(const fv_technique *t, fv_error *err)
+{
+    return fv_error_set(err, FV_ERR_INVALID, "render: %d submitted frame%s not collected (fv_technique_collect)", t->in_flight,
+                        t->in_flight == 1 ? " is" : "s are");
+}
+
+fv_status fv_technique_render(fv_technique *t, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
+{
+    if (!t || !frame || !film || !stats) return fv_error_set(err, FV_ERR_INVALID, "render: missing technique, frame, film or stats");
+    return t->in_flight ? refuse_in_flight(t, err) : render_one(t, frame, film, stats, err);
+}
+
+fv_status fv_technique_render_pair(fv_technique *t, const fv_frame frames[2], fv_film *const films[2], fv_stats *stats, fv_error *err)
+{
+    if (!t || !frames || !films || !films[0] || !films[1] || !stats)
+        return fv_error_set(err, FV_ERR_INVALID, "render: missing technique, frames, films or stats");
+    return t->in_flight ? refuse_in_flight(t, err) : render_two(t, frames, films, stats, err);
+}
+
+fv_status fv_technique_submit(fv_technique *t, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    if (!t || !frames || !films || !films[0] || (eyes == 2 && !films[1]) || !stats)
+        return fv_error_set(err, FV_ERR_INVALID, "submit: missing technique, frames, films or stats");
+    if (eyes != 1 && eyes != 2) return fv_error_set(err, FV_ERR_INVALID, "submit: %d eyes (expected 1, or 2 for a stereo pair)", eyes);
+    if (t->in_flight >= FV_TECHNIQUE_IN_FLIGHT)
+        return fv_error_set(err, FV_ERR_INVALID, "submit: %d frames in flight already (collect one first)", t->in_flight);
+    if (!t->cls->submit) {
+        /* rendered now: collect only hands it over */
+        const fv_status s = eyes == 2 ? render_two(t, frames, films, stats, err) : render_one(t, frames, films[0], stats, err);
+        if (s == FV_OK) t->in_flight++;
+        return s;
+    }
+    fv_status s = eyes == 2 ? check_pair(frames, films, err) : check_frame(&frames[0], films[0], err);
+    if (s != FV_OK) return s;
+    const uint64_t regions = fv_region_count();
+    relay r[2];
+    fv_frame f[2];
+    for (int e = 0; e < eyes; e++) relay_frame(&frames[e], &r[e], &f[e]);
+    s = t->cls->submit(t->state, eyes, f, films, stats, err);
+    if (s == FV_OK && (r[0].cancelled || (eyes == 2 && r[1].cancelled))) {
+        /* cancelled where the method could not stop (a launch already queued): its frame is
+         * taken back, so that nothing of it stays in flight */
+        fv_error ignored;
+        t->cls->collect(t->state, &ignored);
+        s = fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    } else if (s == FV_OK) {
+        t->in_flight++;
+    }
+    fv_stats_add_count(stats, "parallel_regions", (double)(fv_region_count() - regions));
+    return s;
+}
+
+fv_status fv_technique_collect(fv_technique *t, fv_error *err)
+{
+    if (!t) return fv_error_set(err, FV_ERR_INVALID, "collect: missing technique");
+    if (!t->in_flight) return fv_error_set(err, FV_ERR_INVALID, "collect: no submitted frame in flight");
+    t->in_flight--;
+    return t->cls->collect ? t->cls->collect(t->state, err) : FV_OK;
+}
+
+int fv_technique_in_flight(const fv_technique *t) { return t ? t->in_flight : 0; }
 
 const char *fv_technique_name_of(const fv_technique *t) { return t->cls->name; }
 

@@ -21,7 +21,8 @@
  * them; __shared__ variables are function statics, which is right because one block runs at a time.
  * Host waits are counted as CUDA makes the host wait (its "API synchronization behavior"): a
  * synchronize or a cudaFree that comes after work was queued (a launch, an async copy or memset) is
- * one wait of the host for the device; so is every synchronous cudaMemcpy, and every copy, async or
+ * one wait of the host for the device (a cudaEventSynchronize only when work queued before its
+ * event was not waited for, and work queued after the event stays queued); so is every synchronous cudaMemcpy, and every copy, async or
  * not, between the device and pageable host memory (host memory not from cudaHostAlloc or
  * cudaHostRegister), which CUDA stages through a pinned buffer while the host waits. An async copy
  * to or from pinned memory is queued like a kernel. Bytes each way, allocations and frees, and per

@@ -40,6 +40,7 @@ struct fv_cuda_sim_stream {
 
 struct fv_cuda_sim_event {
     bool recorded;
+    uint64_t at; /* the device's queued-work number when it was recorded */
     std::chrono::steady_clock::time_point t;
 };
 
@@ -307,6 +308,7 @@ public:
     cudaError_t last = cudaSuccess; /* for cudaGetLastError: set by every call that fails, as CUDA's */
     std::map<std::string, unsigned long long> launches_of; /* by kernel name: odd ones run their blocks reversed */
     bool queued = false;            /* work was queued since the host last waited */
+    uint64_t seq = 0, waited = 0;   /* work queued so far (numbered), and up to where the host waited */
     std::set<cudaStream_t> launched; /* streams a kernel was launched on since the host last waited */
     int64_t fail_in = -1;           /* fv_cuda_sim_fail_allocation */
     /* FOVEA_CUDA_SIM_CALLS_ONLY=1: launches are checked and counted but run nothing, so the host's
@@ -384,7 +386,28 @@ public:
     {
         if (queued || always) counts.host_waits++;
         queued = false;
+        waited = seq;
         launched.clear();
+    }
+
+    void queue()
+    {
+        queued = true;
+        seq++;
+    }
+
+    /* The host waits for an event: for what was queued before it, if the host had not waited for
+     * that yet; what was queued after it stays queued. */
+    void event_wait(const fv_cuda_sim_event *e)
+    {
+        if (e->at > waited) {
+            counts.host_waits++;
+            waited = e->at;
+        }
+        if (waited == seq) {
+            queued = false;
+            launched.clear();
+        }
     }
 };
 
@@ -425,7 +448,7 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
             return;
         }
         d.counts.launches++;
-        d.queued = true;
+        d.queue();
         d.launched.insert(s);
         /* CUDA runs a launch's blocks in no order: every other launch of a kernel runs them last
          * to first, so a kernel that reads what another block of its launch writes finds it
@@ -593,6 +616,7 @@ cudaError_t cudaEventRecord(cudaEvent_t e, cudaStream_t s)
     d.check_stream(s, "cudaEventRecord", nullptr, 0);
     /* the work before it has run already: the host clock now is when the device reaches it */
     e->recorded = true;
+    e->at = d.seq;
     e->t = std::chrono::steady_clock::now();
     return cudaSuccess;
 }
@@ -603,7 +627,7 @@ cudaError_t cudaEventSynchronize(cudaEvent_t e)
     std::lock_guard<std::mutex> l(d.m);
     d.check_event(e, "cudaEventSynchronize");
     d.counts.syncs++;
-    d.host_wait();
+    d.event_wait(e);
     return cudaSuccess;
 }
 
@@ -703,7 +727,7 @@ cudaError_t fv_cuda_sim_memcpy(void *dst, const void *src, size_t bytes, cudaMem
         d.counts.pageable_copies++;
         d.host_wait(true);
     } else if (async) {
-        if (src_dev || dst_dev) d.queued = true; /* pinned memory, or device to device: queued like a kernel */
+        if (src_dev || dst_dev) d.queue(); /* pinned memory, or device to device: queued like a kernel */
     } else if (src_dev || dst_dev) {
         d.host_wait(true); /* a synchronous copy waits for the work before it and for itself */
     }
@@ -719,7 +743,7 @@ cudaError_t fv_cuda_sim_memset(void *p, int value, size_t bytes, bool async, cud
     if (bytes == 0) return cudaSuccess;
     d.check_range(p, bytes, what, file, line);
     memset(p, value, bytes);
-    d.queued = true; /* the host does not wait for a memset of device memory */
+    d.queue(); /* the host does not wait for a memset of device memory */
     return cudaSuccess;
 }
 

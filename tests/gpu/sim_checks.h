@@ -55,6 +55,9 @@ static inline void fv_sim_expect(fv_sim_mark since, uint64_t syncs, long launche
         fail_msg("%s: %llu kernel launches, expected %ld", what, (unsigned long long)l, launches);
 }
 
+/* Pinned host ranges not yet freed (cudaHostAlloc's): what a frame's read-back slots hold. */
+static inline uint64_t fv_sim_live_pinned(void) { return fv_sim_now().live_pinned; }
+
 /* Since `since`, what the simulator counted equals what the backend reported in `stats` (its own
  * count of its calls, fv_cuda_calls: the figures --stats-json shows on a GPU): launches, host waits,
  * pageable copies, bytes each way, device allocations and frees. So no runtime call escapes the
@@ -164,6 +167,7 @@ static inline fv_status fv_sim_run_frames(void *ctx, fv_error *err)
 #define FV_SIM_SIDE(n) (n)
 typedef int fv_sim_mark;
 static inline fv_sim_mark fv_sim_now(void) { return 0; }
+static inline uint64_t fv_sim_live_pinned(void) { return 0; }
 static inline void fv_sim_expect(fv_sim_mark since, uint64_t syncs, long launches, const char *what)
 {
     (void)since, (void)syncs, (void)launches, (void)what;

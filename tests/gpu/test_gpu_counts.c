@@ -27,6 +27,7 @@
 #include "fovea/fovea.h"
 #include "../unit/testkit.h"
 #include "sim_checks.h"
+#include "in_flight_check.h"
 
 /* A family's stereo frame and its figures at 64x48 per eye (steady state: frame 2 of 3). */
 typedef struct family {
@@ -104,7 +105,7 @@ static void print_simt(const char *what)
 }
 #endif
 
-static void run_family(const family *fam, bool mono, int w, int h, bool exact)
+static void run_family_films(const family *fam, bool mono, bool display, int w, int h, bool exact)
 {
     fv_scene *s = NULL;
     fv_view *v = NULL;
@@ -118,11 +119,13 @@ static void run_family(const family *fam, bool mono, int w, int h, bool exact)
     fv_film *film[2];
     fv_error err;
     for (int e = 0; e < 2; e++)
-        if (fv_film_create(w, h, 0, &film[e], &err) != FV_OK) fail_msg("%s", err.msg);
+        if (fv_film_create(w, h, 0, &film[e], &err) != FV_OK || (display && fv_film_set_display(film[e], 1.0f, &err) != FV_OK))
+            fail_msg("%s", err.msg);
     char what[160];
 #ifdef FOVEA_CUDA_SIM
     fv_cuda_sim_simt_reset();
 #endif
+    uint64_t pinned_after_first = 0;
     for (int i = 0; i < 3; i++) {
         /* cornell-fpm moves: its scene is copied each frame */
         const double time = fam->moving ? 0.1 * i : 0.0;
@@ -135,11 +138,18 @@ static void run_family(const family *fam, bool mono, int w, int h, bool exact)
         const fv_sim_mark m = fv_sim_now();
         const fv_status rs = mono ? fv_technique_render(t, &f[0], film[0], &st, &err) : fv_technique_render_pair(t, f, film, &st, &err);
         if (rs != FV_OK) fail_msg("%s %s frame %d: %s", fam->method, fam->scene, i, err.msg);
-        snprintf(what, sizeof what, "%s %s [%s] %s %dx%d frame %d", fam->method, fam->scene, fam->params, mono ? "mono" : "stereo", w, h, i);
+        snprintf(what, sizeof what, "%s %s [%s] %s%s %dx%d frame %d", fam->method, fam->scene, fam->params, mono ? "mono" : "stereo",
+                 display ? " display-only" : "", w, h, i);
+        if (display && !fv_film_display(film[0])) fail_msg("%s: the display output was not filled", what);
         fv_sim_expect_reported(m, &st, what);
         printf("| %s |", what);
         for (size_t k = 0; k < NKEYS; k++) printf(" %s %.0f |", k_keys[k], fv_stats_get_count(&st, k_keys[k]));
         printf("\n");
+        /* frame 0 makes both of the films' read-back slots (device/film_device.h), so that a
+         * pipelined sequence's frame 1, in the other slot, allocates no pinned memory either */
+        if (i == 0) pinned_after_first = fv_sim_live_pinned();
+        else if (fv_sim_live_pinned() != pinned_after_first)
+            fail_msg("%s: %llu pinned ranges, %llu after frame 0", what, (unsigned long long)fv_sim_live_pinned(), (unsigned long long)pinned_after_first);
         if (i < 1) continue;
         /* after the first frame: its buffers are kept, nothing is allocated or freed; one host wait,
          * no pageable copy; a scene that stands still uploads nothing though the gaze moves */
@@ -167,6 +177,22 @@ static void run_family(const family *fam, bool mono, int w, int h, bool exact)
     fv_sim_expect_freed(what);
 }
 
+static void run_family(const family *fam, bool mono, int w, int h, bool exact) { run_family_films(fam, mono, false, w, h, exact); }
+
+/* Display-only films (fv_film_set_display): the colour converted on the device, RGBA8 read back,
+ * 4 bytes a pixel instead of 12 (the counters as in k_families). */
+#define DISPLAY (2 * 64 * 48 * 4)
+static const family k_display[] = {
+    {"pt", "cornell", "spp=1", 64.0f, false, 4, 1, 0, 0, DISPLAY + 4 * 8},
+    {"fipr", "sdf-temple", "spp=1", 0.064f, false, 18, 1, 0, 0, DISPLAY + 5 * 7 * 8},
+};
+
+static void test_display_only(void **st)
+{
+    (void)st;
+    for (size_t i = 0; i < sizeof k_display / sizeof k_display[0]; i++) run_family_films(&k_display[i], false, true, 64, 48, true);
+}
+
 static void test_families(void **st)
 {
     (void)st;
@@ -190,6 +216,24 @@ static void test_gaze_tables_size(void **st)
         if (!strcmp(k_mono[i].method, "vpolar")) run_family(&k_mono[i], true, 104, 76, false);
 }
 
+/* Frames in flight (fv_technique_submit / _collect): pt's, fipr's and vpolar's stereo sequences
+ * and sdf-gt's and cartesian-full's mono ones pipelined are byte-identical to the frames rendered
+ * one by one, with the same counters per frame; no synchronize within a submit, one within a
+ * collect (in_flight_check.h). The host's one wait of
+ * frame N then comes after frame N+1 is queued: none blocks the next frame's queueing. */
+static void test_in_flight(void **st)
+{
+    (void)st;
+    static const fv_in_flight_case cases[] = {
+        {"pt", "cornell", "spp=1 device=cuda", 64.0f, 64, 48, 3},
+        {"fipr", "sdf-temple", "spp=1 device=cuda", 0.064f, 64, 48, 3},
+        {"sdf-gt", "sdf-temple", "spp=1 device=cuda", 0.0f, 64, 48, 3},
+        {"vpolar", "cornell", "device=cuda", 64.0f, 64, 48, 3},
+        {"cartesian-full", "cornell", "device=cuda", 0.0f, 64, 48, 3},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) fv_in_flight_check(&cases[i]);
+}
+
 int main(void)
 {
     char why[256];
@@ -197,6 +241,7 @@ int main(void)
         printf("skipped: %s\n", why);
         return FV_GPU_TEST_NO_DEVICE;
     }
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_families), cmocka_unit_test(test_gaze_tables_size)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_families), cmocka_unit_test(test_gaze_tables_size), cmocka_unit_test(test_in_flight),
+                                       cmocka_unit_test(test_display_only)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

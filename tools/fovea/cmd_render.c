@@ -556,7 +556,7 @@ static int render(int argc, char **argv, void *dist)
     fv_view *view = NULL;
     fv_technique *tech = NULL;
     fv_driver *driver = NULL;
-    fv_film *film[2] = {NULL, NULL};
+    fv_film *film[2] = {NULL, NULL}, *film_b[2] = {NULL, NULL}; /* film_b: a sequence's second set */
     fv_gaze_path *trace = NULL;
     fv_camera_path ctrace = {NULL, 0};
     fv_stats_log *slog = NULL;
@@ -696,23 +696,59 @@ static int render(int argc, char **argv, void *dist)
     fv_cli_progress_init(&prog, o.quiet, o.frames);
     fv_cli_interrupt_defer(true);
     s = warm_up(&o, &rec, driver, tech, film, fv_cli_progress_frame, &prog, &prog, &err);
-    for (int f = 0; f < o.frames && s == FV_OK && !fv_cli_interrupted(); f++) {
-        fv_stats stats;
-        fv_stats_clear(&stats);
-        prog.frame = f;
-        double t0 = fv_time_ms();
-        if ((s = fv_driver_render(driver, tech, f, f > 0 || rec.warmup > 0, film, &stats, fv_cli_progress_frame, &prog, &err)) != FV_OK) break;
-        double ms = fv_time_ms() - t0;
+    /* A sequence is pipelined (docs/gpu.md, "Frames in flight"): frame f+1 is submitted before
+     * frame f is collected and written, each into its own films and stats, so that a device runs
+     * f+1 while the host writes f. The files are those of rendering the frames one by one: a
+     * submit that is cancelled or fails still lets the frame before it be written, and whatever
+     * is in flight when the loop stops is collected and dropped. */
+    for (int e = 0; e < neyes && s == FV_OK && o.frames > 1; e++) s = fv_film_create(o.width, o.height, aux, &film_b[e], &err);
+    /* PNGs without an overlay need nothing but what a display shows: a device frame converts there
+     * and reads back 4 bytes a pixel instead of 12 (docs/gpu.md, "Display output on the device") */
+    const bool display_only = fmt == FV_IMG_PNG && !o.overlay;
+    for (int e = 0; e < neyes && s == FV_OK && display_only; e++) {
+        s = fv_film_set_display(film[e], (float)o.exposure, &err);
+        if (s == FV_OK && film_b[e]) s = fv_film_set_display(film_b[e], (float)o.exposure, &err);
+    }
+    fv_film *const sets[2][2] = {{film[0], film[1]}, {film_b[0], film_b[1]}};
+    fv_stats stats[2];
+    double frame_ms[2] = {0.0, 0.0}; /* each frame's time in its submit and collect */
+    if (s == FV_OK && o.frames > 0 && !fv_cli_interrupted()) {
+        fv_stats_clear(&stats[0]);
+        const double t0 = fv_time_ms();
+        s = fv_driver_submit(driver, tech, 0, rec.warmup > 0, sets[0], &stats[0], fv_cli_progress_frame, &prog, &err);
+        frame_ms[0] = fv_time_ms() - t0;
+    }
+    for (int f = 0; f < o.frames && s == FV_OK; f++) {
+        const int k = f % 2, kn = (f + 1) % 2;
+        const bool more = f + 1 < o.frames && !fv_cli_interrupted();
+        fv_status sn = FV_OK;
+        fv_error errn;
+        if (more) {
+            fv_stats_clear(&stats[kn]);
+            prog.frame = f + 1;
+            const double t0 = fv_time_ms();
+            sn = fv_driver_submit(driver, tech, f + 1, true, sets[kn], &stats[kn], fv_cli_progress_frame, &prog, &errn);
+            frame_ms[kn] = fv_time_ms() - t0;
+        }
+        const double t0 = fv_time_ms();
+        s = fv_driver_collect(driver, tech, &err);
+        const double ms = frame_ms[k] + fv_time_ms() - t0;
         fv_frame_views views;
         fv_driver_views(driver, f, &views);
-        if (slog) s = fv_stats_log_add(slog, f, &views, ms, &stats, &err);
-        if (s == FV_OK) s = write_frame(&o, &rec, driver, film, neyes, f, ms, &err);
+        if (s == FV_OK && slog) s = fv_stats_log_add(slog, f, &views, ms, &stats[k], &err);
+        if (s == FV_OK) s = write_frame(&o, &rec, driver, sets[k], neyes, f, ms, &err);
         if (s != FV_OK) break;
         if (!o.quiet) {
             fv_cli_progress_done(&prog);
             if (o.show_stats && f == 0) fprintf(stderr, "  threads: %d (%s)\n", fv_thread_count(o.threads), fv_cli_thread_plan());
-            print_frame(f, ms, &stats, o.show_stats);
+            print_frame(f, ms, &stats[k], o.show_stats);
         }
+        if (!more) break;
+        if (sn != FV_OK) s = sn, err = errn;
+    }
+    while (fv_technique_in_flight(tech) > 0) {
+        fv_error dropped;
+        (void)fv_driver_collect(driver, tech, &dropped);
     }
     fv_cli_interrupt_defer(false);
     fv_cli_progress_done(&prog);
@@ -744,6 +780,8 @@ done:
     fv_camera_keys_free(ctrace.keys);
     fv_film_destroy(film[0]);
     fv_film_destroy(film[1]);
+    fv_film_destroy(film_b[0]);
+    fv_film_destroy(film_b[1]);
     fv_technique_destroy(tech);
     fv_scene_destroy(scene);
     fv_view_destroy(view);

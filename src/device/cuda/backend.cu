@@ -1,6 +1,6 @@
 /* fovea — the device backend on CUDA (device/backend.h, device/cuda/backend_api.h): one stream per
  * backend, on which every copy, clear and launch is queued in order; the host waits only in
- * fv_cuda_backend_wait, in a free after queued work, and in a copy whose host side is pageable
+ * fv_cuda_backend_wait and _wait_fence, in a free after queued work, and in a copy whose host side is pageable
  * (which CUDA makes blocking: the families use pinned memory, fv_pinned_ensure, so they have none).
  * Every runtime call goes through device/cuda/common.h's counted wrappers, so the figures
  * fv_backend_calls reports are what this code asked of the runtime, on a GPU as on the simulator.
@@ -18,6 +18,8 @@ struct fv_cuda_backend {
     cudaStream_t stream;
     cudaEvent_t mark[FV_BACKEND_MARKS];
     unsigned marked; /* slots recorded since the backend was made */
+    cudaEvent_t fence[FV_BACKEND_FENCES];
+    uint64_t fence_at[FV_BACKEND_FENCES]; /* the tally's seq when each was recorded */
 };
 
 extern "C" bool fv_cuda_backend_probe(char *why, size_t why_len)
@@ -45,9 +47,11 @@ extern "C" void fv_cuda_backend_destroy(fv_cuda_backend *c)
 {
     if (!c) return;
     /* nothing queued may outlive its buffers (a frame ends with its wait, so usually nothing is) */
-    if (c->stream && c->calls.queued) fv_cuda_wait(&c->calls, c->stream);
+    if (c->stream && fv_cuda_queued(&c->calls)) fv_cuda_wait(&c->calls, c->stream);
     for (int i = 0; i < FV_BACKEND_MARKS; i++)
         if (c->mark[i]) cudaEventDestroy(c->mark[i]);
+    for (int i = 0; i < FV_BACKEND_FENCES; i++)
+        if (c->fence[i]) cudaEventDestroy(c->fence[i]);
     if (c->stream) cudaStreamDestroy(c->stream);
     free(c);
 }
@@ -62,6 +66,7 @@ extern "C" fv_status fv_cuda_backend_create(fv_cuda_backend **out, fv_error *err
     fv_cuda_forget_error();
     cudaError_t e = cudaStreamCreate(&c->stream);
     for (int i = 0; e == cudaSuccess && i < FV_BACKEND_MARKS; i++) e = cudaEventCreate(&c->mark[i]);
+    for (int i = 0; e == cudaSuccess && i < FV_BACKEND_FENCES; i++) e = cudaEventCreate(&c->fence[i]);
     if (e != cudaSuccess) {
         fv_cuda_backend_destroy(c);
         return fv_cuda_fail(e, "creating a stream and its events", err);
@@ -154,6 +159,21 @@ extern "C" double fv_cuda_backend_elapsed_ms(fv_cuda_backend *c, int from, int t
     if (!(c->marked & (1u << from)) || !(c->marked & (1u << to))) return 0.0;
     float ms = 0.0f;
     return cudaEventElapsedTime(&ms, c->mark[from], c->mark[to]) == cudaSuccess ? (double)ms : 0.0;
+}
+
+extern "C" void fv_cuda_backend_fence(fv_cuda_backend *c, int slot)
+{
+    if (cudaEventRecord(c->fence[slot], c->stream) == cudaSuccess) c->fence_at[slot] = c->calls.seq;
+}
+
+extern "C" fv_status fv_cuda_backend_wait_fence(fv_cuda_backend *c, int slot, const char *what, fv_error *err)
+{
+    cudaError_t e = fv_cuda_fence_wait(&c->calls, c->fence[slot], c->fence_at[slot]);
+    if (e == cudaSuccess) e = cudaGetLastError();
+    if (e == cudaSuccess) return FV_OK;
+    char msg[160];
+    snprintf(msg, sizeof msg, "running %s", what);
+    return fv_cuda_fail(e, msg, err);
 }
 
 extern "C" fv_status fv_cuda_backend_wait(fv_cuda_backend *c, const char *what, fv_error *err)

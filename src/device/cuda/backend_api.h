@@ -34,6 +34,8 @@ fv_status fv_cuda_backend_clear(fv_cuda_backend *c, void *p, int byte, size_t by
 fv_status fv_cuda_backend_launch(fv_cuda_backend *c, const fv_kernel *k, int w, int h, const void *args, uint64_t *counts, fv_error *err);
 void fv_cuda_backend_mark(fv_cuda_backend *c, int slot);
 double fv_cuda_backend_elapsed_ms(fv_cuda_backend *c, int from, int to);
+void fv_cuda_backend_fence(fv_cuda_backend *c, int slot);
+fv_status fv_cuda_backend_wait_fence(fv_cuda_backend *c, int slot, const char *what, fv_error *err);
 fv_status fv_cuda_backend_wait(fv_cuda_backend *c, const char *what, fv_error *err);
 
 #ifdef __cplusplus

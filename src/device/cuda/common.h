@@ -18,14 +18,18 @@
  *
  * Every allocation, copy, clear, synchronize and launch of a backend goes through these, with the
  * backend's tally: the counts are then what the backend did, on a GPU as on the simulator (whose own
- * counts the sim tests compare with them). `queued` follows what CUDA would make the host wait for:
- * work queued since the host last waited. */
+ * counts the sim tests compare with them). What CUDA would make the host wait for is the work
+ * queued since the host last waited: every queued call takes the next number (seq), and a wait
+ * covers the numbers up to `waited` (all of them, or those before a fence: fv_cuda_fence_wait). */
 typedef fv_backend_calls fv_cuda_calls;
 
 typedef struct fv_cuda_tally {
     fv_cuda_calls n;
-    bool queued;
+    uint64_t seq, waited; /* calls queued so far; the last one the host has waited for */
 } fv_cuda_tally;
+
+static inline bool fv_cuda_queued(const fv_cuda_tally *k) { return k->seq != k->waited; }
+static inline void fv_cuda_queue(fv_cuda_tally *k) { k->seq++; }
 
 /* Whether host memory p is pageable (neither cudaHostAlloc's nor registered): a copy between it and
  * the device blocks the host. An address CUDA cannot classify counts as pageable. */
@@ -42,8 +46,8 @@ static inline bool fv_cuda_pageable(const void *p)
 /* The host waited: for the queued work, and with `always` for the call's own transfer too. */
 static inline void fv_cuda_waited(fv_cuda_tally *k, bool always)
 {
-    if (k->queued || always) k->n.host_waits++;
-    k->queued = false;
+    if (fv_cuda_queued(k) || always) k->n.host_waits++;
+    k->waited = k->seq;
 }
 
 static inline cudaError_t fv_cuda_alloc(fv_cuda_tally *k, void **p, size_t bytes)
@@ -86,7 +90,7 @@ static inline cudaError_t fv_cuda_copy(fv_cuda_tally *k, void *dst, const void *
     if (pageable) {
         fv_cuda_waited(k, true);
     } else {
-        k->queued = true;
+        fv_cuda_queue(k);
     }
     return e;
 }
@@ -94,7 +98,7 @@ static inline cudaError_t fv_cuda_copy(fv_cuda_tally *k, void *dst, const void *
 static inline cudaError_t fv_cuda_clear(fv_cuda_tally *k, void *p, int value, size_t bytes, cudaStream_t st)
 {
     if (bytes == 0) return cudaSuccess;
-    k->queued = true;
+    fv_cuda_queue(k);
     return cudaMemsetAsync(p, value, bytes, st);
 }
 
@@ -105,11 +109,24 @@ static inline cudaError_t fv_cuda_wait(fv_cuda_tally *k, cudaStream_t st)
     return cudaStreamSynchronize(st);
 }
 
+/* cudaEventSynchronize on an event recorded when the tally stood at `at` (its seq then): the host
+ * waits only if something queued before the event was not waited for, and what was queued after it
+ * stays queued (a frame collected while the next one runs). */
+static inline cudaError_t fv_cuda_fence_wait(fv_cuda_tally *k, cudaEvent_t ev, uint64_t at)
+{
+    k->n.syncs++;
+    if (at > k->waited) {
+        k->n.host_waits++;
+        k->waited = at;
+    }
+    return cudaEventSynchronize(ev);
+}
+
 /* For FV_CUDA_LAUNCH (device/cuda/launch.h): a launch is about to be queued. */
 static inline int fv_cuda_launching(fv_cuda_tally *k)
 {
     k->n.launches++;
-    k->queued = true;
+    fv_cuda_queue(k);
     return 1;
 }
 

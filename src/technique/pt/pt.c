@@ -38,7 +38,17 @@ typedef struct pt_state {
     fv_backend *backend;
     fv_scene_device *dscene;   /* its copy on the backend */
     fv_film_device film[2];    /* per eye: a stereo pair is read back after both ran */
-    fv_buffer counts, counts_host; /* FV_PT_COUNTS per eye, on the device and pinned */
+    fv_buffer counts;          /* FV_PT_COUNTS per eye */
+    /* The frames in flight (pt_submit), oldest first from `head`, each in its staging slot
+     * (device/film_device.h): what collect delivers, and its counters read back (pinned). */
+    struct pt_flight {
+        int eyes;
+        fv_film *films[2];
+        fv_stats *stats;
+        fv_stage_clock t0;
+        fv_buffer counts_host;
+    } flight[FV_FILM_DEVICE_SLOTS];
+    int head, in_flight;
     fv_kit_counters *counters; /* every frame's, kept (fv_kit_counters_reuse) */
 } pt_state;
 
@@ -48,9 +58,11 @@ static void pt_destroy(void *state)
     if (!st) return;
     if (st->backend) {
         fv_scene_device_destroy(st->dscene);
+        /* frames in flight are dropped: nothing queued may outlive the buffers it writes */
+        if (st->in_flight) fv_backend_wait(st->backend, "the pt kernel", NULL);
         for (int e = 0; e < 2; e++) fv_film_device_release(st->backend, &st->film[e]);
         fv_buffer_release(st->backend, &st->counts);
-        fv_pinned_release(st->backend, &st->counts_host);
+        for (int k = 0; k < FV_FILM_DEVICE_SLOTS; k++) fv_pinned_release(st->backend, &st->flight[k].counts_host);
         fv_backend_destroy(st->backend);
     }
     fv_scene_export_destroy(st->flat);
@@ -159,12 +171,17 @@ static void pt_tile(void *ctx, const fv_tile *tile)
     fv_kit_count(j->counters, tile->thread, FV_KIT_NAN, bad);
 }
 
-/* `eyes` eyes of one frame (1, or both of a stereo pair) on a device backend, the scene brought to
- * the frame's time once: every eye's launch queued, then the films' and counters' read-back, then
- * the one wait (on the portable backend each launch runs at once, with progress and cancel). */
-static fv_status pt_render_device(pt_state *st, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+/* Queues `eyes` eyes of one frame (1, or both of a stereo pair) on a device backend, the scene
+ * brought to the frame's time once: every eye's launch, then the films' and counters' read-back
+ * into the next staging slot, then a fence; no host wait (on the portable backend each launch
+ * runs at once, with progress and cancel). A failure or a cancel waits for what was queued and
+ * leaves nothing of this frame in flight. */
+static fv_status pt_submit_device(pt_state *st, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
 {
     fv_backend *b = st->backend;
+    if (st->in_flight >= FV_FILM_DEVICE_SLOTS) return fv_error_set(err, FV_ERR_INTERNAL, "pt: %d frames in flight already", st->in_flight);
+    const int slot = (st->head + st->in_flight) % FV_FILM_DEVICE_SLOTS;
+    struct pt_flight *fl = &st->flight[slot];
     fv_pt_pixel_args a[2];
     fv_film_views host[2];
     size_t n[2];
@@ -180,14 +197,15 @@ static fv_status pt_render_device(pt_state *st, int eyes, const fv_frame *frames
         (s = fv_scene_device_update(st->dscene, fv_scene_export_view(st->flat), err)) != FV_OK)
         return s;
     fv_stage_stop(stats, "scene", t0);
-    const size_t count_bytes = (size_t)eyes * FV_PT_COUNTS * sizeof(uint64_t);
-    if ((s = fv_buffer_ensure(b, &st->counts, count_bytes, "pt's counters", err)) != FV_OK ||
-        (s = fv_pinned_ensure(b, &st->counts_host, count_bytes, "pt's counters", err)) != FV_OK ||
+    const size_t count_bytes = (size_t)eyes * FV_PT_COUNTS * sizeof(uint64_t), count_max = 2 * FV_PT_COUNTS * sizeof(uint64_t);
+    /* room for a pair in every slot at once, so that no later frame allocates */
+    for (int k = 0; k < FV_FILM_DEVICE_SLOTS && s == FV_OK; k++) s = fv_pinned_ensure(b, &st->flight[k].counts_host, count_max, "pt's counters", err);
+    if (s != FV_OK || (s = fv_buffer_ensure(b, &st->counts, count_max, "pt's counters", err)) != FV_OK ||
         (s = fv_backend_clear(b, st->counts.p, 0, count_bytes, "pt's counters", err)) != FV_OK)
         return s;
     uint64_t *counts = st->counts.p;
     t0 = fv_stage_clock_now();
-    fv_backend_mark(b, 0);
+    fv_backend_mark(b, 2 * slot);
     bool done = true;
     for (int e = 0; e < eyes && s == FV_OK && done; e++) {
         const fv_camera *cam = frames[e].camera;
@@ -205,29 +223,65 @@ static fv_status pt_render_device(pt_state *st, int eyes, const fv_frame *frames
         if ((s = fv_film_device_views(b, &st->film[e], &host[e], n[e], &a[e].out, err)) == FV_OK)
             s = fv_backend_launch_progress(b, &fv_pt_pixel_kernel, cam->width, cam->height, &a[e], counts + e * FV_PT_COUNTS, &lp, &done, err);
     }
-    fv_backend_mark(b, 1);
-    for (int e = 0; e < eyes && s == FV_OK && done; e++) s = fv_film_device_download(b, &st->film[e], &host[e], n[e], err);
-    if (s == FV_OK) s = fv_backend_download(b, st->counts_host.p, st->counts.p, count_bytes, "pt's counters", err);
-    /* the wait even after a failure: nothing queued may write into a film the caller has back */
-    const fv_status sw = fv_backend_wait(b, "the pt kernel", err);
-    if (s == FV_OK) s = sw;
-    if (s != FV_OK) return s;
-    if (!done) return fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
-    for (int e = 0; e < eyes; e++) fv_film_device_deliver(b, &st->film[e], &host[e], n[e]);
-    fv_stage_stop(stats, "trace", t0);
-    const uint64_t *c = st->counts_host.p;
-    uint64_t rays = 0, bad = 0;
-    for (int e = 0; e < eyes; e++) rays += c[e * FV_PT_COUNTS + FV_PT_COUNT_RAYS], bad += c[e * FV_PT_COUNTS + FV_PT_COUNT_NAN];
-    fv_stats_add_count(stats, "rays", (double)rays);
-    fv_stats_add_count(stats, "nan_samples", (double)bad);
+    fv_backend_mark(b, 2 * slot + 1);
+    for (int e = 0; e < eyes && s == FV_OK && done; e++) s = fv_film_device_download_film(b, &st->film[e], slot, films[e], err);
+    if (s == FV_OK) s = fv_backend_download(b, fl->counts_host.p, st->counts.p, count_bytes, "pt's counters", err);
+    if (s != FV_OK || !done) {
+        /* the wait even after a failure: nothing queued may write into a film the caller has back */
+        fv_backend_wait(b, "the pt kernel", NULL);
+        return s != FV_OK ? s : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    }
+    fv_backend_fence(b, slot);
+    fl->eyes = eyes;
+    fl->films[0] = films[0], fl->films[1] = eyes == 2 ? films[1] : NULL;
+    fl->stats = stats;
+    fl->t0 = t0;
+    st->in_flight++;
     if (st->device == FV_DEVICE_CUDA) {
-        fv_stats_add_ms(stats, "kernel", fv_backend_elapsed_ms(b, 0, 1));
-        fv_stats_add_count(stats, "host_syncs", 1.0);
         fv_backend_calls after;
         fv_backend_calls_get(b, &after);
         fv_backend_calls_report(stats, &before, &after);
     }
     return FV_OK;
+}
+
+/* The oldest frame in flight: its fence waited for, its films and counters delivered. */
+static fv_status pt_collect_device(pt_state *st, fv_error *err)
+{
+    fv_backend *b = st->backend;
+    if (!st->in_flight) return fv_error_set(err, FV_ERR_INTERNAL, "pt: no frame in flight");
+    const int slot = st->head;
+    struct pt_flight *fl = &st->flight[slot];
+    st->head = (st->head + 1) % FV_FILM_DEVICE_SLOTS;
+    st->in_flight--;
+    fv_stats *stats = fl->stats;
+    fv_backend_calls before, after;
+    fv_backend_calls_get(b, &before);
+    const fv_status s = fv_backend_wait_fence(b, slot, "the pt kernel", err);
+    fv_backend_calls_get(b, &after);
+    if (s != FV_OK) return s;
+    uint64_t rays = 0, bad = 0;
+    const uint64_t *c = fl->counts_host.p;
+    for (int e = 0; e < fl->eyes; e++) {
+        fv_film_device_deliver_film(b, &st->film[e], slot, fl->films[e]);
+        rays += c[e * FV_PT_COUNTS + FV_PT_COUNT_RAYS], bad += c[e * FV_PT_COUNTS + FV_PT_COUNT_NAN];
+    }
+    fv_stage_stop(stats, "trace", fl->t0);
+    fv_stats_add_count(stats, "rays", (double)rays);
+    fv_stats_add_count(stats, "nan_samples", (double)bad);
+    if (st->device == FV_DEVICE_CUDA) {
+        fv_stats_add_ms(stats, "kernel", fv_backend_elapsed_ms(b, 2 * slot, 2 * slot + 1));
+        fv_stats_add_count(stats, "host_syncs", 1.0);
+        fv_backend_calls_report(stats, &before, &after);
+    }
+    return FV_OK;
+}
+
+/* A device frame rendered now: submitted, then collected. */
+static fv_status pt_render_device(pt_state *st, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    const fv_status s = pt_submit_device(st, eyes, frames, films, stats, err);
+    return s == FV_OK ? pt_collect_device(st, err) : s;
 }
 
 static fv_status pt_render(void *state, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
@@ -266,6 +320,21 @@ static fv_status pt_render_pair(void *state, const fv_frame *frames, fv_film *co
     return s == FV_OK ? pt_render(state, &frames[1], films[1], stats, err) : s;
 }
 
+/* A frame queued (docs/gpu.md, "Frames in flight"): on a device without a host wait; on the CPU
+ * rendered now, collect then only hands it over. */
+static fv_status pt_submit(void *state, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    pt_state *st = state;
+    if (st->device != FV_DEVICE_CPU) return pt_submit_device(st, eyes, frames, films, stats, err);
+    return eyes == 2 ? pt_render_pair(state, frames, films, stats, err) : pt_render(state, frames, films[0], stats, err);
+}
+
+static fv_status pt_collect(void *state, fv_error *err)
+{
+    pt_state *st = state;
+    return st->device != FV_DEVICE_CPU ? pt_collect_device(st, err) : FV_OK;
+}
+
 /* transport/path.c reads the first three (fv_path_read_opts), this file the blocks: 2^20 samples
  * are 16384 blocks of FV_SAMPLE_BLOCK, the most any spp makes. */
 static const fv_param_info k_params[] = {
@@ -290,6 +359,8 @@ const fv_technique_class fv_technique_pt = {
     .devices = (1u << FV_DEVICE_PORTABLE) | (1u << FV_DEVICE_CUDA),
     .render = pt_render,
     .render_pair = pt_render_pair,
+    .submit = pt_submit,
+    .collect = pt_collect,
     .destroy = pt_destroy,
     /* furnace: 1 - 0.5^9 with 8 vertices, Russian roulette unbiased */
     .test_params = "spp=64",

@@ -129,6 +129,21 @@ static fv_status render_pair(void *state, const fv_frame *frames, fv_film *const
     return s == FV_OK ? render(state, &frames[1], films[1], stats, err) : s;
 }
 
+/* A frame queued (docs/gpu.md, "Frames in flight"): on a device without a host wait; on the CPU
+ * rendered now, collect then only hands it over. */
+static fv_status submit(void *state, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    family_state *st = state;
+    if (st->dev) return fv_sdf_device_submit(st->dev, eyes, frames, films, stats, err);
+    return eyes == 2 ? render_pair(state, frames, films, stats, err) : render(state, frames, films[0], stats, err);
+}
+
+static fv_status collect(void *state, fv_error *err)
+{
+    family_state *st = state;
+    return st->dev ? fv_sdf_device_collect(st->dev, err) : FV_OK;
+}
+
 static void destroy(void *state)
 {
     family_state *st = state;
@@ -222,7 +237,7 @@ static const fv_param_info k_fipr_params[] = {
 
 #define SDF_CLASS(id, nm, sum, base, table, fn, fn_on, devs, fov, warmup)                                             \
     const fv_technique_class id = {.name = nm, .summary = sum, .family = FV_FAMILY_SDF, .baseline = base, FV_CLASS_PARAMS(table), \
-                                   .main = SDF_STEPS, .create = fn, .create_on = fn_on, .devices = devs, .render = render, .render_pair = render_pair, .destroy = destroy, .sdf_only = true, \
+                                   .main = SDF_STEPS, .create = fn, .create_on = fn_on, .devices = devs, .render = render, .render_pair = render_pair, .submit = submit, .collect = collect, .destroy = destroy, .sdf_only = true, \
                                    .test_params = "spp=1", .furnace_radiance = 1.0, .furnace_tolerance = 0.01, .spp_param = "spp", \
                                    .foveated = fov, .warmup_frames = warmup, .bench_scene = "sdf-temple"}
 

@@ -48,7 +48,19 @@ struct fv_sdf_device {
     bool world_sent; /* the mirrors hold world (cuda) */
     fv_mirror ops, objs, lights, mats;
     fv_film_device film[2];        /* per eye: a stereo pair is read back after both ran */
-    fv_buffer counts, counts_host; /* the frame's counters (counts_of), on the device and pinned */
+    fv_buffer counts;              /* the frame's counters (counts_of) */
+    /* The frames in flight (fv_sdf_device_submit), oldest first from `head`, each in its staging
+     * slot (device/film_device.h): what collect delivers, and its counters read back (pinned).
+     * A pair of two sizes is rendered at submit (rendered: collect only hands it over). */
+    struct flight {
+        int eyes;
+        bool rendered;
+        fv_film *films[2];
+        fv_stats *stats;
+        double t0, blur_ms;
+        fv_buffer counts_host;
+    } flight[FV_FILM_DEVICE_SLOTS];
+    int head, in_flight;
     /* ipr and fipr: the pyramid's buffers, the eyes' in turn (the queue orders eye 1's passes after
      * eye 0's), and fipr's per eye */
     fv_buffer depth[FV_PYRAMID_MAX_LEVELS], steps[FV_PYRAMID_MAX_LEVELS], need, edge, mask, vis;
@@ -80,6 +92,8 @@ void fv_sdf_device_destroy(fv_sdf_device *d)
 {
     if (!d) return;
     fv_backend *b = d->b;
+    /* frames in flight are dropped: nothing queued may outlive the buffers it writes */
+    if (d->in_flight) fv_backend_wait(b, "the sphere tracers' kernels", NULL);
     fv_mirror_release(b, &d->ops);
     fv_mirror_release(b, &d->objs);
     fv_mirror_release(b, &d->lights);
@@ -90,7 +104,7 @@ void fv_sdf_device_destroy(fv_sdf_device *d)
         fv_buffer_release(b, &d->hist[e].stamp);
     }
     fv_buffer_release(b, &d->counts);
-    fv_pinned_release(b, &d->counts_host);
+    for (int k = 0; k < FV_FILM_DEVICE_SLOTS; k++) fv_pinned_release(b, &d->flight[k].counts_host);
     for (int i = 0; i < FV_PYRAMID_MAX_LEVELS; i++) {
         fv_buffer_release(b, &d->depth[i]);
         fv_buffer_release(b, &d->steps[i]);
@@ -400,17 +414,21 @@ static fv_status eye_passes(fv_sdf_device *d, const fv_frame *frame, const fv_ks
     return s;
 }
 
-/* Renders `eyes` eyes of one frame (1, or a stereo pair of one size): the world brought to the
- * frame's time once, every eye's passes queued, then the films' and counters' read-back into pinned
- * memory, then the one wait (on the portable backend each launch runs at once, with progress and
- * cancel, and nothing is copied). */
-static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+/* Queues `eyes` eyes of one frame (1, or a stereo pair of one size): the world brought to the
+ * frame's time once, every eye's passes, then the films' and counters' read-back into the next
+ * staging slot's pinned memory, then a fence; no host wait (on the portable backend each launch
+ * runs at once, with progress and cancel, and nothing is copied). A failure or a cancel waits for
+ * what was queued and leaves nothing of this frame in flight. */
+static fv_status submit_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
 {
     fv_backend *b = d->b;
     const fv_sdf_opts *o = &d->o;
     const bool pyramid = o->method == FV_SDF_IPR || o->method == FV_SDF_FIPR;
     const bool blurred = o->method == FV_SDF_FIPR && o->blur;
     const bool portable = fv_backend_device(b) == FV_DEVICE_PORTABLE;
+    if (d->in_flight >= FV_FILM_DEVICE_SLOTS) return fv_error_set(err, FV_ERR_INTERNAL, "sphere tracers: %d frames in flight already", d->in_flight);
+    const int slot = (d->head + d->in_flight) % FV_FILM_DEVICE_SLOTS;
+    struct flight *fl = &d->flight[slot];
     fv_ksdf_frame f[2];
     memset(f, 0, sizeof f);
     fv_status s;
@@ -431,10 +449,12 @@ static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
     memset(&bt, 0, sizeof bt);
     const int nslots = slots_of(o);
     const size_t count_bytes = (size_t)nslots * FV_SDF_COUNTS * sizeof(uint64_t);
+    /* every staging slot's counters now, so that no later frame allocates */
+    for (int i = 0; i < FV_FILM_DEVICE_SLOTS; i++)
+        if ((s = fv_pinned_ensure(b, &d->flight[i].counts_host, count_bytes, "the sphere tracers' counters", err)) != FV_OK) return s;
     if ((s = world_on_device(d, &dw, err)) != FV_OK || (pyramid && (s = pyramid_on_device(d, w, h, S, &k, err)) != FV_OK) ||
         (blurred && (s = blur_on_device(d, w, h, o->blur_sigma, &bt, err)) != FV_OK) ||
         (s = fv_buffer_ensure(b, &d->counts, count_bytes, "the sphere tracers' counters", err)) != FV_OK ||
-        (s = fv_pinned_ensure(b, &d->counts_host, count_bytes, "the sphere tracers' counters", err)) != FV_OK ||
         (s = fv_backend_clear(b, d->counts.p, 0, count_bytes, "the sphere tracers' counters", err)) != FV_OK)
         return s;
     fv_film_views host[2], out[2];
@@ -449,26 +469,26 @@ static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
     }
     double blur_ms = 0.0;
     bool done = true;
-    fv_backend_mark(b, 0);
+    fv_backend_mark(b, 2 * slot);
     for (int e = 0; e < eyes && s == FV_OK && done; e++)
         s = eye_passes(d, &frames[e], &dw, &f[e], &k, &bt, &out[e], d->counts.p, &blur_ms, &done, err);
-    fv_backend_mark(b, 1);
-    for (int e = 0; e < eyes && s == FV_OK && done; e++) s = fv_film_device_download(b, &d->film[e], &host[e], np, err);
-    if (s == FV_OK) s = fv_backend_download(b, d->counts_host.p, d->counts.p, count_bytes, "the sphere tracers' counters", err);
-    /* the wait even after a failure: nothing queued may write into a film the caller has back */
-    const fv_status sw = fv_backend_wait(b, "the sphere tracers' kernels", err);
-    if (s == FV_OK) s = sw;
-    if (s != FV_OK) return s;
-    if (!done) return fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
-    for (int e = 0; e < eyes; e++) fv_film_device_deliver(b, &d->film[e], &host[e], np);
-    fv_stats_add_ms(stats, "target", fv_time_ms() - t0 - (portable ? blur_ms : 0.0));
-    if (blurred && portable) fv_stats_add_ms(stats, "blur", blur_ms);
-    fv_ksdf_pyr_counts c;
-    counts_of(o, d->counts_host.p, &c);
-    report(o, &c, (double)w * h * o->spp * eyes, stats);
+    fv_backend_mark(b, 2 * slot + 1);
+    for (int e = 0; e < eyes && s == FV_OK && done; e++) s = fv_film_device_download_film(b, &d->film[e], slot, films[e], err);
+    if (s == FV_OK) s = fv_backend_download(b, fl->counts_host.p, d->counts.p, count_bytes, "the sphere tracers' counters", err);
+    if (s != FV_OK || !done) {
+        /* the wait even after a failure: nothing queued may write into a film the caller has back */
+        fv_backend_wait(b, "the sphere tracers' kernels", NULL);
+        return s != FV_OK ? s : fv_error_set(err, FV_ERR_CANCELLED, "render cancelled");
+    }
+    fv_backend_fence(b, slot);
+    fl->eyes = eyes;
+    fl->rendered = false;
+    fl->films[0] = films[0], fl->films[1] = eyes == 2 ? films[1] : NULL;
+    fl->stats = stats;
+    fl->t0 = t0;
+    fl->blur_ms = blur_ms;
+    d->in_flight++;
     if (!portable) {
-        fv_stats_add_ms(stats, "kernel", fv_backend_elapsed_ms(b, 0, 1));
-        fv_stats_add_count(stats, "host_syncs", 1.0);
         fv_backend_calls after;
         fv_backend_calls_get(b, &after);
         fv_backend_calls_report(stats, &before, &after);
@@ -476,17 +496,78 @@ static fv_status render_eyes(fv_sdf_device *d, int eyes, const fv_frame *frames,
     return FV_OK;
 }
 
+/* A frame in flight in `slot`: its fence waited for (and with it everything queued before), its
+ * films and counters delivered into what it was submitted with. */
+static fv_status finish(fv_sdf_device *d, int slot, fv_error *err)
+{
+    fv_backend *b = d->b;
+    const fv_sdf_opts *o = &d->o;
+    const bool blurred = o->method == FV_SDF_FIPR && o->blur;
+    const bool portable = fv_backend_device(b) == FV_DEVICE_PORTABLE;
+    struct flight *fl = &d->flight[slot];
+    fv_stats *stats = fl->stats;
+    fv_backend_calls before, after;
+    fv_backend_calls_get(b, &before);
+    const fv_status s = fv_backend_wait_fence(b, slot, "the sphere tracers' kernels", err);
+    fv_backend_calls_get(b, &after);
+    if (s != FV_OK) return s;
+    const int w = fv_film_width(fl->films[0]), h = fv_film_height(fl->films[0]);
+    for (int e = 0; e < fl->eyes; e++) fv_film_device_deliver_film(b, &d->film[e], slot, fl->films[e]);
+    fv_stats_add_ms(stats, "target", fv_time_ms() - fl->t0 - (portable ? fl->blur_ms : 0.0));
+    if (blurred && portable) fv_stats_add_ms(stats, "blur", fl->blur_ms);
+    fv_ksdf_pyr_counts c;
+    counts_of(o, fl->counts_host.p, &c);
+    report(o, &c, (double)w * h * o->spp * fl->eyes, stats);
+    if (!portable) {
+        fv_stats_add_ms(stats, "kernel", fv_backend_elapsed_ms(b, 2 * slot, 2 * slot + 1));
+        fv_stats_add_count(stats, "host_syncs", 1.0);
+        fv_backend_calls_report(stats, &before, &after);
+    }
+    return FV_OK;
+}
+
+fv_status fv_sdf_device_collect(fv_sdf_device *d, fv_error *err)
+{
+    if (!d->in_flight) return fv_error_set(err, FV_ERR_INTERNAL, "sphere tracers: no frame in flight");
+    const int slot = d->head;
+    d->head = (d->head + 1) % FV_FILM_DEVICE_SLOTS;
+    d->in_flight--;
+    return d->flight[slot].rendered ? FV_OK : finish(d, slot, err);
+}
+
+/* The newest frame in flight finished now and taken back: its slot is free again. */
+static fv_status finish_newest(fv_sdf_device *d, fv_error *err)
+{
+    const fv_status s = finish(d, (d->head + d->in_flight - 1) % FV_FILM_DEVICE_SLOTS, err);
+    d->in_flight--;
+    return s;
+}
+
+fv_status fv_sdf_device_submit(fv_sdf_device *d, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    if (eyes == 1 || (fv_film_width(films[0]) == fv_film_width(films[1]) && fv_film_height(films[0]) == fv_film_height(films[1])))
+        return submit_eyes(d, eyes, frames, films, stats, err);
+    /* The pair shares the pyramid's buffers: eyes of different sizes go one at a time, now, each
+     * through the slot this frame takes; the frame is then in flight already rendered, so that
+     * the one before it is still collected first. */
+    fv_status s = FV_OK;
+    for (int e = 0; e < 2 && s == FV_OK; e++)
+        if ((s = submit_eyes(d, 1, &frames[e], &films[e], stats, err)) == FV_OK) s = finish_newest(d, err);
+    if (s != FV_OK) return s;
+    struct flight *fl = &d->flight[(d->head + d->in_flight) % FV_FILM_DEVICE_SLOTS];
+    fl->rendered = true;
+    d->in_flight++;
+    return FV_OK;
+}
+
 fv_status fv_sdf_device_render(fv_sdf_device *d, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
 {
-    return render_eyes(d, 1, frame, &film, stats, err);
+    const fv_status s = submit_eyes(d, 1, frame, &film, stats, err);
+    return s == FV_OK ? fv_sdf_device_collect(d, err) : s;
 }
 
 fv_status fv_sdf_device_render_pair(fv_sdf_device *d, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
 {
-    /* the pair shares the pyramid's buffers: eyes of different sizes go one at a time */
-    if (fv_film_width(films[0]) != fv_film_width(films[1]) || fv_film_height(films[0]) != fv_film_height(films[1])) {
-        fv_status s = render_eyes(d, 1, &frames[0], &films[0], stats, err);
-        return s == FV_OK ? render_eyes(d, 1, &frames[1], &films[1], stats, err) : s;
-    }
-    return render_eyes(d, 2, frames, films, stats, err);
+    const fv_status s = fv_sdf_device_submit(d, 2, frames, films, stats, err);
+    return s == FV_OK ? fv_sdf_device_collect(d, err) : s;
 }

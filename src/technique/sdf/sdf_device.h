@@ -31,6 +31,11 @@ fv_status fv_sdf_device_render(fv_sdf_device *d, const fv_frame *frame, fv_film 
  * class's render_pair): the same images and counters as two calls of fv_sdf_device_render, with
  * one host wait on CUDA ("host_syncs" 1 for the pair). */
 fv_status fv_sdf_device_render_pair(fv_sdf_device *d, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err);
+/* The technique class's submit and collect (technique/class.h): a frame of `eyes` eyes queued with
+ * its read-back into the next of two staging slots, no host wait; the oldest one waited for and
+ * delivered. render and render_pair are submit then collect. */
+fv_status fv_sdf_device_submit(fv_sdf_device *d, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err);
+fv_status fv_sdf_device_collect(fv_sdf_device *d, fv_error *err);
 void fv_sdf_device_destroy(fv_sdf_device *d);
 
 #endif

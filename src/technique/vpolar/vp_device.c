@@ -29,11 +29,22 @@ enum { ST_TRACE = 0, ST_DENOISE, ST_MIP, ST_MAP, ST_BLUR, ST_COUNT };
 #define MARKS_PER_EYE (ST_COUNT + 1)
 #define ALIGN 256 /* bytes: each array carved from a buffer starts on this */
 
+/* A frame in flight (fv_vp_device_submit): its eyes, their frames (the scalars eye_result reads)
+ * and films, and what its submit asked of the backend; in staging slot `slot`. */
+typedef struct flight {
+    int eyes;
+    fv_vp_device_eye *eye[2];
+    fv_vp_device_frame f[2];
+    fv_film_views out[2];
+} flight;
+
 struct fv_vp_device {
     const fv_scene *scene;
     fv_backend *b;
     fv_scene_export *flat;   /* the flat scene at the frame's time */
     fv_scene_device *dscene; /* its copy on b */
+    flight flight[FV_FILM_DEVICE_SLOTS]; /* the frames in flight, oldest first from head */
+    int head, in_flight;
 };
 
 /* SVGF on the device: filter/ksvgf.h's state with device pointers (the frame's inputs set per
@@ -61,7 +72,7 @@ struct fv_vp_device_eye {
     fv_mirror col_h, shape, blur_off, blur_k;
     fv_vp_gaze_tables tables; /* the on-screen mask and the radial tables */
     fv_buffer counts;         /* FV_VP_COUNTS */
-    fv_buffer host;           /* pinned: the counts, then SVGF's rows' counters */
+    fv_buffer host[FV_FILM_DEVICE_SLOTS]; /* pinned, a staging slot each: the counts, then SVGF's rows' counters */
     dev_svgf svgf;
     bool have_image;          /* a frame was traced since the grid was made */
 };
@@ -111,7 +122,7 @@ void fv_vp_device_eye_destroy(fv_vp_device_eye *e)
 {
     if (!e) return;
     fv_backend *b = e->d->b;
-    /* nothing queued may outlive its buffers (each frame ends with its wait: this finds none) */
+    /* nothing queued may outlive its buffers (frames in flight are dropped) */
     fv_backend_wait(b, "the Visual-Polar frame", NULL);
     fv_buffer_release(b, &e->grid);
     fv_buffer_release(b, &e->sigma);
@@ -123,7 +134,7 @@ void fv_vp_device_eye_destroy(fv_vp_device_eye *e)
     for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) fv_mirror_release(b, m[i]);
     fv_vp_gaze_tables_release(b, &e->tables);
     fv_buffer_release(b, &e->counts);
-    fv_pinned_release(b, &e->host);
+    for (int k = 0; k < FV_FILM_DEVICE_SLOTS; k++) fv_pinned_release(b, &e->host[k]);
     fv_buffer_release(b, &e->svgf.mem);
     free(e);
 }
@@ -336,7 +347,7 @@ static fv_status svgf_queue(fv_vp_device_eye *e, const fv_vp_device_frame *f, co
 
 /* Queues one eye's frame, marks from slot m0; nothing waits. *done false: the trace was cancelled
  * (portable) and nothing after it was queued. */
-static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, const fv_film_views *out, int m0, bool *done, fv_error *err)
+static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, const fv_film_views *out, int slot, int m0, bool *done, fv_error *err)
 {
     fv_backend *b = e->d->b;
     const int gw = f->trace.space.gw, gh = f->trace.space.gh, sw = f->trace.space.sw, sh = f->trace.space.sh;
@@ -362,7 +373,9 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
         (s = fv_buffer_ensure(b, &e->sigma, ns * sizeof(float), "the blur's sigma", err)) != FV_OK ||
         (f->blur && (s = fv_buffer_ensure(b, &e->blur_tmp, 3 * ns * sizeof(float), "the blur's image", err)) != FV_OK) ||
         (s = fv_buffer_ensure(b, &e->counts, counts_bytes, "the trace's counters", err)) != FV_OK ||
-        (s = fv_pinned_ensure(b, &e->host, counts_bytes + rows_bytes, "the frame's counters", err)) != FV_OK ||
+        /* every staging slot's now, so that no later frame allocates */
+        (s = fv_pinned_ensure(b, &e->host[0], counts_bytes + rows_bytes, "the frame's counters", err)) != FV_OK ||
+        (s = fv_pinned_ensure(b, &e->host[1], counts_bytes + rows_bytes, "the frame's counters", err)) != FV_OK ||
         (s = fv_film_device_views(b, &e->film, out, ns, &dv, err)) != FV_OK ||
         (s = fv_backend_clear(b, e->counts.p, 0, counts_bytes, "the trace's counters", err)) != FV_OK)
         return s;
@@ -434,8 +447,8 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
     fv_vp_gaze_tables_advance(&e->tables); /* the next frame's reprojection reads this frame's table */
 
     /* the read-back, into pinned memory */
-    char *host = e->host.p;
-    if ((s = fv_film_device_download(b, &e->film, out, ns, err)) != FV_OK ||
+    char *host = e->host[slot].p;
+    if ((s = fv_film_device_download(b, &e->film, slot, out, ns, err)) != FV_OK ||
         (s = fv_backend_download(b, host, e->counts.p, counts_bytes, "the trace's counters", err)) != FV_OK ||
         (f->denoise && (s = fv_backend_download(b, host + counts_bytes, (char *)e->svgf.mem.p + e->svgf.rows_at, rows_bytes, "SVGF's counters", err)) != FV_OK))
         return s;
@@ -443,17 +456,17 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
 }
 
 /* One eye's result from what was read back (after the wait). */
-static void eye_result(fv_vp_device_eye *e, const fv_vp_device_frame *f, const fv_film_views *out, int m0, fv_vp_device_result *r)
+static void eye_result(fv_vp_device_eye *e, const fv_vp_device_frame *f, const fv_film_views *out, int slot, int m0, fv_vp_device_result *r)
 {
     fv_backend *b = e->d->b;
     const size_t ns = (size_t)f->trace.space.sw * (size_t)f->trace.space.sh;
-    fv_film_device_deliver(b, &e->film, out, ns);
+    fv_film_device_deliver(b, &e->film, slot, out, ns);
     uint64_t c[FV_VP_COUNTS];
-    memcpy(c, e->host.p, sizeof c);
+    memcpy(c, e->host[slot].p, sizeof c);
     r->rays = c[FV_VP_COUNT_RAYS], r->paths = c[FV_VP_COUNT_PATHS], r->nan_paths = c[FV_VP_COUNT_NAN];
     if (f->denoise) {
         const size_t h = (size_t)f->grid.h;
-        const char *rows = (const char *)e->host.p + sizeof c;
+        const char *rows = (const char *)e->host[slot].p + sizeof c;
         double mean_history;
         fv_ksvgf_sum_rows((int)h, (const long *)rows, (const long *)(rows + h * 8), (const long *)(rows + 2 * h * 8), (const double *)(rows + 3 * h * 8),
                           &r->history_fraction, &mean_history);
@@ -462,11 +475,17 @@ static void eye_result(fv_vp_device_eye *e, const fv_vp_device_frame *f, const f
     r->kernel_ms = fv_backend_elapsed_ms(b, m0 + ST_TRACE, m0 + ST_COUNT);
 }
 
-fv_status fv_vp_device_frames(fv_vp_device *d, fv_vp_device_eye *const *eye, int eyes, const fv_vp_device_frame *f, const fv_film_views *out,
-                              fv_vp_device_result *res, fv_backend_calls *calls, fv_error *err)
+/* The marks of eye e of the frame in staging slot `slot`. */
+static int marks_of(int slot, int e) { return (slot * 2 + e) * MARKS_PER_EYE; }
+
+fv_status fv_vp_device_submit(fv_vp_device *d, fv_vp_device_eye *const *eye, int eyes, const fv_vp_device_frame *f, const fv_film_views *out,
+                              fv_vp_device_result *res, fv_backend_calls *calls, bool *in_flight, fv_error *err)
 {
+    *in_flight = false;
+    memset(calls, 0, sizeof *calls);
     if (eyes < 1 || eyes > 2) return fv_error_set(err, FV_ERR_INTERNAL, "Visual-Polar device frames for %d eyes", eyes);
     if (eyes == 2 && eye[0] == eye[1]) return fv_error_set(err, FV_ERR_INTERNAL, "a stereo pair's eyes share their buffers");
+    if (d->in_flight >= FV_FILM_DEVICE_SLOTS) return fv_error_set(err, FV_ERR_INTERNAL, "Visual-Polar: %d frames in flight already", d->in_flight);
     fv_status s;
     for (int e = 0; e < eyes; e++) {
         memset(&res[e], 0, sizeof res[e]);
@@ -474,6 +493,7 @@ fv_status fv_vp_device_frames(fv_vp_device *d, fv_vp_device_eye *const *eye, int
         if ((s = check_frame(&f[e], err)) != FV_OK) return s;
     }
     fv_backend *b = d->b;
+    const int slot = (d->head + d->in_flight) % FV_FILM_DEVICE_SLOTS;
     fv_backend_calls before;
     fv_backend_calls_get(b, &before);
     fv_backend_set_threads(b, f[0].threads);
@@ -483,20 +503,55 @@ fv_status fv_vp_device_frames(fv_vp_device *d, fv_vp_device_eye *const *eye, int
         return s;
     bool done = true, queued[2] = {false, false};
     for (int e = 0; e < eyes && s == FV_OK && done; e++)
-        if ((s = queue_eye(eye[e], &f[e], &out[e], e * MARKS_PER_EYE, &done, err)) == FV_OK) queued[e] = done;
-    /* the wait even after a failure: nothing queued may write into a film the caller has back */
-    const fv_status sw = fv_backend_wait(b, "the Visual-Polar frame", s == FV_OK ? err : NULL);
-    if (s == FV_OK) s = sw;
+        if ((s = queue_eye(eye[e], &f[e], &out[e], slot, marks_of(slot, e), &done, err)) == FV_OK) queued[e] = done;
+    if (s == FV_OK && done) {
+        /* every eye queued whole: in flight, collected later */
+        fv_backend_fence(b, slot);
+        flight *fl = &d->flight[slot];
+        fl->eyes = eyes;
+        for (int e = 0; e < eyes; e++) fl->eye[e] = eye[e], fl->f[e] = f[e], fl->out[e] = out[e];
+        d->in_flight++;
+        *in_flight = true;
+    } else {
+        /* a failure or a cancel: waited for now, nothing of this frame left in flight (the wait
+         * even after a failure: nothing queued may write into a film the caller has back) */
+        const fv_status sw = fv_backend_wait(b, "the Visual-Polar frame", s == FV_OK ? err : NULL);
+        if (s == FV_OK) s = sw;
+        /* an eye queued whole has run (its device history moved on), even when the next one's
+         * trace was cancelled */
+        for (int e = 0; e < eyes && s == FV_OK; e++)
+            if (queued[e]) {
+                eye_result(eye[e], &f[e], &out[e], slot, marks_of(slot, e), &res[e]);
+                res[e].done = true;
+            }
+    }
     fv_backend_calls after;
     fv_backend_calls_get(b, &after);
     fv_backend_calls_diff(&after, &before, calls);
-    if (s != FV_OK) return s;
-    /* an eye queued whole has run (its device history moved on), even when the next one's trace
-     * was cancelled */
-    for (int e = 0; e < eyes; e++)
-        if (queued[e]) {
-            eye_result(eye[e], &f[e], &out[e], e * MARKS_PER_EYE, &res[e]);
-            res[e].done = true;
-        }
-    return FV_OK;
+    return s;
 }
+
+fv_status fv_vp_device_collect(fv_vp_device *d, fv_vp_device_result *res, fv_backend_calls *calls, fv_error *err)
+{
+    memset(calls, 0, sizeof *calls);
+    if (!d->in_flight) return fv_error_set(err, FV_ERR_INTERNAL, "Visual-Polar: no frame in flight");
+    fv_backend *b = d->b;
+    const int slot = d->head;
+    const flight *fl = &d->flight[slot];
+    d->head = (d->head + 1) % FV_FILM_DEVICE_SLOTS;
+    d->in_flight--;
+    fv_backend_calls before, after;
+    fv_backend_calls_get(b, &before);
+    const fv_status s = fv_backend_wait_fence(b, slot, "the Visual-Polar frame", err);
+    fv_backend_calls_get(b, &after);
+    fv_backend_calls_diff(&after, &before, calls);
+    for (int e = 0; e < fl->eyes; e++) {
+        memset(&res[e], 0, sizeof res[e]);
+        if (s != FV_OK) continue;
+        eye_result(fl->eye[e], &fl->f[e], &fl->out[e], slot, marks_of(slot, e), &res[e]);
+        res[e].done = true;
+    }
+    return s;
+}
+
+int fv_vp_device_in_flight(const fv_vp_device *d) { return d->in_flight; }

@@ -105,11 +105,18 @@ typedef struct fv_vp_device_result {
                                   (portable), and nothing of it after the trace ran */
 } fv_vp_device_result;
 
-/* Renders `eyes` frames (1, or 2: a stereo pair; an eye, frame, film and result each, the eyes
- * distinct and on d) into the films (host memory: colour and the auxiliary buffers that are set):
- * the scene brought to the frame's time once, every eye queued, then the one host wait. *calls
- * receives what the frames asked of the backend. */
-fv_status fv_vp_device_frames(fv_vp_device *d, fv_vp_device_eye *const *eye, int eyes, const fv_vp_device_frame *f, const fv_film_views *out,
-                              fv_vp_device_result *res, fv_backend_calls *calls, fv_error *err);
+/* Queues `eyes` frames (1, or 2: a stereo pair; an eye, frame, film and result each, the eyes
+ * distinct and on d) with their read-back into the next of two staging slots (device/film_device.h),
+ * the scene brought to the frame's time once, and no host wait: *in_flight true, and
+ * fv_vp_device_collect delivers them into the films (host memory: colour and the auxiliary buffers
+ * that are set). After a cancel (portable) or a failure the frame is waited for at once and not in
+ * flight: res then holds the eyes that ran (done). *calls receives what the submit asked of the
+ * backend. */
+fv_status fv_vp_device_submit(fv_vp_device *d, fv_vp_device_eye *const *eye, int eyes, const fv_vp_device_frame *f, const fv_film_views *out,
+                              fv_vp_device_result *res, fv_backend_calls *calls, bool *in_flight, fv_error *err);
+/* The oldest frame in flight: waited for (its fence: a frame queued after it runs on), each eye's
+ * film and result delivered (res: as many as it had eyes); *calls: what the collect asked. */
+fv_status fv_vp_device_collect(fv_vp_device *d, fv_vp_device_result *res, fv_backend_calls *calls, fv_error *err);
+int fv_vp_device_in_flight(const fv_vp_device *d);
 
 #endif

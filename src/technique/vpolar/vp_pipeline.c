@@ -32,6 +32,13 @@ struct fv_vp_pipeline {
     fv_vp_opts o;
     fv_vp_device *dev;      /* NULL: the CPU's own stages; else the method's device (not owned) */
     fv_vp_device_eye *deye; /* this pipeline's buffers and history there */
+    /* its frames submitted on the device and not yet collected (fv_vp_pipeline_submit), oldest
+     * first from pend_head: where their stats go and what they are reported with */
+    struct pending {
+        fv_stats *stats;
+        double grid_samples, pixels;
+    } pend[2];
+    int pend_head, pend_count;
     bool fresh;             /* setup made a new grid: the device's next frame starts it afresh */
     int sw, sh;             /* screen size the buffers are for, 0 before the first frame */
     double ppd;
@@ -485,26 +492,41 @@ static fv_status device_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
     return FV_OK;
 }
 
-static fv_status device_finish(fv_vp_pipeline *p, const fv_frame *frame, fv_stats *stats, const fv_vp_trace_job *job, const fv_space_view *view,
-                               const fv_vp_device_result *res, fv_kit_progress *prog, fv_error *err)
+/* A device frame's results as stats, the pipeline's figures (grid samples, screen pixels) those it
+ * was submitted with. */
+static void device_stats(fv_stats *stats, const fv_vp_device_result *res, double grid_samples, double pixels, bool denoise, bool cuda)
 {
     const fv_vp_device_result r = *res;
     static const char *const stage[5] = {"trace", "denoise", "mip", "map", "blur"};
     for (int i = 0; i < 5; i++) fv_stats_add_ms(stats, stage[i], r.stage_ms[i]);
-    if (fv_vp_device_kind(p->dev) == FV_DEVICE_CUDA) fv_stats_add_ms(stats, "kernel", r.kernel_ms);
+    if (cuda) fv_stats_add_ms(stats, "kernel", r.kernel_ms);
     fv_stats_add_count(stats, "rays", (double)r.rays);
     fv_stats_add_count(stats, "samples", (double)r.paths);
-    fv_stats_add_count(stats, "grid_samples", (double)fv_space_sample_count(p->space));
-    fv_stats_add_count(stats, "sample_share", (double)r.paths / ((double)p->sw * p->sh));
+    fv_stats_add_count(stats, "grid_samples", grid_samples);
+    fv_stats_add_count(stats, "sample_share", (double)r.paths / pixels);
     fv_stats_add_count(stats, "mrays_per_s", r.stage_ms[0] > 0.0 ? (double)r.rays / r.stage_ms[0] / 1000.0 : 0.0);
     fv_stats_add_count(stats, "nan_samples", (double)r.nan_paths);
-    if (p->o.denoise) fv_stats_add_count(stats, "history_fraction", r.history_fraction);
+    if (denoise) fv_stats_add_count(stats, "history_fraction", r.history_fraction);
+}
+
+/* What the pipeline keeps of a frame the device ran (or will run: it is queued whole), which the
+ * next frame's preparation reads. */
+static void device_state(fv_vp_pipeline *p, const fv_vp_trace_job *job, const fv_space_view *view)
+{
     p->fresh = false;
     p->prev_cam = job->cam;
     p->prev_view = *view;
     p->have_prev = true;
     /* the sample-space image where the host can read it (portable; show= is refused on cuda) */
     p->have_image = fv_vp_device_eye_image(p->deye) != NULL;
+}
+
+static fv_status device_finish(fv_vp_pipeline *p, const fv_frame *frame, fv_stats *stats, const fv_vp_trace_job *job, const fv_space_view *view,
+                               const fv_vp_device_result *res, fv_kit_progress *prog, fv_error *err)
+{
+    device_stats(stats, res, (double)fv_space_sample_count(p->space), (double)p->sw * p->sh, p->o.denoise,
+                 fv_vp_device_kind(p->dev) == FV_DEVICE_CUDA);
+    device_state(p, job, view);
     fv_kit_phase(prog, frame, 0.8, 0.2);
     return fv_kit_phase_end(prog, err);
 }
@@ -551,11 +573,15 @@ static fv_status begin_frame(fv_vp_pipeline *p, const fv_frame *frame, fv_film *
 }
 
 /* `eyes` frames (1, or a stereo pair: a pipeline, frame, film and eye_frame each, the pipelines on
- * one device) queued on the device with one host wait for them all; each eye's film, counters and
- * history as if it were rendered alone, eye 0's stats added before eye 1's. */
-static fv_status render_device(fv_vp_pipeline *const *p, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, eye_frame *ef,
-                               fv_error *err)
+ * one device) queued on the device with their read-back and no host wait (*in_flight true;
+ * device_collect delivers them); each eye's film, counters and history as if it were rendered
+ * alone, eye 0's stats added before eye 1's. The pipelines' state moves on now, as the next
+ * frame's preparation needs it. A cancel (portable) or a failure is waited for at once: not in
+ * flight, every eye that ran takes its result. */
+static fv_status device_submit(fv_vp_pipeline *const *p, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, eye_frame *ef,
+                               bool *in_flight, fv_error *err)
 {
+    *in_flight = false;
     device_frame w[2];
     memset(w, 0, sizeof w);
     fv_status s = FV_OK;
@@ -563,18 +589,32 @@ static fv_status render_device(fv_vp_pipeline *const *p, int eyes, const fv_fram
     fv_vp_device_frame f[2];
     fv_film_views out[2];
     fv_vp_device_result r[2];
-    fv_vp_device_eye *eye[2];
+    fv_vp_device_eye *eye[2] = {NULL, NULL};
     fv_backend_calls calls;
     memset(&calls, 0, sizeof calls);
+    memset(f, 0, sizeof f);
+    memset(out, 0, sizeof out);
     for (int e = 0; e < eyes; e++) f[e] = w[e].f, out[e] = w[e].out, eye[e] = p[e]->deye;
-    if (s == FV_OK) s = fv_vp_device_frames(p[0]->dev, eye, eyes, f, out, r, &calls, err);
+    if (s == FV_OK) s = fv_vp_device_submit(p[0]->dev, eye, eyes, f, out, r, &calls, in_flight, err);
     if (s != FV_OK) return s;
-    if (fv_vp_device_kind(p[0]->dev) == FV_DEVICE_CUDA) {
-        /* the pair's one wait and what it asked of the runtime, with eye 0's figures */
-        const fv_backend_calls none = {0};
-        fv_stats_add_count(stats, "host_syncs", 1.0);
-        fv_backend_calls_report(stats, &none, &calls);
+    const bool cuda = fv_vp_device_kind(p[0]->dev) == FV_DEVICE_CUDA;
+    /* what the submit asked of the runtime, with eye 0's figures */
+    const fv_backend_calls none = {0};
+    if (cuda) fv_backend_calls_report(stats, &none, &calls);
+    if (*in_flight) {
+        for (int e = 0; e < eyes; e++) {
+            device_state(p[e], &ef[e].job, &ef[e].view);
+            struct pending *q = &p[e]->pend[(p[e]->pend_head + p[e]->pend_count++) % 2];
+            *q = (struct pending){stats, (double)fv_space_sample_count(p[e]->space), (double)p[e]->sw * p[e]->sh};
+            /* the frame's progress ends here (it is reported within the submit only); a cancel
+             * asked now is the registry's to act on: it collects the frame */
+            fv_kit_phase(&ef[e].prog, &frames[e], 0.8, 0.2);
+            fv_error ignored;
+            (void)fv_kit_phase_end(&ef[e].prog, &ignored);
+        }
+        return FV_OK;
     }
+    if (cuda) fv_stats_add_count(stats, "host_syncs", 1.0);
     /* Every eye the device ran takes its result and history, even after a later eye's trace was
      * cancelled (portable): the device's history has moved on for it. A cancelled eye's history
      * is left as it was. */
@@ -587,6 +627,39 @@ static fv_status render_device(fv_vp_pipeline *const *p, int eyes, const fv_fram
         if (s == FV_OK) s = se;
     }
     return s;
+}
+
+/* The oldest frame the device has in flight, its eyes on p[0 .. eyes-1]: waited for, delivered,
+ * its stats added to those it was submitted with. */
+static fv_status device_collect(fv_vp_pipeline *const *p, int eyes, fv_error *err)
+{
+    fv_vp_device_result r[2];
+    fv_backend_calls calls;
+    const fv_status s = fv_vp_device_collect(p[0]->dev, r, &calls, err);
+    struct pending q[2];
+    for (int e = 0; e < eyes; e++) {
+        q[e] = p[e]->pend[p[e]->pend_head];
+        p[e]->pend_head = (p[e]->pend_head + 1) % 2;
+        p[e]->pend_count--;
+    }
+    if (s != FV_OK) return s;
+    const bool cuda = fv_vp_device_kind(p[0]->dev) == FV_DEVICE_CUDA;
+    if (cuda) {
+        const fv_backend_calls none = {0};
+        fv_stats_add_count(q[0].stats, "host_syncs", 1.0);
+        fv_backend_calls_report(q[0].stats, &none, &calls);
+    }
+    for (int e = 0; e < eyes; e++) device_stats(q[e].stats, &r[e], q[e].grid_samples, q[e].pixels, p[e]->o.denoise, cuda);
+    return FV_OK;
+}
+
+/* A device frame rendered now: submitted, then collected. */
+static fv_status render_device(fv_vp_pipeline *const *p, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, eye_frame *ef,
+                               fv_error *err)
+{
+    bool in_flight = false;
+    const fv_status s = device_submit(p, eyes, frames, films, stats, ef, &in_flight, err);
+    return s == FV_OK && in_flight ? device_collect(p, eyes, err) : s;
 }
 
 fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, fv_error *err)
@@ -694,6 +767,27 @@ fv_status fv_vp_pipeline_render_pair(fv_vp_pipeline *const *p, const fv_frame *f
     for (int e = 0; e < 2; e++)
         if ((s = begin_frame(p[e], &frames[e], films[e], &ef[e], err)) != FV_OK) return s;
     return render_device(p, 2, frames, films, stats, ef, err);
+}
+
+fv_status fv_vp_pipeline_submit(fv_vp_pipeline *const *p, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, bool *in_flight,
+                                fv_error *err)
+{
+    *in_flight = false;
+    /* the CPU's stages, and a pair not on one device, render now */
+    if (!p[0]->dev || (eyes == 2 && (p[0] == p[1] || p[0]->dev != p[1]->dev)))
+        return eyes == 2 ? fv_vp_pipeline_render_pair(p, frames, films, stats, err) : fv_vp_pipeline_render(p[0], frames, films[0], stats, err);
+    eye_frame ef[2];
+    fv_status s;
+    for (int e = 0; e < eyes; e++)
+        if ((s = begin_frame(p[e], &frames[e], films[e], &ef[e], err)) != FV_OK) return s;
+    return device_submit(p, eyes, frames, films, stats, ef, in_flight, err);
+}
+
+fv_status fv_vp_pipeline_collect(fv_vp_pipeline *const *p, int eyes, fv_error *err)
+{
+    for (int e = 0; e < eyes; e++)
+        if (!p[e]->dev || !p[e]->pend_count) return fv_error_set(err, FV_ERR_INTERNAL, "Visual-Polar: no frame in flight on this pipeline");
+    return device_collect(p, eyes, err);
 }
 
 const fv_space *fv_vp_pipeline_space(const fv_vp_pipeline *p, fv_space_view *view, const float **image, double *px_per_deg)

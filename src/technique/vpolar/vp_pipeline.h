@@ -55,6 +55,14 @@ fv_status fv_vp_pipeline_render(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
  * counters and histories of fv_vp_pipeline_render called for eye 0 then eye 1. On a device (both
  * pipelines on the same one) both eyes are queued before one host wait; on the CPU the two calls. */
 fv_status fv_vp_pipeline_render_pair(fv_vp_pipeline *const *p, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err);
+/* The same split in two (technique/class.h's submit and collect): `eyes` frames (1, or a pair as
+ * above) queued on the device with their read-back and no host wait, *in_flight true; then
+ * fv_vp_pipeline_collect with the same pipelines delivers them into the films and stats they were
+ * submitted with, in the order submitted. On the CPU, for a pair not on one device, and after a
+ * cancel or a failure, the frame is rendered (or ended) now and *in_flight is false. */
+fv_status fv_vp_pipeline_submit(fv_vp_pipeline *const *p, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, bool *in_flight,
+                                fv_error *err);
+fv_status fv_vp_pipeline_collect(fv_vp_pipeline *const *p, int eyes, fv_error *err);
 
 /* The last frame's sample space, its view (where the gaze was), the sample-space image (denoised
  * when denoising is on) and the display's pixels per degree, for pictures of the space itself

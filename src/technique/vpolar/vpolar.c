@@ -39,6 +39,14 @@ typedef struct vp_state {
      * the two rendered this eye's last frame (a switch starts the other's history afresh). */
     fv_vp_pipeline *full[2];
     bool in_full[2];
+    /* The frames submitted (vp_submit), oldest first from head: the pipelines each eye went to,
+     * and whether the device still has it in flight (else it was rendered in its submit). */
+    struct vp_flight {
+        int eyes;
+        fv_vp_pipeline *p[2];
+        bool in_flight;
+    } flight[2];
+    int head, in_flight;
 } vp_state;
 
 #define VP_PERIPHERY_PASSES 3 /* vpolar's periphery_passes default */
@@ -317,6 +325,43 @@ static fv_status vp_render_pair(void *state, const fv_frame *frames, fv_film *co
     return FV_OK;
 }
 
+/* A frame queued (docs/gpu.md, "Frames in flight"): on a device, with the diagnostics off, every
+ * eye on its pipeline as vp_render_pair and vp_render choose it, without a host wait; otherwise
+ * rendered now, and collect only hands it over. */
+static fv_status vp_submit(void *state, int eyes, const fv_frame *frames, fv_film *const *films, fv_stats *stats, fv_error *err)
+{
+    vp_state *st = state;
+    if (st->in_flight >= 2) return fv_error_set(err, FV_ERR_INTERNAL, "%s: %d frames in flight already", st->name, st->in_flight);
+    struct vp_flight *fl = &st->flight[(st->head + st->in_flight) % 2];
+    fv_status s;
+    memset(fl, 0, sizeof *fl);
+    if (st->o.device == FV_DEVICE_CPU || st->show != SHOW_SCREEN) {
+        s = eyes == 2 ? vp_render_pair(state, frames, films, stats, err) : vp_render(state, frames, films[0], stats, err);
+        if (s == FV_OK) st->in_flight++;
+        return s;
+    }
+    fv_frame f[2];
+    bool full[2] = {false, false};
+    memset(f, 0, sizeof f);
+    for (int e = 0; e < eyes; e++)
+        if ((s = eye_pipeline(st, &frames[e], &fl->p[e], &f[e], &full[e], err)) != FV_OK) return s;
+    if ((s = fv_vp_pipeline_submit(fl->p, eyes, f, films, stats, &fl->in_flight, err)) != FV_OK) return s;
+    for (int e = 0; e < eyes; e++) st->in_full[frames[e].eye] = full[e];
+    fl->eyes = eyes;
+    st->in_flight++;
+    return FV_OK;
+}
+
+static fv_status vp_collect(void *state, fv_error *err)
+{
+    vp_state *st = state;
+    if (!st->in_flight) return fv_error_set(err, FV_ERR_INTERNAL, "%s: no frame in flight", st->name);
+    const struct vp_flight fl = st->flight[st->head];
+    st->head = (st->head + 1) % 2;
+    st->in_flight--;
+    return fl.in_flight ? fv_vp_pipeline_collect(fl.p, fl.eyes, err) : FV_OK;
+}
+
 static void vp_destroy(void *state)
 {
     vp_state *st = state;
@@ -462,7 +507,7 @@ const fv_technique_class fv_technique_vpolar = {
     .name = "vpolar",
     .summary = "foveated path tracing in Visual-Polar space: 1 spp on the VP grid, SVGF in VP space, φ-mipmapped mapping, foveated blur",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_vpolar_params), .main = REDUCTION_STEPS,
-    .create = create_vpolar, .create_on = create_vpolar_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .destroy = vp_destroy,
+    .create = create_vpolar, .create_on = create_vpolar_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .submit = vp_submit, .collect = vp_collect, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
 
@@ -470,7 +515,7 @@ const fv_technique_class fv_technique_cartesian = {
     .name = "cartesian",
     .summary = "uniform screen grid with vpolar's sample count, SVGF, bilinear upscaling (Visual-Polar Sec. 4.3 baseline)",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_cartesian_params), .main = REDUCTION_STEPS,
-    .create = create_cartesian, .create_on = create_cartesian_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .destroy = vp_destroy,
+    .create = create_cartesian, .create_on = create_cartesian_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .submit = vp_submit, .collect = vp_collect, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp",
 };
 
@@ -478,7 +523,7 @@ const fv_technique_class fv_technique_cartesian_full = {
     .name = "cartesian-full",
     .summary = "1 spp at full resolution with SVGF: the cost reference of Visual-Polar Fig. 12",
     .family = FV_FAMILY_VPOLAR, .baseline = "pt", FV_CLASS_PARAMS(k_cartesian_full_params), .main = BOUNCE_STEPS,
-    .create = create_cartesian_full, .create_on = create_cartesian_full_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .destroy = vp_destroy,
+    .create = create_cartesian_full, .create_on = create_cartesian_full_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .submit = vp_submit, .collect = vp_collect, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp",
 };
 
@@ -486,7 +531,7 @@ const fv_technique_class fv_technique_linear_falloff = {
     .name = "linear-falloff",
     .summary = "full-resolution launch, paths killed at random outside the fovea (Weier et al. 2016), SVGF, blur",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_linear_falloff_params), .main = BOUNCE_STEPS,
-    .create = create_linear_falloff, .create_on = create_linear_falloff_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .destroy = vp_destroy,
+    .create = create_linear_falloff, .create_on = create_linear_falloff_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .submit = vp_submit, .collect = vp_collect, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
 
@@ -494,6 +539,6 @@ const fv_technique_class fv_technique_logpolar = {
     .name = "log-polar",
     .summary = "kernel log-polar space (Meng et al. 2018), SVGF in log-polar space, φ-mipmapped mapping",
     .family = FV_FAMILY_VPOLAR, .baseline = "cartesian-full", FV_CLASS_PARAMS(k_logpolar_params), .main = BOUNCE_STEPS,
-    .create = create_logpolar, .create_on = create_logpolar_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .destroy = vp_destroy,
+    .create = create_logpolar, .create_on = create_logpolar_on, .devices = VP_DEVICES, .render = vp_render, .render_pair = vp_render_pair, .submit = vp_submit, .collect = vp_collect, .destroy = vp_destroy,
     FURNACE_TEST, .warmup_frames = SVGF_WARMUP, .still_warmup_frames = SVGF_WARMUP, .spp_param = "spp", .foveated = true,
 };
