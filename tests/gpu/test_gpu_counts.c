@@ -179,12 +179,13 @@ static void run_family_films(const family *fam, bool mono, bool display, int w, 
 
 static void run_family(const family *fam, bool mono, int w, int h, bool exact) { run_family_films(fam, mono, false, w, h, exact); }
 
-/* Display-only films (fv_film_set_display): the colour converted on the device, RGBA8 read back,
+/* Display-only films (fv_film_set_display): the colour converted on the device (one launch an eye), RGBA8 read back,
  * 4 bytes a pixel instead of 12 (the counters as in k_families). */
 #define DISPLAY (2 * 64 * 48 * 4)
 static const family k_display[] = {
     {"pt", "cornell", "spp=1", 64.0f, false, 4, 1, 0, 0, DISPLAY + 4 * 8},
     {"fipr", "sdf-temple", "spp=1", 0.064f, false, 18, 1, 0, 0, DISPLAY + 5 * 7 * 8},
+    {"vpolar", "cornell", "", 64.0f, false, 46, 1, 0, 0, 75760 - FILM + DISPLAY},
 };
 
 static void test_display_only(void **st)

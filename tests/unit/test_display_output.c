@@ -81,6 +81,7 @@ static void test_png_identical(void **st)
     (void)st;
     compare("pt", "cornell", "spp=2 device=portable", true);
     compare("fipr", "sdf-temple", "spp=1 device=portable", true);
+    compare("vpolar", "cornell", "device=portable", true);
     compare("pt", "cornell", "spp=2", false);
 }
 

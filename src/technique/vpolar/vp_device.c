@@ -35,7 +35,7 @@ typedef struct flight {
     int eyes;
     fv_vp_device_eye *eye[2];
     fv_vp_device_frame f[2];
-    fv_film_views out[2];
+    fv_film *film[2];
 } flight;
 
 struct fv_vp_device {
@@ -347,12 +347,15 @@ static fv_status svgf_queue(fv_vp_device_eye *e, const fv_vp_device_frame *f, co
 
 /* Queues one eye's frame, marks from slot m0; nothing waits. *done false: the trace was cancelled
  * (portable) and nothing after it was queued. */
-static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, const fv_film_views *out, int slot, int m0, bool *done, fv_error *err)
+static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, fv_film *film, int slot, int m0, bool *done, fv_error *err)
 {
     fv_backend *b = e->d->b;
     const int gw = f->trace.space.gw, gh = f->trace.space.gh, sw = f->trace.space.sw, sh = f->trace.space.sh;
     const size_t n = (size_t)gw * (size_t)gh, ns = (size_t)sw * (size_t)sh;
     const bool fresh = f->fresh != 0;
+    /* the film's buffers as the kernels write them; a display-only film (fv_film_set_display) then
+     * has its colour converted on the device and read back as RGBA8 (fv_film_device_download_film) */
+    const fv_film_views out = fv_film_views_of(film);
     const size_t rows_bytes = f->denoise ? 4 * (size_t)gh * 8 : 0, counts_bytes = FV_VP_COUNTS * sizeof(uint64_t);
     *done = true;
 
@@ -376,7 +379,7 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
         /* every staging slot's now, so that no later frame allocates */
         (s = fv_pinned_ensure(b, &e->host[0], counts_bytes + rows_bytes, "the frame's counters", err)) != FV_OK ||
         (s = fv_pinned_ensure(b, &e->host[1], counts_bytes + rows_bytes, "the frame's counters", err)) != FV_OK ||
-        (s = fv_film_device_views(b, &e->film, out, ns, &dv, err)) != FV_OK ||
+        (s = fv_film_device_views(b, &e->film, &out, ns, &dv, err)) != FV_OK ||
         (s = fv_backend_clear(b, e->counts.p, 0, counts_bytes, "the trace's counters", err)) != FV_OK)
         return s;
     const int *dcol_h = dcol_h_v;
@@ -448,7 +451,7 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
 
     /* the read-back, into pinned memory */
     char *host = e->host[slot].p;
-    if ((s = fv_film_device_download(b, &e->film, slot, out, ns, err)) != FV_OK ||
+    if ((s = fv_film_device_download_film(b, &e->film, slot, film, err)) != FV_OK ||
         (s = fv_backend_download(b, host, e->counts.p, counts_bytes, "the trace's counters", err)) != FV_OK ||
         (f->denoise && (s = fv_backend_download(b, host + counts_bytes, (char *)e->svgf.mem.p + e->svgf.rows_at, rows_bytes, "SVGF's counters", err)) != FV_OK))
         return s;
@@ -456,11 +459,10 @@ static fv_status queue_eye(fv_vp_device_eye *e, const fv_vp_device_frame *f, con
 }
 
 /* One eye's result from what was read back (after the wait). */
-static void eye_result(fv_vp_device_eye *e, const fv_vp_device_frame *f, const fv_film_views *out, int slot, int m0, fv_vp_device_result *r)
+static void eye_result(fv_vp_device_eye *e, const fv_vp_device_frame *f, fv_film *film, int slot, int m0, fv_vp_device_result *r)
 {
     fv_backend *b = e->d->b;
-    const size_t ns = (size_t)f->trace.space.sw * (size_t)f->trace.space.sh;
-    fv_film_device_deliver(b, &e->film, slot, out, ns);
+    fv_film_device_deliver_film(b, &e->film, slot, film);
     uint64_t c[FV_VP_COUNTS];
     memcpy(c, e->host[slot].p, sizeof c);
     r->rays = c[FV_VP_COUNT_RAYS], r->paths = c[FV_VP_COUNT_PATHS], r->nan_paths = c[FV_VP_COUNT_NAN];
@@ -478,7 +480,7 @@ static void eye_result(fv_vp_device_eye *e, const fv_vp_device_frame *f, const f
 /* The marks of eye e of the frame in staging slot `slot`. */
 static int marks_of(int slot, int e) { return (slot * 2 + e) * MARKS_PER_EYE; }
 
-fv_status fv_vp_device_submit(fv_vp_device *d, fv_vp_device_eye *const *eye, int eyes, const fv_vp_device_frame *f, const fv_film_views *out,
+fv_status fv_vp_device_submit(fv_vp_device *d, fv_vp_device_eye *const *eye, int eyes, const fv_vp_device_frame *f, fv_film *const *films,
                               fv_vp_device_result *res, fv_backend_calls *calls, bool *in_flight, fv_error *err)
 {
     *in_flight = false;
@@ -503,13 +505,13 @@ fv_status fv_vp_device_submit(fv_vp_device *d, fv_vp_device_eye *const *eye, int
         return s;
     bool done = true, queued[2] = {false, false};
     for (int e = 0; e < eyes && s == FV_OK && done; e++)
-        if ((s = queue_eye(eye[e], &f[e], &out[e], slot, marks_of(slot, e), &done, err)) == FV_OK) queued[e] = done;
+        if ((s = queue_eye(eye[e], &f[e], films[e], slot, marks_of(slot, e), &done, err)) == FV_OK) queued[e] = done;
     if (s == FV_OK && done) {
         /* every eye queued whole: in flight, collected later */
         fv_backend_fence(b, slot);
         flight *fl = &d->flight[slot];
         fl->eyes = eyes;
-        for (int e = 0; e < eyes; e++) fl->eye[e] = eye[e], fl->f[e] = f[e], fl->out[e] = out[e];
+        for (int e = 0; e < eyes; e++) fl->eye[e] = eye[e], fl->f[e] = f[e], fl->film[e] = films[e];
         d->in_flight++;
         *in_flight = true;
     } else {
@@ -521,7 +523,7 @@ fv_status fv_vp_device_submit(fv_vp_device *d, fv_vp_device_eye *const *eye, int
          * trace was cancelled */
         for (int e = 0; e < eyes && s == FV_OK; e++)
             if (queued[e]) {
-                eye_result(eye[e], &f[e], &out[e], slot, marks_of(slot, e), &res[e]);
+                eye_result(eye[e], &f[e], films[e], slot, marks_of(slot, e), &res[e]);
                 res[e].done = true;
             }
     }
@@ -548,7 +550,7 @@ fv_status fv_vp_device_collect(fv_vp_device *d, fv_vp_device_result *res, fv_bac
     for (int e = 0; e < fl->eyes; e++) {
         memset(&res[e], 0, sizeof res[e]);
         if (s != FV_OK) continue;
-        eye_result(fl->eye[e], &fl->f[e], &fl->out[e], slot, marks_of(slot, e), &res[e]);
+        eye_result(fl->eye[e], &fl->f[e], fl->film[e], slot, marks_of(slot, e), &res[e]);
         res[e].done = true;
     }
     return s;

@@ -109,10 +109,11 @@ typedef struct fv_vp_device_result {
  * distinct and on d) with their read-back into the next of two staging slots (device/film_device.h),
  * the scene brought to the frame's time once, and no host wait: *in_flight true, and
  * fv_vp_device_collect delivers them into the films (host memory: colour and the auxiliary buffers
- * that are set). After a cancel (portable) or a failure the frame is waited for at once and not in
+ * that are set; a display-only film, fv_film_set_display, receives its colour as RGBA8 converted on
+ * the device instead of floats). After a cancel (portable) or a failure the frame is waited for at once and not in
  * flight: res then holds the eyes that ran (done). *calls receives what the submit asked of the
  * backend. */
-fv_status fv_vp_device_submit(fv_vp_device *d, fv_vp_device_eye *const *eye, int eyes, const fv_vp_device_frame *f, const fv_film_views *out,
+fv_status fv_vp_device_submit(fv_vp_device *d, fv_vp_device_eye *const *eye, int eyes, const fv_vp_device_frame *f, fv_film *const *films,
                               fv_vp_device_result *res, fv_backend_calls *calls, bool *in_flight, fv_error *err);
 /* The oldest frame in flight: waited for (its fence: a frame queued after it runs on), each eye's
  * film and result delivered (res: as many as it had eyes); *calls: what the collect asked. */

@@ -430,10 +430,10 @@ static void reproject_frame(const fv_vp_pipeline *p, fv_kvp_reproject_frame *rf)
     rf->inv_step = 1.0f / LUT_STEP;
 }
 
-/* A frame on a device (vp_device.h), as the host prepared it: the device's frame and the film's views. */
+/* A frame on a device (vp_device.h), as the host prepared it (the film goes to the device frame as
+ * it is: a display-only one is read back as RGBA8). */
 typedef struct device_frame {
     fv_vp_device_frame f;
-    fv_film_views out;
 } device_frame;
 
 /* A frame on the device: the host describes it (the view, the radial table's and the on-screen
@@ -443,7 +443,7 @@ typedef struct device_frame {
  * grid: setup). device_prepare builds the frame,
  * fv_vp_device_frames renders it (with the other eye's, for a stereo pair), device_finish takes its
  * result. The stage times are the device's (the backend's marks). */
-static fv_status device_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_film *film, fv_stats *stats, const fv_vp_trace_job *job,
+static fv_status device_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_stats *stats, const fv_vp_trace_job *job,
                                 const fv_space_view *view, device_frame *w, fv_error *err)
 {
     memset(w, 0, sizeof *w);
@@ -488,7 +488,6 @@ static fv_status device_prepare(fv_vp_pipeline *p, const fv_frame *frame, fv_fil
         f.blur_nk = p->blur_nk;
     }
     w->f = f;
-    w->out = fv_film_views_of(film);
     return FV_OK;
 }
 
@@ -585,17 +584,15 @@ static fv_status device_submit(fv_vp_pipeline *const *p, int eyes, const fv_fram
     device_frame w[2];
     memset(w, 0, sizeof w);
     fv_status s = FV_OK;
-    for (int e = 0; e < eyes && s == FV_OK; e++) s = device_prepare(p[e], &frames[e], films[e], stats, &ef[e].job, &ef[e].view, &w[e], err);
+    for (int e = 0; e < eyes && s == FV_OK; e++) s = device_prepare(p[e], &frames[e], stats, &ef[e].job, &ef[e].view, &w[e], err);
     fv_vp_device_frame f[2];
-    fv_film_views out[2];
     fv_vp_device_result r[2];
     fv_vp_device_eye *eye[2] = {NULL, NULL};
     fv_backend_calls calls;
     memset(&calls, 0, sizeof calls);
     memset(f, 0, sizeof f);
-    memset(out, 0, sizeof out);
-    for (int e = 0; e < eyes; e++) f[e] = w[e].f, out[e] = w[e].out, eye[e] = p[e]->deye;
-    if (s == FV_OK) s = fv_vp_device_submit(p[0]->dev, eye, eyes, f, out, r, &calls, in_flight, err);
+    for (int e = 0; e < eyes; e++) f[e] = w[e].f, eye[e] = p[e]->deye;
+    if (s == FV_OK) s = fv_vp_device_submit(p[0]->dev, eye, eyes, f, films, r, &calls, in_flight, err);
     if (s != FV_OK) return s;
     const bool cuda = fv_vp_device_kind(p[0]->dev) == FV_DEVICE_CUDA;
     /* what the submit asked of the runtime, with eye 0's figures */
