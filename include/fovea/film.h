@@ -125,9 +125,9 @@ FV_API void fv_image_free(fv_image *img);
  * fv_film_set_display makes film display-only, for a consumer that wants nothing but what a
  * display shows (a PNG sequence, `fovea render` asks for it then): a frame rendered on a device (pt,
  * the sphere tracers and the Visual-Polar family on portable or cuda) converts its colour there with
- * `exposure` (clamped,
- * sRGB-encoded, 8 bits: what a PNG holds) and reads back 4 bytes a pixel (RGBA8, alpha 255)
- * instead of the 12 of its float colour, which that frame then leaves unwritten. Any other method
+ * `exposure` (clamped, sRGB-encoded, 8 bits: what a PNG holds) and reads back 4 bytes a pixel
+ * (RGBA8, alpha 255) instead of the 12 of its float colour, which that frame then leaves unwritten.
+ * Any other method
  * writes the float colour as before. fv_film_display returns the RGBA8 pixels when the last frame
  * filled them, else NULL. fv_film_write_meta writes a PNG from them (the bytes it would write from
  * the float colour at that exposure) and refuses, for such a frame, another format or exposure.
