@@ -8,7 +8,8 @@
  * What it checks, aborting with a line that names the call site: a cudaFree of a pointer that is
  * not a device allocation, a copy or memset whose device range is not inside one allocation (or
  * whose host side lies in device memory), an unknown or destroyed stream or event, threads of a
- * block that reach __syncthreads a different number of times, a launch from inside a kernel, and
+ * block that reach __syncthreads a different number of times, __syncthreads in a launch marked
+ * barrier-free (FV_CUDA_LAUNCH_NO_BARRIER), a launch from inside a kernel, and
  * at exit any device allocation, stream or event never freed. A launch of an impossible shape sets
  * cudaErrorInvalidConfiguration for cudaGetLastError, and any call that fails (a cudaMalloc out of
  * memory included) leaves its error there too, as CUDA does. Device memory is host memory
@@ -16,9 +17,12 @@
  * out-of-bounds access.
  *
  * Execution: a launch runs at once and to completion (one device, in-order streams): block after
- * block (first to last, then last to first on the kernel's next launch: CUDA promises no order),
- * the threads of a block concurrently on a pool of OS threads, __syncthreads a barrier among
- * them; __shared__ variables are function statics, which is right because one block runs at a time.
+ * block (first to last, then last to first on the kernel's next launch: CUDA promises no order).
+ * A launch marked barrier-free (FV_CUDA_LAUNCH_NO_BARRIER: every declared kernel's) runs a block's
+ * threads one after another on the calling thread, as nothing makes one wait for another; any
+ * other runs them concurrently on a pool of OS threads, __syncthreads a barrier among them (far
+ * dearer: a context switch per thread and block). __shared__ variables are function statics, which
+ * is right because one block runs at a time.
  * Host waits are counted as CUDA makes the host wait (its "API synchronization behavior"): a
  * synchronize or a cudaFree that comes after work was queued (a launch, an async copy or memset) is
  * one wait of the host for the device (a cudaEventSynchronize only when work queued before its
@@ -114,7 +118,8 @@ struct cudaDeviceProp {
 #define __host__
 #define __forceinline__ inline
 #define __grid_constant__
-/* One block runs at a time, so a function static is the block's shared memory. */
+/* One block runs at a time (in either way of running a launch), so a function static is the
+ * block's shared memory. */
 #define __shared__ static
 
 /* Set for each simulated thread before it runs the kernel (thread-local; functions, since GCC's
@@ -227,8 +232,12 @@ inline cudaStream_t fv_cuda_sim_stream_arg(cudaStream_t s = 0) { return s; }
 
 namespace fv_cuda_sim {
 
-/* Runs body(ctx) as every thread of every block of grid x block; returns after the last. */
-void run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s, const char *file, int line, void (*body)(void *), void *ctx);
+/* Runs body(ctx) as every thread of every block of grid x block; returns after the last.
+ * no_barrier: the launch promises never to reach __syncthreads (FV_CUDA_LAUNCH_NO_BARRIER), so a
+ * block's threads run one after another on the calling thread; otherwise each on a thread of the
+ * pool, concurrently, with a barrier among them. */
+void run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s, const char *file, int line, void (*body)(void *), void *ctx,
+         bool no_barrier);
 
 template <class K> struct launcher {
     K *kernel;
@@ -237,19 +246,21 @@ template <class K> struct launcher {
     cudaStream_t stream;
     const char *file;
     int line;
+    bool no_barrier;
     /* The arguments are evaluated once, by the host, as for a real launch; each simulated thread
      * passes them to the kernel by value, so a kernel that changes a parameter changes its own. */
     template <class... A> void operator()(A &&...args) const
     {
         K *k = kernel;
         auto call = [&] { k(args...); };
-        run(name, grid, block, stream, file, line, [](void *c) { (*static_cast<decltype(call) *>(c))(); }, &call);
+        run(name, grid, block, stream, file, line, [](void *c) { (*static_cast<decltype(call) *>(c))(); }, &call, no_barrier);
     }
 };
 
-template <class K> inline launcher<K> launch(K *kernel, const char *name, dim3 grid, dim3 block, cudaStream_t s, const char *file, int line)
+template <class K>
+inline launcher<K> launch(K *kernel, const char *name, dim3 grid, dim3 block, cudaStream_t s, const char *file, int line, bool no_barrier = false)
 {
-    return launcher<K>{kernel, name, grid, block, s, file, line};
+    return launcher<K>{kernel, name, grid, block, s, file, line, no_barrier};
 }
 
 } // namespace fv_cuda_sim

@@ -1,6 +1,8 @@
 /* fovea — the CUDA simulator's runtime (see cuda_runtime.h beside this file, docs/gpu.md "The CUDA
- * simulator"): the device's memory table, streams, events, counters and the pool of threads that
- * run a launch's blocks.
+ * simulator"): the device's memory table, streams, events, counters, and what runs a launch's
+ * blocks: the calling thread, one simulated thread after another, for a launch that promises no
+ * __syncthreads (FV_CUDA_LAUNCH_NO_BARRIER); a pool of OS threads, one per simulated thread with a
+ * barrier among them, for the others.
  *
  * The simulated device is one per process, as a real CUDA context is: its state lives in one object
  * (device()), created at first use and checked at exit for what was never freed.
@@ -110,6 +112,7 @@ struct Job {
 
 class Pool;
 thread_local Pool *t_pool;  /* set on the pool's threads: they are running a kernel */
+thread_local const Job *t_serial; /* set on a thread running a barrier-free launch's threads in turn */
 thread_local unsigned t_id; /* the thread's index in its block */
 typedef std::array<uint64_t, FV_SIMT_KINDS> Steps;
 thread_local Steps t_steps; /* kernel/ksimt.h: this thread's iterations in its current block */
@@ -121,7 +124,65 @@ struct Simt {
     uint64_t lane_total = 0, warp_total = 0;
 };
 
-/* The threads that run a launch: as many as the largest block so far, each running one thread of
+/* The block's threads in warps of 32 by their linear index, as the hardware groups them (the last
+ * warp of a block whose size is not a multiple of 32 has idle lanes too): each warp pays for 32
+ * lanes times its busiest lane's iterations. lane_steps: each thread's counts in the block. */
+void count_warps(Simt &simt, const std::vector<Steps> &lane_steps, unsigned threads)
+{
+    for (unsigned w0 = 0; w0 < threads; w0 += 32) {
+        const unsigned w1 = w0 + 32 < threads ? w0 + 32 : threads;
+        Steps most{};
+        uint64_t most_total = 0;
+        for (unsigned i = w0; i < w1; i++) {
+            uint64_t total = 0;
+            for (int k = 0; k < FV_SIMT_KINDS; k++) {
+                simt.lane[k] += lane_steps[i][k];
+                if (lane_steps[i][k] > most[k]) most[k] = lane_steps[i][k];
+                total += lane_steps[i][k];
+            }
+            simt.lane_total += total;
+            if (total > most_total) most_total = total;
+        }
+        for (int k = 0; k < FV_SIMT_KINDS; k++) simt.warp[k] += 32 * most[k];
+        simt.warp_total += 32 * most_total;
+        simt.warps++;
+    }
+}
+
+/* A barrier-free launch (FV_CUDA_LAUNCH_NO_BARRIER): with no barrier to meet, a block's threads
+ * need not be live at once, so they run one after another on the calling thread, in the blocks'
+ * order as the pool's. No thread is woken and none switched to: a pooled launch costs a context
+ * switch per simulated thread and block, which was most of the sim tests' time. Each thread's SIMT
+ * counts are kept apart as the pool keeps them, so the warps' figures are the same. Returns the
+ * blocks it ran, and its SIMT sums in *out. */
+unsigned long long run_serial(const Job &j, Simt *out)
+{
+    std::vector<Steps> lane_steps(j.threads);
+    Simt simt;
+    unsigned long long blocks = 0;
+    t_serial = &j;
+    t_block_dim = j.block;
+    t_grid_dim = j.grid;
+    for (unsigned bz = 0; bz < j.grid.z; bz++)
+        for (unsigned by = 0; by < j.grid.y; by++)
+            for (unsigned bx = 0; bx < j.grid.x; bx++) {
+                if (j.reverse) t_block_idx = uint3{j.grid.x - 1 - bx, j.grid.y - 1 - by, j.grid.z - 1 - bz};
+                else t_block_idx = uint3{bx, by, bz};
+                for (unsigned id = 0; id < j.threads; id++) {
+                    t_thread_idx = uint3{id % j.block.x, id / j.block.x % j.block.y, id / (j.block.x * j.block.y)};
+                    t_steps.fill(0);
+                    j.body(j.ctx);
+                    lane_steps[id] = t_steps;
+                }
+                count_warps(simt, lane_steps, j.threads);
+                blocks++;
+            }
+    t_serial = nullptr;
+    *out = simt;
+    return blocks;
+}
+
+/* The threads that run a launch that may reach __syncthreads: as many as the largest block so far, each running one thread of
  * every block, the blocks one after another (in the order the launch's Job says). */
 class Pool {
     std::mutex m;
@@ -220,33 +281,8 @@ class Pool {
                     j.kernel, t_block_idx.x, t_block_idx.y, t_block_idx.z, i, sync_calls[i], sync_calls[0]);
         sync_calls.assign(j.threads, 0);
         sync.reset(j.threads);
-        count_warps(j.threads);
+        count_warps(simt, lane_steps, j.threads);
         blocks_run++;
-    }
-
-    /* The block's threads in warps of 32 by their linear index, as the hardware groups them (the
-     * last warp of a block whose size is not a multiple of 32 has idle lanes too): each warp pays
-     * for 32 lanes times its busiest lane's iterations. */
-    void count_warps(unsigned threads)
-    {
-        for (unsigned w0 = 0; w0 < threads; w0 += 32) {
-            const unsigned w1 = w0 + 32 < threads ? w0 + 32 : threads;
-            Steps most{};
-            uint64_t most_total = 0;
-            for (unsigned i = w0; i < w1; i++) {
-                uint64_t total = 0;
-                for (int k = 0; k < FV_SIMT_KINDS; k++) {
-                    simt.lane[k] += lane_steps[i][k];
-                    if (lane_steps[i][k] > most[k]) most[k] = lane_steps[i][k];
-                    total += lane_steps[i][k];
-                }
-                simt.lane_total += total;
-                if (total > most_total) most_total = total;
-            }
-            for (int k = 0; k < FV_SIMT_KINDS; k++) simt.warp[k] += 32 * most[k];
-            simt.warp_total += 32 * most_total;
-            simt.warps++;
-        }
     }
 
 public:
@@ -429,13 +465,19 @@ cudaError_t fail_unlocked(cudaError_t e)
 
 void fv_cuda_sim_syncthreads(void)
 {
+    if (t_serial)
+        die(t_serial->file, t_serial->line,
+            "kernel %s, block (%u, %u, %u), thread (%u, %u, %u): __syncthreads in a launch marked barrier-free "
+            "(FV_CUDA_LAUNCH_NO_BARRIER runs a block's threads one after another); launch it with FV_CUDA_LAUNCH",
+            t_serial->kernel, t_block_idx.x, t_block_idx.y, t_block_idx.z, t_thread_idx.x, t_thread_idx.y, t_thread_idx.z);
     if (!t_pool) die(nullptr, 0, "__syncthreads called outside a kernel");
     t_pool->syncthreads();
 }
 
-void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s, const char *file, int line, void (*body)(void *), void *ctx)
+void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s, const char *file, int line, void (*body)(void *), void *ctx,
+                      bool no_barrier)
 {
-    if (t_pool) die(file, line, "kernel %s launched from inside a kernel (dynamic parallelism is not simulated)", kernel);
+    if (t_pool || t_serial) die(file, line, "kernel %s launched from inside a kernel (dynamic parallelism is not simulated)", kernel);
     Device &d = device();
     bool reverse = false;
     {
@@ -459,7 +501,7 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
     std::lock_guard<std::mutex> one(d.launch_m);
     Job j = {kernel, file, line, grid, block, block.x * block.y * block.z, body, ctx, reverse};
     Simt simt;
-    const unsigned long long blocks = d.pool.run(j, &simt);
+    const unsigned long long blocks = no_barrier ? run_serial(j, &simt) : d.pool.run(j, &simt);
     std::lock_guard<std::mutex> l(d.m);
     d.counts.blocks += blocks;
     fv_cuda_sim_simt &r = d.simt[kernel];
@@ -477,7 +519,7 @@ void fv_cuda_sim::run(const char *kernel, dim3 grid, dim3 block, cudaStream_t s,
 
 void fv_cuda_sim_simt_step(int kind)
 {
-    if (t_pool && kind >= 0 && kind < FV_SIMT_KINDS) t_steps[kind]++;
+    if ((t_pool || t_serial) && kind >= 0 && kind < FV_SIMT_KINDS) t_steps[kind]++;
 }
 
 cudaError_t cudaGetDeviceCount(int *count)

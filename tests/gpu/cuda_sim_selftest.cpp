@@ -1,7 +1,8 @@
 /* The CUDA simulator's own checks (tests/cuda_sim, docs/gpu.md "The CUDA simulator"), so that
  * sim_test_gpu_* can trust it: kernels written as for nvcc and launched with FV_CUDA_LAUNCH.
  *
- *   cuda_sim_selftest          every thread of every block runs once with its own indices; a block
+ *   cuda_sim_selftest          every thread of every block runs once with its own indices, on the
+ *                              pool and in a barrier-free launch (one thread after another); a block
  *                              reduction in shared memory with several __syncthreads per thread
  *                              gives the hand-computed sums; a kernel's launches alternate the
  *                              order of their blocks; an impossible launch shape is an error
@@ -98,6 +99,14 @@ static int selftest(void)
     CHECK(cudaMemcpy(&h, hits, sizeof h, cudaMemcpyDeviceToHost) == cudaSuccess);
     CHECK(h == n);
     for (unsigned i = 0; i < n; i++) CHECK(host[i] == i);
+    /* the same launch barrier-free: the threads in turn on this thread, each once, with its indices */
+    CHECK(cudaMemset(hits, 0, sizeof(unsigned)) == cudaSuccess && cudaMemset(cell, 0, n * sizeof(unsigned)) == cudaSuccess);
+    FV_CUDA_LAUNCH_NO_BARRIER(whoami, dim3(5, 3, 2), dim3(4, 3, 2), 0)(cell, hits, n);
+    CHECK(cudaGetLastError() == cudaSuccess);
+    CHECK(cudaMemcpy(host, cell, sizeof host, cudaMemcpyDeviceToHost) == cudaSuccess);
+    CHECK(cudaMemcpy(&h, hits, sizeof h, cudaMemcpyDeviceToHost) == cudaSuccess);
+    CHECK(h == n);
+    for (unsigned i = 0; i < n; i++) CHECK(host[i] == i);
 
     /* the reduction: block b sums b * 256 + t for t < 256 = 65536 b + 32640 */
     const unsigned blocks = 6;
@@ -121,9 +130,9 @@ static int selftest(void)
     CHECK(cudaMemcpyAsync(sums, dout, 6 * sizeof *sums, cudaMemcpyDeviceToHost, st) == cudaSuccess);
     fv_cuda_sim_counts c1;
     fv_cuda_sim_counts_get(&c1);
-    /* whoami's two read-backs and the upload of in, all pageable: three waits */
-    CHECK(c1.host_waits == c0.host_waits + 3 && c1.pageable_copies == c0.pageable_copies + 3);
-    CHECK(c1.bytes_h2d == c0.bytes_h2d + sizeof in && c1.bytes_d2h == c0.bytes_d2h + n * sizeof(unsigned) + sizeof h + 6 * sizeof *sums);
+    /* whoami's two read-backs twice and the upload of in, all pageable: five waits */
+    CHECK(c1.host_waits == c0.host_waits + 5 && c1.pageable_copies == c0.pageable_copies + 5);
+    CHECK(c1.bytes_h2d == c0.bytes_h2d + sizeof in && c1.bytes_d2h == c0.bytes_d2h + 2 * (n * sizeof(unsigned) + sizeof h) + 6 * sizeof *sums);
     CHECK(cudaStreamSynchronize(st) == cudaSuccess);
     fv_cuda_sim_counts c2;
     fv_cuda_sim_counts_get(&c2);
@@ -171,6 +180,13 @@ static int selftest(void)
     CHECK(fv_cuda_sim_simt_get(sr, 4) == 1 && !strcmp(sr[0].kernel, "simt_steps") && sr[0].launches == 2 && sr[0].threads_per_block == 40);
     CHECK(sr[0].warps == 6 && sr[0].lane_total == 3 * 528 && sr[0].warp_total == 3 * 1120);
     CHECK(sr[0].lane_steps[FV_SIMT_MARCH] == 3 * 528 && sr[0].warp_steps[FV_SIMT_MARCH] == 3 * 1120 && sr[0].warp_steps[FV_SIMT_TRAVERSE] == 0);
+    /* barrier-free, the threads run in turn but each counts apart: the same figures */
+    fv_cuda_sim_simt_reset();
+    FV_CUDA_LAUNCH_NO_BARRIER(simt_steps, 1, 40, 0)();
+    FV_CUDA_LAUNCH_NO_BARRIER(simt_steps, 2, 40, 0)();
+    CHECK(fv_cuda_sim_simt_get(sr, 4) == 1 && sr[0].launches == 2 && sr[0].threads_per_block == 40);
+    CHECK(sr[0].warps == 6 && sr[0].lane_total == 3 * 528 && sr[0].warp_total == 3 * 1120);
+    CHECK(sr[0].lane_steps[FV_SIMT_MARCH] == 3 * 528 && sr[0].warp_steps[FV_SIMT_MARCH] == 3 * 1120 && sr[0].warp_steps[FV_SIMT_TRAVERSE] == 0);
     fv_cuda_sim_simt_reset();
     CHECK(fv_cuda_sim_simt_get(sr, 4) == 0);
 
@@ -192,6 +208,13 @@ static int selftest(void)
     for (unsigned run = 0; run < 2; run++) {
         CHECK(cudaMemset(hits, 0, sizeof(unsigned)) == cudaSuccess);
         FV_CUDA_LAUNCH(&tally, turn, 4, 32, 0)(hits, dorder);
+        CHECK(cudaMemcpy(order, dorder, sizeof order, cudaMemcpyDeviceToHost) == cudaSuccess);
+        for (unsigned b = 0; b < 4; b++) CHECK(order[b] == (run == 0 ? b : 3 - b));
+    }
+    /* barrier-free launches alternate too (the kernel's count of launches is shared: the third) */
+    for (unsigned run = 0; run < 2; run++) {
+        CHECK(cudaMemset(hits, 0, sizeof(unsigned)) == cudaSuccess);
+        FV_CUDA_LAUNCH_NO_BARRIER(turn, 4, 32, 0)(hits, dorder);
         CHECK(cudaMemcpy(order, dorder, sizeof order, cudaMemcpyDeviceToHost) == cudaSuccess);
         for (unsigned b = 0; b < 4; b++) CHECK(order[b] == (run == 0 ? b : 3 - b));
     }
@@ -230,8 +253,8 @@ static int selftest(void)
     fv_cuda_sim_counts e;
     fv_cuda_sim_counts_get(&e);
     CHECK(e.live_allocations == 0 && e.live_bytes == 0 && e.live_streams == 0 && e.live_events == 0 && e.live_pinned == 0);
-    CHECK(e.launches == c0.launches + 8);  /* the two impossible ones are not launches */
-    CHECK(e.blocks == c0.blocks + 30 + 3 * 6 + 2 * 4 + 1 + 2);
+    CHECK(e.launches == c0.launches + 8 + 5);  /* the two impossible ones are not launches */
+    CHECK(e.blocks == c0.blocks + 2 * 30 + 3 * 6 + 2 * (1 + 2) + 4 * 4);
     CHECK(e.allocations == c0.allocations + 5 && e.frees == c0.frees + 5); /* cell, hits, din, dout, dorder */
     printf("CUDA simulator self-test: passed\n");
     return 0;
@@ -255,6 +278,7 @@ static int misuse(const char *what)
     } else if (!strcmp(what, "free-offset")) cudaFree((char *)p + 8);
     else if (!strcmp(what, "leak")) return 0; /* p is never freed: the check at exit aborts */
     else if (!strcmp(what, "divergent-barrier")) FV_CUDA_LAUNCH(&tally, divergent_barrier, 1, 16, 0)((int *)p);
+    else if (!strcmp(what, "barrier-in-no-barrier-launch")) FV_CUDA_LAUNCH_NO_BARRIER(divergent_barrier, 2, dim3(4, 2), 0)((int *)p);
     else if (!strcmp(what, "destroyed-stream")) {
         cudaStream_t s;
         cudaStreamCreate(&s);

@@ -10,7 +10,8 @@
 #include "device/cuda/launch.h"
 #include "device/kernel_decl.h"
 
-/* A kernel's launcher: items w x h, args its argument struct (copied into the launch), counts
+/* A kernel's launcher (its launches are barrier-free: the item functions never reach
+ * __syncthreads, and the simulator relies on it, device/cuda/launch.h): items w x h, args its argument struct (copied into the launch), counts
  * device memory for its counters (NULL: none). */
 struct fv_kernel_cuda {
     void (*launch)(const void *args, int w, int h, unsigned long long *counts, cudaStream_t st);
@@ -47,7 +48,7 @@ template <int N> __device__ __forceinline__ void fv_cuda_kernel_add(const uint64
         const unsigned b_ = (dims_) == 1 ? FV_KERNEL_CUDA_BLOCK_1D : FV_KERNEL_CUDA_BLOCK_2D;                       \
         const dim3 block_(b_, (dims_) == 1 ? 1u : b_);                                                           \
         const dim3 grid_((unsigned)(((unsigned)w_ + block_.x - 1) / block_.x), (unsigned)(((unsigned)h_ + block_.y - 1) / block_.y)); \
-        FV_CUDA_LAUNCH_PLAIN(name##_global, grid_, block_, st_)(*(const args_t *)args_, w_, h_, counts_);          \
+        FV_CUDA_LAUNCH_NO_BARRIER(name##_global, grid_, block_, st_)(*(const args_t *)args_, w_, h_, counts_);     \
     }                                                                                                              \
     extern "C" const fv_kernel_cuda name##_cuda = {name##_launch};
 
